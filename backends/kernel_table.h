@@ -1,0 +1,27 @@
+// kernel_table.h — what every backend needs to know about each kernel: its
+// name (the same in every kernel language), how many buffers it binds and
+// the size of its parameter struct. create_program checks dispatches against it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "sinew/device.h"
+
+namespace sinew {
+
+struct KernelSignature {
+  std::string_view name;
+  std::uint32_t bindings;
+  std::uint32_t params_bytes;
+};
+
+/// [pre] kernel < Kernel::count_
+const KernelSignature& kernel_signature(Kernel kernel);
+
+/// Checks a program's dispatches against the kernel table and the number of
+/// buffers the device has. Errors name the dispatch by position and kernel.
+Status check_program(const FrameProgram& program, std::uint32_t buffer_count);
+
+}  // namespace sinew

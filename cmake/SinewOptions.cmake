@@ -1,0 +1,51 @@
+# Optional dependencies: an option whose dependency is missing turns itself
+# off with a message instead of failing the configure.
+
+macro(sinew_optional option_name found_var what)
+  if(${option_name} AND NOT ${found_var})
+    message(STATUS "sinew: ${option_name} turned OFF: ${what} not found")
+    # A plain variable shadows the cached option for this configure only, so
+    # installing the dependency later and re-running cmake turns it back on.
+    set(${option_name} OFF)
+  endif()
+endmacro()
+
+if(SINEW_OPENCL)
+  find_package(OpenCL QUIET)
+  sinew_optional(SINEW_OPENCL OpenCL_FOUND "OpenCL headers/loader (apt-get install ocl-icd-opencl-dev)")
+endif()
+
+if(SINEW_VULKAN)
+  find_package(Vulkan QUIET COMPONENTS glslc)
+  set(_sinew_vulkan_ok FALSE)
+  if(Vulkan_FOUND AND Vulkan_GLSLC_EXECUTABLE)
+    set(_sinew_vulkan_ok TRUE)
+  endif()
+  sinew_optional(SINEW_VULKAN _sinew_vulkan_ok "Vulkan loader/headers or glslc (apt-get install libvulkan-dev glslc)")
+endif()
+
+if(SINEW_OPENVDB)
+  # Debian's FindOpenVDB.cmake hard-fails when a Boost component is missing,
+  # so look for the header and library directly (the level-set code wires
+  # the imported target when it lands).
+  find_path(SINEW_OPENVDB_INCLUDE_DIR openvdb/openvdb.h)
+  find_path(SINEW_NANOVDB_INCLUDE_DIR nanovdb/NanoVDB.h)
+  find_library(SINEW_OPENVDB_LIBRARY openvdb)
+  set(_sinew_openvdb_ok FALSE)
+  if(SINEW_OPENVDB_INCLUDE_DIR AND SINEW_NANOVDB_INCLUDE_DIR AND SINEW_OPENVDB_LIBRARY)
+    set(_sinew_openvdb_ok TRUE)
+  endif()
+  sinew_optional(SINEW_OPENVDB _sinew_openvdb_ok "OpenVDB + NanoVDB (apt-get install libopenvdb-dev libboost-dev)")
+endif()
+
+if(SINEW_EMBREE)
+  find_package(embree 3 QUIET)
+  sinew_optional(SINEW_EMBREE embree_FOUND "Embree 3 (apt-get install libembree-dev)")
+endif()
+
+function(sinew_set_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor)
+  if(SINEW_WARNINGS_AS_ERRORS)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+endfunction()

@@ -1,0 +1,108 @@
+// sinew/mesh.h — tetrahedral and triangle meshes: generation, reading,
+// checking, boundary extraction and VTU output for ParaView.
+//
+// Units: positions are whatever the file holds; sinew is SI throughout, so a
+// mesh stored in millimetres (e.g. ../shared/data/meshes/tet/kidney_57k) is
+// scaled with scale_mesh(mesh, 1e-3) before it is used in a scene.
+//
+// Orientation: a tet {a, b, c, d} is positively oriented when
+// dot(b - a, cross(c - a, d - a)) > 0 (six times its signed volume).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "sinew/result.h"
+
+namespace sinew {
+
+using Vec3d = std::array<double, 3>;
+
+/// A tetrahedral mesh: vertex positions and tets as 0-based vertex indices.
+struct TetMesh {
+  std::vector<Vec3d> vertices;                  ///< positions [m]
+  std::vector<std::array<std::uint32_t, 4>> tets;  ///< 0-based, positively oriented
+};
+
+/// A triangle mesh. For a boundary surface the vertex indices refer to the
+/// tet mesh it came from, and triangles wind counter-clockwise seen from
+/// outside (normals point outward).
+struct TriMesh {
+  std::vector<Vec3d> vertices;                     ///< positions [m]
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+/// How a box cell of a tet grid is split.
+enum class TetsPerCell {
+  five,  ///< 5 tets per cell, alternating mirrored cells so faces match
+  six,   ///< 6 tets per cell around the cell's main diagonal (Freudenthal/Kuhn)
+};
+
+/// A box [origin, origin + (nx, ny, nz) * cell_size] of nx*ny*nz cells.
+struct TetGridDesc {
+  int nx = 1, ny = 1, nz = 1;     ///< cells per axis, >= 1
+  Vec3d origin{0.0, 0.0, 0.0};    ///< lowest corner [m]
+  Vec3d cell_size{1.0, 1.0, 1.0}; ///< cell edge lengths [m], > 0
+  TetsPerCell split = TetsPerCell::six;
+};
+
+/// [in] desc: grid size; errors name the bad parameter.
+/// [out] (nx+1)(ny+1)(nz+1) vertices, vertex (i,j,k) at index i + (nx+1)*(j + (ny+1)*k);
+/// 5 or 6 positively oriented tets per cell, conforming across cells.
+Result<TetMesh> make_tet_grid(const TetGridDesc& desc);
+
+/// Reads a TetGen mesh: `path` is the .node file, the .ele file or their
+/// common stem; both files must exist. Handles 0- and 1-based numbering
+/// (detected from the first index in .node), attributes and boundary markers
+/// (ignored), `#` comments, and tets with 4 nodes (10-node tets: the first 4).
+/// [out] a mesh that passes check_tet_mesh; errors name file:line.
+Result<TetMesh> read_tetgen(const std::filesystem::path& path);
+
+/// Reads a Gmsh .msh file, ASCII format 2.x or 4.x, keeping the linear
+/// tetrahedra (element type 4) and dropping other element types. Node tags
+/// may be sparse; they are renumbered densely, and nodes used by no tet are
+/// dropped. [out] a mesh that passes check_tet_mesh; errors name file:line.
+Result<TetMesh> read_gmsh(const std::filesystem::path& path);
+
+/// Reads a tet mesh by extension: .msh (Gmsh), .node/.ele (TetGen).
+Result<TetMesh> read_tet_mesh(const std::filesystem::path& path);
+
+/// Checks a tet mesh: at least one tet; all coordinates finite; all indices
+/// in range; no tet repeats a vertex; every tet has positive volume above
+/// 1e-12 of the cube of the bounding-box diagonal (zero-volume and inverted
+/// tets are errors, naming the tet). `origin` prefixes the messages (e.g. a file name).
+Status check_tet_mesh(const TetMesh& mesh, const std::string& origin = "mesh");
+
+/// Multiplies every position by `factor` (e.g. 1e-3 for millimetres to metres).
+void scale_mesh(TetMesh& mesh, double factor);
+
+/// The faces that belong to exactly one tet, wound outward; the returned
+/// mesh shares the tet mesh's vertex array and indices (unused vertices are
+/// kept so indices match). Deterministic order.
+TriMesh extract_boundary_surface(const TetMesh& mesh);
+
+/// A per-vertex field written to VTU: 1 (scalar) or 3 (vector) components.
+struct VertexField {
+  std::string name;
+  int components = 1;             ///< 1 or 3
+  std::span<const float> values;  ///< vertex_count * components values
+};
+
+/// Writes a VTK XML unstructured grid (.vtu, ASCII) of tets with per-vertex
+/// fields. [in] positions: xyz per vertex [m], as 3 floats per vertex
+/// (stride 3) or 4 (stride 4, the w component is skipped).
+/// Errors name the file or the field whose size is wrong.
+Status write_vtu(const std::filesystem::path& path, std::span<const float> positions, int stride,
+                 std::span<const std::array<std::uint32_t, 4>> tets,
+                 std::span<const VertexField> fields = {});
+
+/// Writes a ParaView collection (.pvd) that lists a series of VTU files with
+/// their times [s]; file names are written relative to the .pvd's folder.
+Status write_pvd(const std::filesystem::path& path,
+                 std::span<const std::filesystem::path> vtu_files, std::span<const double> times);
+
+}  // namespace sinew

@@ -1,0 +1,72 @@
+// sinew/simulation.h — running a scene on a backend.
+//
+//   sinew::SceneDesc scene = ...;
+//   auto sim = sinew::Simulation::create(scene, {.backend = "auto"});
+//   if (!sim) { std::cerr << sim.error().message(); return 1; }
+//   for (int f = 0; f < 100; ++f) if (auto s = sim->step(); !s) ...;
+//   std::vector<float> x; sim->read_positions(x);
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sinew/device.h"
+#include "sinew/scene.h"
+
+namespace sinew {
+
+/// What a compiled scene holds; fixed for the life of a Simulation.
+struct SceneInfo {
+  std::uint32_t particles = 0;
+  std::uint32_t distance_constraints = 0;
+  std::uint32_t volume_constraints = 0;
+  std::uint32_t distance_colors = 0;  ///< colours of the distance constraints
+  std::uint32_t volume_colors = 0;    ///< colours of the volume constraints
+  std::uint32_t colors = 0;           ///< dependent sweeps per iteration (sum of the above)
+  std::uint32_t dispatches_per_frame = 0;
+  std::uint32_t barriers_per_frame = 0;
+  std::vector<std::uint32_t> tet_body_first_particle;   ///< body i's vertex 0 is this particle
+  std::vector<std::uint32_t> line_body_first_particle;
+  [[nodiscard]] std::uint32_t constraints() const { return distance_constraints + volume_constraints; }
+};
+
+/// Timing of the last frame.
+struct FrameStats {
+  std::uint64_t frame = 0;  ///< frames done
+  double time = 0.0;        ///< simulated time [s]
+  double wall_ms = 0.0;     ///< wall time of the last step() [ms], run and wait included
+};
+
+class Simulation {
+ public:
+  /// Checks and compiles the scene and prepares it on a device. Errors name
+  /// the bad parameter, or say why the backend is not available.
+  static Result<Simulation> create(const SceneDesc& scene, const DeviceOptions& device = {});
+
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+  ~Simulation();
+
+  /// Advances one frame (SolverSettings::time_step).
+  Status step();
+
+  /// [out] xyzw per particle: position [m] and inverse mass [1/kg] in w.
+  Status read_positions(std::vector<float>& xyzw) const;
+  /// [out] xyz0 per particle: velocity [m/s], w unused.
+  Status read_velocities(std::vector<float>& xyzw) const;
+
+  [[nodiscard]] const SceneInfo& info() const;
+  [[nodiscard]] const FrameStats& last_frame() const;
+  [[nodiscard]] const Device& device() const;
+  /// The frame program run by step(), for inspection.
+  [[nodiscard]] const FrameProgram& program() const;
+
+ private:
+  struct Impl;
+  explicit Simulation(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sinew

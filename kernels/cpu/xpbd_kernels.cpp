@@ -1,0 +1,106 @@
+// xpbd_kernels.cpp — CPU reference kernels of the xPBD solver.
+//
+// Macklin, Müller, Chentanez, "XPBD: Position-Based Simulation of Compliant
+// Constrained Dynamics", MIG 2016, eq. 18: for one constraint C with
+// compliance alpha, alpha~ = alpha / h^2 and
+//   dlambda = (-C - alpha~ lambda) / (sum_i w_i |grad_i C|^2 + alpha~),
+//   dx_i    = w_i grad_i C dlambda.
+// Each work item solves one constraint. All constraints of one dispatch have
+// one colour, so no two share a movable particle: the writes never race and
+// the result does not depend on how items are split across threads.
+#include "cpu/xpbd_kernels.h"
+
+#include "xpbd_params.h"
+
+namespace sinew::kernels {
+
+void xpbd_predict(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const PredictParams*>(params);
+  auto* x = reinterpret_cast<float4*>(bindings[0]);
+  auto* prev = reinterpret_cast<float4*>(bindings[1]);
+  auto* v = reinterpret_cast<float4*>(bindings[2]);
+  const float4 g{p.gravity_x, p.gravity_y, p.gravity_z, 0.0f};
+  for (std::uint32_t i = begin; i < end; ++i) {
+    prev[i] = x[i];
+    if (x[i].w == 0.0f) continue;  // pinned or kinematic: inverse mass 0
+    v[i] = add_scaled3(v[i], p.h, g);
+    x[i] = add_scaled3(x[i], p.h, v[i]);
+  }
+}
+
+void xpbd_update_velocity(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                          std::uint32_t end) {
+  const auto& p = *static_cast<const UpdateVelocityParams*>(params);
+  const auto* x = reinterpret_cast<const float4*>(bindings[0]);
+  const auto* prev = reinterpret_cast<const float4*>(bindings[1]);
+  auto* v = reinterpret_cast<float4*>(bindings[2]);
+  for (std::uint32_t i = begin; i < end; ++i) {
+    if (x[i].w == 0.0f) {
+      v[i] = float4{0.0f, 0.0f, 0.0f, 0.0f};
+      continue;
+    }
+    const float4 d = x[i] - prev[i];
+    v[i] = float4{d.x * p.inv_h, d.y * p.inv_h, d.z * p.inv_h, 0.0f};
+  }
+}
+
+void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                         std::uint32_t end) {
+  const auto& p = *static_cast<const SolveDistanceParams*>(params);
+  auto* x = reinterpret_cast<float4*>(bindings[0]);
+  const auto* idx = reinterpret_cast<const uint2*>(bindings[1]);
+  const auto* rest_alpha = reinterpret_cast<const float2*>(bindings[2]);
+  auto* lambda = reinterpret_cast<float*>(bindings[3]);
+  for (std::uint32_t i = p.first + begin; i < p.first + end; ++i) {
+    const uint2 e = idx[i];
+    const float4 xa = x[e.x];
+    const float4 xb = x[e.y];
+    const float len = edge_length(xa, xb);
+    const float w = xa.w + xb.w;
+    const float alpha_t = rest_alpha[i].y * p.inv_h2;
+    const float lambda_i = p.reset_lambda ? 0.0f : lambda[i];
+    // A zero-length edge has no direction to push along; a constraint
+    // between two immovable particles (w == 0 and alpha == 0) has nothing to do.
+    if (len <= 0.0f || w + alpha_t <= 0.0f) {
+      lambda[i] = lambda_i;
+      continue;
+    }
+    const float c = len - rest_alpha[i].x;
+    const float dlambda = (-c - alpha_t * lambda_i) / (w + alpha_t);
+    const float4 n = edge_length_gradient(xa, xb, len);  // grad_a C = n, grad_b C = -n
+    x[e.x] = add_scaled3(xa, xa.w * dlambda, n);
+    x[e.y] = add_scaled3(xb, -xb.w * dlambda, n);
+    lambda[i] = lambda_i + dlambda;
+  }
+}
+
+void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                       std::uint32_t end) {
+  const auto& p = *static_cast<const SolveVolumeParams*>(params);
+  auto* x = reinterpret_cast<float4*>(bindings[0]);
+  const auto* idx = reinterpret_cast<const uint4*>(bindings[1]);
+  const auto* rest_alpha = reinterpret_cast<const float2*>(bindings[2]);
+  auto* lambda = reinterpret_cast<float*>(bindings[3]);
+  for (std::uint32_t i = p.first + begin; i < p.first + end; ++i) {
+    const uint4 t = idx[i];
+    const float4 x0 = x[t.x], x1 = x[t.y], x2 = x[t.z], x3 = x[t.w];
+    float4 g[4];
+    tet_volume_gradients(x0, x1, x2, x3, g);
+    const float w = x0.w * dot3(g[0], g[0]) + x1.w * dot3(g[1], g[1]) + x2.w * dot3(g[2], g[2]) + x3.w * dot3(g[3], g[3]);
+    const float alpha_t = rest_alpha[i].y * p.inv_h2;
+    const float lambda_i = p.reset_lambda ? 0.0f : lambda[i];
+    if (w + alpha_t <= 0.0f) {  // fully collapsed or immovable: no direction
+      lambda[i] = lambda_i;
+      continue;
+    }
+    const float c = tet_volume(x0, x1, x2, x3) - rest_alpha[i].x;
+    const float dlambda = (-c - alpha_t * lambda_i) / (w + alpha_t);
+    x[t.x] = add_scaled3(x0, x0.w * dlambda, g[0]);
+    x[t.y] = add_scaled3(x1, x1.w * dlambda, g[1]);
+    x[t.z] = add_scaled3(x2, x2.w * dlambda, g[2]);
+    x[t.w] = add_scaled3(x3, x3.w * dlambda, g[3]);
+    lambda[i] = lambda_i + dlambda;
+  }
+}
+
+}  // namespace sinew::kernels

@@ -1,0 +1,73 @@
+/* xpbd_params.h — parameters of the xPBD kernels, shared by every kernel
+ * language (see sinew_lang.h). Buffer bindings are listed per kernel in
+ * binding order; every backend binds them in that order.
+ *
+ * Units: SI. h is the substep length [s]; positions [m]; velocities [m/s];
+ * gravity [m/s^2]; compliances as stored per constraint (see scene.h). */
+#ifndef SINEW_XPBD_PARAMS_H
+#define SINEW_XPBD_PARAMS_H
+
+#include "sinew_lang.h"
+
+#ifdef __cplusplus
+namespace sinew::kernels {
+#endif
+
+/* xpbd_predict: one item per particle.
+ * bindings: 0 position float4 (xyz, w = inverse mass) [in/out]
+ *           1 previous position float4 [out]
+ *           2 velocity float4 (xyz) [in/out]
+ * v += h g; prev = x; x += h v — for particles with w > 0 only. */
+SINEW_STRUCT_BEGIN(PredictParams)
+  float h;
+  float gravity_x;
+  float gravity_y;
+  float gravity_z;
+  uint count;
+  uint pad0;
+  uint pad1;
+  uint pad2;
+SINEW_STRUCT_END(PredictParams)
+
+/* xpbd_update_velocity: one item per particle.
+ * bindings: 0 position float4 [in], 1 previous position float4 [in],
+ *           2 velocity float4 [out]
+ * v = (x - prev) / h for particles with w > 0; 0 otherwise. */
+SINEW_STRUCT_BEGIN(UpdateVelocityParams)
+  float inv_h;
+  uint count;
+  uint pad0;
+  uint pad1;
+SINEW_STRUCT_END(UpdateVelocityParams)
+
+/* xpbd_solve_distance: one item per constraint of one colour, constraints
+ * [first, first + count). C = |x_a - x_b| - rest [m]; alpha [m/N].
+ * bindings: 0 position float4 [in/out]
+ *           1 particle indices uint2 (a, b) per constraint [in]
+ *           2 rest and compliance float2 (rest [m], alpha [m/N]) [in]
+ *           3 lambda float [in/out] (reset to 0 when reset_lambda != 0) */
+SINEW_STRUCT_BEGIN(SolveDistanceParams)
+  uint first;
+  uint count;
+  float inv_h2;       /* 1 / h^2 [1/s^2]: alpha~ = alpha / h^2 */
+  uint reset_lambda;  /* nonzero in the first iteration of a substep */
+SINEW_STRUCT_END(SolveDistanceParams)
+
+/* xpbd_solve_volume: one item per tet constraint of one colour.
+ * C = V - rest [m^3] with V = dot(x1 - x0, cross(x2 - x0, x3 - x0)) / 6.
+ * bindings: 0 position float4 [in/out]
+ *           1 particle indices uint4 per constraint [in]
+ *           2 rest and compliance float2 (rest volume [m^3], alpha [m^3/Pa]) [in]
+ *           3 lambda float [in/out] */
+SINEW_STRUCT_BEGIN(SolveVolumeParams)
+  uint first;
+  uint count;
+  float inv_h2;
+  uint reset_lambda;
+SINEW_STRUCT_END(SolveVolumeParams)
+
+#ifdef __cplusplus
+}  /* namespace sinew::kernels */
+#endif
+
+#endif /* SINEW_XPBD_PARAMS_H */

@@ -1,0 +1,169 @@
+// scene_compiler.cpp — from a scene description to flat, colour-sorted
+// arrays. Rest lengths and volumes are computed from the float positions
+// with the very functions the kernels use, so a body at rest has C == 0
+// exactly and stays bitwise at rest.
+#include "scene/scene_compiler.h"
+
+#include <algorithm>
+#include <limits>
+#include <string>
+
+#include "coloring/greedy_coloring.h"
+#include "cpu/xpbd_kernels.h"
+
+namespace sinew {
+namespace {
+
+using kernels::float4;
+
+// Constraints of one type, unsorted, before colouring.
+struct RawConstraints {
+  std::uint32_t arity;
+  std::vector<std::uint32_t> particles;
+  std::vector<float> rest_alpha;
+};
+
+struct Builder {
+  std::vector<float4> positions;
+  std::vector<double> mass;
+  RawConstraints distance{2, {}, {}};
+  RawConstraints volume{4, {}, {}};
+
+  std::uint32_t add_vertices(const std::vector<Vec3d>& vertices) {
+    const auto first = static_cast<std::uint32_t>(positions.size());
+    for (const Vec3d& v : vertices)
+      positions.push_back({static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]), 0.0f});
+    mass.resize(positions.size(), 0.0);
+    return first;
+  }
+};
+
+Status add_tet_body(Builder& b, const TetBodyDesc& body, const std::string& name) {
+  const std::uint32_t first = b.add_vertices(body.mesh.vertices);
+  const auto& tets = body.mesh.tets;
+
+  // Rest volumes in float, as the kernel computes them; lumped masses.
+  std::vector<float> rest_volume(tets.size());
+  for (std::size_t t = 0; t < tets.size(); ++t) {
+    const auto& q = tets[t];
+    const float v = kernels::tet_volume(b.positions[first + q[0]], b.positions[first + q[1]],
+                                        b.positions[first + q[2]], b.positions[first + q[3]]);
+    if (!(v > 0.0f))
+      return Error(name + ".mesh: tet " + std::to_string(t) +
+                   " has no positive volume in single precision (too small for float32 positions)");
+    rest_volume[t] = v;
+    for (std::uint32_t k : q) b.mass[first + k] += body.density * v / 4.0;
+  }
+
+  if (body.volume_constraints) {
+    for (std::size_t t = 0; t < tets.size(); ++t) {
+      for (std::uint32_t k : tets[t]) b.volume.particles.push_back(first + k);
+      b.volume.rest_alpha.push_back(rest_volume[t]);
+      b.volume.rest_alpha.push_back(static_cast<float>(body.volume_compliance * rest_volume[t]));
+    }
+  }
+
+  if (body.distance_constraints) {
+    // Unique edges, sorted (a < b) for memory locality; each tet gives V/6
+    // of its volume to each of its six edges.
+    using Edge = std::pair<std::uint32_t, std::uint32_t>;
+    std::vector<Edge> edges;
+    edges.reserve(tets.size() * 6);
+    auto each_edge = [&](const auto& tet, auto&& fn) {
+      static constexpr int kPairs[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+      for (const auto& pr : kPairs) fn(Edge{std::min(tet[pr[0]], tet[pr[1]]), std::max(tet[pr[0]], tet[pr[1]])});
+    };
+    for (const auto& tet : tets) each_edge(tet, [&](Edge e) { edges.push_back(e); });
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::vector<double> share(edges.size(), 0.0);
+    for (std::size_t t = 0; t < tets.size(); ++t)
+      each_edge(tets[t], [&](Edge e) {
+        share[std::lower_bound(edges.begin(), edges.end(), e) - edges.begin()] += rest_volume[t] / 6.0;
+      });
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      const float len = kernels::edge_length(b.positions[first + edges[i].first], b.positions[first + edges[i].second]);
+      b.distance.particles.push_back(first + edges[i].first);
+      b.distance.particles.push_back(first + edges[i].second);
+      b.distance.rest_alpha.push_back(len);
+      b.distance.rest_alpha.push_back(
+          static_cast<float>(body.distance_compliance * static_cast<double>(len) * len / share[i]));
+    }
+  }
+  // Vertices used by no tet get no mass and so stay where they are (w = 0).
+  for (std::uint32_t p : body.pinned) b.mass[first + p] = 0.0;
+  return {};
+}
+
+Status add_line_body(Builder& b, const LineBodyDesc& body, const std::string& name) {
+  const std::uint32_t first = b.add_vertices(body.vertices);
+  for (std::size_t i = 0; i < body.masses.size(); ++i) b.mass[first + i] = body.masses[i];
+  for (std::size_t s = 0; s < body.segments.size(); ++s) {
+    const auto [p, q] = body.segments[s];
+    const float len = kernels::edge_length(b.positions[first + p], b.positions[first + q]);
+    if (!(len > 0.0f)) return Error(name + ".segments[" + std::to_string(s) + "] has zero length in single precision");
+    b.distance.particles.push_back(first + p);
+    b.distance.particles.push_back(first + q);
+    b.distance.rest_alpha.push_back(len);
+    b.distance.rest_alpha.push_back(static_cast<float>(body.compliance));
+  }
+  for (std::uint32_t p : body.pinned) b.mass[first + p] = 0.0;
+  return {};
+}
+
+// Colours a block's constraints and reorders them colour by colour, keeping
+// the original order inside each colour (stable counting sort).
+ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::uint8_t> movable) {
+  ConstraintBlock out;
+  out.arity = raw.arity;
+  const auto n = static_cast<std::uint32_t>(raw.particles.size() / raw.arity);
+  if (n == 0) return out;
+  const Coloring coloring = color_constraints(raw.particles, raw.arity, movable);
+  out.color_offsets.assign(coloring.color_count() + 1, 0);
+  for (std::uint32_t k = 0; k < coloring.color_count(); ++k)
+    out.color_offsets[k + 1] = out.color_offsets[k] + coloring.color_sizes[k];
+  std::vector<std::uint32_t> slot(out.color_offsets.begin(), out.color_offsets.end() - 1);
+  out.particles.resize(raw.particles.size());
+  out.rest_alpha.resize(raw.rest_alpha.size());
+  for (std::uint32_t c = 0; c < n; ++c) {
+    const std::uint32_t to = slot[coloring.color_of[c]]++;
+    std::copy_n(&raw.particles[c * raw.arity], raw.arity, &out.particles[to * raw.arity]);
+    std::copy_n(&raw.rest_alpha[c * 2], 2, &out.rest_alpha[to * 2]);
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<CompiledScene> compile_scene(const SceneDesc& scene) {
+  if (Status s = check_scene(scene); !s) return s.error();
+  std::size_t total = 0;
+  for (const auto& body : scene.tet_bodies) total += body.mesh.vertices.size();
+  for (const auto& body : scene.line_bodies) total += body.vertices.size();
+  if (total >= std::numeric_limits<std::uint32_t>::max())
+    return Error("the scene has " + std::to_string(total) + " particles, more than 32-bit indices can address");
+
+  Builder b;
+  CompiledScene out;
+  for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i) {
+    out.tet_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
+    if (Status s = add_tet_body(b, scene.tet_bodies[i], "tet_bodies[" + std::to_string(i) + "]"); !s) return s.error();
+  }
+  for (std::size_t i = 0; i < scene.line_bodies.size(); ++i) {
+    out.line_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
+    if (Status s = add_line_body(b, scene.line_bodies[i], "line_bodies[" + std::to_string(i) + "]"); !s)
+      return s.error();
+  }
+
+  std::vector<std::uint8_t> movable(b.positions.size());
+  for (std::size_t p = 0; p < b.positions.size(); ++p) {
+    b.positions[p].w = b.mass[p] > 0.0 ? static_cast<float>(1.0 / b.mass[p]) : 0.0f;
+    movable[p] = b.positions[p].w > 0.0f;
+  }
+  out.distance = color_and_sort(b.distance, movable);
+  out.volume = color_and_sort(b.volume, movable);
+  out.positions = std::move(b.positions);
+  return out;
+}
+
+}  // namespace sinew

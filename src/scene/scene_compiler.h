@@ -1,0 +1,37 @@
+// scene_compiler.h — turns a SceneDesc into flat arrays ready for a device:
+// float4 particles (xyz + inverse mass), and per constraint type a
+// structure-of-arrays sorted by colour, with each colour's range.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "cpu/cpu_math.h"
+#include "sinew/scene.h"
+#include "sinew/simulation.h"
+
+namespace sinew {
+
+/// Constraints of one type (arity particles each), sorted by colour:
+/// colour k holds constraints [color_offsets[k], color_offsets[k+1]).
+struct ConstraintBlock {
+  std::uint32_t arity = 0;
+  std::vector<std::uint32_t> particles;   ///< arity per constraint
+  std::vector<float> rest_alpha;          ///< (rest value, compliance alpha) per constraint
+  std::vector<std::uint32_t> color_offsets{0};
+  [[nodiscard]] std::uint32_t size() const { return arity ? static_cast<std::uint32_t>(particles.size() / arity) : 0; }
+  [[nodiscard]] std::uint32_t colors() const { return static_cast<std::uint32_t>(color_offsets.size() - 1); }
+};
+
+struct CompiledScene {
+  std::vector<kernels::float4> positions;  ///< xyz [m], w = inverse mass [1/kg]
+  ConstraintBlock distance;                ///< C = |xa - xb| - rest, alpha [m/N]
+  ConstraintBlock volume;                  ///< C = V - rest, alpha [m^3/Pa]
+  std::vector<std::uint32_t> tet_body_first_particle;
+  std::vector<std::uint32_t> line_body_first_particle;
+};
+
+/// Checks (check_scene) and compiles a scene. Errors name the parameter.
+Result<CompiledScene> compile_scene(const SceneDesc& scene);
+
+}  // namespace sinew

@@ -1,0 +1,25 @@
+// xpbd_program.h — the frame program of the xPBD solver: per substep,
+// predict, `iterations` colour-by-colour sweeps, update velocities. Only the
+// stages a scene has constraints for are emitted.
+#pragma once
+
+#include "scene/scene_compiler.h"
+#include "sinew/device.h"
+
+namespace sinew {
+
+/// The device buffers a compiled scene lives in.
+struct XpbdBuffers {
+  BufferHandle position, previous, velocity;
+  BufferHandle distance_particles, distance_rest_alpha, distance_lambda;
+  BufferHandle volume_particles, volume_rest_alpha, volume_lambda;
+};
+
+/// Creates the buffers on `device` and uploads the compiled scene.
+Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
+
+/// The dispatches of one frame of `solver`, with `gravity` [m/s^2].
+FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
+                                const std::array<double, 3>& gravity);
+
+}  // namespace sinew

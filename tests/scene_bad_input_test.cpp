@@ -1,0 +1,145 @@
+// Bad input to the scene API and the device interface: every problem is an
+// error whose message names the parameter; nothing crashes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <algorithm>
+#include <functional>
+#include <limits>
+
+#include "test_support.h"
+#include "xpbd_params.h"
+
+namespace sinew {
+namespace {
+
+SceneDesc valid_scene() {
+  SceneDesc scene;
+  TetBodyDesc body;
+  body.mesh = test::box_mesh(2, 2, 2, 0.1);
+  scene.tet_bodies.push_back(body);
+  LineBodyDesc chain;
+  chain.vertices = {{0, 0, 0}, {0, -1, 0}};
+  chain.masses = {1, 1};
+  chain.segments = {{0, 1}};
+  scene.line_bodies.push_back(chain);
+  return scene;
+}
+
+void expect_error(const std::function<void(SceneDesc&)>& spoil, const std::string& needle) {
+  SceneDesc scene = valid_scene();
+  spoil(scene);
+  auto sim = Simulation::create(scene, {.backend = "cpu"});
+  ASSERT_FALSE(sim.ok()) << "expected an error mentioning '" << needle << "'";
+  EXPECT_NE(sim.error().message().find(needle), std::string::npos) << sim.error().message();
+}
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+TEST(SceneBadInput, ValidSceneIsAccepted) {
+  auto sim = Simulation::create(valid_scene(), {.backend = "cpu"});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+}
+
+TEST(SceneBadInput, SolverAndGravity) {
+  expect_error([](SceneDesc& s) { s.solver.time_step = 0.0; }, "solver.time_step");
+  expect_error([](SceneDesc& s) { s.solver.time_step = kNaN; }, "solver.time_step");
+  expect_error([](SceneDesc& s) { s.solver.substeps = 0; }, "solver.substeps");
+  expect_error([](SceneDesc& s) { s.solver.iterations = -1; }, "solver.iterations");
+  expect_error([](SceneDesc& s) { s.gravity[1] = kInf; }, "gravity[1]");
+  expect_error([](SceneDesc& s) { s.tet_bodies.clear(); s.line_bodies.clear(); }, "no bodies");
+}
+
+TEST(SceneBadInput, TetBodyParameters) {
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].density = -1.0; }, "tet_bodies[0].density");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].density = kNaN; }, "tet_bodies[0].density");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].distance_compliance = -1e-6; }, "tet_bodies[0].distance_compliance");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].volume_compliance = kNaN; }, "tet_bodies[0].volume_compliance");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].pinned = {3, 1000}; }, "tet_bodies[0].pinned[1]");
+}
+
+TEST(SceneBadInput, TetBodyMesh) {
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].mesh.vertices[3][2] = kNaN; }, "tet_bodies[0].mesh");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].mesh.tets[5][2] = 9999; }, "tet_bodies[0].mesh");
+  expect_error([](SceneDesc& s) { std::swap(s.tet_bodies[0].mesh.tets[4][0], s.tet_bodies[0].mesh.tets[4][1]); },
+               "tet 4");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].mesh.tets[2][3] = s.tet_bodies[0].mesh.tets[2][0]; }, "tet 2");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].mesh.tets.clear(); }, "tet_bodies[0].mesh");
+}
+
+TEST(SceneBadInput, LineBody) {
+  expect_error([](SceneDesc& s) { s.line_bodies[0].masses = {1.0}; }, "line_bodies[0].masses");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].masses[1] = 0.0; }, "line_bodies[0].masses[1]");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].vertices[0][0] = kInf; }, "line_bodies[0].vertices[0]");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].segments.push_back({0, 7}); }, "line_bodies[0].segments[1]");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].segments.push_back({1, 1}); }, "line_bodies[0].segments[1]");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].compliance = -1.0; }, "line_bodies[0].compliance");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].vertices.clear(); }, "line_bodies[0].vertices");
+}
+
+TEST(SceneBadInput, ElasticMaterial) {
+  TetBodyDesc body;
+  for (double e : {0.0, -5.0, kNaN, kInf}) {
+    Status s = body.set_elastic(e, 0.3);
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.error().message().find("youngs_modulus"), std::string::npos);
+  }
+  for (double nu : {0.5, 0.7, -1.0, kNaN}) {
+    Status s = body.set_elastic(1e4, nu);
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.error().message().find("poisson_ratio"), std::string::npos);
+  }
+  SINEW_ASSERT_OK(body.set_elastic(1e4, 0.25));
+  EXPECT_DOUBLE_EQ(body.distance_compliance, 1e-4);
+  EXPECT_DOUBLE_EQ(body.volume_compliance, 3.0 * 0.5 / 1e4);
+}
+
+TEST(SceneBadInput, Backends) {
+  auto unknown = Simulation::create(valid_scene(), {.backend = "cuda"});
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().message().find("unknown backend 'cuda'"), std::string::npos);
+  for (const char* name : {"opencl", "vulkan"}) {
+    const auto built = built_backends();
+    if (std::find(built.begin(), built.end(), name) != built.end()) continue;
+    auto missing = Simulation::create(valid_scene(), {.backend = name});
+    ASSERT_FALSE(missing.ok());
+    EXPECT_NE(missing.error().message().find(name), std::string::npos) << missing.error().message();
+  }
+  auto threads = Simulation::create(valid_scene(), {.backend = "cpu", .threads = -2});
+  ASSERT_FALSE(threads.ok());
+  EXPECT_NE(threads.error().message().find("threads"), std::string::npos);
+  auto fallback = Simulation::create(valid_scene(), {.backend = "auto", .quiet = true});
+  ASSERT_TRUE(fallback.ok()) << fallback.error().message();
+}
+
+TEST(DeviceBadInput, BuffersAndPrograms) {
+  auto made = create_device({.backend = "cpu"});
+  ASSERT_TRUE(made.ok());
+  Device& device = **made;
+  EXPECT_FALSE(device.create_buffer(0, "empty").ok());
+  auto buffer = device.create_buffer(64, "small");
+  ASSERT_TRUE(buffer.ok());
+  float data[32] = {};
+  Status past_end = device.write_buffer(*buffer, 32, data, 64);
+  ASSERT_FALSE(past_end.ok());
+  EXPECT_NE(past_end.error().message().find("small"), std::string::npos);
+  EXPECT_FALSE(device.read_buffer(BufferHandle{77}, 0, data, 4).ok());
+
+  FrameProgram wrong_bindings;
+  wrong_bindings.dispatch(Kernel::xpbd_predict, 4, {*buffer}, kernels::PredictParams{});
+  auto p1 = device.create_program(wrong_bindings);
+  ASSERT_FALSE(p1.ok());
+  EXPECT_NE(p1.error().message().find("xpbd_predict"), std::string::npos) << p1.error().message();
+
+  FrameProgram foreign_buffer;
+  foreign_buffer.dispatch(Kernel::xpbd_predict, 4, {*buffer, *buffer, BufferHandle{99}}, kernels::PredictParams{});
+  auto p2 = device.create_program(foreign_buffer);
+  ASSERT_FALSE(p2.ok());
+  EXPECT_NE(p2.error().message().find("binding 2"), std::string::npos) << p2.error().message();
+
+  EXPECT_FALSE(device.run_program(ProgramHandle{5}).ok());
+}
+
+}  // namespace
+}  // namespace sinew

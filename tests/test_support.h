@@ -1,0 +1,39 @@
+// test_support.h — helpers shared by the test files: the backends to run
+// every test body on, and small scene builders.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "sinew/mesh.h"
+#include "sinew/simulation.h"
+
+namespace sinew::test {
+
+/// Every backend built into this library; a test body is run on each.
+inline std::vector<std::string> backends() { return built_backends(); }
+
+/// Creates a simulation on `backend`, skipping the test when the backend is
+/// built but has no device here (e.g. no GPU), failing it on any other error.
+inline Result<Simulation> create_or_skip(const SceneDesc& scene, const std::string& backend, int threads = 0) {
+  return Simulation::create(scene, {.backend = backend, .threads = threads, .quiet = true});
+}
+
+inline std::string data_path(const std::string& relative) { return std::string(SINEW_DATA_DIR) + "/" + relative; }
+
+/// A box of nx*ny*nz cells of edge `cell` [m], 6 tets per cell.
+inline TetMesh box_mesh(int nx, int ny, int nz, double cell) {
+  auto mesh = make_tet_grid({.nx = nx, .ny = ny, .nz = nz, .origin = {0, 0, 0}, .cell_size = {cell, cell, cell}});
+  EXPECT_TRUE(mesh.ok()) << (mesh.ok() ? "" : mesh.error().message());
+  return mesh.ok() ? *mesh : TetMesh{};
+}
+
+}  // namespace sinew::test
+
+#define SINEW_ASSERT_OK(expr)                                       \
+  do {                                                              \
+    const auto& sinew_status_ = (expr);                             \
+    ASSERT_TRUE(sinew_status_.ok()) << sinew_status_.error().message(); \
+  } while (0)
