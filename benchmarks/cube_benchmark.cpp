@@ -8,7 +8,8 @@
 // Each run reports the real time per frame and the user counters
 // `constraints`, `colors` (dependent sweeps per iteration) and `particles`.
 //   bench_cube --benchmark_out=cube.csv --benchmark_out_format=csv
-//   SINEW_BACKEND=cpu|opencl|vulkan|auto (default auto) picks the backend.
+//   SINEW_BACKEND=cpu|opencl|vulkan|auto (default auto) picks the backend;
+//   SINEW_THREADS=N sets the CPU backend's threads (default: all).
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -22,6 +23,11 @@ namespace {
 std::string backend_from_env() {
   const char* b = std::getenv("SINEW_BACKEND");
   return b ? b : "auto";
+}
+
+int threads_from_env() {
+  const char* t = std::getenv("SINEW_THREADS");
+  return t ? std::atoi(t) : 0;
 }
 
 // A 1 m cube of n^3 cells (6 tets each), hanging from its top face.
@@ -42,7 +48,7 @@ sinew::SceneDesc cube_scene(int n, int iterations) {
 void BM_Cube(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int iterations = static_cast<int>(state.range(1));
-  auto sim = sinew::Simulation::create(cube_scene(n, iterations), {.backend = backend_from_env(), .quiet = true});
+  auto sim = sinew::Simulation::create(cube_scene(n, iterations), {.backend = backend_from_env(), .threads = threads_from_env(), .quiet = true});
   if (!sim) {
     state.SkipWithError(sim.error().message().c_str());
     return;

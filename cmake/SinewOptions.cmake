@@ -45,6 +45,11 @@ endif()
 
 function(sinew_set_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+    # GCC 12 reports a false -Wrestrict inside std::string concatenation
+    # (GCC bug 105651), which error messages do everywhere.
+    target_compile_options(${target} PRIVATE -Wno-restrict)
+  endif()
   if(SINEW_WARNINGS_AS_ERRORS)
     target_compile_options(${target} PRIVATE -Werror)
   endif()

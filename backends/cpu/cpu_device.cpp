@@ -21,7 +21,17 @@
 namespace sinew {
 namespace {
 
-kernels::CpuKernelFn cpu_kernel(Kernel kernel) {
+// The AVX2 solves do whole groups of eight; the scalar kernel does the rest.
+void solve_distance_simd(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  kernels::xpbd_solve_distance(params, bindings, kernels::xpbd_solve_distance_avx2(params, bindings, begin, end), end);
+}
+void solve_volume_simd(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  kernels::xpbd_solve_volume(params, bindings, kernels::xpbd_solve_volume_avx2(params, bindings, begin, end), end);
+}
+
+kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
+  if (simd && kernel == Kernel::xpbd_solve_distance) return solve_distance_simd;
+  if (simd && kernel == Kernel::xpbd_solve_volume) return solve_volume_simd;
   switch (kernel) {
     case Kernel::xpbd_predict: return kernels::xpbd_predict;
     case Kernel::xpbd_update_velocity: return kernels::xpbd_update_velocity;
@@ -52,11 +62,12 @@ struct CpuDispatch {
 
 class CpuDevice final : public Device {
  public:
-  explicit CpuDevice(int threads) : threads_(threads), arena_(threads) {}
+  CpuDevice(int threads, bool simd) : threads_(threads), simd_(simd), arena_(threads) {}
 
   std::string backend_name() const override { return "cpu"; }
   std::string device_name() const override {
-    return "CPU reference (" + std::to_string(threads_) + (threads_ == 1 ? " thread)" : " threads)");
+    return "CPU reference (" + std::to_string(threads_) + (threads_ == 1 ? " thread" : " threads") +
+           (simd_ ? ", AVX2)" : ", scalar)");
   }
 
   Result<BufferHandle> create_buffer(std::size_t bytes, std::string_view label) override {
@@ -93,7 +104,7 @@ class CpuDevice final : public Device {
       const auto* d = std::get_if<Dispatch>(&command);
       if (!d || d->count == 0) continue;  // barriers are implicit, see the top of this file
       CpuDispatch c{};
-      c.fn = cpu_kernel(d->kernel);
+      c.fn = cpu_kernel(d->kernel, simd_);
       c.count = d->count;
       for (std::uint32_t b = 0; b < d->binding_count; ++b) c.bindings[b] = buffers_[d->bindings[b].id].data.get();
       std::memcpy(c.params, d->params, d->params_bytes);
@@ -139,6 +150,7 @@ class CpuDevice final : public Device {
   }
 
   int threads_;
+  bool simd_;
   tbb::task_arena arena_;
   std::vector<HostBuffer> buffers_;
   std::vector<std::vector<CpuDispatch>> programs_;
@@ -151,7 +163,8 @@ Result<std::unique_ptr<Device>> make_cpu_device(const DeviceOptions& options) {
                                         std::to_string(options.threads));
   const int threads =
       options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  return std::unique_ptr<Device>(std::make_unique<CpuDevice>(threads));
+  const bool simd = options.cpu_simd && kernels::cpu_has_avx2();
+  return std::unique_ptr<Device>(std::make_unique<CpuDevice>(threads, simd));
 }
 
 }  // namespace sinew

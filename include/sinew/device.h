@@ -106,6 +106,8 @@ struct ProgramHandle {
 struct DeviceOptions {
   std::string backend = "auto";  ///< "cpu", "opencl", "vulkan" or "auto"
   int threads = 0;               ///< cpu: worker threads; 0 = all hardware threads
+  bool cpu_simd = true;          ///< cpu: use the AVX2 solves where the CPU has AVX2 (bitwise
+                                 ///< equal to the scalar reference kernels, only faster)
   bool quiet = false;            ///< true: do not print the one-line fallback notice of "auto"
 };
 

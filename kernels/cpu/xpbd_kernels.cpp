@@ -68,8 +68,10 @@ void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::ui
     const float c = len - rest_alpha[i].x;
     const float dlambda = (-c - alpha_t * lambda_i) / (w + alpha_t);
     const float4 n = edge_length_gradient(xa, xb, len);  // grad_a C = n, grad_b C = -n
-    x[e.x] = add_scaled3(xa, xa.w * dlambda, n);
-    x[e.y] = add_scaled3(xb, -xb.w * dlambda, n);
+    // Immovable particles (w == 0) are never written: two constraints of one
+    // colour may share one, and a write would race (even with equal bytes).
+    if (xa.w > 0.0f) x[e.x] = add_scaled3(xa, xa.w * dlambda, n);
+    if (xb.w > 0.0f) x[e.y] = add_scaled3(xb, -xb.w * dlambda, n);
     lambda[i] = lambda_i + dlambda;
   }
 }
@@ -93,12 +95,12 @@ void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint
       lambda[i] = lambda_i;
       continue;
     }
-    const float c = tet_volume(x0, x1, x2, x3) - rest_alpha[i].x;
+    const float c = tet_volume(x0, x1, x2, x3) - rest_alpha[i].x;  // rounds as the rest volume did
     const float dlambda = (-c - alpha_t * lambda_i) / (w + alpha_t);
-    x[t.x] = add_scaled3(x0, x0.w * dlambda, g[0]);
-    x[t.y] = add_scaled3(x1, x1.w * dlambda, g[1]);
-    x[t.z] = add_scaled3(x2, x2.w * dlambda, g[2]);
-    x[t.w] = add_scaled3(x3, x3.w * dlambda, g[3]);
+    if (x0.w > 0.0f) x[t.x] = add_scaled3(x0, x0.w * dlambda, g[0]);
+    if (x1.w > 0.0f) x[t.y] = add_scaled3(x1, x1.w * dlambda, g[1]);
+    if (x2.w > 0.0f) x[t.z] = add_scaled3(x2, x2.w * dlambda, g[2]);
+    if (x3.w > 0.0f) x[t.w] = add_scaled3(x3, x3.w * dlambda, g[3]);
     lambda[i] = lambda_i + dlambda;
   }
 }

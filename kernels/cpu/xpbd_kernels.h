@@ -58,4 +58,16 @@ void xpbd_update_velocity(const void* params, std::byte* const* bindings, std::u
 void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 
+/// True when this CPU runs AVX2 (checked once by the CPU backend).
+bool cpu_has_avx2();
+
+/// AVX2 versions of the two solves, bitwise equal to the scalar ones. They
+/// process whole groups of eight items from `begin` and return the first
+/// item not done; the scalar kernel finishes [returned, end).
+/// [pre] cpu_has_avx2()
+std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                                       std::uint32_t end);
+std::uint32_t xpbd_solve_volume_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                                     std::uint32_t end);
+
 }  // namespace sinew::kernels
