@@ -9,7 +9,8 @@
 // `constraints`, `colors` (dependent sweeps per iteration) and `particles`.
 //   bench_cube --benchmark_out=cube.csv --benchmark_out_format=csv
 //   SINEW_BACKEND=cpu|opencl|vulkan|auto (default auto) picks the backend;
-//   SINEW_THREADS=N sets the CPU backend's threads (default: all).
+//   SINEW_THREADS=N sets the CPU backend's threads (default: all);
+//   SINEW_CPU_SIMD=0 runs the scalar reference solves instead of AVX2.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -30,6 +31,11 @@ int threads_from_env() {
   return t ? std::atoi(t) : 0;
 }
 
+bool simd_from_env() {
+  const char* s = std::getenv("SINEW_CPU_SIMD");
+  return !(s && std::string(s) == "0");
+}
+
 // A 1 m cube of n^3 cells (6 tets each), hanging from its top face.
 sinew::SceneDesc cube_scene(int n, int iterations) {
   sinew::TetBodyDesc body;
@@ -48,7 +54,7 @@ sinew::SceneDesc cube_scene(int n, int iterations) {
 void BM_Cube(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int iterations = static_cast<int>(state.range(1));
-  auto sim = sinew::Simulation::create(cube_scene(n, iterations), {.backend = backend_from_env(), .threads = threads_from_env(), .quiet = true});
+  auto sim = sinew::Simulation::create(cube_scene(n, iterations), {.backend = backend_from_env(), .threads = threads_from_env(), .cpu_simd = simd_from_env(), .quiet = true});
   if (!sim) {
     state.SkipWithError(sim.error().message().c_str());
     return;
@@ -65,7 +71,7 @@ void BM_Cube(benchmark::State& state) {
   state.counters["colors"] = info.colors;
   state.counters["particles"] = info.particles;
   state.counters["iterations"] = iterations;
-  state.SetLabel(sim->device().backend_name());
+  state.SetLabel(sim->device().device_name());
 }
 
 void CubeArgs(benchmark::internal::Benchmark* b) {
