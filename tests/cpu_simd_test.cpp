@@ -44,7 +44,7 @@ Case make_case(std::mt19937& rng, std::uint32_t arity, std::uint32_t count) {
   return c;
 }
 
-void run(CpuKernelFn fn, Case& c, const SolveDistanceParams& p, std::uint32_t begin, std::uint32_t end) {
+void run(CpuKernelFn fn, Case& c, const SolveParams& p, std::uint32_t begin, std::uint32_t end) {
   std::byte* bindings[4] = {reinterpret_cast<std::byte*>(c.x.data()), reinterpret_cast<std::byte*>(c.idx.data()),
                             reinterpret_cast<std::byte*>(c.rest_alpha.data()),
                             reinterpret_cast<std::byte*>(c.lambda.data())};
@@ -65,7 +65,7 @@ void compare(std::uint32_t arity, CpuKernelFn scalar, CpuKernelFn simd) {
       // A dispatch over constraints [first, first + n) split into two chunks,
       // as threads would split it.
       const std::uint32_t first = count % 5, n = count - first, split = n / 3;
-      const SolveDistanceParams p{first, n, 3600.0f, reset};
+      const SolveParams p{first, n, 3600.0f, reset};
       run(scalar, ref, p, 0, n);
       run(simd, fast, p, 0, split);
       run(simd, fast, p, split, n);

@@ -46,7 +46,7 @@ void xpbd_update_velocity(const void* params, std::byte* const* bindings, std::u
 
 void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::uint32_t begin,
                          std::uint32_t end) {
-  const auto& p = *static_cast<const SolveDistanceParams*>(params);
+  const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float4*>(bindings[0]);
   const auto* idx = reinterpret_cast<const uint2*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float2*>(bindings[2]);
@@ -78,7 +78,7 @@ void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::ui
 
 void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint32_t begin,
                        std::uint32_t end) {
-  const auto& p = *static_cast<const SolveVolumeParams*>(params);
+  const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float4*>(bindings[0]);
   const auto* idx = reinterpret_cast<const uint4*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float2*>(bindings[2]);

@@ -103,7 +103,7 @@ inline __m256 load_lambda(const float* lambda, std::uint32_t reset) {
 
 std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
                                        std::uint32_t end) {
-  const auto& p = *static_cast<const SolveDistanceParams*>(params);
+  const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float*>(bindings[0]);
   const auto* idx = reinterpret_cast<const std::uint32_t*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float*>(bindings[2]);
@@ -139,7 +139,7 @@ std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bin
 
 std::uint32_t xpbd_solve_volume_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
                                      std::uint32_t end) {
-  const auto& p = *static_cast<const SolveVolumeParams*>(params);
+  const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float*>(bindings[0]);
   const auto* idx = reinterpret_cast<const std::uint32_t*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float*>(bindings[2]);

@@ -40,31 +40,23 @@ SINEW_STRUCT_BEGIN(UpdateVelocityParams)
   uint pad1;
 SINEW_STRUCT_END(UpdateVelocityParams)
 
-/* xpbd_solve_distance: one item per constraint of one colour, constraints
- * [first, first + count). C = |x_a - x_b| - rest [m]; alpha [m/N].
- * bindings: 0 position float4 [in/out]
- *           1 particle indices uint2 (a, b) per constraint [in]
- *           2 rest and compliance float2 (rest [m], alpha [m/N]) [in]
- *           3 lambda float [in/out] (reset to 0 when reset_lambda != 0) */
-SINEW_STRUCT_BEGIN(SolveDistanceParams)
+/* Every constraint-solve kernel (xpbd_solve_*) takes SolveParams: one work
+ * item per constraint of one colour, constraints [first, first + count).
+ * Bindings of every solve kernel:
+ *   0 position float4 (xyz, w = inverse mass) [in/out]
+ *   1 particle indices, `arity` uint per constraint [in]
+ *   2 constraint data, per constraint (rest value, compliance alpha) [in]
+ *   3 lambda, one float per constraint [in/out] (reset to 0 when reset_lambda != 0)
+ *
+ * xpbd_solve_distance: arity 2 (uint2). C = |x_a - x_b| - rest [m]; alpha [m/N].
+ * xpbd_solve_volume: arity 4 (uint4). C = V - rest [m^3] with
+ *   V = dot(x1 - x0, cross(x2 - x0, x3 - x0)) / 6; alpha [m^3/Pa]. */
+SINEW_STRUCT_BEGIN(SolveParams)
   uint first;
   uint count;
   float inv_h2;       /* 1 / h^2 [1/s^2]: alpha~ = alpha / h^2 */
   uint reset_lambda;  /* nonzero in the first iteration of a substep */
-SINEW_STRUCT_END(SolveDistanceParams)
-
-/* xpbd_solve_volume: one item per tet constraint of one colour.
- * C = V - rest [m^3] with V = dot(x1 - x0, cross(x2 - x0, x3 - x0)) / 6.
- * bindings: 0 position float4 [in/out]
- *           1 particle indices uint4 per constraint [in]
- *           2 rest and compliance float2 (rest volume [m^3], alpha [m^3/Pa]) [in]
- *           3 lambda float [in/out] */
-SINEW_STRUCT_BEGIN(SolveVolumeParams)
-  uint first;
-  uint count;
-  float inv_h2;
-  uint reset_lambda;
-SINEW_STRUCT_END(SolveVolumeParams)
+SINEW_STRUCT_END(SolveParams)
 
 #ifdef __cplusplus
 }  /* namespace sinew::kernels */

@@ -16,18 +16,11 @@ namespace {
 
 using kernels::float4;
 
-// Constraints of one type, unsorted, before colouring.
-struct RawConstraints {
-  std::uint32_t arity;
-  std::vector<std::uint32_t> particles;
-  std::vector<float> rest_alpha;
-};
-
 struct Builder {
   std::vector<float4> positions;
   std::vector<double> mass;
-  RawConstraints distance{2, {}, {}};
-  RawConstraints volume{4, {}, {}};
+  RawConstraints distance{Kernel::xpbd_solve_distance, 2, {}, {}};
+  RawConstraints volume{Kernel::xpbd_solve_volume, 4, {}, {}};
 
   std::uint32_t add_vertices(const std::vector<Vec3d>& vertices) {
     const auto first = static_cast<std::uint32_t>(positions.size());
@@ -115,6 +108,7 @@ Status add_line_body(Builder& b, const LineBodyDesc& body, const std::string& na
 // the original order inside each colour (stable counting sort).
 ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::uint8_t> movable) {
   ConstraintBlock out;
+  out.kernel = raw.kernel;
   out.arity = raw.arity;
   const auto n = static_cast<std::uint32_t>(raw.particles.size() / raw.arity);
   if (n == 0) return out;
@@ -160,8 +154,8 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
     b.positions[p].w = b.mass[p] > 0.0 ? static_cast<float>(1.0 / b.mass[p]) : 0.0f;
     movable[p] = b.positions[p].w > 0.0f;
   }
-  out.distance = color_and_sort(b.distance, movable);
-  out.volume = color_and_sort(b.volume, movable);
+  for (const RawConstraints* raw : {&b.distance, &b.volume})
+    if (!raw->particles.empty()) out.blocks.push_back(color_and_sort(*raw, movable));
   out.positions = std::move(b.positions);
   return out;
 }

@@ -12,9 +12,11 @@
 
 namespace sinew {
 
-/// Constraints of one type (arity particles each), sorted by colour:
-/// colour k holds constraints [color_offsets[k], color_offsets[k+1]).
+/// Constraints solved by one kernel (arity particles each), sorted by
+/// colour: colour k holds constraints [color_offsets[k], color_offsets[k+1]).
+/// The solve kernels' bindings are described in kernels/shared/xpbd_params.h.
 struct ConstraintBlock {
+  Kernel kernel = Kernel::count_;
   std::uint32_t arity = 0;
   std::vector<std::uint32_t> particles;   ///< arity per constraint
   std::vector<float> rest_alpha;          ///< (rest value, compliance alpha) per constraint
@@ -23,10 +25,18 @@ struct ConstraintBlock {
   [[nodiscard]] std::uint32_t colors() const { return static_cast<std::uint32_t>(color_offsets.size() - 1); }
 };
 
+/// The constraints of one kind before colouring.
+struct RawConstraints {
+  Kernel kernel;
+  std::uint32_t arity;
+  std::vector<std::uint32_t> particles;
+  std::vector<float> rest_alpha;
+};
+
 struct CompiledScene {
   std::vector<kernels::float4> positions;  ///< xyz [m], w = inverse mass [1/kg]
-  ConstraintBlock distance;                ///< C = |xa - xb| - rest, alpha [m/N]
-  ConstraintBlock volume;                  ///< C = V - rest, alpha [m^3/Pa]
+  /// Solved in this order in every iteration; empty blocks are left out.
+  std::vector<ConstraintBlock> blocks;
   std::vector<std::uint32_t> tet_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;
 };

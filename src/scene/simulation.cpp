@@ -43,11 +43,16 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
 
   SceneInfo& info = impl->info;
   info.particles = static_cast<std::uint32_t>(compiled->positions.size());
-  info.distance_constraints = compiled->distance.size();
-  info.volume_constraints = compiled->volume.size();
-  info.distance_colors = compiled->distance.colors();
-  info.volume_colors = compiled->volume.colors();
-  info.colors = info.distance_colors + info.volume_colors;
+  for (const ConstraintBlock& block : compiled->blocks) {
+    if (block.kernel == Kernel::xpbd_solve_distance) {
+      info.distance_constraints += block.size();
+      info.distance_colors += block.colors();
+    } else if (block.kernel == Kernel::xpbd_solve_volume) {
+      info.volume_constraints += block.size();
+      info.volume_colors += block.colors();
+    }
+    info.colors += block.colors();
+  }
   info.dispatches_per_frame = static_cast<std::uint32_t>(impl->program.dispatch_count());
   info.barriers_per_frame = static_cast<std::uint32_t>(impl->program.barrier_count());
   info.tet_body_first_particle = compiled->tet_body_first_particle;

@@ -9,6 +9,9 @@
 // constraints share no movable particle); each colour ends with a barrier.
 #include "xpbd/xpbd_program.h"
 
+#include <string>
+#include <tuple>
+
 #include "xpbd_params.h"
 
 namespace sinew {
@@ -24,17 +27,17 @@ Result<BufferHandle> make_buffer(Device& device, const std::vector<T>& data, std
   return buffer;
 }
 
-void sweep(FrameProgram& program, const ConstraintBlock& block, Kernel kernel, BufferHandle position,
-           BufferHandle particles, BufferHandle rest_alpha, BufferHandle lambda, float inv_h2, bool first_iteration) {
-  // SolveDistanceParams and SolveVolumeParams have the same fields.
-  static_assert(sizeof(kernels::SolveDistanceParams) == sizeof(kernels::SolveVolumeParams));
+// One Gauss-Seidel sweep over a block: a dispatch per colour, each followed
+// by a barrier since the next colour reads what this one wrote.
+void sweep(FrameProgram& program, const ConstraintBlock& block, const BlockBuffers& buffers, BufferHandle position,
+           float inv_h2, bool first_iteration) {
   for (std::uint32_t c = 0; c < block.colors(); ++c) {
-    kernels::SolveDistanceParams p{};
+    kernels::SolveParams p{};
     p.first = block.color_offsets[c];
     p.count = block.color_offsets[c + 1] - block.color_offsets[c];
     p.inv_h2 = inv_h2;
     p.reset_lambda = first_iteration ? 1u : 0u;
-    program.dispatch(kernel, p.count, {position, particles, rest_alpha, lambda}, p);
+    program.dispatch(block.kernel, p.count, {position, buffers.particles, buffers.rest_alpha, buffers.lambda}, p);
     program.barrier();
   }
 }
@@ -44,26 +47,22 @@ void sweep(FrameProgram& program, const ConstraintBlock& block, Kernel kernel, B
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
   XpbdBuffers b;
   const std::vector<kernels::float4> zeros(scene.positions.size(), kernels::float4{0, 0, 0, 0});
-  const std::vector<float> no_lambda_d(scene.distance.size(), 0.0f);
-  const std::vector<float> no_lambda_v(scene.volume.size(), 0.0f);
-  struct Upload {
-    BufferHandle* handle;
-    Result<BufferHandle> made;
-  };
-  Upload uploads[] = {
-      {&b.position, make_buffer(device, scene.positions, "position")},
-      {&b.previous, make_buffer(device, zeros, "previous position")},
-      {&b.velocity, make_buffer(device, zeros, "velocity")},
-      {&b.distance_particles, make_buffer(device, scene.distance.particles, "distance particles")},
-      {&b.distance_rest_alpha, make_buffer(device, scene.distance.rest_alpha, "distance rest/compliance")},
-      {&b.distance_lambda, make_buffer(device, no_lambda_d, "distance lambda")},
-      {&b.volume_particles, make_buffer(device, scene.volume.particles, "volume particles")},
-      {&b.volume_rest_alpha, make_buffer(device, scene.volume.rest_alpha, "volume rest/compliance")},
-      {&b.volume_lambda, make_buffer(device, no_lambda_v, "volume lambda")},
-  };
-  for (auto& u : uploads) {
-    if (!u.made) return u.made.error();
-    *u.handle = *u.made;
+  for (auto [handle, data, label] : {std::tuple{&b.position, &scene.positions, "position"},
+                                     std::tuple{&b.previous, &zeros, "previous position"},
+                                     std::tuple{&b.velocity, &zeros, "velocity"}}) {
+    auto made = make_buffer(device, *data, label);
+    if (!made) return made.error();
+    *handle = *made;
+  }
+  for (const ConstraintBlock& block : scene.blocks) {
+    const std::string name(kernel_name(block.kernel));
+    auto particles = make_buffer(device, block.particles, name + " particles");
+    if (!particles) return particles.error();
+    auto rest_alpha = make_buffer(device, block.rest_alpha, name + " rest/compliance");
+    if (!rest_alpha) return rest_alpha.error();
+    auto lambda = make_buffer(device, std::vector<float>(block.size(), 0.0f), name + " lambda");
+    if (!lambda) return lambda.error();
+    b.blocks.push_back({*particles, *rest_alpha, *lambda});
   }
   return b;
 }
@@ -88,12 +87,9 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   for (int s = 0; s < solver.substeps; ++s) {
     program.dispatch(Kernel::xpbd_predict, particles, {buffers.position, buffers.previous, buffers.velocity}, predict);
     program.barrier();
-    for (int it = 0; it < solver.iterations; ++it) {
-      sweep(program, scene.distance, Kernel::xpbd_solve_distance, buffers.position, buffers.distance_particles,
-            buffers.distance_rest_alpha, buffers.distance_lambda, inv_h2, it == 0);
-      sweep(program, scene.volume, Kernel::xpbd_solve_volume, buffers.position, buffers.volume_particles,
-            buffers.volume_rest_alpha, buffers.volume_lambda, inv_h2, it == 0);
-    }
+    for (int it = 0; it < solver.iterations; ++it)
+      for (std::size_t k = 0; k < scene.blocks.size(); ++k)
+        sweep(program, scene.blocks[k], buffers.blocks[k], buffers.position, inv_h2, it == 0);
     program.dispatch(Kernel::xpbd_update_velocity, particles, {buffers.position, buffers.previous, buffers.velocity},
                      update);
     program.barrier();

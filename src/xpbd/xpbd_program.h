@@ -8,11 +8,15 @@
 
 namespace sinew {
 
+/// The device buffers of one constraint block.
+struct BlockBuffers {
+  BufferHandle particles, rest_alpha, lambda;
+};
+
 /// The device buffers a compiled scene lives in.
 struct XpbdBuffers {
   BufferHandle position, previous, velocity;
-  BufferHandle distance_particles, distance_rest_alpha, distance_lambda;
-  BufferHandle volume_particles, volume_rest_alpha, volume_lambda;
+  std::vector<BlockBuffers> blocks;  ///< one per CompiledScene::blocks entry
 };
 
 /// Creates the buffers on `device` and uploads the compiled scene.
