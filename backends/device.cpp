@@ -15,8 +15,8 @@ using namespace kernels;
 constexpr KernelSignature kSignatures[] = {
     {"xpbd_predict", 3, sizeof(PredictParams)},
     {"xpbd_update_velocity", 3, sizeof(UpdateVelocityParams)},
-    {"xpbd_solve_distance", 4, sizeof(SolveParams)},
-    {"xpbd_solve_volume", 4, sizeof(SolveParams)},
+    {"xpbd_solve_distance", 5, sizeof(SolveParams)},
+    {"xpbd_solve_volume", 5, sizeof(SolveParams)},
 };
 static_assert(std::size(kSignatures) == static_cast<std::size_t>(Kernel::count_),
               "every Kernel needs a signature");

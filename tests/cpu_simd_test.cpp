@@ -20,6 +20,7 @@ struct Case {
   std::vector<std::uint32_t> idx;
   std::vector<float> rest_alpha;
   std::vector<float> lambda;
+  std::vector<float> residual;
 };
 
 // `count` constraints of `arity` particles with no shared movable particle.
@@ -40,14 +41,16 @@ Case make_case(std::mt19937& rng, std::uint32_t arity, std::uint32_t count) {
     c.rest_alpha.push_back(pos(rng) * (arity == 2 ? 1.0f : 0.2f));
     c.rest_alpha.push_back(k % 3 == 0 ? 0.0f : pos(rng) * 1e-4f);  // rigid and compliant
     c.lambda.push_back(u(rng) * 1e-3f);
+    c.residual.push_back(-1.0f);  // poison: every item must overwrite it when asked
   }
   return c;
 }
 
 void run(CpuKernelFn fn, Case& c, const SolveParams& p, std::uint32_t begin, std::uint32_t end) {
-  std::byte* bindings[4] = {reinterpret_cast<std::byte*>(c.x.data()), reinterpret_cast<std::byte*>(c.idx.data()),
+  std::byte* bindings[5] = {reinterpret_cast<std::byte*>(c.x.data()), reinterpret_cast<std::byte*>(c.idx.data()),
                             reinterpret_cast<std::byte*>(c.rest_alpha.data()),
-                            reinterpret_cast<std::byte*>(c.lambda.data())};
+                            reinterpret_cast<std::byte*>(c.lambda.data()),
+                            reinterpret_cast<std::byte*>(c.residual.data())};
   fn(&p, bindings, begin, end);
 }
 
@@ -60,12 +63,13 @@ void compare(std::uint32_t arity, CpuKernelFn scalar, CpuKernelFn simd) {
   std::mt19937 rng(std::random_device{}());
   for (std::uint32_t count : {8u, 13u, 64u, 203u}) {
     for (std::uint32_t reset : {0u, 1u}) {
+      const std::uint32_t write_residual = 1u - reset;
       Case ref = make_case(rng, arity, count);
       Case fast = ref;
       // A dispatch over constraints [first, first + n) split into two chunks,
       // as threads would split it.
       const std::uint32_t first = count % 5, n = count - first, split = n / 3;
-      const SolveParams p{first, n, 3600.0f, reset};
+      const SolveParams p{first, n, 3600.0f, reset, 1.0f / 60.0f, 1.0f, write_residual, 0};
       run(scalar, ref, p, 0, n);
       run(simd, fast, p, 0, split);
       run(simd, fast, p, split, n);
@@ -73,6 +77,11 @@ void compare(std::uint32_t arity, CpuKernelFn scalar, CpuKernelFn simd) {
           << "positions differ, arity " << arity << ", count " << count;
       ASSERT_EQ(0, std::memcmp(ref.lambda.data(), fast.lambda.data(), ref.lambda.size() * sizeof(float)))
           << "lambdas differ, arity " << arity << ", count " << count;
+      ASSERT_EQ(0, std::memcmp(ref.residual.data(), fast.residual.data(), ref.residual.size() * sizeof(float)))
+          << "residuals differ, arity " << arity << ", count " << count;
+      if (write_residual) {
+        for (std::uint32_t k = first; k < count; ++k) ASSERT_GE(ref.residual[k], 0.0f) << "residual not written";
+      }
       // The solve did something: compare with the untouched input.
       Case untouched = make_case(rng, arity, count);
       EXPECT_NE(0, std::memcmp(untouched.x.data(), ref.x.data(), 16));

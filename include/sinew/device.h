@@ -16,6 +16,7 @@
 #include <cstring>
 #include <initializer_list>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -71,6 +72,10 @@ class FrameProgram {
   template <class Params>
   void dispatch(Kernel kernel, std::uint32_t count, std::initializer_list<BufferHandle> bindings,
                 const Params& params) {
+    dispatch(kernel, count, std::span<const BufferHandle>(bindings.begin(), bindings.size()), params);
+  }
+  template <class Params>
+  void dispatch(Kernel kernel, std::uint32_t count, std::span<const BufferHandle> bindings, const Params& params) {
     static_assert(std::is_trivially_copyable_v<Params> && sizeof(Params) <= Dispatch::max_params_bytes);
     Dispatch d;
     d.kernel = kernel;

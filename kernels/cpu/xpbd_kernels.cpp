@@ -51,6 +51,7 @@ void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::ui
   const auto* idx = reinterpret_cast<const uint2*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float2*>(bindings[2]);
   auto* lambda = reinterpret_cast<float*>(bindings[3]);
+  auto* residual = reinterpret_cast<float*>(bindings[4]);
   for (std::uint32_t i = p.first + begin; i < p.first + end; ++i) {
     const uint2 e = idx[i];
     const float4 xa = x[e.x];
@@ -61,11 +62,12 @@ void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::ui
     const float lambda_i = p.reset_lambda ? 0.0f : lambda[i];
     // A zero-length edge has no direction to push along; a constraint
     // between two immovable particles (w == 0 and alpha == 0) has nothing to do.
+    const float c = len - rest_alpha[i].x;
+    if (p.write_residual) residual[i] = std::abs(c + alpha_t * lambda_i) / rest_alpha[i].x;
     if (len <= 0.0f || w + alpha_t <= 0.0f) {
       lambda[i] = lambda_i;
       continue;
     }
-    const float c = len - rest_alpha[i].x;
     const float dlambda = (-c - alpha_t * lambda_i) / (w + alpha_t);
     const float4 n = edge_length_gradient(xa, xb, len);  // grad_a C = n, grad_b C = -n
     // Immovable particles (w == 0) are never written: two constraints of one
@@ -83,6 +85,7 @@ void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint
   const auto* idx = reinterpret_cast<const uint4*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float2*>(bindings[2]);
   auto* lambda = reinterpret_cast<float*>(bindings[3]);
+  auto* residual = reinterpret_cast<float*>(bindings[4]);
   for (std::uint32_t i = p.first + begin; i < p.first + end; ++i) {
     const uint4 t = idx[i];
     const float4 x0 = x[t.x], x1 = x[t.y], x2 = x[t.z], x3 = x[t.w];
@@ -91,11 +94,12 @@ void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint
     const float w = x0.w * dot3(g[0], g[0]) + x1.w * dot3(g[1], g[1]) + x2.w * dot3(g[2], g[2]) + x3.w * dot3(g[3], g[3]);
     const float alpha_t = rest_alpha[i].y * p.inv_h2;
     const float lambda_i = p.reset_lambda ? 0.0f : lambda[i];
+    const float c = tet_volume(x0, x1, x2, x3) - rest_alpha[i].x;  // rounds as the rest volume did
+    if (p.write_residual) residual[i] = std::abs(c + alpha_t * lambda_i) / rest_alpha[i].x;
     if (w + alpha_t <= 0.0f) {  // fully collapsed or immovable: no direction
       lambda[i] = lambda_i;
       continue;
     }
-    const float c = tet_volume(x0, x1, x2, x3) - rest_alpha[i].x;  // rounds as the rest volume did
     const float dlambda = (-c - alpha_t * lambda_i) / (w + alpha_t);
     if (x0.w > 0.0f) x[t.x] = add_scaled3(x0, x0.w * dlambda, g[0]);
     if (x1.w > 0.0f) x[t.y] = add_scaled3(x1, x1.w * dlambda, g[1]);

@@ -99,6 +99,12 @@ inline __m256 load_lambda(const float* lambda, std::uint32_t reset) {
   return reset ? _mm256_setzero_ps() : _mm256_loadu_ps(lambda);
 }
 
+// |c + alpha~ lambda| / rest, as the scalar kernels compute the residual.
+inline void store_residual(float* residual, __m256 c, __m256 alpha_t, __m256 lambda_i, __m256 rest) {
+  const __m256 r = add(c, mul(alpha_t, lambda_i));
+  _mm256_storeu_ps(residual, _mm256_div_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), r), rest));
+}
+
 }  // namespace
 
 std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
@@ -108,6 +114,7 @@ std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bin
   const auto* idx = reinterpret_cast<const std::uint32_t*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float*>(bindings[2]);
   auto* lambda = reinterpret_cast<float*>(bindings[3]);
+  auto* residual = reinterpret_cast<float*>(bindings[4]);
   const __m256 inv_h2 = _mm256_set1_ps(p.inv_h2), one = _mm256_set1_ps(1.0f);
   std::uint32_t i = p.first + begin;
   for (; i + 8 <= p.first + end; i += 8) {
@@ -126,6 +133,7 @@ std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bin
     const __m256 lambda_i = load_lambda(lambda + i, p.reset_lambda);
     const __m256 valid = _mm256_and_ps(not_le_zero(len), not_le_zero(add(w, alpha_t)));
     const __m256 c = sub(len, rest);
+    if (p.write_residual) store_residual(residual + i, c, alpha_t, lambda_i, rest);
     const __m256 dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
     const Lanes n = scale(_mm256_div_ps(one, len), d);
     const Lanes a_new = add_scaled3(a, mul(a.w, dlambda), n, valid);
@@ -144,6 +152,7 @@ std::uint32_t xpbd_solve_volume_avx2(const void* params, std::byte* const* bindi
   const auto* idx = reinterpret_cast<const std::uint32_t*>(bindings[1]);
   const auto* rest_alpha = reinterpret_cast<const float*>(bindings[2]);
   auto* lambda = reinterpret_cast<float*>(bindings[3]);
+  auto* residual = reinterpret_cast<float*>(bindings[4]);
   const __m256 inv_h2 = _mm256_set1_ps(p.inv_h2), sixth = _mm256_set1_ps(1.0f / 6.0f);
   std::uint32_t i = p.first + begin;
   for (; i + 8 <= p.first + end; i += 8) {
@@ -166,6 +175,7 @@ std::uint32_t xpbd_solve_volume_avx2(const void* params, std::byte* const* bindi
     const __m256 lambda_i = load_lambda(lambda + i, p.reset_lambda);
     const __m256 valid = not_le_zero(add(w, alpha_t));
     const __m256 c = sub(mul(dot3(e1, c23), sixth), rest);  // tet_volume(x0, x1, x2, x3) - rest
+    if (p.write_residual) store_residual(residual + i, c, alpha_t, lambda_i, rest);
     const __m256 dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
     _mm256_storeu_ps(lambda + i, _mm256_blendv_ps(lambda_i, add(lambda_i, dlambda), valid));
     store_particles(x, iv[0], add_scaled3(x0, mul(x0.w, dlambda), g0, valid), _mm256_movemask_ps(positive(x0.w)));

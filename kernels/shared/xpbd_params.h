@@ -42,20 +42,30 @@ SINEW_STRUCT_END(UpdateVelocityParams)
 
 /* Every constraint-solve kernel (xpbd_solve_*) takes SolveParams: one work
  * item per constraint of one colour, constraints [first, first + count).
- * Bindings of every solve kernel:
+ * Bindings of every solve kernel, then any extra ones its block lists:
  *   0 position float4 (xyz, w = inverse mass) [in/out]
  *   1 particle indices, `arity` uint per constraint [in]
- *   2 constraint data, per constraint (rest value, compliance alpha) [in]
- *   3 lambda, one float per constraint [in/out] (reset to 0 when reset_lambda != 0)
+ *   2 constraint data, `data_stride` floats per constraint [in]
+ *   3 lambda, `lambda_stride` floats per constraint [in/out] (reset to 0
+ *     when reset_lambda != 0)
+ *   4 residual, one float per constraint [out] (written only when
+ *     write_residual != 0: |C + alpha~ lambda| before the constraint's
+ *     update, normalised by its rest value; see each kernel)
  *
- * xpbd_solve_distance: arity 2 (uint2). C = |x_a - x_b| - rest [m]; alpha [m/N].
- * xpbd_solve_volume: arity 4 (uint4). C = V - rest [m^3] with
- *   V = dot(x1 - x0, cross(x2 - x0, x3 - x0)) / 6; alpha [m^3/Pa]. */
+ * xpbd_solve_distance: arity 2, data (rest [m], alpha [m/N]).
+ *   C = |x_a - x_b| - rest; residual / rest.
+ * xpbd_solve_volume: arity 4, data (rest [m^3], alpha [m^3/Pa]).
+ *   C = V - rest with V = dot(x1 - x0, cross(x2 - x0, x3 - x0)) / 6;
+ *   residual / rest. */
 SINEW_STRUCT_BEGIN(SolveParams)
   uint first;
   uint count;
-  float inv_h2;       /* 1 / h^2 [1/s^2]: alpha~ = alpha / h^2 */
-  uint reset_lambda;  /* nonzero in the first iteration of a substep */
+  float inv_h2;         /* 1 / h^2 [1/s^2]: alpha~ = alpha / h^2 */
+  uint reset_lambda;    /* nonzero in the first iteration of a substep */
+  float h;              /* substep length [s] */
+  float substep_end;    /* fraction of the frame done at the end of this substep, in (0, 1] */
+  uint write_residual;  /* nonzero in the last iteration of the last substep */
+  uint pad0;
 SINEW_STRUCT_END(SolveParams)
 
 #ifdef __cplusplus

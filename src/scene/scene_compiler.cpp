@@ -19,8 +19,8 @@ using kernels::float4;
 struct Builder {
   std::vector<float4> positions;
   std::vector<double> mass;
-  RawConstraints distance{Kernel::xpbd_solve_distance, 2, {}, {}};
-  RawConstraints volume{Kernel::xpbd_solve_volume, 4, {}, {}};
+  RawConstraints distance{Kernel::xpbd_solve_distance, 2};
+  RawConstraints volume{Kernel::xpbd_solve_volume, 4};
 
   std::uint32_t add_vertices(const std::vector<Vec3d>& vertices) {
     const auto first = static_cast<std::uint32_t>(positions.size());
@@ -51,8 +51,8 @@ Status add_tet_body(Builder& b, const TetBodyDesc& body, const std::string& name
   if (body.volume_constraints) {
     for (std::size_t t = 0; t < tets.size(); ++t) {
       for (std::uint32_t k : tets[t]) b.volume.particles.push_back(first + k);
-      b.volume.rest_alpha.push_back(rest_volume[t]);
-      b.volume.rest_alpha.push_back(static_cast<float>(body.volume_compliance * rest_volume[t]));
+      b.volume.data.push_back(rest_volume[t]);
+      b.volume.data.push_back(static_cast<float>(body.volume_compliance * rest_volume[t]));
     }
   }
 
@@ -78,8 +78,8 @@ Status add_tet_body(Builder& b, const TetBodyDesc& body, const std::string& name
       const float len = kernels::edge_length(b.positions[first + edges[i].first], b.positions[first + edges[i].second]);
       b.distance.particles.push_back(first + edges[i].first);
       b.distance.particles.push_back(first + edges[i].second);
-      b.distance.rest_alpha.push_back(len);
-      b.distance.rest_alpha.push_back(
+      b.distance.data.push_back(len);
+      b.distance.data.push_back(
           static_cast<float>(body.distance_compliance * static_cast<double>(len) * len / share[i]));
     }
   }
@@ -97,8 +97,8 @@ Status add_line_body(Builder& b, const LineBodyDesc& body, const std::string& na
     if (!(len > 0.0f)) return Error(name + ".segments[" + std::to_string(s) + "] has zero length in single precision");
     b.distance.particles.push_back(first + p);
     b.distance.particles.push_back(first + q);
-    b.distance.rest_alpha.push_back(len);
-    b.distance.rest_alpha.push_back(static_cast<float>(body.compliance));
+    b.distance.data.push_back(len);
+    b.distance.data.push_back(static_cast<float>(body.compliance));
   }
   for (std::uint32_t p : body.pinned) b.mass[first + p] = 0.0;
   return {};
@@ -110,6 +110,9 @@ ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::u
   ConstraintBlock out;
   out.kernel = raw.kernel;
   out.arity = raw.arity;
+  out.data_stride = raw.data_stride;
+  out.lambda_stride = raw.lambda_stride;
+  out.extra_bindings = raw.extra_bindings;
   const auto n = static_cast<std::uint32_t>(raw.particles.size() / raw.arity);
   if (n == 0) return out;
   const Coloring coloring = color_constraints(raw.particles, raw.arity, movable);
@@ -118,11 +121,11 @@ ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::u
     out.color_offsets[k + 1] = out.color_offsets[k] + coloring.color_sizes[k];
   std::vector<std::uint32_t> slot(out.color_offsets.begin(), out.color_offsets.end() - 1);
   out.particles.resize(raw.particles.size());
-  out.rest_alpha.resize(raw.rest_alpha.size());
+  out.data.resize(raw.data.size());
   for (std::uint32_t c = 0; c < n; ++c) {
     const std::uint32_t to = slot[coloring.color_of[c]]++;
     std::copy_n(&raw.particles[c * raw.arity], raw.arity, &out.particles[to * raw.arity]);
-    std::copy_n(&raw.rest_alpha[c * 2], 2, &out.rest_alpha[to * 2]);
+    std::copy_n(&raw.data[c * raw.data_stride], raw.data_stride, &out.data[to * raw.data_stride]);
   }
   return out;
 }

@@ -15,11 +15,17 @@ namespace sinew {
 /// Constraints solved by one kernel (arity particles each), sorted by
 /// colour: colour k holds constraints [color_offsets[k], color_offsets[k+1]).
 /// The solve kernels' bindings are described in kernels/shared/xpbd_params.h.
+/// Scene-wide buffers a solve kernel may bind after its five standard ones.
+enum class SceneBuffer { previous_position };
+
 struct ConstraintBlock {
   Kernel kernel = Kernel::count_;
   std::uint32_t arity = 0;
+  std::uint32_t data_stride = 2;          ///< floats of data per constraint
+  std::uint32_t lambda_stride = 1;        ///< lambdas per constraint
+  std::vector<SceneBuffer> extra_bindings;
   std::vector<std::uint32_t> particles;   ///< arity per constraint
-  std::vector<float> rest_alpha;          ///< (rest value, compliance alpha) per constraint
+  std::vector<float> data;                ///< data_stride per constraint, e.g. (rest value, compliance alpha)
   std::vector<std::uint32_t> color_offsets{0};
   [[nodiscard]] std::uint32_t size() const { return arity ? static_cast<std::uint32_t>(particles.size() / arity) : 0; }
   [[nodiscard]] std::uint32_t colors() const { return static_cast<std::uint32_t>(color_offsets.size() - 1); }
@@ -29,8 +35,11 @@ struct ConstraintBlock {
 struct RawConstraints {
   Kernel kernel;
   std::uint32_t arity;
-  std::vector<std::uint32_t> particles;
-  std::vector<float> rest_alpha;
+  std::uint32_t data_stride = 2;
+  std::uint32_t lambda_stride = 1;
+  std::vector<SceneBuffer> extra_bindings = {};
+  std::vector<std::uint32_t> particles = {};
+  std::vector<float> data = {};
 };
 
 struct CompiledScene {

@@ -29,15 +29,19 @@ Result<BufferHandle> make_buffer(Device& device, const std::vector<T>& data, std
 
 // One Gauss-Seidel sweep over a block: a dispatch per colour, each followed
 // by a barrier since the next colour reads what this one wrote.
-void sweep(FrameProgram& program, const ConstraintBlock& block, const BlockBuffers& buffers, BufferHandle position,
-           float inv_h2, bool first_iteration) {
+void sweep(FrameProgram& program, const ConstraintBlock& block, const BlockBuffers& buffers,
+           const XpbdBuffers& scene_buffers, kernels::SolveParams p) {
+  std::vector<BufferHandle> bindings{scene_buffers.position, buffers.particles, buffers.data, buffers.lambda,
+                                     buffers.residual};
+  for (SceneBuffer extra : block.extra_bindings) {
+    switch (extra) {
+      case SceneBuffer::previous_position: bindings.push_back(scene_buffers.previous); break;
+    }
+  }
   for (std::uint32_t c = 0; c < block.colors(); ++c) {
-    kernels::SolveParams p{};
     p.first = block.color_offsets[c];
     p.count = block.color_offsets[c + 1] - block.color_offsets[c];
-    p.inv_h2 = inv_h2;
-    p.reset_lambda = first_iteration ? 1u : 0u;
-    program.dispatch(block.kernel, p.count, {position, buffers.particles, buffers.rest_alpha, buffers.lambda}, p);
+    program.dispatch(block.kernel, p.count, bindings, p);
     program.barrier();
   }
 }
@@ -58,11 +62,14 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
     const std::string name(kernel_name(block.kernel));
     auto particles = make_buffer(device, block.particles, name + " particles");
     if (!particles) return particles.error();
-    auto rest_alpha = make_buffer(device, block.rest_alpha, name + " rest/compliance");
-    if (!rest_alpha) return rest_alpha.error();
-    auto lambda = make_buffer(device, std::vector<float>(block.size(), 0.0f), name + " lambda");
+    auto data = make_buffer(device, block.data, name + " data");
+    if (!data) return data.error();
+    auto lambda = make_buffer(device, std::vector<float>(std::size_t{block.size()} * block.lambda_stride, 0.0f),
+                              name + " lambda");
     if (!lambda) return lambda.error();
-    b.blocks.push_back({*particles, *rest_alpha, *lambda});
+    auto residual = make_buffer(device, std::vector<float>(block.size(), 0.0f), name + " residual");
+    if (!residual) return residual.error();
+    b.blocks.push_back({*particles, *data, *lambda, *residual});
   }
   return b;
 }
@@ -87,9 +94,15 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   for (int s = 0; s < solver.substeps; ++s) {
     program.dispatch(Kernel::xpbd_predict, particles, {buffers.position, buffers.previous, buffers.velocity}, predict);
     program.barrier();
-    for (int it = 0; it < solver.iterations; ++it)
-      for (std::size_t k = 0; k < scene.blocks.size(); ++k)
-        sweep(program, scene.blocks[k], buffers.blocks[k], buffers.position, inv_h2, it == 0);
+    for (int it = 0; it < solver.iterations; ++it) {
+      kernels::SolveParams p{};
+      p.inv_h2 = inv_h2;
+      p.reset_lambda = it == 0 ? 1u : 0u;
+      p.h = static_cast<float>(h);
+      p.substep_end = static_cast<float>(double(s + 1) / solver.substeps);
+      p.write_residual = (s + 1 == solver.substeps && it + 1 == solver.iterations) ? 1u : 0u;
+      for (std::size_t k = 0; k < scene.blocks.size(); ++k) sweep(program, scene.blocks[k], buffers.blocks[k], buffers, p);
+    }
     program.dispatch(Kernel::xpbd_update_velocity, particles, {buffers.position, buffers.previous, buffers.velocity},
                      update);
     program.barrier();

@@ -10,7 +10,7 @@ namespace sinew {
 
 /// The device buffers of one constraint block.
 struct BlockBuffers {
-  BufferHandle particles, rest_alpha, lambda;
+  BufferHandle particles, data, lambda, residual;
 };
 
 /// The device buffers a compiled scene lives in.
