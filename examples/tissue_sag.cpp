@@ -109,8 +109,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s\n", s.error().message().c_str());
       return 1;
     }
-    std::printf("frame %4d  t = %.3f s  %.3f ms/frame (mean so far %.3f)  lowest point %.2f mm\n", f,
-                sim->last_frame().time, sim->last_frame().wall_ms, total_ms / f, 1e3 * tip);
+    const sinew::FrameStats& st = sim->last_frame();
+    std::printf("frame %4d  t = %.3f s  %.3f ms/frame (mean %.3f)  residual rms %.2e  volume change %+.3f%%  "
+                "kinetic energy %.2e J  lowest point %.1f mm\n",
+                f, st.time, st.wall_ms, total_ms / f, st.residual_rms, 100.0 * st.volume_change, st.kinetic_energy,
+                1e3 * tip);
   }
   if (auto s = sinew::write_pvd(opt.out + "/tissue_sag.pvd", files, times); !s) {
     std::fprintf(stderr, "%s\n", s.error().message().c_str());

@@ -169,7 +169,11 @@ TEST_P(Xpbd, ProgramHoldsOnlyTheStagesTheSceneUses) {
   const FrameProgram& prog = sim.program();
   EXPECT_EQ(prog.dispatch_count(Kernel::xpbd_solve_volume), 0u) << "a chain has no volume constraints";
   EXPECT_EQ(prog.dispatch_count(Kernel::xpbd_predict), 3u);
-  EXPECT_EQ(prog.dispatch_count(Kernel::xpbd_solve_distance), 3u * 2u * sim.info().distance_colors);
+  // substeps x iterations x colours, plus one measuring pass per frame.
+  EXPECT_EQ(prog.dispatch_count(Kernel::xpbd_solve_distance), 3u * 2u * sim.info().distance_colors + 1u);
+  scene.solver.measure_errors = false;
+  EXPECT_EQ(make(scene, GetParam()).program().dispatch_count(Kernel::xpbd_solve_distance),
+            3u * 2u * sim.info().distance_colors);
   EXPECT_EQ(sim.info().distance_colors, 2u) << "two links sharing a particle need two colours";
 
   TetBodyDesc body;
@@ -181,6 +185,47 @@ TEST_P(Xpbd, ProgramHoldsOnlyTheStagesTheSceneUses) {
   EXPECT_EQ(volume_only.program().dispatch_count(Kernel::xpbd_solve_distance), 0u);
   EXPECT_EQ(volume_only.info().distance_constraints, 0u);
   EXPECT_EQ(volume_only.info().volume_constraints, 48u);
+}
+
+TEST_P(Xpbd, FrameStatsReportTheErrors) {
+  // Kinetic energy of a falling particle is m v^2 / 2 of its velocity.
+  LineBodyDesc p;
+  p.vertices = {{0.0, 0.0, 0.0}};
+  p.masses = {2.0};
+  SceneDesc fall;
+  fall.line_bodies.push_back(p);
+  Simulation sim = make(fall, GetParam());
+  for (int f = 0; f < 10; ++f) SINEW_ASSERT_OK(sim.step());
+  std::vector<float> v;
+  SINEW_ASSERT_OK(sim.read_velocities(v));
+  EXPECT_NEAR(sim.last_frame().kinetic_energy, 0.5 * 2.0 * double(v[1]) * v[1], 1e-9);
+  EXPECT_GT(sim.last_frame().kinetic_energy, 1.0);
+
+  // The residual of a stiff block shrinks as iterations converge the solve.
+  auto residual_after = [&](int iterations) {
+    TetBodyDesc body;
+    body.mesh = test::box_mesh(3, 6, 3, 0.01);
+    EXPECT_TRUE(body.set_elastic(1e5, 0.3).ok());
+    for (std::uint32_t k = 0; k < body.mesh.vertices.size(); ++k)
+      if (body.mesh.vertices[k][1] > 0.06 - 1e-9) body.pinned.push_back(k);
+    SceneDesc scene;
+    scene.solver = {.time_step = 1.0 / 60.0, .substeps = 1, .iterations = iterations};
+    scene.tet_bodies.push_back(body);
+    Simulation s = make(scene, GetParam());
+    for (int f = 0; f < 5; ++f) EXPECT_TRUE(s.step().ok());
+    EXPECT_NE(s.last_frame().volume_change, 0.0) << "the block deforms";
+    EXPECT_LT(std::abs(s.last_frame().volume_change), 0.05);
+    return s.last_frame().residual_rms;
+  };
+  const double few = residual_after(2), many = residual_after(64);
+  EXPECT_GT(few, 0.0);
+  EXPECT_LT(many, 0.5 * few) << "64 iterations should leave less residual than 2";
+
+  // Without measurement, nothing is measured.
+  fall.solver.measure_errors = false;
+  Simulation quiet = make(fall, GetParam());
+  SINEW_ASSERT_OK(quiet.step());
+  EXPECT_EQ(quiet.last_frame().kinetic_energy, 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Xpbd, ::testing::ValuesIn(test::backends()));

@@ -32,11 +32,20 @@ struct SceneInfo {
   [[nodiscard]] std::uint32_t constraints() const { return distance_constraints + volume_constraints; }
 };
 
-/// Timing of the last frame.
+/// Timing and error of the last frame. The errors are measured when
+/// SolverSettings::measure_errors is set (the default), else left at 0.
 struct FrameStats {
   std::uint64_t frame = 0;  ///< frames done
   double time = 0.0;        ///< simulated time [s]
-  double wall_ms = 0.0;     ///< wall time of the last step() [ms], run and wait included
+  double wall_ms = 0.0;     ///< wall time of the solve in the last step() [ms], run and wait included
+  double measure_ms = 0.0;  ///< wall time spent measuring the errors below [ms]
+  /// RMS over all constraints of |C + alpha~ lambda| at the start of the
+  /// frame's last sweep, each normalised by its rest value (rest length,
+  /// rest volume, ...): 0 when the xPBD system is solved exactly.
+  double residual_rms = 0.0;
+  double max_residual = 0.0;     ///< the largest of those normalised residuals
+  double kinetic_energy = 0.0;   ///< sum of m |v|^2 / 2 over movable particles [J]
+  double volume_change = 0.0;    ///< total tet volume / rest total - 1 (0 without tet bodies)
 };
 
 class Simulation {

@@ -63,7 +63,10 @@ void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::ui
     // A zero-length edge has no direction to push along; a constraint
     // between two immovable particles (w == 0 and alpha == 0) has nothing to do.
     const float c = len - rest_alpha[i].x;
-    if (p.write_residual) residual[i] = std::abs(c + alpha_t * lambda_i) / rest_alpha[i].x;
+    if (p.measure_only) {
+      residual[i] = std::abs(c + alpha_t * lambda_i) / rest_alpha[i].x;
+      continue;
+    }
     if (len <= 0.0f || w + alpha_t <= 0.0f) {
       lambda[i] = lambda_i;
       continue;
@@ -95,7 +98,10 @@ void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint
     const float alpha_t = rest_alpha[i].y * p.inv_h2;
     const float lambda_i = p.reset_lambda ? 0.0f : lambda[i];
     const float c = tet_volume(x0, x1, x2, x3) - rest_alpha[i].x;  // rounds as the rest volume did
-    if (p.write_residual) residual[i] = std::abs(c + alpha_t * lambda_i) / rest_alpha[i].x;
+    if (p.measure_only) {
+      residual[i] = std::abs(c + alpha_t * lambda_i) / rest_alpha[i].x;
+      continue;
+    }
     if (w + alpha_t <= 0.0f) {  // fully collapsed or immovable: no direction
       lambda[i] = lambda_i;
       continue;

@@ -133,7 +133,10 @@ std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bin
     const __m256 lambda_i = load_lambda(lambda + i, p.reset_lambda);
     const __m256 valid = _mm256_and_ps(not_le_zero(len), not_le_zero(add(w, alpha_t)));
     const __m256 c = sub(len, rest);
-    if (p.write_residual) store_residual(residual + i, c, alpha_t, lambda_i, rest);
+    if (p.measure_only) {
+      store_residual(residual + i, c, alpha_t, lambda_i, rest);
+      continue;
+    }
     const __m256 dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
     const Lanes n = scale(_mm256_div_ps(one, len), d);
     const Lanes a_new = add_scaled3(a, mul(a.w, dlambda), n, valid);
@@ -175,7 +178,10 @@ std::uint32_t xpbd_solve_volume_avx2(const void* params, std::byte* const* bindi
     const __m256 lambda_i = load_lambda(lambda + i, p.reset_lambda);
     const __m256 valid = not_le_zero(add(w, alpha_t));
     const __m256 c = sub(mul(dot3(e1, c23), sixth), rest);  // tet_volume(x0, x1, x2, x3) - rest
-    if (p.write_residual) store_residual(residual + i, c, alpha_t, lambda_i, rest);
+    if (p.measure_only) {
+      store_residual(residual + i, c, alpha_t, lambda_i, rest);
+      continue;
+    }
     const __m256 dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
     _mm256_storeu_ps(lambda + i, _mm256_blendv_ps(lambda_i, add(lambda_i, dlambda), valid));
     store_particles(x, iv[0], add_scaled3(x0, mul(x0.w, dlambda), g0, valid), _mm256_movemask_ps(positive(x0.w)));

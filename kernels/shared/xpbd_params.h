@@ -48,9 +48,10 @@ SINEW_STRUCT_END(UpdateVelocityParams)
  *   2 constraint data, `data_stride` floats per constraint [in]
  *   3 lambda, `lambda_stride` floats per constraint [in/out] (reset to 0
  *     when reset_lambda != 0)
- *   4 residual, one float per constraint [out] (written only when
- *     write_residual != 0: |C + alpha~ lambda| before the constraint's
- *     update, normalised by its rest value; see each kernel)
+ *   4 residual, one float per constraint [out], written only in a measuring
+ *     pass (measure_only != 0): |C + alpha~ lambda| normalised by the
+ *     constraint's rest value (see each kernel). A measuring pass changes
+ *     nothing else, so it may run over a whole block in one dispatch.
  *
  * xpbd_solve_distance: arity 2, data (rest [m], alpha [m/N]).
  *   C = |x_a - x_b| - rest; residual / rest.
@@ -64,7 +65,7 @@ SINEW_STRUCT_BEGIN(SolveParams)
   uint reset_lambda;    /* nonzero in the first iteration of a substep */
   float h;              /* substep length [s] */
   float substep_end;    /* fraction of the frame done at the end of this substep, in (0, 1] */
-  uint write_residual;  /* nonzero in the last iteration of the last substep */
+  uint measure_only;    /* nonzero: write the residual only, after the frame's last sweep */
   uint pad0;
 SINEW_STRUCT_END(SolveParams)
 

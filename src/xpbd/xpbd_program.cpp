@@ -9,6 +9,7 @@
 // constraints share no movable particle); each colour ends with a barrier.
 #include "xpbd/xpbd_program.h"
 
+#include <span>
 #include <string>
 #include <tuple>
 
@@ -27,10 +28,11 @@ Result<BufferHandle> make_buffer(Device& device, const std::vector<T>& data, std
   return buffer;
 }
 
-// One Gauss-Seidel sweep over a block: a dispatch per colour, each followed
-// by a barrier since the next colour reads what this one wrote.
-void sweep(FrameProgram& program, const ConstraintBlock& block, const BlockBuffers& buffers,
-           const XpbdBuffers& scene_buffers, kernels::SolveParams p) {
+// One Gauss-Seidel sweep over a block: a dispatch per range of
+// `offsets` (the colours), each followed by a barrier since the next colour
+// reads what this one wrote.
+void sweep(FrameProgram& program, const ConstraintBlock& block, std::span<const std::uint32_t> offsets,
+           const BlockBuffers& buffers, const XpbdBuffers& scene_buffers, kernels::SolveParams p) {
   std::vector<BufferHandle> bindings{scene_buffers.position, buffers.particles, buffers.data, buffers.lambda,
                                      buffers.residual};
   for (SceneBuffer extra : block.extra_bindings) {
@@ -38,9 +40,9 @@ void sweep(FrameProgram& program, const ConstraintBlock& block, const BlockBuffe
       case SceneBuffer::previous_position: bindings.push_back(scene_buffers.previous); break;
     }
   }
-  for (std::uint32_t c = 0; c < block.colors(); ++c) {
-    p.first = block.color_offsets[c];
-    p.count = block.color_offsets[c + 1] - block.color_offsets[c];
+  for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
+    p.first = offsets[c];
+    p.count = offsets[c + 1] - offsets[c];
     program.dispatch(block.kernel, p.count, bindings, p);
     program.barrier();
   }
@@ -76,6 +78,7 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
 
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
                                 const std::array<double, 3>& gravity) {
+  const bool measure_errors = solver.measure_errors;
   const double h = solver.time_step / solver.substeps;
   const auto particles = static_cast<std::uint32_t>(scene.positions.size());
   const auto inv_h2 = static_cast<float>(1.0 / (h * h));
@@ -100,8 +103,20 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
       p.reset_lambda = it == 0 ? 1u : 0u;
       p.h = static_cast<float>(h);
       p.substep_end = static_cast<float>(double(s + 1) / solver.substeps);
-      p.write_residual = (s + 1 == solver.substeps && it + 1 == solver.iterations) ? 1u : 0u;
-      for (std::size_t k = 0; k < scene.blocks.size(); ++k) sweep(program, scene.blocks[k], buffers.blocks[k], buffers, p);
+      for (std::size_t k = 0; k < scene.blocks.size(); ++k)
+        sweep(program, scene.blocks[k], scene.blocks[k].color_offsets, buffers.blocks[k], buffers, p);
+    }
+    if (measure_errors && s + 1 == solver.substeps) {
+      // Residuals of the final state: read-only, one dispatch per block.
+      kernels::SolveParams p{};
+      p.inv_h2 = inv_h2;
+      p.h = static_cast<float>(h);
+      p.substep_end = 1.0f;
+      p.measure_only = 1;
+      for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
+        const std::uint32_t whole[2] = {0, scene.blocks[k].size()};
+        sweep(program, scene.blocks[k], whole, buffers.blocks[k], buffers, p);
+      }
     }
     program.dispatch(Kernel::xpbd_update_velocity, particles, {buffers.position, buffers.previous, buffers.velocity},
                      update);
