@@ -1,0 +1,115 @@
+// check_tet_mesh and scale_mesh.
+//
+// The checks run in double precision. The volume tolerance is relative to
+// the mesh size (1e-12 of the cube of the bounding-box diagonal), so the
+// verdict does not change when a mesh is rescaled, e.g. from mm to m.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "sinew/mesh.h"
+
+namespace sinew {
+namespace {
+
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+std::string tet_text(std::size_t t, const std::array<std::uint32_t, 4>& tet) {
+  return "tet " + std::to_string(t) + " (vertices " + std::to_string(tet[0]) + " " + std::to_string(tet[1]) +
+         " " + std::to_string(tet[2]) + " " + std::to_string(tet[3]) + ")";
+}
+
+// Six times the signed volume: dot(b - a, cross(c - a, d - a)).
+double orientation(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
+  const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+  const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+  const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+  return ux * (vy * wz - vz * wy) + uy * (vz * wx - vx * wz) + uz * (vx * wy - vy * wx);
+}
+
+Status check_vertices(const TetMesh& mesh, const std::string& origin) {
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Vec3d& p = mesh.vertices[v];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      return Error(origin + ": vertex " + std::to_string(v) + " has a non-finite coordinate (" +
+                   short_number(p[0]) + ", " + short_number(p[1]) + ", " + short_number(p[2]) + ")");
+    }
+  }
+  return {};
+}
+
+Status check_indices(const TetMesh& mesh, const std::string& origin) {
+  const std::size_t n = mesh.vertices.size();
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    const auto& tet = mesh.tets[t];
+    for (std::uint32_t v : tet) {
+      if (v >= n) {
+        return Error(origin + ": " + tet_text(t, tet) + " refers to vertex " + std::to_string(v) +
+                     ", but the mesh has only " + std::to_string(n) + " vertices");
+      }
+    }
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        if (tet[static_cast<std::size_t>(i)] == tet[static_cast<std::size_t>(j)]) {
+          return Error(origin + ": " + tet_text(t, tet) + " repeats vertex " +
+                       std::to_string(tet[static_cast<std::size_t>(i)]));
+        }
+      }
+    }
+  }
+  return {};
+}
+
+double bbox_diagonal(const std::vector<Vec3d>& vertices) {
+  Vec3d lo = vertices.front(), hi = vertices.front();
+  for (const Vec3d& p : vertices) {
+    for (std::size_t a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a]);
+    }
+  }
+  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
+
+// [pre] vertices finite, indices valid.
+Status check_volumes(const TetMesh& mesh, const std::string& origin) {
+  const double diagonal = bbox_diagonal(mesh.vertices);
+  const double min_volume = 1e-12 * diagonal * diagonal * diagonal;
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    const auto& tet = mesh.tets[t];
+    const double volume = orientation(mesh.vertices[tet[0]], mesh.vertices[tet[1]], mesh.vertices[tet[2]],
+                                      mesh.vertices[tet[3]]) /
+                          6.0;
+    if (volume > min_volume) continue;
+    // A sliver that is inverted by less than the tolerance is reported as
+    // zero-volume: its sign is not meaningful at that size.
+    const char* what = volume < -min_volume ? " is inverted" : " has zero volume";
+    return Error(origin + ": " + tet_text(t, tet) + what + " (signed volume " + short_number(volume) +
+                 ", minimum " + short_number(min_volume) + ")");
+  }
+  return {};
+}
+
+}  // namespace
+
+Status check_tet_mesh(const TetMesh& mesh, const std::string& origin) {
+  if (mesh.tets.empty()) return Error(origin + ": mesh has no tets");
+  if (Status s = check_vertices(mesh, origin); !s) return s;
+  if (Status s = check_indices(mesh, origin); !s) return s;
+  return check_volumes(mesh, origin);
+}
+
+void scale_mesh(TetMesh& mesh, double factor) {
+  for (Vec3d& p : mesh.vertices) {
+    for (double& x : p) x *= factor;
+  }
+}
+
+}  // namespace sinew
