@@ -14,6 +14,25 @@
 
 namespace sinew {
 
+/// FEM materials for tet bodies, each solved as two xPBD constraints per
+/// tet on the deformation gradient F (a deviatoric and a hydrostatic one),
+/// from Young's modulus E and Poisson's ratio nu (Lame mu, lambda):
+///  - neo_hookean: stable Neo-Hookean (Macklin & Müller, "A Constraint-based
+///    Formulation of Stable Neo-Hookean Materials", MIG 2021):
+///    C_D = |F|_F, alpha = 1/(mu V); C_H = det F - gamma, alpha = 1/(lambda' V),
+///    gamma = 1 + mu/lambda', lambda' = lambda + mu (so small-strain E, nu hold).
+///  - stvk: St. Venant-Kirchhoff, energy mu |E|^2 + lambda/2 (tr E)^2 with the
+///    Green strain E: C_D = |E|_F, alpha = 1/(2 mu V); the hydrostatic term
+///    uses det F - 1 (equal to tr E to first order), alpha = 1/(lambda V),
+///    because pure StVK has zero energy for a tet turned inside out and so
+///    could not recover inverted elements.
+///  - corotational: corotational linear, energy mu |F - R|^2 +
+///    lambda/2 tr(R^T F - I)^2 with R the rotation of F's polar decomposition
+///    (det R = +1, so inverted tets are pushed back): C_D = |F - R|_F,
+///    alpha = 1/(2 mu V); C_H = tr(R^T F) - 3, alpha = 1/(lambda V).
+/// Every model is invertible: its hydrostatic constraint pushes det F > 0.
+enum class TetMaterial { none, neo_hookean, stvk, corotational };
+
 /// A volumetric body simulated on a tet mesh with xPBD constraints.
 ///
 /// Distance constraints (one per mesh edge) resist stretch; volume
@@ -34,21 +53,117 @@ struct TetBodyDesc {
   bool volume_constraints = true;       ///< one volume constraint per tet
   double volume_compliance = 1e-6;      ///< c_v [1/Pa], >= 0 (1/K, the bulk compliance)
   std::vector<std::uint32_t> pinned;    ///< vertices held fixed (inverse mass 0)
+  TetMaterial material = TetMaterial::none;  ///< FEM constraints per tet (with E and nu below)
+  double youngs_modulus = 0.0;          ///< E [Pa], > 0 when material != none
+  double poisson_ratio = 0.0;           ///< nu, in (-1, 0.5) when material != none
 
   /// Sets both compliances from Young's modulus E [Pa] (> 0) and Poisson's
   /// ratio nu (in (-1, 0.5)): c_d = 1/E, c_v = 3 (1 - 2 nu) / E. This is
   /// the usual approximation of a linear material by an edge network plus
   /// volume constraints, not an FEM material. Errors name the parameter.
-  Status set_elastic(double youngs_modulus, double poisson_ratio);
+  Status set_elastic(double young, double poisson);
+
+  /// Makes this an FEM body: sets material, E [Pa] and nu, and turns the
+  /// distance and volume constraints off. Errors name the parameter.
+  Status set_material(TetMaterial model, double young, double poisson);
 };
 
-/// Particles joined by distance constraints (a chain, a simple thread).
+/// Particles joined by distance constraints: a chain, or a suture thread.
+///
+/// Bending (when bending_compliance >= 0): every vertex joined to exactly two
+/// segments gets a bending constraint on the triangle it forms with its two
+/// neighbours (Kelager, Niebe, Erleben, "A Triangle Bending Constraint Model
+/// for Position-Based Dynamics", VRIPHYS 2010): C = |x_mid - centroid| - h0,
+/// with h0 its rest value, alpha = bending_compliance [m/N].
 struct LineBodyDesc {
   std::vector<Vec3d> vertices;                          ///< rest positions [m]
   std::vector<double> masses;                           ///< per vertex [kg], > 0
   std::vector<std::array<std::uint32_t, 2>> segments;   ///< vertex pairs, rest length > 0
   double compliance = 0.0;                              ///< per segment [m/N], >= 0
+  double bending_compliance = -1.0;                     ///< [m/N], >= 0; < 0: no bending constraints
   std::vector<std::uint32_t> pinned;                    ///< vertices held fixed
+};
+
+/// A thin body on a triangle mesh: a membrane, a vessel wall, a ligament.
+/// Mass: density * thickness * area, lumped a third to each vertex.
+///  - distance constraints on the edges: alpha_e = c_d * L^2 / (A_e * t)
+///    [m/N], A_e the edge's share of its triangles' areas (A/3 each), t the
+///    thickness: the membrane analogue of TetBodyDesc's edges;
+///  - area constraints: C = A - A0 [m^2], alpha = c_a / (A0 t) [m^2/N... per
+///    the energy (K/2) (dA/A0)^2 A0 t with K = 1/c_a];
+///  - dihedral bending on every interior edge (two triangles): C = angle -
+///    rest angle [rad], alpha = bending_compliance [1/(N m)]
+///    (Müller et al., "Position Based Dynamics", 2007, section 4.2).
+struct TriBodyDesc {
+  TriMesh mesh;                           ///< rest shape [m]
+  double thickness = 1e-3;                ///< [m], > 0
+  double density = 1000.0;                ///< [kg/m^3], > 0
+  bool distance_constraints = true;
+  double distance_compliance = 1e-5;      ///< c_d [1/Pa], >= 0
+  bool area_constraints = true;
+  double area_compliance = 1e-5;          ///< c_a [1/Pa], >= 0
+  double bending_compliance = -1.0;       ///< [1/(N m)], >= 0; < 0: no bending constraints
+  std::vector<std::uint32_t> pinned;      ///< vertices held fixed
+};
+
+/// Analytic collider shapes. Pose: `position` [m] and unit quaternion
+/// `rotation` (w, x, y, z). In the collider's frame: a plane is y = 0 with
+/// solid below (normal +y); a sphere has `radius`; a capsule is the segment
+/// from (0, -half_height, 0) to (0, +half_height, 0) swollen by `radius`; a
+/// box has `half_extents`.
+enum class ColliderShape { plane, sphere, capsule, box };
+
+/// A static or kinematic collider that every body's particles collide with,
+/// as xPBD contact constraints C = signed distance >= 0 with `compliance`
+/// [m/N] and Coulomb friction (static and dynamic coefficients). Move it
+/// between frames with Simulation::set_collider_pose; it is interpolated
+/// across the frame's substeps.
+struct ColliderDesc {
+  ColliderShape shape = ColliderShape::plane;
+  std::array<double, 3> position{0.0, 0.0, 0.0};       ///< [m]
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
+  double radius = 0.0;                                  ///< sphere, capsule [m], > 0
+  double half_height = 0.0;                             ///< capsule [m], >= 0
+  std::array<double, 3> half_extents{0.0, 0.0, 0.0};    ///< box [m], > 0
+  double static_friction = 0.5;                         ///< >= 0
+  double dynamic_friction = 0.4;                        ///< >= 0, <= static_friction
+  double compliance = 0.0;                              ///< [m/N], >= 0
+};
+
+/// Which body a vertex belongs to.
+enum class BodyKind { tet, tri, line };
+struct VertexRef {
+  BodyKind body_kind = BodyKind::tet;
+  std::uint32_t body = 0;    ///< index into the scene's bodies of that kind
+  std::uint32_t vertex = 0;  ///< vertex of that body
+};
+
+/// A vertex attached to a kinematic target (a grasper jaw) by a zero-length
+/// xPBD distance constraint of `compliance` [m/N]. Targets are scene-wide
+/// points moved between frames with Simulation::set_target and interpolated
+/// across the substeps; several attachments may share one target.
+struct AttachmentDesc {
+  VertexRef vertex;
+  std::uint32_t target = 0;   ///< index into SceneDesc::targets
+  double compliance = 0.0;    ///< [m/N], >= 0
+};
+
+/// A rigid tool: a capsule (in its frame, the segment +-half_height along y
+/// swollen by radius) with mass and inertia, driven by a force and torque
+/// (Simulation::apply_tool_force) and pushed back by the tissue it touches.
+/// Its contacts with particles are solved like a collider's; the reaction of
+/// the tissue acts on the tool at the end of each frame.
+struct ToolDesc {
+  double radius = 0.005;                                ///< [m], > 0
+  double half_height = 0.05;                            ///< [m], >= 0
+  double mass = 0.1;                                    ///< [kg], > 0
+  std::array<double, 3> inertia{1e-4, 1e-5, 1e-4};      ///< principal moments in the tool frame [kg m^2], > 0
+  std::array<double, 3> position{0.0, 0.0, 0.0};       ///< initial [m]
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< initial unit quaternion (w, x, y, z)
+  bool gravity = true;                                  ///< whether gravity acts on the tool
+  double static_friction = 0.3;
+  double dynamic_friction = 0.2;
+  double compliance = 0.0;                              ///< of its contacts [m/N]
 };
 
 /// How each frame is solved: a frame of length time_step is split into
@@ -69,7 +184,12 @@ struct SceneDesc {
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
   SolverSettings solver;
   std::vector<TetBodyDesc> tet_bodies;
+  std::vector<TriBodyDesc> tri_bodies;
   std::vector<LineBodyDesc> line_bodies;
+  std::vector<ColliderDesc> colliders;
+  std::vector<std::array<double, 3>> targets;       ///< initial kinematic target positions [m]
+  std::vector<AttachmentDesc> attachments;
+  std::vector<ToolDesc> tools;
 };
 
 /// Checks every parameter of a scene; the first problem found is returned,

@@ -13,7 +13,7 @@
 namespace sinew::kernels {
 
 template <class T>
-struct alignas(4 * sizeof(T)) vec4 {
+struct alignas(16) vec4 {
   T x, y, z, w;
 };
 using float4 = vec4<float>;

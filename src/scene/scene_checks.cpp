@@ -1,5 +1,6 @@
 // scene_checks.cpp — parameter checks for SceneDesc. Every message names the
 // parameter path and the offending value so a user can fix the scene.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -25,6 +26,13 @@ Status non_negative(const std::string& name, double v) {
   return {};
 }
 
+Status check_elastic(const std::string& prefix, double young, double poisson) {
+  if (Status s = positive(prefix + "youngs_modulus", young); !s) return s;
+  if (!std::isfinite(poisson) || poisson <= -1.0 || poisson >= 0.5)
+    return Error(prefix + "poisson_ratio must be in (-1, 0.5) (got " + str(poisson) + ")");
+  return {};
+}
+
 Status check_pinned(const std::string& body, const std::vector<std::uint32_t>& pinned, std::size_t vertex_count) {
   for (std::size_t i = 0; i < pinned.size(); ++i)
     if (pinned[i] >= vertex_count)
@@ -38,6 +46,8 @@ Status check_tet_body(const TetBodyDesc& b, const std::string& name) {
   if (Status s = positive(name + ".density", b.density); !s) return s;
   if (Status s = non_negative(name + ".distance_compliance", b.distance_compliance); !s) return s;
   if (Status s = non_negative(name + ".volume_compliance", b.volume_compliance); !s) return s;
+  if (b.material != TetMaterial::none)
+    if (Status s = check_elastic(name + ".", b.youngs_modulus, b.poisson_ratio); !s) return s;
   return check_pinned(name, b.pinned, b.mesh.vertices.size());
 }
 
@@ -64,34 +74,156 @@ Status check_line_body(const LineBodyDesc& b, const std::string& name) {
     if (!(len > 0.0)) return Error(seg + " has zero rest length");
   }
   if (Status s = non_negative(name + ".compliance", b.compliance); !s) return s;
+  if (std::isnan(b.bending_compliance)) return Error(name + ".bending_compliance is NaN");
   return check_pinned(name, b.pinned, n);
+}
+
+Status finite3(const std::string& name, const std::array<double, 3>& v) {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(v[k])) return Error(name + "[" + std::to_string(k) + "] must be finite (got " + str(v[k]) + ")");
+  return {};
+}
+
+Status unit_quaternion(const std::string& name, const std::array<double, 4>& q) {
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-6)
+    return Error(name + " must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
+  return {};
+}
+
+Status check_friction(const std::string& name, double mu_s, double mu_k) {
+  if (Status s = non_negative(name + ".static_friction", mu_s); !s) return s;
+  if (Status s = non_negative(name + ".dynamic_friction", mu_k); !s) return s;
+  if (mu_k > mu_s)
+    return Error(name + ".dynamic_friction (" + str(mu_k) + ") must not exceed static_friction (" + str(mu_s) + ")");
+  return {};
+}
+
+Status check_tri_body(const TriBodyDesc& b, const std::string& name) {
+  const std::size_t n = b.mesh.vertices.size();
+  if (b.mesh.triangles.empty()) return Error(name + ".mesh has no triangles");
+  for (std::size_t i = 0; i < n; ++i)
+    if (Status s = finite3(name + ".mesh.vertices[" + std::to_string(i) + "]", b.mesh.vertices[i]); !s) return s;
+  for (std::size_t t = 0; t < b.mesh.triangles.size(); ++t) {
+    const auto& tri = b.mesh.triangles[t];
+    const std::string where = name + ".mesh.triangles[" + std::to_string(t) + "]";
+    for (std::uint32_t v : tri)
+      if (v >= n) return Error(where + " refers to vertex " + std::to_string(v) + " of " + std::to_string(n));
+    const Vec3d& p = b.mesh.vertices[tri[0]];
+    const Vec3d& q = b.mesh.vertices[tri[1]];
+    const Vec3d& r = b.mesh.vertices[tri[2]];
+    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+    const double area = 0.5 * std::hypot(u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]);
+    const double scale = std::max({std::hypot(u[0], u[1], u[2]), std::hypot(w[0], w[1], w[2])});
+    if (!(area > 1e-12 * scale * scale)) return Error(where + " has zero area (degenerate triangle)");
+  }
+  if (Status s = positive(name + ".thickness", b.thickness); !s) return s;
+  if (Status s = positive(name + ".density", b.density); !s) return s;
+  if (Status s = non_negative(name + ".distance_compliance", b.distance_compliance); !s) return s;
+  if (Status s = non_negative(name + ".area_compliance", b.area_compliance); !s) return s;
+  if (std::isnan(b.bending_compliance)) return Error(name + ".bending_compliance is NaN");
+  return check_pinned(name, b.pinned, n);
+}
+
+Status check_collider(const ColliderDesc& c, const std::string& name) {
+  if (Status s = finite3(name + ".position", c.position); !s) return s;
+  if (Status s = unit_quaternion(name + ".rotation", c.rotation); !s) return s;
+  switch (c.shape) {
+    case ColliderShape::plane: break;
+    case ColliderShape::sphere:
+      if (Status s = positive(name + ".radius", c.radius); !s) return s;
+      break;
+    case ColliderShape::capsule:
+      if (Status s = positive(name + ".radius", c.radius); !s) return s;
+      if (Status s = non_negative(name + ".half_height", c.half_height); !s) return s;
+      break;
+    case ColliderShape::box:
+      for (int k = 0; k < 3; ++k)
+        if (Status s = positive(name + ".half_extents[" + std::to_string(k) + "]", c.half_extents[k]); !s) return s;
+      break;
+  }
+  if (Status s = check_friction(name, c.static_friction, c.dynamic_friction); !s) return s;
+  return non_negative(name + ".compliance", c.compliance);
+}
+
+Status check_tool(const ToolDesc& t, const std::string& name) {
+  if (Status s = positive(name + ".radius", t.radius); !s) return s;
+  if (Status s = non_negative(name + ".half_height", t.half_height); !s) return s;
+  if (Status s = positive(name + ".mass", t.mass); !s) return s;
+  for (int k = 0; k < 3; ++k)
+    if (Status s = positive(name + ".inertia[" + std::to_string(k) + "]", t.inertia[k]); !s) return s;
+  if (Status s = finite3(name + ".position", t.position); !s) return s;
+  if (Status s = unit_quaternion(name + ".rotation", t.rotation); !s) return s;
+  if (Status s = check_friction(name, t.static_friction, t.dynamic_friction); !s) return s;
+  return non_negative(name + ".compliance", t.compliance);
+}
+
+std::size_t vertex_count(const SceneDesc& scene, const VertexRef& ref) {
+  switch (ref.body_kind) {
+    case BodyKind::tet: return ref.body < scene.tet_bodies.size() ? scene.tet_bodies[ref.body].mesh.vertices.size() : 0;
+    case BodyKind::tri: return ref.body < scene.tri_bodies.size() ? scene.tri_bodies[ref.body].mesh.vertices.size() : 0;
+    case BodyKind::line: return ref.body < scene.line_bodies.size() ? scene.line_bodies[ref.body].vertices.size() : 0;
+  }
+  return 0;
+}
+
+Status check_attachment(const SceneDesc& scene, const AttachmentDesc& a, const std::string& name) {
+  const std::size_t n = vertex_count(scene, a.vertex);
+  if (n == 0) return Error(name + ".vertex refers to body " + std::to_string(a.vertex.body) + ", which does not exist");
+  if (a.vertex.vertex >= n)
+    return Error(name + ".vertex.vertex = " + std::to_string(a.vertex.vertex) + " is not a vertex (the body has " +
+                 std::to_string(n) + ")");
+  if (a.target >= scene.targets.size())
+    return Error(name + ".target = " + std::to_string(a.target) + " is not a target (the scene has " +
+                 std::to_string(scene.targets.size()) + ")");
+  return non_negative(name + ".compliance", a.compliance);
+}
+
+template <class T, class Check>
+Status check_all(const std::vector<T>& items, const std::string& name, Check&& check) {
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (Status s = check(items[i], name + "[" + std::to_string(i) + "]"); !s) return s;
+  return {};
 }
 
 }  // namespace
 
-Status TetBodyDesc::set_elastic(double youngs_modulus, double poisson_ratio) {
-  if (Status s = positive("youngs_modulus", youngs_modulus); !s) return s;
-  if (!std::isfinite(poisson_ratio) || poisson_ratio <= -1.0 || poisson_ratio >= 0.5)
-    return Error("poisson_ratio must be in (-1, 0.5) (got " + str(poisson_ratio) + ")");
-  distance_compliance = 1.0 / youngs_modulus;
-  volume_compliance = 3.0 * (1.0 - 2.0 * poisson_ratio) / youngs_modulus;
+Status TetBodyDesc::set_elastic(double young, double poisson) {
+  if (Status s = check_elastic("", young, poisson); !s) return s;
+  distance_compliance = 1.0 / young;
+  volume_compliance = 3.0 * (1.0 - 2.0 * poisson) / young;
+  return {};
+}
+
+Status TetBodyDesc::set_material(TetMaterial model, double young, double poisson) {
+  if (Status s = check_elastic("", young, poisson); !s) return s;
+  material = model;
+  youngs_modulus = young;
+  poisson_ratio = poisson;
+  distance_constraints = false;
+  volume_constraints = false;
   return {};
 }
 
 Status check_scene(const SceneDesc& scene) {
-  for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(scene.gravity[k]))
-      return Error("gravity[" + std::to_string(k) + "] must be finite (got " + str(scene.gravity[k]) + ")");
+  if (Status s = finite3("gravity", scene.gravity); !s) return s;
   if (Status s = positive("solver.time_step", scene.solver.time_step); !s) return s;
   if (scene.solver.substeps < 1)
     return Error("solver.substeps must be >= 1 (got " + std::to_string(scene.solver.substeps) + ")");
   if (scene.solver.iterations < 1)
     return Error("solver.iterations must be >= 1 (got " + std::to_string(scene.solver.iterations) + ")");
-  if (scene.tet_bodies.empty() && scene.line_bodies.empty()) return Error("the scene has no bodies");
-  for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i)
-    if (Status s = check_tet_body(scene.tet_bodies[i], "tet_bodies[" + std::to_string(i) + "]"); !s) return s;
-  for (std::size_t i = 0; i < scene.line_bodies.size(); ++i)
-    if (Status s = check_line_body(scene.line_bodies[i], "line_bodies[" + std::to_string(i) + "]"); !s) return s;
+  if (scene.tet_bodies.empty() && scene.tri_bodies.empty() && scene.line_bodies.empty() && scene.tools.empty())
+    return Error("the scene has no bodies");
+  if (Status s = check_all(scene.tet_bodies, "tet_bodies", check_tet_body); !s) return s;
+  if (Status s = check_all(scene.tri_bodies, "tri_bodies", check_tri_body); !s) return s;
+  if (Status s = check_all(scene.line_bodies, "line_bodies", check_line_body); !s) return s;
+  if (Status s = check_all(scene.colliders, "colliders", check_collider); !s) return s;
+  if (Status s = check_all(scene.tools, "tools", check_tool); !s) return s;
+  for (std::size_t i = 0; i < scene.targets.size(); ++i)
+    if (Status s = finite3("targets[" + std::to_string(i) + "]", scene.targets[i]); !s) return s;
+  for (std::size_t i = 0; i < scene.attachments.size(); ++i)
+    if (Status s = check_attachment(scene, scene.attachments[i], "attachments[" + std::to_string(i) + "]"); !s)
+      return s;
   return {};
 }
 

@@ -134,6 +134,17 @@ ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::u
 
 Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   if (Status s = check_scene(scene); !s) return s.error();
+  // Parts of the scene API whose solver stages have not landed yet are
+  // refused rather than silently ignored.
+  auto not_yet = [](const char* what) { return Error(std::string(what) + " are not supported yet by this version of sinew"); };
+  if (!scene.tri_bodies.empty()) return not_yet("tri_bodies");
+  if (!scene.colliders.empty()) return not_yet("colliders");
+  if (!scene.attachments.empty()) return not_yet("attachments");
+  if (!scene.tools.empty()) return not_yet("tools");
+  for (const auto& body : scene.tet_bodies)
+    if (body.material != TetMaterial::none) return not_yet("FEM materials (TetBodyDesc::material)");
+  for (const auto& body : scene.line_bodies)
+    if (body.bending_compliance >= 0.0) return not_yet("line bending constraints");
   std::size_t total = 0;
   for (const auto& body : scene.tet_bodies) total += body.mesh.vertices.size();
   for (const auto& body : scene.line_bodies) total += body.vertices.size();
