@@ -17,6 +17,14 @@ constexpr KernelSignature kSignatures[] = {
     {"xpbd_update_velocity", 3, sizeof(UpdateVelocityParams)},
     {"xpbd_solve_distance", 5, sizeof(SolveParams)},
     {"xpbd_solve_volume", 5, sizeof(SolveParams)},
+    {"xpbd_solve_neo_hookean", 5, sizeof(SolveParams)},
+    {"xpbd_solve_stvk", 5, sizeof(SolveParams)},
+    {"xpbd_solve_corotational", 5, sizeof(SolveParams)},
+    {"xpbd_solve_area", 5, sizeof(SolveParams)},
+    {"xpbd_solve_dihedral", 5, sizeof(SolveParams)},
+    {"xpbd_solve_line_bending", 5, sizeof(SolveParams)},
+    {"xpbd_solve_attachment", 6, sizeof(SolveParams)},  // + targets
+    {"xpbd_solve_contacts", 8, sizeof(SolveParams)},    // + previous position, colliders, contact impulses
 };
 static_assert(std::size(kSignatures) == static_cast<std::size_t>(Kernel::count_),
               "every Kernel needs a signature");

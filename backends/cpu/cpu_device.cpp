@@ -16,6 +16,9 @@
 #include <thread>
 
 #include "backends/kernel_table.h"
+#include "cpu/contact_kernels.h"
+#include "cpu/fem_kernels.h"
+#include "cpu/thin_kernels.h"
 #include "cpu/xpbd_kernels.h"
 
 namespace sinew {
@@ -37,6 +40,14 @@ kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
     case Kernel::xpbd_update_velocity: return kernels::xpbd_update_velocity;
     case Kernel::xpbd_solve_distance: return kernels::xpbd_solve_distance;
     case Kernel::xpbd_solve_volume: return kernels::xpbd_solve_volume;
+    case Kernel::xpbd_solve_neo_hookean: return kernels::xpbd_solve_neo_hookean;
+    case Kernel::xpbd_solve_stvk: return kernels::xpbd_solve_stvk;
+    case Kernel::xpbd_solve_corotational: return kernels::xpbd_solve_corotational;
+    case Kernel::xpbd_solve_area: return kernels::xpbd_solve_area;
+    case Kernel::xpbd_solve_dihedral: return kernels::xpbd_solve_dihedral;
+    case Kernel::xpbd_solve_line_bending: return kernels::xpbd_solve_line_bending;
+    case Kernel::xpbd_solve_attachment: return kernels::xpbd_solve_attachment;
+    case Kernel::xpbd_solve_contacts: return kernels::xpbd_solve_contacts;
     case Kernel::count_: break;
   }
   return nullptr;

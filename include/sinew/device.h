@@ -28,12 +28,21 @@
 namespace sinew {
 
 /// The kernels every backend implements, by name (kernel_name). Their
-/// parameters and buffer bindings are declared once in kernels/shared.
+/// parameters and buffer bindings are declared once in kernels/shared. The
+/// solve kernels run in this order within an iteration (contacts last).
 enum class Kernel : std::uint32_t {
   xpbd_predict,
   xpbd_update_velocity,
   xpbd_solve_distance,
   xpbd_solve_volume,
+  xpbd_solve_neo_hookean,
+  xpbd_solve_stvk,
+  xpbd_solve_corotational,
+  xpbd_solve_area,
+  xpbd_solve_dihedral,
+  xpbd_solve_line_bending,
+  xpbd_solve_attachment,
+  xpbd_solve_contacts,
   count_  ///< number of kernels, not a kernel
 };
 

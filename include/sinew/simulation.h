@@ -7,6 +7,8 @@
 //   std::vector<float> x; sim->read_positions(x);
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -65,6 +67,27 @@ class Simulation {
   Status read_positions(std::vector<float>& xyzw) const;
   /// [out] xyz0 per particle: velocity [m/s], w unused.
   Status read_velocities(std::vector<float>& xyzw) const;
+
+  /// Moves collider `index` to this pose [m, unit quaternion (w, x, y, z)]
+  /// by the end of the next frame; its substeps interpolate the motion.
+  Status set_collider_pose(std::size_t index, const std::array<double, 3>& position,
+                           const std::array<double, 4>& rotation);
+  /// Moves kinematic target `index` to `position` [m] by the end of the next frame.
+  Status set_target(std::size_t index, const std::array<double, 3>& position);
+  /// Force [N] and torque [N m] (world frame, about the tool's centre)
+  /// acting on tool `index` during the next frame (then reset to zero).
+  Status apply_tool_force(std::size_t index, const std::array<double, 3>& force, const std::array<double, 3>& torque);
+
+  /// A tool's state at the end of the last frame.
+  struct ToolState {
+    std::array<double, 3> position{};          ///< [m]
+    std::array<double, 4> rotation{1, 0, 0, 0};  ///< unit quaternion (w, x, y, z)
+    std::array<double, 3> velocity{};          ///< [m/s]
+    std::array<double, 3> angular_velocity{};  ///< world frame [rad/s]
+    std::array<double, 3> contact_force{};     ///< what the tissue pushed the tool with, frame average [N]
+    std::array<double, 3> contact_torque{};    ///< about the tool's centre [N m]
+  };
+  Result<ToolState> tool_state(std::size_t index) const;
 
   [[nodiscard]] const SceneInfo& info() const;
   [[nodiscard]] const FrameStats& last_frame() const;

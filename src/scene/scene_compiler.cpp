@@ -5,6 +5,7 @@
 #include "scene/scene_compiler.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -16,22 +17,9 @@ namespace {
 
 using kernels::float4;
 
-struct Builder {
-  std::vector<float4> positions;
-  std::vector<double> mass;
-  RawConstraints distance{Kernel::xpbd_solve_distance, 2};
-  RawConstraints volume{Kernel::xpbd_solve_volume, 4};
+}  // namespace
 
-  std::uint32_t add_vertices(const std::vector<Vec3d>& vertices) {
-    const auto first = static_cast<std::uint32_t>(positions.size());
-    for (const Vec3d& v : vertices)
-      positions.push_back({static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]), 0.0f});
-    mass.resize(positions.size(), 0.0);
-    return first;
-  }
-};
-
-Status add_tet_body(Builder& b, const TetBodyDesc& body, const std::string& name) {
+Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string& name) {
   const std::uint32_t first = b.add_vertices(body.mesh.vertices);
   const auto& tets = body.mesh.tets;
 
@@ -49,10 +37,11 @@ Status add_tet_body(Builder& b, const TetBodyDesc& body, const std::string& name
   }
 
   if (body.volume_constraints) {
+    RawConstraints& volume = b.constraints(Kernel::xpbd_solve_volume, 4);
     for (std::size_t t = 0; t < tets.size(); ++t) {
-      for (std::uint32_t k : tets[t]) b.volume.particles.push_back(first + k);
-      b.volume.data.push_back(rest_volume[t]);
-      b.volume.data.push_back(static_cast<float>(body.volume_compliance * rest_volume[t]));
+      for (std::uint32_t k : tets[t]) volume.particles.push_back(first + k);
+      volume.data.push_back(rest_volume[t]);
+      volume.data.push_back(static_cast<float>(body.volume_compliance * rest_volume[t]));
     }
   }
 
@@ -74,35 +63,59 @@ Status add_tet_body(Builder& b, const TetBodyDesc& body, const std::string& name
       each_edge(tets[t], [&](Edge e) {
         share[std::lower_bound(edges.begin(), edges.end(), e) - edges.begin()] += rest_volume[t] / 6.0;
       });
+    RawConstraints& distance = b.constraints(Kernel::xpbd_solve_distance, 2);
     for (std::size_t i = 0; i < edges.size(); ++i) {
       const float len = kernels::edge_length(b.positions[first + edges[i].first], b.positions[first + edges[i].second]);
-      b.distance.particles.push_back(first + edges[i].first);
-      b.distance.particles.push_back(first + edges[i].second);
-      b.distance.data.push_back(len);
-      b.distance.data.push_back(
+      distance.particles.push_back(first + edges[i].first);
+      distance.particles.push_back(first + edges[i].second);
+      distance.data.push_back(len);
+      distance.data.push_back(
           static_cast<float>(body.distance_compliance * static_cast<double>(len) * len / share[i]));
     }
   }
+  if (body.material != TetMaterial::none)
+    if (Status s = add_fem_constraints(b, body, first, name); !s) return s;
   // Vertices used by no tet get no mass and so stay where they are (w = 0).
   for (std::uint32_t p : body.pinned) b.mass[first + p] = 0.0;
   return {};
 }
 
-Status add_line_body(Builder& b, const LineBodyDesc& body, const std::string& name) {
+Status add_line_body(SceneBuilder& b, const LineBodyDesc& body, const std::string& name) {
   const std::uint32_t first = b.add_vertices(body.vertices);
   for (std::size_t i = 0; i < body.masses.size(); ++i) b.mass[first + i] = body.masses[i];
+  RawConstraints& distance = b.constraints(Kernel::xpbd_solve_distance, 2);
   for (std::size_t s = 0; s < body.segments.size(); ++s) {
     const auto [p, q] = body.segments[s];
     const float len = kernels::edge_length(b.positions[first + p], b.positions[first + q]);
     if (!(len > 0.0f)) return Error(name + ".segments[" + std::to_string(s) + "] has zero length in single precision");
-    b.distance.particles.push_back(first + p);
-    b.distance.particles.push_back(first + q);
-    b.distance.data.push_back(len);
-    b.distance.data.push_back(static_cast<float>(body.compliance));
+    distance.particles.push_back(first + p);
+    distance.particles.push_back(first + q);
+    distance.data.push_back(len);
+    distance.data.push_back(static_cast<float>(body.compliance));
   }
+  if (body.bending_compliance >= 0.0)
+    if (Status s = add_line_bending(b, body, first, name); !s) return s;
   for (std::uint32_t p : body.pinned) b.mass[first + p] = 0.0;
   return {};
 }
+
+std::uint32_t SceneBuilder::add_vertices(const std::vector<Vec3d>& vertices) {
+  const auto first = static_cast<std::uint32_t>(positions.size());
+  for (const Vec3d& v : vertices)
+    positions.push_back({static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]), 0.0f});
+  mass.resize(positions.size(), 0.0);
+  return first;
+}
+
+RawConstraints& SceneBuilder::constraints(Kernel kernel, std::uint32_t arity, std::uint32_t data_stride,
+                                          std::uint32_t lambda_stride, std::vector<SceneBuffer> extra_bindings) {
+  for (RawConstraints& r : raw)
+    if (r.kernel == kernel) return r;
+  raw.push_back({kernel, arity, data_stride, lambda_stride, std::move(extra_bindings)});
+  return raw.back();
+}
+
+namespace {
 
 // Colours a block's constraints and reorders them colour by colour, keeping
 // the original order inside each colour (stable counting sort).
@@ -134,42 +147,46 @@ ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::u
 
 Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   if (Status s = check_scene(scene); !s) return s.error();
-  // Parts of the scene API whose solver stages have not landed yet are
-  // refused rather than silently ignored.
-  auto not_yet = [](const char* what) { return Error(std::string(what) + " are not supported yet by this version of sinew"); };
-  if (!scene.tri_bodies.empty()) return not_yet("tri_bodies");
-  if (!scene.colliders.empty()) return not_yet("colliders");
-  if (!scene.attachments.empty()) return not_yet("attachments");
-  if (!scene.tools.empty()) return not_yet("tools");
-  for (const auto& body : scene.tet_bodies)
-    if (body.material != TetMaterial::none) return not_yet("FEM materials (TetBodyDesc::material)");
-  for (const auto& body : scene.line_bodies)
-    if (body.bending_compliance >= 0.0) return not_yet("line bending constraints");
+
   std::size_t total = 0;
   for (const auto& body : scene.tet_bodies) total += body.mesh.vertices.size();
+  for (const auto& body : scene.tri_bodies) total += body.mesh.vertices.size();
   for (const auto& body : scene.line_bodies) total += body.vertices.size();
   if (total >= std::numeric_limits<std::uint32_t>::max())
     return Error("the scene has " + std::to_string(total) + " particles, more than 32-bit indices can address");
 
-  Builder b;
+  SceneBuilder b;
   CompiledScene out;
   for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i) {
     out.tet_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
     if (Status s = add_tet_body(b, scene.tet_bodies[i], "tet_bodies[" + std::to_string(i) + "]"); !s) return s.error();
+  }
+  for (std::size_t i = 0; i < scene.tri_bodies.size(); ++i) {
+    out.tri_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
+    if (Status s = add_tri_body(b, scene.tri_bodies[i], "tri_bodies[" + std::to_string(i) + "]"); !s) return s.error();
   }
   for (std::size_t i = 0; i < scene.line_bodies.size(); ++i) {
     out.line_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
     if (Status s = add_line_body(b, scene.line_bodies[i], "line_bodies[" + std::to_string(i) + "]"); !s)
       return s.error();
   }
+  out.positions = b.positions;  // add_contacts may need the bodies' layout
+  if (Status s = add_contacts(b, scene, out); !s) return s.error();
 
   std::vector<std::uint8_t> movable(b.positions.size());
   for (std::size_t p = 0; p < b.positions.size(); ++p) {
-    b.positions[p].w = b.mass[p] > 0.0 ? static_cast<float>(1.0 / b.mass[p]) : 0.0f;
+    const double w = b.mass[p] > 0.0 ? 1.0 / b.mass[p] : 0.0;
+    if (!std::isfinite(static_cast<float>(w)))
+      return Error("particle " + std::to_string(p) + " has a mass of " + std::to_string(b.mass[p]) +
+                   " kg, too small for a float32 inverse mass");
+    b.positions[p].w = static_cast<float>(w);
     movable[p] = b.positions[p].w > 0.0f;
   }
-  for (const RawConstraints* raw : {&b.distance, &b.volume})
-    if (!raw->particles.empty()) out.blocks.push_back(color_and_sort(*raw, movable));
+  // Gauss-Seidel order: the order of Kernel (contacts last, so they win).
+  std::stable_sort(b.raw.begin(), b.raw.end(),
+                   [](const RawConstraints& x, const RawConstraints& y) { return x.kernel < y.kernel; });
+  for (const RawConstraints& raw : b.raw)
+    if (!raw.particles.empty()) out.blocks.push_back(color_and_sort(raw, movable));
   out.positions = std::move(b.positions);
   return out;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "cpu/cpu_math.h"
@@ -16,7 +17,12 @@ namespace sinew {
 /// colour: colour k holds constraints [color_offsets[k], color_offsets[k+1]).
 /// The solve kernels' bindings are described in kernels/shared/xpbd_params.h.
 /// Scene-wide buffers a solve kernel may bind after its five standard ones.
-enum class SceneBuffer { previous_position };
+enum class SceneBuffer {
+  previous_position,  ///< float4 per particle: positions at the start of the substep
+  colliders,          ///< CompiledScene::colliders (kernels/shared/contact_params.h)
+  targets,            ///< CompiledScene::targets (kernels/shared/contact_params.h)
+  contact_impulses,   ///< float4 per particle and tool: what the tissue pushed back with
+};
 
 struct ConstraintBlock {
   Kernel kernel = Kernel::count_;
@@ -31,7 +37,7 @@ struct ConstraintBlock {
   [[nodiscard]] std::uint32_t colors() const { return static_cast<std::uint32_t>(color_offsets.size() - 1); }
 };
 
-/// The constraints of one kind before colouring.
+/// The constraints of one kernel before colouring.
 struct RawConstraints {
   Kernel kernel;
   std::uint32_t arity;
@@ -44,11 +50,48 @@ struct RawConstraints {
 
 struct CompiledScene {
   std::vector<kernels::float4> positions;  ///< xyz [m], w = inverse mass [1/kg]
-  /// Solved in this order in every iteration; empty blocks are left out.
+  /// Solved in this order (the order of Kernel) in every iteration; there
+  /// are no empty blocks.
   std::vector<ConstraintBlock> blocks;
+  /// Scene-wide buffers that blocks bind (SceneBuffer), as uploaded; the
+  /// Simulation rewrites colliders and targets between frames.
+  std::vector<float> colliders;
+  std::vector<float> targets;
+  std::uint32_t contact_impulse_slots = 0;  ///< float4s in the contact_impulses buffer
   std::vector<std::uint32_t> tet_body_first_particle;
+  std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;
 };
+
+/// What each feature's compile step adds to: particles, their masses and
+/// raw constraints. scene_compiler.cpp drives the steps, then colours every
+/// block and sets the inverse masses.
+struct SceneBuilder {
+  std::vector<kernels::float4> positions;  ///< w is set at the end, from mass
+  std::vector<double> mass;                ///< [kg]; 0 = immovable (pinned, kinematic)
+  std::vector<RawConstraints> raw;         ///< one per kernel
+
+  /// Appends vertices as particles of mass 0; returns the first one's index.
+  std::uint32_t add_vertices(const std::vector<Vec3d>& vertices);
+  /// The raw constraints of `kernel`, made with this layout on first use.
+  RawConstraints& constraints(Kernel kernel, std::uint32_t arity, std::uint32_t data_stride = 2,
+                              std::uint32_t lambda_stride = 1, std::vector<SceneBuffer> extra_bindings = {});
+};
+
+// The compile steps of each feature, each in its own file. `first` is the
+// particle index of the body's vertex 0; `name` prefixes error messages
+// (e.g. "tet_bodies[2]").
+
+/// scene_compiler.cpp: distance and volume constraints, lumped masses.
+Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string& name);
+Status add_line_body(SceneBuilder& b, const LineBodyDesc& body, const std::string& name);
+/// compile_fem.cpp: the two FEM constraints per tet (TetBodyDesc::material).
+Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32_t first, const std::string& name);
+/// compile_thin.cpp: triangle bodies, and bending of line bodies.
+Status add_tri_body(SceneBuilder& b, const TriBodyDesc& body, const std::string& name);
+Status add_line_bending(SceneBuilder& b, const LineBodyDesc& body, std::uint32_t first, const std::string& name);
+/// compile_contacts.cpp: colliders, tools, attachments (after all bodies).
+Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out);
 
 /// Checks (check_scene) and compiles a scene. Errors name the parameter.
 Result<CompiledScene> compile_scene(const SceneDesc& scene);

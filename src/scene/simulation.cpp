@@ -8,25 +8,10 @@
 
 #include "cpu/xpbd_kernels.h"
 #include "scene/scene_compiler.h"
+#include "scene/simulation_impl.h"
 #include "xpbd/xpbd_program.h"
 
 namespace sinew {
-
-struct Simulation::Impl {
-  std::unique_ptr<Device> device;
-  XpbdBuffers buffers;
-  FrameProgram program;
-  ProgramHandle prepared;
-  SceneInfo info;
-  FrameStats stats;
-  double time_step = 0.0;
-  bool measure_errors = true;
-  std::vector<std::uint32_t> block_sizes;             // constraints per block, for the residual read-back
-  std::vector<std::array<std::uint32_t, 4>> tets;    // every tet body's tets, as particle indices
-  double rest_volume = 0.0;                           // their total rest volume [m^3]
-
-  Status measure(FrameStats& stats) const;
-};
 
 // Reads back the residuals, velocities and positions and reduces them in
 // double precision, in a fixed order (the same numbers on every backend).
@@ -85,6 +70,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   auto buffers = upload_scene(*impl->device, *compiled);
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
+  if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
   impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
   auto prepared = impl->device->create_program(impl->program);
   if (!prepared) return prepared.error();
@@ -125,7 +111,9 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
 
 Status Simulation::step() {
   const auto start = std::chrono::steady_clock::now();
+  if (Status s = impl_->before_frame(); !s) return s;
   if (Status s = impl_->device->run_program(impl_->prepared); !s) return s;
+  if (Status s = impl_->after_frame(); !s) return s;
   const auto end = std::chrono::steady_clock::now();
   impl_->stats.frame += 1;
   impl_->stats.time = static_cast<double>(impl_->stats.frame) * impl_->time_step;

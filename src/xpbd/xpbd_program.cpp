@@ -38,6 +38,9 @@ void sweep(FrameProgram& program, const ConstraintBlock& block, std::span<const 
   for (SceneBuffer extra : block.extra_bindings) {
     switch (extra) {
       case SceneBuffer::previous_position: bindings.push_back(scene_buffers.previous); break;
+      case SceneBuffer::colliders: bindings.push_back(scene_buffers.colliders); break;
+      case SceneBuffer::targets: bindings.push_back(scene_buffers.targets); break;
+      case SceneBuffer::contact_impulses: bindings.push_back(scene_buffers.contact_impulses); break;
     }
   }
   for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
@@ -60,6 +63,16 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
     if (!made) return made.error();
     *handle = *made;
   }
+  const std::vector<kernels::float4> impulses(scene.contact_impulse_slots, kernels::float4{0, 0, 0, 0});
+  for (auto [handle, data, label] : {std::tuple{&b.colliders, &scene.colliders, "colliders"},
+                                     std::tuple{&b.targets, &scene.targets, "targets"}}) {
+    auto made = make_buffer(device, *data, label);
+    if (!made) return made.error();
+    *handle = *made;
+  }
+  auto contact_impulses = make_buffer(device, impulses, "contact impulses");
+  if (!contact_impulses) return contact_impulses.error();
+  b.contact_impulses = *contact_impulses;
   for (const ConstraintBlock& block : scene.blocks) {
     const std::string name(kernel_name(block.kernel));
     auto particles = make_buffer(device, block.particles, name + " particles");

@@ -16,6 +16,7 @@ struct BlockBuffers {
 /// The device buffers a compiled scene lives in.
 struct XpbdBuffers {
   BufferHandle position, previous, velocity;
+  BufferHandle colliders, targets, contact_impulses;  ///< SceneBuffer (small placeholders when unused)
   std::vector<BlockBuffers> blocks;  ///< one per CompiledScene::blocks entry
 };
 

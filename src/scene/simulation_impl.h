@@ -1,0 +1,41 @@
+// simulation_impl.h — the state behind sinew::Simulation, shared by the
+// files that implement it: simulation.cpp (create, step, read-back, error
+// measurement) and simulation_contacts.cpp (colliders, targets, tools).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "scene/scene_compiler.h"
+#include "sinew/simulation.h"
+#include "xpbd/xpbd_program.h"
+
+namespace sinew {
+
+struct Simulation::Impl {
+  std::unique_ptr<Device> device;
+  XpbdBuffers buffers;
+  FrameProgram program;
+  ProgramHandle prepared;
+  SceneInfo info;
+  FrameStats stats;
+  double time_step = 0.0;
+  bool measure_errors = true;
+  std::vector<std::uint32_t> block_sizes;             // constraints per block, for the residual read-back
+  std::vector<std::array<std::uint32_t, 4>> tets;    // every tet body's tets, as particle indices
+  double rest_volume = 0.0;                           // their total rest volume [m^3]
+
+  Status measure(FrameStats& stats) const;
+
+  // simulation_contacts.cpp: host copies of the collider and target
+  // buffers (rewritten before each frame) and the tools' rigid state.
+  std::vector<float> colliders;
+  std::vector<float> targets;
+  Status init_contacts(const SceneDesc& scene, const CompiledScene& compiled);
+  Status before_frame();  ///< uploads colliders/targets moved since the last frame
+  Status after_frame();   ///< integrates tools from the tissue's reaction
+};
+
+
+}  // namespace sinew

@@ -1,0 +1,1 @@
+// contact_test.cpp — (tests land with their stage)

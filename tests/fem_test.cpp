@@ -1,0 +1,1 @@
+// fem_test.cpp — (tests land with their stage)

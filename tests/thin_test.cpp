@@ -1,0 +1,1 @@
+// thin_test.cpp — (tests land with their stage)
