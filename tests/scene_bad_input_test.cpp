@@ -57,6 +57,14 @@ TEST(SceneBadInput, TetBodyParameters) {
   expect_error([](SceneDesc& s) { s.tet_bodies[0].distance_compliance = -1e-6; }, "tet_bodies[0].distance_compliance");
   expect_error([](SceneDesc& s) { s.tet_bodies[0].volume_compliance = kNaN; }, "tet_bodies[0].volume_compliance");
   expect_error([](SceneDesc& s) { s.tet_bodies[0].pinned = {3, 1000}; }, "tet_bodies[0].pinned[1]");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].initial_vertices = {{0, 0, 0}}; }, "tet_bodies[0].initial_vertices");
+  expect_error(
+      [](SceneDesc& s) {
+        s.tet_bodies[0].initial_vertices = s.tet_bodies[0].mesh.vertices;
+        s.tet_bodies[0].initial_vertices[2][1] = kNaN;
+      },
+      "tet_bodies[0].initial_vertices[2]");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].material = TetMaterial::neo_hookean; }, "tet_bodies[0].youngs_modulus");
 }
 
 TEST(SceneBadInput, TetBodyMesh) {

@@ -47,6 +47,7 @@ enum class TetMaterial { none, neo_hookean, stvk, corotational };
 /// Compliance 0 makes a constraint rigid (solved as a hard constraint).
 struct TetBodyDesc {
   TetMesh mesh;                         ///< rest shape [m]; must pass check_tet_mesh
+  std::vector<Vec3d> initial_vertices;  ///< start positions [m] if not the rest shape (empty: rest)
   double density = 1000.0;              ///< [kg/m^3], > 0; mass is lumped to vertices (V/4 each)
   bool distance_constraints = true;     ///< one distance constraint per edge
   double distance_compliance = 1e-5;    ///< c_d [1/Pa], >= 0 (1/E of the edge network)
@@ -77,6 +78,7 @@ struct TetBodyDesc {
 /// with h0 its rest value, alpha = bending_compliance [m/N].
 struct LineBodyDesc {
   std::vector<Vec3d> vertices;                          ///< rest positions [m]
+  std::vector<Vec3d> initial_vertices;                  ///< start positions [m] if not the rest ones (empty: rest)
   std::vector<double> masses;                           ///< per vertex [kg], > 0
   std::vector<std::array<std::uint32_t, 2>> segments;   ///< vertex pairs, rest length > 0
   double compliance = 0.0;                              ///< per segment [m/N], >= 0
@@ -96,6 +98,7 @@ struct LineBodyDesc {
 ///    (Müller et al., "Position Based Dynamics", 2007, section 4.2).
 struct TriBodyDesc {
   TriMesh mesh;                           ///< rest shape [m]
+  std::vector<Vec3d> initial_vertices;    ///< start positions [m] if not the rest shape (empty: rest)
   double thickness = 1e-3;                ///< [m], > 0
   double density = 1000.0;                ///< [kg/m^3], > 0
   bool distance_constraints = true;

@@ -33,6 +33,18 @@ Status check_elastic(const std::string& prefix, double young, double poisson) {
   return {};
 }
 
+Status check_initial(const std::string& name, const std::vector<Vec3d>& initial, std::size_t vertex_count) {
+  if (initial.empty()) return {};
+  if (initial.size() != vertex_count)
+    return Error(name + ".initial_vertices has " + std::to_string(initial.size()) + " entries for " +
+                 std::to_string(vertex_count) + " vertices");
+  for (std::size_t i = 0; i < initial.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(initial[i][k]))
+        return Error(name + ".initial_vertices[" + std::to_string(i) + "] is not finite");
+  return {};
+}
+
 Status check_pinned(const std::string& body, const std::vector<std::uint32_t>& pinned, std::size_t vertex_count) {
   for (std::size_t i = 0; i < pinned.size(); ++i)
     if (pinned[i] >= vertex_count)
@@ -48,6 +60,7 @@ Status check_tet_body(const TetBodyDesc& b, const std::string& name) {
   if (Status s = non_negative(name + ".volume_compliance", b.volume_compliance); !s) return s;
   if (b.material != TetMaterial::none)
     if (Status s = check_elastic(name + ".", b.youngs_modulus, b.poisson_ratio); !s) return s;
+  if (Status s = check_initial(name, b.initial_vertices, b.mesh.vertices.size()); !s) return s;
   return check_pinned(name, b.pinned, b.mesh.vertices.size());
 }
 
@@ -75,6 +88,7 @@ Status check_line_body(const LineBodyDesc& b, const std::string& name) {
   }
   if (Status s = non_negative(name + ".compliance", b.compliance); !s) return s;
   if (std::isnan(b.bending_compliance)) return Error(name + ".bending_compliance is NaN");
+  if (Status s = check_initial(name, b.initial_vertices, n); !s) return s;
   return check_pinned(name, b.pinned, n);
 }
 
@@ -122,6 +136,7 @@ Status check_tri_body(const TriBodyDesc& b, const std::string& name) {
   if (Status s = non_negative(name + ".distance_compliance", b.distance_compliance); !s) return s;
   if (Status s = non_negative(name + ".area_compliance", b.area_compliance); !s) return s;
   if (std::isnan(b.bending_compliance)) return Error(name + ".bending_compliance is NaN");
+  if (Status s = check_initial(name, b.initial_vertices, n); !s) return s;
   return check_pinned(name, b.pinned, n);
 }
 

@@ -75,6 +75,7 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
   }
   if (body.material != TetMaterial::none)
     if (Status s = add_fem_constraints(b, body, first, name); !s) return s;
+  if (!body.initial_vertices.empty()) b.initial.emplace_back(first, &body.initial_vertices);
   // Vertices used by no tet get no mass and so stay where they are (w = 0).
   for (std::uint32_t p : body.pinned) b.mass[first + p] = 0.0;
   return {};
@@ -95,6 +96,7 @@ Status add_line_body(SceneBuilder& b, const LineBodyDesc& body, const std::strin
   }
   if (body.bending_compliance >= 0.0)
     if (Status s = add_line_bending(b, body, first, name); !s) return s;
+  if (!body.initial_vertices.empty()) b.initial.emplace_back(first, &body.initial_vertices);
   for (std::uint32_t p : body.pinned) b.mass[first + p] = 0.0;
   return {};
 }
@@ -173,6 +175,11 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   out.positions = b.positions;  // add_contacts may need the bodies' layout
   if (Status s = add_contacts(b, scene, out); !s) return s.error();
 
+  for (const auto& [first, start] : b.initial)
+    for (std::size_t i = 0; i < start->size(); ++i) {
+      const Vec3d& p = (*start)[i];
+      b.positions[first + i] = {static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]), 0.0f};
+    }
   std::vector<std::uint8_t> movable(b.positions.size());
   for (std::size_t p = 0; p < b.positions.size(); ++p) {
     const double w = b.mass[p] > 0.0 ? 1.0 / b.mass[p] : 0.0;

@@ -70,6 +70,9 @@ struct SceneBuilder {
   std::vector<kernels::float4> positions;  ///< w is set at the end, from mass
   std::vector<double> mass;                ///< [kg]; 0 = immovable (pinned, kinematic)
   std::vector<RawConstraints> raw;         ///< one per kernel
+  /// Bodies that start away from their rest shape: (first particle, start
+  /// positions), applied after every rest value has been computed.
+  std::vector<std::pair<std::uint32_t, const std::vector<Vec3d>*>> initial;
 
   /// Appends vertices as particles of mass 0; returns the first one's index.
   std::uint32_t add_vertices(const std::vector<Vec3d>& vertices);
