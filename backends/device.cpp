@@ -3,7 +3,12 @@
 #include <cstdio>
 #include <string>
 
+#include <mutex>
+
 #include "backends/cpu/cpu_device.h"
+#if SINEW_HAS_OPENCL
+#include "backends/opencl/opencl_device.h"
+#endif
 #include "backends/kernel_table.h"
 #include "xpbd_params.h"
 
@@ -79,22 +84,57 @@ Status check_program(const FrameProgram& program, std::uint32_t buffer_count) {
 
 std::vector<std::string> built_backends() {
   std::vector<std::string> names{"cpu"};
+#if SINEW_HAS_OPENCL
+  names.push_back("opencl");
+#endif
   return names;
 }
+
+namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+// "auto": the first GPU of a built GPU backend, else the CPU backend.
+Result<std::unique_ptr<Device>> create_auto_device(const DeviceOptions& options) {
+  std::string why = "no GPU backend is built";
+#if SINEW_HAS_OPENCL
+  if (auto devices = list_opencl_devices(); devices) {
+    for (std::size_t i = 0; i < devices->size(); ++i) {
+      if (!(*devices)[i].gpu) continue;
+      DeviceOptions gpu = options;
+      gpu.backend = "opencl";
+      if (gpu.device.empty()) gpu.device = std::to_string(i);
+      return make_opencl_device(gpu);
+    }
+    why = "OpenCL found no GPU";
+  } else {
+    why = devices.error().message();
+  }
+#endif
+  static std::once_flag said;  // "saying so once"
+  if (!options.quiet) std::call_once(said, [&] { std::fprintf(stderr, "sinew: backend auto -> cpu (%s)\n", why.c_str()); });
+  return make_cpu_device(options);
+}
+
+}  // namespace
 
 Result<std::unique_ptr<Device>> create_device(const DeviceOptions& options) {
   const std::string& name = options.backend;
   if (name == "cpu") return make_cpu_device(options);
-  if (name == "opencl" || name == "vulkan") {
-    // The GPU backends land with their own issues; until then a request for
-    // one is an error, never a silent substitute.
-    return Error("backend '" + name + "' is not built into this version of sinew (built: cpu)");
+  if (name == "opencl") {
+#if SINEW_HAS_OPENCL
+    return make_opencl_device(options);
+#endif
   }
-  if (name == "auto") {
-    // No GPU backend is built yet, so "auto" means the CPU reference.
-    if (!options.quiet) std::fprintf(stderr, "sinew: backend auto -> cpu (no GPU backend is built)\n");
-    return make_cpu_device(options);
-  }
+  if (name == "opencl" || name == "vulkan")
+    return Error("backend '" + name + "' is not built into this sinew (built: " + joined(built_backends()) +
+                 "); configure with -DSINEW_" + (name == "opencl" ? "OPENCL" : "VULKAN") +
+                 "=ON and its dependencies installed");
+  if (name == "auto") return create_auto_device(options);
   return Error("unknown backend '" + name + "' (choose cpu, opencl, vulkan or auto)");
 }
 

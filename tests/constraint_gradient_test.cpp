@@ -38,18 +38,21 @@ void check_distance(double4 a, double4 b) {
   auto c = [](const double4* q) { return edge_length(q[0], q[1]); };
   const double len = c(p);
   const double4 ga = edge_length_gradient(p[0], p[1], len);
-  const double step = 1e-6 * len;
+  // Central differences: truncation error ~ (step / len)^2, cancellation
+  // error ~ eps * |coordinates| / step; the tolerance covers both.
+  const double step = 1e-4 * len;
+  const double coords = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z), std::abs(b.x), std::abs(b.y), std::abs(b.z)});
+  const double fd_tol = 1e-7 + 8 * 2.2e-16 * coords / step;
   for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(central_difference(c, p, 0, k, step), component(ga, k), 1e-6) << "d/da" << k;
-    EXPECT_NEAR(central_difference(c, p, 1, k, step), -component(ga, k), 1e-6) << "d/db" << k;
+    EXPECT_NEAR(central_difference(c, p, 0, k, step), component(ga, k), fd_tol) << "d/da" << k;
+    EXPECT_NEAR(central_difference(c, p, 1, k, step), -component(ga, k), fd_tol) << "d/db" << k;
   }
   // The float instance (what the kernel runs) agrees with the double one up
   // to the rounding of a - b in float: a few ulps of the coordinates,
   // relative to the edge length.
   const float4 fa{float(a.x), float(a.y), float(a.z), 1.f}, fb{float(b.x), float(b.y), float(b.z), 1.f};
   const float4 fg = edge_length_gradient(fa, fb, edge_length(fa, fb));
-  const double coord = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z), std::abs(b.x), std::abs(b.y), std::abs(b.z)});
-  const double tol = 1e-6 + 8 * 1.2e-7 * coord / len;
+  const double tol = 1e-6 + 8 * 1.2e-7 * coords / len;
   EXPECT_NEAR(fg.x, ga.x, tol);
   EXPECT_NEAR(fg.y, ga.y, tol);
   EXPECT_NEAR(fg.z, ga.z, tol);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,27 @@ namespace sinew::test {
 
 /// Every backend built into this library; a test body is run on each.
 inline std::vector<std::string> backends() { return built_backends(); }
+
+/// Names parameterised tests after their backend ("Backends/Xpbd.Name/opencl").
+inline std::string backend_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
+
+/// Why `backend` has no device here ("" when it has one); probed once.
+inline std::string missing_device(const std::string& backend) {
+  static std::map<std::string, std::string> known;
+  if (auto it = known.find(backend); it != known.end()) return it->second;
+  auto device = create_device({.backend = backend, .quiet = true});
+  return known[backend] = device.ok() ? "" : device.error().message();
+}
+
+/// Fixture of every test body run on each backend: a backend that is built
+/// but has no device on this machine (no GPU, no driver) skips the test.
+class BackendTest : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    if (const std::string why = missing_device(GetParam()); !why.empty())
+      GTEST_SKIP() << "backend " << GetParam() << " has no device here: " << why;
+  }
+};
 
 /// Creates a simulation on `backend`, skipping the test when the backend is
 /// built but has no device here (e.g. no GPU), failing it on any other error.

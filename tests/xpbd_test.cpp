@@ -12,7 +12,7 @@
 namespace sinew {
 namespace {
 
-class Xpbd : public ::testing::TestWithParam<std::string> {};
+class Xpbd : public test::BackendTest {};
 
 Simulation make(const SceneDesc& scene, const std::string& backend) {
   auto sim = test::create_or_skip(scene, backend);
@@ -251,7 +251,7 @@ TEST_P(Xpbd, BodyStartingCompressedRecoversItsRestVolume) {
   EXPECT_NEAR(sim.last_frame().volume_change, 0.0, 0.05);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Xpbd, ::testing::ValuesIn(test::backends()));
+INSTANTIATE_TEST_SUITE_P(Backends, Xpbd, ::testing::ValuesIn(test::backends()), test::backend_name);
 
 TEST(XpbdCpu, SameResultWithOneAndTwoThreads) {
   // Colour order fixes the order of every update, so the split of a colour

@@ -119,6 +119,10 @@ struct ProgramHandle {
 /// How to pick a backend and device.
 struct DeviceOptions {
   std::string backend = "auto";  ///< "cpu", "opencl", "vulkan" or "auto"
+  /// opencl/vulkan: a device index or a substring of its name; empty: the
+  /// environment variable SINEW_OPENCL_DEVICE / SINEW_VULKAN_DEVICE, else the
+  /// first GPU, else the first device.
+  std::string device = "";
   int threads = 0;               ///< cpu: worker threads; 0 = all hardware threads
   bool cpu_simd = true;          ///< cpu: use the AVX2 solves where the CPU has AVX2 (bitwise
                                  ///< equal to the scalar reference kernels, only faster)
@@ -148,8 +152,10 @@ class Device {
 };
 
 /// Makes a device. Asking for a backend that is not built, or that has no
-/// device, returns an error that says so; "auto" falls back to "cpu" and
-/// prints one line saying why (unless options.quiet).
+/// device, returns an error that says so. "auto" takes the first GPU found
+/// by a built GPU backend (OpenCL, then Vulkan); without one it falls back
+/// to "cpu" and prints one line saying why, once per process (unless
+/// options.quiet).
 Result<std::unique_ptr<Device>> create_device(const DeviceOptions& options = {});
 
 /// The backends built into this library ("cpu" always).

@@ -2,7 +2,7 @@
  * C++ (host and CPU kernels), OpenCL C and GLSL (Vulkan).
  *
  * Rules for shared structs, so that every language lays them out alike:
- *  - only 4-byte scalars (float, uint, int), declared with SINEW_FIELD;
+ *  - only 4-byte scalars (float, uint, int) between SINEW_STRUCT_BEGIN/END;
  *  - total size a multiple of 16 bytes (pad explicitly);
  *  - no vectors: std140/std430, OpenCL and C++ disagree on float3 alignment.
  * Buffers hold float4 (xyz + inverse mass in w) for the same reason. */
