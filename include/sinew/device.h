@@ -97,6 +97,8 @@ class FrameProgram {
     std::memcpy(d.params, &params, sizeof(Params));
     commands_.emplace_back(d);
   }
+  /// Appends a dispatch built by hand (tests, tools).
+  void dispatch_raw(const Dispatch& d) { commands_.emplace_back(d); }
   /// Appends a barrier (two barriers in a row collapse into one).
   void barrier() {
     if (!commands_.empty() && !std::holds_alternative<Barrier>(commands_.back())) commands_.emplace_back(Barrier{});
