@@ -82,6 +82,14 @@ Status check_program(const FrameProgram& program, std::uint32_t buffer_count) {
   return {};
 }
 
+Status check_buffer_range(const std::string& label, std::size_t size, std::size_t offset, std::size_t bytes,
+                          const char* what) {
+  if (offset > size || bytes > size - offset)
+    return Error(std::string(what) + " '" + label + "': bytes [" + std::to_string(offset) + ", " +
+                 std::to_string(offset + bytes) + ") outside the buffer's " + std::to_string(size) + " bytes");
+  return {};
+}
+
 std::vector<std::string> built_backends() {
   std::vector<std::string> names{"cpu"};
 #if SINEW_HAS_OPENCL

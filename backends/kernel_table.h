@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <string_view>
 
 #include "sinew/device.h"
@@ -23,5 +24,10 @@ const KernelSignature& kernel_signature(Kernel kernel);
 /// Checks a program's dispatches against the kernel table and the number of
 /// buffers the device has. Errors name the dispatch by position and kernel.
 Status check_program(const FrameProgram& program, std::uint32_t buffer_count);
+
+/// Checks that bytes [offset, offset + bytes) lie in a buffer of `size`
+/// bytes named `label`; `what` names the call in the error.
+Status check_buffer_range(const std::string& label, std::size_t size, std::size_t offset, std::size_t bytes,
+                          const char* what);
 
 }  // namespace sinew

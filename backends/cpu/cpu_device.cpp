@@ -154,9 +154,7 @@ class CpuDevice final : public Device {
   Result<std::byte*> range(BufferHandle buffer, std::size_t offset, std::size_t bytes, const char* what) {
     if (buffer.id >= buffers_.size()) return Error(std::string(what) + ": not a buffer of this device");
     HostBuffer& b = buffers_[buffer.id];
-    if (offset > b.bytes || bytes > b.bytes - offset)
-      return Error(std::string(what) + " '" + b.label + "': bytes [" + std::to_string(offset) + ", " +
-                   std::to_string(offset + bytes) + ") outside the buffer's " + std::to_string(b.bytes) + " bytes");
+    if (Status s = check_buffer_range(b.label, b.bytes, offset, bytes, what); !s) return s.error();
     return b.data.get() + offset;
   }
 

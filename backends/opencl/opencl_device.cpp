@@ -37,23 +37,19 @@ constexpr std::size_t kLocalSize = 64;
 
 std::string cl_status(cl_int code) { return "OpenCL error " + std::to_string(code); }
 
-std::string device_string(cl_device_id d, cl_device_info what) {
+// A string property through one of OpenCL's two-call getters
+// (clGetDeviceInfo, clGetPlatformInfo): ask the size, then the bytes.
+template <class Getter, class Object, class Param>
+std::string info_string(Getter get, Object object, Param what) {
   std::size_t n = 0;
-  if (clGetDeviceInfo(d, what, 0, nullptr, &n) != CL_SUCCESS || n == 0) return "";
+  if (get(object, what, 0, nullptr, &n) != CL_SUCCESS || n == 0) return "";
   std::string s(n, '\0');
-  clGetDeviceInfo(d, what, n, s.data(), nullptr);
+  get(object, what, n, s.data(), nullptr);
   while (!s.empty() && s.back() == '\0') s.pop_back();
   return s;
 }
-
-std::string platform_string(cl_platform_id p, cl_platform_info what) {
-  std::size_t n = 0;
-  if (clGetPlatformInfo(p, what, 0, nullptr, &n) != CL_SUCCESS || n == 0) return "";
-  std::string s(n, '\0');
-  clGetPlatformInfo(p, what, n, s.data(), nullptr);
-  while (!s.empty() && s.back() == '\0') s.pop_back();
-  return s;
-}
+std::string device_string(cl_device_id d, cl_device_info what) { return info_string(clGetDeviceInfo, d, what); }
+std::string platform_string(cl_platform_id p, cl_platform_info what) { return info_string(clGetPlatformInfo, p, what); }
 
 struct Found {
   cl_platform_id platform;
@@ -301,10 +297,7 @@ class OpenclDevice final : public Device {
   Status check_range(BufferHandle buffer, std::size_t offset, std::size_t bytes, const char* what) const {
     if (buffer.id >= buffers_.size()) return Error(std::string(what) + ": not a buffer of this device");
     const ClBuffer& b = buffers_[buffer.id];
-    if (offset > b.bytes || bytes > b.bytes - offset)
-      return Error(std::string(what) + " '" + b.label + "': bytes [" + std::to_string(offset) + ", " +
-                   std::to_string(offset + bytes) + ") outside the buffer's " + std::to_string(b.bytes) + " bytes");
-    return {};
+    return check_buffer_range(b.label, b.bytes, offset, bytes, what);
   }
 
   Found found_;
