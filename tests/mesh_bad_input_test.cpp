@@ -10,17 +10,14 @@
 #include <string>
 #include <vector>
 
+#include "mesh_test_helpers.h"
 #include "sinew/mesh.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path tmp_dir() {
-  const fs::path dir = fs::path(SINEW_TEST_TMP_DIR) / "mesh_bad_input";
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path tmp_dir() { return sinew::mesh_test::tmp_dir("mesh_bad_input"); }
 
 fs::path write_file(const std::string& name, const std::string& text) {
   const fs::path p = tmp_dir() / name;
@@ -338,13 +335,37 @@ TEST(MeshBadInput, CheckTetMeshNamesOriginAndTet) {
   const auto nan = sinew::check_tet_mesh(m, "unit");
   ASSERT_FALSE(nan.ok());
   EXPECT_NE(nan.error().message().find("vertex 2"), std::string::npos) << nan.error().message();
-  // A tet far thinner than 1e-12 of the diagonal cubed is degenerate, at any scale.
+  // A tet far flatter than 1e-12 of its longest edge cubed is degenerate, at any scale.
   m.vertices = {{0, 0, 0}, {1e3, 0, 0}, {0, 1e3, 0}, {0, 0, 1e-10}};
   const auto thin = sinew::check_tet_mesh(m, "km");
   ASSERT_FALSE(thin.ok());
   EXPECT_NE(thin.error().message().find("zero volume"), std::string::npos) << thin.error().message();
   m.vertices = {{0, 0, 0}, {1e-3, 0, 0}, {0, 1e-3, 0}, {0, 0, 1e-3}};
   EXPECT_TRUE(sinew::check_tet_mesh(m, "mm").ok());
+}
+
+// The tolerance is per tet: a tiny, well-shaped tet in a large (graded) mesh
+// passes; a flat one of the same size fails, naming the tet, its vertices,
+// its signed volume and the minimum.
+TEST(MeshBadInput, CheckTetMeshJudgesEachTetByItsOwnSize) {
+  sinew::TetMesh m;
+  m.vertices = {{0, 0, 0}, {1e3, 0, 0}, {0, 1e3, 0}, {0, 0, 1e3},                 // large tet
+                {5, 5, 5}, {5 + 1e-3, 5, 5}, {5, 5 + 1e-3, 5}, {5, 5, 5 + 1e-3}};  // 1e-3 edge
+  m.tets = {{0, 1, 2, 3}, {4, 5, 6, 7}};
+  const auto graded = sinew::check_tet_mesh(m, "graded");
+  EXPECT_TRUE(graded.ok()) << graded.error().message();
+  m.vertices[7][2] = 5 + 4e-15;  // height ~4e-15 against edges of 1e-3: flatter than 1e-12
+  const auto flat = sinew::check_tet_mesh(m, "graded");
+  ASSERT_FALSE(flat.ok());
+  const std::string& msg = flat.error().message();
+  for (const char* part : {"graded: tet 1 (vertices 4 5 6 7)", "zero volume", "signed volume", "minimum"}) {
+    EXPECT_NE(msg.find(part), std::string::npos) << part << " not in: " << msg;
+  }
+  m.vertices[7][2] = 5 - 1e-4;  // below the base: inverted
+  const auto inverted = sinew::check_tet_mesh(m, "graded");
+  ASSERT_FALSE(inverted.ok());
+  EXPECT_NE(inverted.error().message().find("tet 1 (vertices 4 5 6 7) is inverted"), std::string::npos)
+      << inverted.error().message();
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "mesh_test_helpers.h"
 #include "sinew/mesh.h"
 
 namespace {
@@ -24,17 +25,11 @@ using sinew::TetMesh;
 using sinew::Vec3d;
 using Face = std::array<std::uint32_t, 3>;
 
-fs::path tmp_dir() {
-  const fs::path dir = fs::path(SINEW_TEST_TMP_DIR) / "mesh_boundary_vtu";
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path tmp_dir() { return sinew::mesh_test::tmp_dir("mesh_boundary_vtu"); }
 
-Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using sinew::mesh_test::cross;
+using sinew::mesh_test::dot;
+using sinew::mesh_test::sub;
 
 Face sorted(Face f) {
   std::sort(f.begin(), f.end());

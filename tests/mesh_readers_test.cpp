@@ -20,6 +20,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mesh_test_helpers.h"
 #include "sinew/mesh.h"
 
 namespace {
@@ -30,24 +31,16 @@ using sinew::Vec3d;
 
 const fs::path kTetDir = fs::path(SINEW_DATA_DIR) / "meshes" / "tet";
 
-fs::path tmp_dir() {
-  const fs::path dir = fs::path(SINEW_TEST_TMP_DIR) / "mesh_readers";
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path tmp_dir() { return sinew::mesh_test::tmp_dir("mesh_readers"); }
 
-Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using sinew::mesh_test::cross;
+using sinew::mesh_test::dot;
+using sinew::mesh_test::signed_volume;
+using sinew::mesh_test::sub;
 
 double tet_volume_sum(const TetMesh& m) {
   double v = 0.0;
-  for (const auto& t : m.tets) {
-    const Vec3d& a = m.vertices[t[0]];
-    v += dot(sub(m.vertices[t[1]], a), cross(sub(m.vertices[t[2]], a), sub(m.vertices[t[3]], a))) / 6.0;
-  }
+  for (const auto& t : m.tets) v += signed_volume(m, t);
   return v;
 }
 
@@ -151,15 +144,10 @@ TEST(MeshReaders, Kidney57kIsAKidneySizedOrganInMillimetres) {
   EXPECT_LT(litres, 0.4);
 }
 
-// Disabled: under the volume tolerance mesh.h states for check_tet_mesh
-// (1e-12 of the cube of the bounding-box diagonal, 3.1e-5 mm^3 here), 20 of
-// the liver's tets are rejected as zero-volume although they are positive
-// and well shaped (smallest 1.2e-5 mm^3; volume / longest edge^3 >= 5e-4
-// for every tet): the mesh is graded, and its smallest tets are tiny next to
-// the organ. It reads in ~0.1 s and passes everything below once the
-// tolerance is taken per tet (e.g. 1e-12 of the cube of the tet's longest
-// edge). Enable it when the header's contract is settled.
-TEST(MeshReaders, DISABLED_Liver382kIsALiverSizedOrganInMillimetres) {
+// A graded mesh: its smallest tets (1.2e-5 mm^3) are tiny next to the organ
+// but well shaped (volume / longest edge^3 >= 5e-4), so they pass the
+// per-tet flatness test of check_tet_mesh.
+TEST(MeshReaders, Liver382kIsALiverSizedOrganInMillimetres) {
   sinew::Result<TetMesh> mesh = sinew::Error("not read");
   const double t = seconds([&] { mesh = sinew::read_tetgen(kTetDir / "liver_382k.node"); });
   ASSERT_TRUE(mesh.ok()) << mesh.error().message();

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh_test_helpers.h"
 #include "sinew/mesh.h"
 
 namespace {
@@ -21,16 +22,10 @@ using sinew::TetsPerCell;
 using sinew::Vec3d;
 using Face = std::array<std::uint32_t, 3>;
 
-Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-double signed_volume(const TetMesh& m, const std::array<std::uint32_t, 4>& t) {
-  const Vec3d& a = m.vertices[t[0]];
-  return dot(sub(m.vertices[t[1]], a), cross(sub(m.vertices[t[2]], a), sub(m.vertices[t[3]], a))) / 6.0;
-}
+using sinew::mesh_test::cross;
+using sinew::mesh_test::dot;
+using sinew::mesh_test::sub;
+using sinew::mesh_test::signed_volume;
 
 // Volume enclosed by a closed triangle surface (divergence theorem); positive
 // only when the triangles wind counter-clockwise seen from outside.

@@ -73,8 +73,10 @@ Result<TetMesh> read_tet_mesh(const std::filesystem::path& path);
 
 /// Checks a tet mesh: at least one tet; all coordinates finite; all indices
 /// in range; no tet repeats a vertex; every tet has positive volume above
-/// 1e-12 of the cube of the bounding-box diagonal (zero-volume and inverted
-/// tets are errors, naming the tet). `origin` prefixes the messages (e.g. a file name).
+/// 1e-12 of the cube of its own longest edge, a flatness test independent of
+/// units, mesh size and grading (zero-volume and inverted tets are errors,
+/// naming the tet, its vertices, its signed volume and that minimum).
+/// `origin` prefixes the messages (e.g. a file name).
 Status check_tet_mesh(const TetMesh& mesh, const std::string& origin = "mesh");
 
 /// Multiplies every position by `factor` (e.g. 1e-3 for millimetres to metres).

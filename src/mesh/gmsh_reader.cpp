@@ -22,47 +22,35 @@
 // line. Only element type 4 (4-node tetrahedron, reference corners
 // (0,0,0), (1,0,0), (0,1,0), (0,0,1): positively oriented) is kept.
 //
-// The file is read whole and tokenised in place with std::from_chars.
+// The file is read whole and tokenised in place with std::from_chars
+// (text_scan.h).
 #include <algorithm>
-#include <cerrno>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
 #include <limits>
 #include <new>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <utility>
 #include <vector>
 
 #include "sinew/mesh.h"
+#include "text_scan.h"
 
 namespace sinew {
 namespace {
 
-namespace fs = std::filesystem;
+using detail::parse_double;
+using detail::parse_int;
+using detail::parse_uint;
+using detail::Parsed;
+using detail::quoted;
+using detail::read_whole_file;
+using detail::Scanner;
+using detail::Token;
+using detail::Where;
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
-Result<std::string> read_whole_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return Error(path.string() + ": cannot open file (it does not exist)");
-  if (!fs::is_regular_file(path, ec)) return Error(path.string() + ": not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error(path.string() + ": cannot open file (" + std::strerror(errno) + ")");
-  const auto size = fs::file_size(path, ec);
-  if (ec) return Error(path.string() + ": cannot read file size (" + ec.message() + ")");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) {
-    return Error(path.string() + ": read error (file shorter than its size " + std::to_string(size) + ")");
-  }
-  return text;
-}
 
 // Nodes per element for the MSH element types (reference manual, "MSH file
 // format", elm-type list); -1 for types this reader does not know, whose
@@ -140,71 +128,6 @@ int nodes_per_element(std::uint64_t type) {
   }
 }
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
-
-std::string quoted(std::string_view tok) {
-  constexpr std::size_t kMax = 40;  // keep messages short for binary junk
-  return "'" + std::string(tok.substr(0, kMax)) + (tok.size() > kMax ? "...'" : "'");
-}
-
-struct Token {
-  std::string_view text;
-  std::size_t line = 0;
-};
-
-// Whitespace-separated tokens with their 1-based line numbers.
-class Scanner {
- public:
-  explicit Scanner(std::string_view text) : text_(text) {}
-
-  bool next(Token& t) {
-    while (pos_ < text_.size() && is_space(text_[pos_])) {
-      if (text_[pos_] == '\n') ++line_;
-      ++pos_;
-    }
-    if (pos_ == text_.size()) return false;
-    const std::size_t begin = pos_;
-    while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
-    t = {text_.substr(begin, pos_ - begin), line_};
-    return true;
-  }
-  /// Skips the rest of the current line.
-  void skip_line() {
-    const std::size_t eol = text_.find('\n', pos_);
-    pos_ = eol == std::string_view::npos ? text_.size() : eol;
-  }
-  std::size_t line() const { return line_; }
-  std::size_t remaining() const { return text_.size() - pos_; }
-
- private:
-  std::string_view text_;
-  std::size_t pos_ = 0;
-  std::size_t line_ = 1;
-};
-
-bool parse_uint(std::string_view tok, std::uint64_t& out) {
-  const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
-  return ec == std::errc() && end == tok.data() + tok.size() && !tok.empty();
-}
-
-bool parse_int(std::string_view tok, std::int64_t& out) {
-  const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
-  return ec == std::errc() && end == tok.data() + tok.size() && !tok.empty();
-}
-
-enum class Parsed { ok, not_a_number, not_finite };
-
-// from_chars accepts "nan" and "inf"; they are reported as non-finite
-// rather than as garbage, and overflow (1e999) counts as non-finite too.
-Parsed parse_double(std::string_view tok, double& out) {
-  if (tok.size() > 1 && tok.front() == '+' && tok[1] != '-') tok.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
-  if (end != tok.data() + tok.size() || tok.empty()) return Parsed::not_a_number;
-  if (ec == std::errc::result_out_of_range) return Parsed::not_finite;
-  if (ec != std::errc()) return Parsed::not_a_number;
-  return std::isfinite(out) ? Parsed::ok : Parsed::not_finite;
-}
-
 // Node tag -> index into the $Nodes arrays. Tags are usually dense
 // (1..N), so a direct table is used unless the tags are very sparse.
 class NodeLookup {
@@ -252,7 +175,7 @@ enum class Version { v2, v40, v41 };
 
 class GmshParser {
  public:
-  GmshParser(std::string_view text, std::string file) : scan_(text), file_(std::move(file)) {}
+  GmshParser(std::string_view text, std::string file) : scan_(text), where_{std::move(file)} {}
 
   Result<TetMesh> parse() {
     if (!read_format() || !read_sections() || !check_complete()) return *error_;
@@ -261,7 +184,7 @@ class GmshParser {
 
  private:
   bool fail(std::size_t line, const std::string& what) {
-    error_ = Error(file_ + ":" + std::to_string(line) + ": " + what);
+    error_ = where_.at(line, what);
     return false;
   }
 
@@ -607,12 +530,12 @@ class GmshParser {
     mesh.tets.reserve(tets_.size());
     for (const auto& tet : tets_)
       mesh.tets.push_back({dense[tet[0]], dense[tet[1]], dense[tet[2]], dense[tet[3]]});
-    if (Status s = check_tet_mesh(mesh, file_); !s) return s.error();
+    if (Status s = check_tet_mesh(mesh, where_.file); !s) return s.error();
     return mesh;
   }
 
   Scanner scan_;
-  std::string file_;
+  Where where_;
   std::string section_;
   Version version_ = Version::v41;
   std::optional<Error> error_;

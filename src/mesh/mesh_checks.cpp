@@ -1,8 +1,10 @@
 // check_tet_mesh and scale_mesh.
 //
-// The checks run in double precision. The volume tolerance is relative to
-// the mesh size (1e-12 of the cube of the bounding-box diagonal), so the
-// verdict does not change when a mesh is rescaled, e.g. from mm to m.
+// The checks run in double precision. The volume tolerance is per tet:
+// 1e-12 of the cube of the tet's own longest edge. It is a flatness test
+// (volume / longest edge^3, a shape measure), so the verdict depends neither
+// on units (mm or m) nor on the mesh size or its grading: the small tets of
+// a graded mesh are judged by their own size, not by the whole mesh's.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -67,26 +69,28 @@ Status check_indices(const TetMesh& mesh, const std::string& origin) {
   return {};
 }
 
-double bbox_diagonal(const std::vector<Vec3d>& vertices) {
-  Vec3d lo = vertices.front(), hi = vertices.front();
-  for (const Vec3d& p : vertices) {
-    for (std::size_t a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[a]);
-      hi[a] = std::max(hi[a], p[a]);
-    }
-  }
-  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+double squared_distance(const Vec3d& a, const Vec3d& b) {
+  const double x = b[0] - a[0], y = b[1] - a[1], z = b[2] - a[2];
+  return x * x + y * y + z * z;
+}
+
+double longest_edge(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
+  const double longest = std::max({squared_distance(a, b), squared_distance(a, c), squared_distance(a, d),
+                                   squared_distance(b, c), squared_distance(b, d), squared_distance(c, d)});
+  return std::sqrt(longest);
 }
 
 // [pre] vertices finite, indices valid.
 Status check_volumes(const TetMesh& mesh, const std::string& origin) {
-  const double diagonal = bbox_diagonal(mesh.vertices);
-  const double min_volume = 1e-12 * diagonal * diagonal * diagonal;
   for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
     const auto& tet = mesh.tets[t];
-    const double volume = orientation(mesh.vertices[tet[0]], mesh.vertices[tet[1]], mesh.vertices[tet[2]],
-                                      mesh.vertices[tet[3]]) /
-                          6.0;
+    const Vec3d& a = mesh.vertices[tet[0]];
+    const Vec3d& b = mesh.vertices[tet[1]];
+    const Vec3d& c = mesh.vertices[tet[2]];
+    const Vec3d& d = mesh.vertices[tet[3]];
+    const double volume = orientation(a, b, c, d) / 6.0;
+    const double edge = longest_edge(a, b, c, d);
+    const double min_volume = 1e-12 * edge * edge * edge;
     if (volume > min_volume) continue;
     // A sliver that is inverted by less than the tolerance is reported as
     // zero-volume: its sign is not meaningful at that size.

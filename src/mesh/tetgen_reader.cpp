@@ -13,46 +13,31 @@
 //   nodes are the corners.
 //
 // Speed: the files are read whole and parsed in place with std::from_chars
-// (no streams, no per-line strings), so liver_382k (18 MB) parses in a
-// fraction of a second.
+// (text_scan.h: no streams, no per-line strings), so liver_382k (18 MB)
+// parses in a fraction of a second.
 #include <algorithm>
-#include <cerrno>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
 #include <limits>
 #include <new>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <vector>
 
 #include "sinew/mesh.h"
+#include "text_scan.h"
 
 namespace sinew {
 namespace {
 
 namespace fs = std::filesystem;
-
-Result<std::string> read_whole_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return Error(path.string() + ": cannot open file (it does not exist)");
-  if (!fs::is_regular_file(path, ec)) return Error(path.string() + ": not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error(path.string() + ": cannot open file (" + std::strerror(errno) + ")");
-  const auto size = fs::file_size(path, ec);
-  if (ec) return Error(path.string() + ": cannot read file size (" + ec.message() + ")");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) {
-    return Error(path.string() + ": read error (file shorter than its size " + std::to_string(size) + ")");
-  }
-  return text;
-}
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+using detail::is_space;
+using detail::parse_double;
+using detail::parse_int;
+using detail::Parsed;
+using detail::quoted;
+using detail::read_whole_file;
+using detail::Scanner;
+using detail::Where;
 
 // One line that holds data (comment removed) and its 1-based number.
 struct Record {
@@ -88,63 +73,6 @@ class RecordReader {
   std::size_t line_ = 0;
 };
 
-// Splits a record into whitespace-separated tokens.
-class Tokens {
- public:
-  explicit Tokens(std::string_view s) : s_(s) {}
-  bool next(std::string_view& tok) {
-    while (pos_ < s_.size() && is_space(s_[pos_])) ++pos_;
-    if (pos_ == s_.size()) return false;
-    const std::size_t begin = pos_;
-    while (pos_ < s_.size() && !is_space(s_[pos_])) ++pos_;
-    tok = s_.substr(begin, pos_ - begin);
-    return true;
-  }
-  std::size_t count() const {
-    Tokens copy(s_);
-    std::string_view t;
-    std::size_t n = 0;
-    while (copy.next(t)) ++n;
-    return n;
-  }
-
- private:
-  std::string_view s_;
-  std::size_t pos_ = 0;
-};
-
-bool parse_int(std::string_view tok, std::int64_t& out) {
-  if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
-  return ec == std::errc() && end == tok.data() + tok.size() && !tok.empty();
-}
-
-enum class Parsed { ok, not_a_number, not_finite };
-
-// from_chars accepts "nan" and "inf"; they are reported as non-finite
-// rather than as garbage, and overflow (1e999) counts as non-finite too.
-Parsed parse_double(std::string_view tok, double& out) {
-  if (tok.size() > 1 && tok.front() == '+' && tok[1] != '-') tok.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
-  if (end != tok.data() + tok.size() || tok.empty()) return Parsed::not_a_number;
-  if (ec == std::errc::result_out_of_range) return Parsed::not_finite;
-  if (ec != std::errc()) return Parsed::not_a_number;
-  return std::isfinite(out) ? Parsed::ok : Parsed::not_finite;
-}
-
-// Formats errors as "path:line: what".
-struct Where {
-  std::string file;
-  Error at(std::size_t line, const std::string& what) const {
-    return Error(file + ":" + std::to_string(line) + ": " + what);
-  }
-};
-
-std::string quoted(std::string_view tok) {
-  constexpr std::size_t kMax = 40;  // keep messages short for binary junk
-  return "'" + std::string(tok.substr(0, kMax)) + (tok.size() > kMax ? "...'" : "'");
-}
-
 // Reads the header's integer fields; missing trailing fields keep their
 // defaults, as in TetGen.
 Status read_header(RecordReader& reader, const Where& where, const char* layout,
@@ -154,7 +82,7 @@ Status read_header(RecordReader& reader, const Where& where, const char* layout,
     return where.at(reader.line(), std::string("empty file, expected the header '") + layout + "'");
   }
   line = r.line;
-  Tokens tokens(r.text);
+  Scanner tokens(r.text);
   std::string_view tok;
   for (std::int64_t& f : fields) {
     if (!tokens.next(tok)) break;
@@ -204,7 +132,7 @@ Status check_node_header(const std::vector<std::int64_t>& f, const Where& where,
 // Parses "<point #> <x> <y> <z> [attributes] [marker]".
 Status parse_node_line(const Record& r, const NodeHeader& h, const Where& where, std::int64_t& number,
                        Vec3d& p) {
-  Tokens tokens(r.text);
+  Scanner tokens(r.text);
   const std::size_t expected = static_cast<std::size_t>(4 + h.attributes + h.markers);
   const std::size_t got = tokens.count();
   if (got != expected) {
@@ -301,7 +229,7 @@ Status check_ele_header(const std::vector<std::int64_t>& f, const Where& where, 
 // Parses "<tet #> <node> x4 or x10 [attributes]" into 0-based corners.
 Status parse_ele_line(const Record& r, const EleHeader& h, const NodeFile& nodes, const Where& where,
                       std::array<std::uint32_t, 4>& tet) {
-  Tokens tokens(r.text);
+  Scanner tokens(r.text);
   const std::size_t expected = static_cast<std::size_t>(1 + h.nodes_per_tet + h.attributes);
   const std::size_t got = tokens.count();
   if (got != expected) {
