@@ -43,7 +43,8 @@ struct FrameStats {
   double measure_ms = 0.0;  ///< wall time spent measuring the errors below [ms]
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,
-  /// rest volume, ...): 0 when the xPBD system is solved exactly.
+  /// rest volume, ...): 0 when the xPBD system is solved exactly. Contact
+  /// and attachment residuals have no rest value and count in metres.
   double residual_rms = 0.0;
   double max_residual = 0.0;     ///< the largest of those normalised residuals
   double kinetic_energy = 0.0;   ///< sum of m |v|^2 / 2 over movable particles [J]
@@ -75,7 +76,8 @@ class Simulation {
   /// Moves kinematic target `index` to `position` [m] by the end of the next frame.
   Status set_target(std::size_t index, const std::array<double, 3>& position);
   /// Force [N] and torque [N m] (world frame, about the tool's centre)
-  /// acting on tool `index` during the next frame (then reset to zero).
+  /// acting on tool `index` during the next frame (then reset to zero);
+  /// calls before one step add up.
   Status apply_tool_force(std::size_t index, const std::array<double, 3>& force, const std::array<double, 3>& torque);
 
   /// A tool's state at the end of the last frame.

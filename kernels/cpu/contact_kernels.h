@@ -1,10 +1,49 @@
-// contact_kernels.h — CPU reference kernels of attachments and contacts. (Stage in progress: the kernels are stubs until it lands.)
+// contact_kernels.h — CPU reference kernels of attachments and contacts with
+// analytic colliders, and the geometry they share with the tests: collider
+// poses interpolated across a frame and the signed distance of each shape.
+// The layouts and the formulation are documented in
+// kernels/shared/contact_params.h.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
+#include "contact_params.h"
+#include "cpu/cpu_math.h"
+
 namespace sinew::kernels {
+
+/// A rigid pose: position p [m] (w unused) and unit quaternion q stored as
+/// (x, y, z, w) in the lanes of a float4 (w the scalar part).
+struct Pose {
+  float4 p;
+  float4 q;
+};
+
+/// Rotates v (xyz) by the unit quaternion q: v + 2 w (u x v) + 2 u x (u x v), u = q.xyz.
+inline float4 rotate(float4 q, float4 v) {
+  const float4 t = 2.0f * cross3(q, v);
+  const float4 r = v + q.w * t + cross3(q, t);
+  return {r.x, r.y, r.z, 0.0f};
+}
+
+/// Rotates v by the inverse of the unit quaternion q.
+inline float4 rotate_inverse(float4 q, float4 v) { return rotate(float4{-q.x, -q.y, -q.z, q.w}, v); }
+
+/// The collider's pose at fraction t in [0, 1] of the frame: positions
+/// lerped, rotations nlerped on the shorter arc.
+Pose collider_pose(const ColliderEntry& e, float t);
+
+/// Signed distance [m] of a point given in the collider's frame (negative
+/// inside), and the outward unit normal there, in the collider's frame.
+/// Box inside: the distance to the nearest face (normal of that face);
+/// outside: the distance to the box. Points on a sphere's centre or a
+/// capsule's axis, where the normal is undefined, get +y (sphere) or +x.
+struct SignedDistance {
+  float distance;
+  float4 normal;
+};
+SignedDistance collider_distance(const ColliderEntry& e, float4 local);
 
 void xpbd_solve_attachment(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 void xpbd_solve_contacts(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);

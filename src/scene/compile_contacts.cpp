@@ -1,12 +1,142 @@
-// compile_contacts.cpp — colliders, tools and attachments. (Stage in progress.)
+// compile_contacts.cpp — colliders, tools and attachments: the collider and
+// target buffers (kernels/shared/contact_params.h), one contact constraint
+// per movable particle and one attachment constraint per attached vertex.
+// Called after every body has been added, so the particle layout is final.
+#include <array>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "contact_params.h"
 #include "scene/scene_compiler.h"
 
 namespace sinew {
+namespace {
 
-Status add_contacts(SceneBuilder&, const SceneDesc& scene, CompiledScene&) {
-  if (!scene.colliders.empty()) return Error("colliders are not supported yet by this version of sinew");
-  if (!scene.tools.empty()) return Error("tools are not supported yet by this version of sinew");
-  if (!scene.attachments.empty()) return Error("attachments are not supported yet by this version of sinew");
+using kernels::ColliderEntry;
+using kernels::ColliderHeader;
+using kernels::TargetEntry;
+
+template <class T>
+void append(std::vector<float>& out, const T& value) {
+  static_assert(sizeof(T) % sizeof(float) == 0);
+  const std::size_t at = out.size();
+  out.resize(at + sizeof(T) / sizeof(float));
+  std::memcpy(out.data() + at, &value, sizeof(T));
+}
+
+ColliderEntry entry(std::uint32_t shape, const std::array<double, 3>& position, const std::array<double, 4>& rotation) {
+  ColliderEntry e{};
+  e.shape = shape;
+  e.start_px = e.end_px = static_cast<float>(position[0]);
+  e.start_py = e.end_py = static_cast<float>(position[1]);
+  e.start_pz = e.end_pz = static_cast<float>(position[2]);
+  e.start_qw = e.end_qw = static_cast<float>(rotation[0]);
+  e.start_qx = e.end_qx = static_cast<float>(rotation[1]);
+  e.start_qy = e.end_qy = static_cast<float>(rotation[2]);
+  e.start_qz = e.end_qz = static_cast<float>(rotation[3]);
+  return e;
+}
+
+std::uint32_t shape_code(ColliderShape shape) {
+  switch (shape) {
+    case ColliderShape::plane: return SINEW_SHAPE_PLANE;
+    case ColliderShape::sphere: return SINEW_SHAPE_SPHERE;
+    case ColliderShape::capsule: return SINEW_SHAPE_CAPSULE;
+    case ColliderShape::box: return SINEW_SHAPE_BOX;
+  }
+  return SINEW_SHAPE_PLANE;
+}
+
+std::uint32_t first_particle(const CompiledScene& out, const VertexRef& v) {
+  switch (v.body_kind) {
+    case BodyKind::tet: return out.tet_body_first_particle[v.body];
+    case BodyKind::tri: return out.tri_body_first_particle[v.body];
+    case BodyKind::line: return out.line_body_first_particle[v.body];
+  }
+  return 0;
+}
+
+}  // namespace
+
+Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out) {
+  const auto colliders = static_cast<std::uint32_t>(scene.colliders.size());
+  const auto tools = static_cast<std::uint32_t>(scene.tools.size());
+  const auto particles = static_cast<std::uint32_t>(b.positions.size());
+
+  // The collider buffer: header, scene colliders, then tools as capsules.
+  ColliderHeader header{};
+  header.colliders = colliders;
+  header.tools = tools;
+  header.substep_fraction = static_cast<float>(1.0 / scene.solver.substeps);
+  out.colliders.clear();
+  append(out.colliders, header);
+  for (const ColliderDesc& c : scene.colliders) {
+    ColliderEntry e = entry(shape_code(c.shape), c.position, c.rotation);
+    e.radius = static_cast<float>(c.radius);
+    e.half_height = static_cast<float>(c.half_height);
+    e.half_x = static_cast<float>(c.half_extents[0]);
+    e.half_y = static_cast<float>(c.half_extents[1]);
+    e.half_z = static_cast<float>(c.half_extents[2]);
+    e.static_friction = static_cast<float>(c.static_friction);
+    e.dynamic_friction = static_cast<float>(c.dynamic_friction);
+    e.compliance = static_cast<float>(c.compliance);
+    append(out.colliders, e);
+  }
+  for (const ToolDesc& t : scene.tools) {
+    ColliderEntry e = entry(SINEW_SHAPE_CAPSULE, t.position, t.rotation);
+    e.radius = static_cast<float>(t.radius);
+    e.half_height = static_cast<float>(t.half_height);
+    e.static_friction = static_cast<float>(t.static_friction);
+    e.dynamic_friction = static_cast<float>(t.dynamic_friction);
+    e.compliance = static_cast<float>(t.compliance);
+    append(out.colliders, e);
+  }
+
+  out.targets.clear();
+  for (const auto& t : scene.targets) {
+    TargetEntry e{};
+    e.start_x = e.end_x = static_cast<float>(t[0]);
+    e.start_y = e.end_y = static_cast<float>(t[1]);
+    e.start_z = e.end_z = static_cast<float>(t[2]);
+    append(out.targets, e);
+  }
+
+  // Contacts: every movable particle against every collider and tool.
+  out.contact_impulse_slots = 0;
+  const std::uint32_t surfaces = colliders + tools;
+  if (surfaces > 0 && particles > 0) {
+    const std::uint64_t slots = std::uint64_t{SINEW_CONTACT_IMPULSE_FLOAT4S} * particles * tools;
+    if (slots > std::numeric_limits<std::uint32_t>::max() / 4)
+      return Error("tools: " + std::to_string(tools) + " tools and " + std::to_string(particles) +
+                   " particles need more contact-impulse slots than 32-bit sizes address");
+    RawConstraints& contacts =
+        b.constraints(Kernel::xpbd_solve_contacts, 1, SINEW_CONTACT_DATA_STRIDE,
+                      SINEW_CONTACT_LAMBDA_PER_COLLIDER * surfaces,
+                      {SceneBuffer::previous_position, SceneBuffer::colliders, SceneBuffer::contact_impulses});
+    for (std::uint32_t p = 0; p < particles; ++p) {
+      if (!(b.mass[p] > 0.0)) continue;  // pinned: never moves, never collides
+      contacts.particles.push_back(p);
+      contacts.data.push_back(0.0f);  // margin [m]: mesh vertices touch the surface itself
+    }
+    if (tools > 0) out.contact_impulse_slots = static_cast<std::uint32_t>(slots);
+  }
+
+  // Attachments: a zero-length constraint from a vertex to its target. The
+  // colouring puts several attachments of one particle in different colours.
+  if (scene.targets.size() >= (std::size_t{1} << 24))
+    return Error("targets: " + std::to_string(scene.targets.size()) +
+                 " targets are more than the 2^24 an attachment can index");
+  for (const AttachmentDesc& a : scene.attachments) {
+    const std::uint32_t particle = first_particle(out, a.vertex) + a.vertex.vertex;
+    if (!(b.mass[particle] > 0.0)) continue;  // a pinned vertex stays where it is
+    RawConstraints& attachments = b.constraints(Kernel::xpbd_solve_attachment, 1, SINEW_ATTACHMENT_DATA_STRIDE, 1,
+                                                {SceneBuffer::targets});
+    attachments.particles.push_back(particle);
+    attachments.data.push_back(static_cast<float>(a.target));
+    attachments.data.push_back(static_cast<float>(a.compliance));
+  }
   return {};
 }
 

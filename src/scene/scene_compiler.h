@@ -21,7 +21,7 @@ enum class SceneBuffer {
   previous_position,  ///< float4 per particle: positions at the start of the substep
   colliders,          ///< CompiledScene::colliders (kernels/shared/contact_params.h)
   targets,            ///< CompiledScene::targets (kernels/shared/contact_params.h)
-  contact_impulses,   ///< float4 per particle and tool: what the tissue pushed back with
+  contact_impulses,   ///< SINEW_CONTACT_IMPULSE_FLOAT4S float4 per particle and tool (see contact_params.h)
 };
 
 struct ConstraintBlock {

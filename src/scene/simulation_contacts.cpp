@@ -1,32 +1,493 @@
-// simulation_contacts.cpp — moving colliders and targets between frames,
-// and the tools' rigid-body state. (Stage in progress.)
+// simulation_contacts.cpp — moving colliders and targets between frames, and
+// the tools' rigid-body motion.
+//
+// Colliders and targets: each entry of the collider and target buffers
+// (kernels/shared/contact_params.h) holds a pose at the start and at the end
+// of the frame, which the kernels interpolate per substep. set_collider_pose
+// and set_target write the end pose; after each frame the start pose becomes
+// that end pose. The buffers are uploaded before a frame only when something
+// changed, so static colliders cost no transfer.
+//
+// Tools: a tool is a capsule collider whose motion the host integrates. The
+// coupling with the tissue is explicit and one frame long:
+//  1. before frame n (before_frame): semi-implicit Euler over the frame with
+//     the applied force and torque (apply_tool_force), gravity, and the
+//     tissue's reaction measured in frame n-1: v += dt F / M, x += dt v;
+//     the angular velocity likewise from the torque (inertia in the body
+//     frame, the gyroscopic term implicit), q += dt/2 (0, omega) q. The
+//     tool's collider then moves from its old to its new pose across frame
+//     n's substeps.
+//  2. during frame n the tool is an infinitely heavy kinematic collider: the
+//     particles it touches are pushed out and dragged by friction, and each
+//     correction's impulse (with its moment about the tool's centre) is
+//     summed per particle and tool in the contact-impulse buffer.
+//  3. after frame n (after_frame): the sums are read back and reduced in
+//     particle order, in double precision (deterministic), to the frame's
+//     average contact force and torque (reported by tool_state) and to the
+//     force and torque of the frame's last substep, which step 1 uses: that
+//     one belongs to the pose the tool has at the end of the frame, so the
+//     scheme is symplectic Euler on the tool. (Coupling with the frame
+//     average, which belongs to the middle of the frame, lags half a frame
+//     and pumps energy into the tool at any mass: x_{n+1} - 2 x_n + x_{n-1}
+//     = -(omega dt)^2 (x_n + x_{n-1}) / 2 has roots of modulus
+//     sqrt(1 + (omega dt)^2 / 2) > 1.)
+// Limits.
+//  - Stability: explicit Euler on a contact of stiffness k is stable while
+//    sqrt(k / M) dt < 2. That holds for a tool much heavier than the
+//    particles it touches. A slender tool's tiny inertia about its own axis
+//    would break it in rotation, so rotation is stabilised by the touching
+//    particles' inertia; a light tool would break it in translation, so its
+//    mass is floored at what the bound needs (see integrate()). Neither
+//    makes a light tool right: the tissue is pushed by the tool's full
+//    motion as if the tool were immovable and answers a frame later. In the
+//    tests' scene (20 substeps at 60 Hz) a tool 10^4 times as heavy as a
+//    particle rests; one 3 10^3 times or lighter is not held: it drifts
+//    sideways and slides off the block within a few seconds (without the
+//    mass floor, one 10^2 times as heavy was thrown off at 1.8 m/s). Drive a
+//    light or hand-held tool through a virtual coupling (a spring-damper
+//    from the user's pose, via apply_tool_force, stiff no more than the
+//    bound allows) or use a shorter time step.
+//  - Tunnelling: contacts are between particles (mesh vertices) and the
+//    tool's surface, not the tissue's faces. A tool M times as heavy as the
+//    N particles of mass m it rests on pushes them about
+//    (M / (N m)) g h^2 / iterations deep per substep before the tissue's
+//    response reaches them; when that nears the vertex spacing, or a tool
+//    is narrower than it, the tool pushes vertices apart and passes between
+//    them. More substeps (smaller h) or a finer surface mesh cure it.
+//  - A resting tool keeps a small jitter (no damping is added); compare
+//    averages of tool_state over a few frames.
+//
+// State: Simulation::Impl holds no member for the tools yet, so their rigid
+// state (double precision) and the impulse read-back buffer are kept in
+// Impl::colliders after the part that is uploaded:
+//   [ColliderHeader][ColliderEntry x (colliders + tools)] | [Book][ToolBody x tools][impulses]
+// All memory is sized in init_contacts; nothing here allocates per frame.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <string>
+
+#include "contact_params.h"
 #include "scene/simulation_impl.h"
 
 namespace sinew {
+namespace {
 
-Status Simulation::Impl::init_contacts(const SceneDesc&, const CompiledScene& compiled) {
-  colliders = compiled.colliders;
-  targets = compiled.targets;
+using kernels::ColliderEntry;
+using kernels::ColliderHeader;
+using kernels::TargetEntry;
+using V3 = std::array<double, 3>;
+using Q4 = std::array<double, 4>;  // (w, x, y, z)
+
+constexpr std::size_t kHeaderFloats = sizeof(ColliderHeader) / sizeof(float);
+constexpr std::size_t kEntryFloats = sizeof(ColliderEntry) / sizeof(float);
+constexpr std::size_t kTargetFloats = sizeof(TargetEntry) / sizeof(float);
+
+// Host bookkeeping, after the uploaded part of Impl::colliders.
+struct Book {
+  std::uint32_t colliders, tools, impulse_floats;
+  std::uint32_t colliders_dirty, targets_dirty;
+  std::uint32_t substeps, iterations, pad0;
+};
+
+// A tool's rigid state.
+struct ToolBody {
+  V3 position, velocity, angular_velocity;  // [m], [m/s], world [rad/s]
+  Q4 rotation;                              // unit (w, x, y, z)
+  V3 force, torque;                         // applied during the next frame [N], [N m]
+  V3 contact_force, contact_torque;         // the tissue's reaction, last frame's average
+  V3 coupling_force, coupling_torque;       // the reaction in the last frame's last substep
+  // The particles touching it at the end of the last frame: their mass
+  // [kg] and their inertia about its centre, sum m (|r|^2 I - r r^T)
+  // [kg m^2], world frame, row-major.
+  double touching_mass;
+  std::array<double, 9> touching_inertia;
+  V3 gravity;                               // [m/s^2], zero when ToolDesc::gravity is off
+  V3 inertia;                               // principal moments, body frame [kg m^2]
+  double mass;                              // [kg]
+};
+
+template <class T>
+T load(const std::vector<float>& v, std::size_t at) {
+  T t;
+  std::memcpy(&t, v.data() + at, sizeof(T));
+  return t;
+}
+template <class T>
+void store(std::vector<float>& v, std::size_t at, const T& t) {
+  std::memcpy(v.data() + at, &t, sizeof(T));
+}
+
+std::size_t device_floats(const std::vector<float>& c) {
+  const auto h = load<ColliderHeader>(c, 0);
+  return kHeaderFloats + std::size_t{h.colliders + h.tools} * kEntryFloats;
+}
+std::size_t entry_at(std::size_t k) { return kHeaderFloats + k * kEntryFloats; }
+std::size_t book_at(const std::vector<float>& c) { return device_floats(c); }
+std::size_t tool_at(const std::vector<float>& c, std::size_t t) {
+  return book_at(c) + (sizeof(Book) + t * sizeof(ToolBody)) / sizeof(float);
+}
+std::size_t impulses_at(const std::vector<float>& c, std::size_t tools) { return tool_at(c, tools); }
+static_assert(sizeof(Book) % sizeof(float) == 0 && sizeof(ToolBody) % sizeof(float) == 0);
+
+std::string str(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+Status check_index(const char* call, const char* what, std::size_t index, std::size_t count) {
+  if (index < count) return {};
+  return Error(std::string(call) + ": index " + std::to_string(index) + " is not a " + what + " (the scene has " +
+               std::to_string(count) + ")");
+}
+
+Status check_finite(const char* call, const char* name, const V3& v) {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(v[k]))
+      return Error(std::string(call) + ": " + name + "[" + std::to_string(k) + "] must be finite (got " + str(v[k]) +
+                   ")");
   return {};
 }
 
-Status Simulation::Impl::before_frame() { return {}; }
-Status Simulation::Impl::after_frame() { return {}; }
-
-Status Simulation::set_collider_pose(std::size_t index, const std::array<double, 3>&, const std::array<double, 4>&) {
-  return Error("set_collider_pose: collider " + std::to_string(index) + " does not exist");
+Status check_rotation(const char* call, const Q4& q) {
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-6)
+    return Error(std::string(call) + ": rotation must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
+  return {};
 }
 
-Status Simulation::set_target(std::size_t index, const std::array<double, 3>&) {
-  return Error("set_target: target " + std::to_string(index) + " does not exist");
+void set_end_pose(ColliderEntry& e, const V3& p, const Q4& q) {
+  e.end_px = static_cast<float>(p[0]);
+  e.end_py = static_cast<float>(p[1]);
+  e.end_pz = static_cast<float>(p[2]);
+  e.end_qw = static_cast<float>(q[0]);
+  e.end_qx = static_cast<float>(q[1]);
+  e.end_qy = static_cast<float>(q[2]);
+  e.end_qz = static_cast<float>(q[3]);
 }
 
-Status Simulation::apply_tool_force(std::size_t index, const std::array<double, 3>&, const std::array<double, 3>&) {
-  return Error("apply_tool_force: tool " + std::to_string(index) + " does not exist");
+// Start pose := end pose; true when that changed it.
+bool settle(ColliderEntry& e) {
+  const bool moved = e.start_px != e.end_px || e.start_py != e.end_py || e.start_pz != e.end_pz ||
+                     e.start_qw != e.end_qw || e.start_qx != e.end_qx || e.start_qy != e.end_qy ||
+                     e.start_qz != e.end_qz;
+  e.start_px = e.end_px;
+  e.start_py = e.end_py;
+  e.start_pz = e.end_pz;
+  e.start_qw = e.end_qw;
+  e.start_qx = e.end_qx;
+  e.start_qy = e.end_qy;
+  e.start_qz = e.end_qz;
+  return moved;
+}
+
+V3 cross(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+// v rotated by the unit quaternion q (inverse: conjugate first).
+V3 rotate(const Q4& q, const V3& v, bool inverse = false) {
+  const V3 u{inverse ? -q[1] : q[1], inverse ? -q[2] : q[2], inverse ? -q[3] : q[3]};
+  V3 t = cross(u, v);
+  for (double& c : t) c *= 2.0;
+  const V3 ut = cross(u, t);
+  return {v[0] + q[0] * t[0] + ut[0], v[1] + q[0] * t[1] + ut[1], v[2] + q[0] * t[2] + ut[2]};
+}
+
+using M3 = std::array<V3, 3>;  // row-major
+
+double det3(const M3& a) {
+  return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+         a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+}
+
+// Solves a x = f by Cramer's rule; false (x untouched) when a is singular.
+bool solve3(const M3& a, const V3& f, V3& x) {
+  const double d = det3(a);
+  if (!(std::abs(d) > 0.0) || !std::isfinite(d)) return false;
+  V3 out;
+  for (int k = 0; k < 3; ++k) {
+    M3 m = a;
+    for (int r = 0; r < 3; ++r) m[r][k] = f[r];
+    out[k] = det3(m) / d;
+  }
+  x = out;
+  return true;
+}
+
+// One Newton step of implicit Euler on I (w' - w) + dt w' x (I w') = 0 from
+// w' = w, in the body frame: w' = w - J^-1 dt w x (I w) with
+// J = I + dt (skew(w) I - skew(I w)).
+V3 gyroscopic_step(const V3& inertia, const V3& w, double dt) {
+  const V3 iw{inertia[0] * w[0], inertia[1] * w[1], inertia[2] * w[2]};
+  V3 f = cross(w, iw);
+  for (double& c : f) c *= dt;
+  auto skew = [](const V3& v) { return M3{V3{0.0, -v[2], v[1]}, V3{v[2], 0.0, -v[0]}, V3{-v[1], v[0], 0.0}}; };
+  const M3 sw = skew(w), siw = skew(iw);
+  M3 j;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) j[r][c] = (r == c ? inertia[r] : 0.0) + dt * (sw[r][c] * inertia[c] - siw[r][c]);
+  V3 step{0.0, 0.0, 0.0};
+  if (!solve3(j, f, step)) return w;
+  return {w[0] - step[0], w[1] - step[1], w[2] - step[2]};
+}
+
+// One semi-implicit Euler step of the tool over dt.
+//
+// The explicit coupling is stable while (omega dt)^2 = k dt^2 / M < 4 for
+// the contact's stiffness k. A bound on k: within a substep of length h, a
+// touching particle of mass m_i passes on at most about m_i / h^2 per unit
+// of the tool's displacement per iteration, so k <= K = n_it sum_i m_i / h^2
+// and dt^2 K = n_it n_sub^2 sum_i m_i (and likewise for rotation, with the
+// particles' inertia sum_i m_i (|r_i|^2 I - r_i r_i^T) about the tool's
+// centre). So:
+//  - translation uses the tool's mass M, or dt^2 K / 4 where that is more:
+//    a tool heavy enough for the bound is integrated as it is (the tests'
+//    10^4 mass ratio is); a lighter one is slowed down (over-damped) rather
+//    than thrown off. (Adding dt^2 K to M always, as for rotation, would
+//    also let a heavy tool sink deeper before the tissue stops it.)
+//  - rotation solves (I_tool + dt^2 K) dw = dt tau: (omega dt)^2 < 1 however
+//    small the tool's inertia. That matters for a slender tool, whose
+//    inertia about its own axis (m r^2 / 2) is tiny: without it, friction
+//    spins the tool up until it rolls away. Rotation while touching is
+//    slower than it would be.
+// Equilibria are unchanged (no velocity change where the force and torque
+// vanish). `stiffness` is n_it n_sub^2.
+void integrate(ToolBody& b, double dt, double stiffness) {
+  V3 force, torque;
+  for (int k = 0; k < 3; ++k) {
+    force[k] = b.force[k] + b.coupling_force[k] + b.mass * b.gravity[k];
+    torque[k] = b.torque[k] + b.coupling_torque[k];
+  }
+  // Translation: the tool's own mass, raised where needed to the least
+  // mass that keeps explicit Euler inside its stability bound against K:
+  // dt^2 K / M <= 4 with dt^2 K = n_it n_sub^2 sum m_i (see above).
+  const double mass = std::max(b.mass, 0.25 * stiffness * b.touching_mass);
+  for (int k = 0; k < 3; ++k) b.velocity[k] += dt * force[k] / mass;
+  // The tool's inertia in the world frame, R I R^T, plus the touching
+  // particles' scaled inertia about its centre.
+  M3 a;
+  for (int c = 0; c < 3; ++c) {
+    V3 e{0.0, 0.0, 0.0};
+    e[c] = 1.0;
+    V3 local = rotate(b.rotation, e, true);
+    for (int k = 0; k < 3; ++k) local[k] *= b.inertia[k];
+    const V3 column = rotate(b.rotation, local);
+    for (int r = 0; r < 3; ++r) a[r][c] = column[r] + stiffness * b.touching_inertia[3 * r + c];
+  }
+  V3 dw{0.0, 0.0, 0.0};
+  const V3 impulse{dt * torque[0], dt * torque[1], dt * torque[2]};
+  if (solve3(a, impulse, dw))  // a is symmetric positive definite: inertia > 0
+    for (int k = 0; k < 3; ++k) b.angular_velocity[k] += dw[k];
+  // The gyroscopic term of Euler's equations, I dw/dt = -w x (I w) in the
+  // body frame, implicitly by one Newton step (Catto, "Numerical Methods",
+  // GDC 2015): explicitly, a free tumbling tool would gain energy.
+  b.angular_velocity = rotate(b.rotation, gyroscopic_step(b.inertia, rotate(b.rotation, b.angular_velocity, true), dt));
+
+  for (int k = 0; k < 3; ++k) b.position[k] += dt * b.velocity[k];
+  const V3& o = b.angular_velocity;
+  const Q4& q = b.rotation;
+  const Q4 dq{-(o[0] * q[1] + o[1] * q[2] + o[2] * q[3]), o[0] * q[0] + o[1] * q[3] - o[2] * q[2],
+              o[1] * q[0] + o[2] * q[1] - o[0] * q[3], o[2] * q[0] + o[0] * q[2] - o[1] * q[1]};  // (0, o) q
+  Q4 r;
+  double norm = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    r[k] = q[k] + 0.5 * dt * dq[k];
+    norm += r[k] * r[k];
+  }
+  norm = std::sqrt(norm);
+  for (double& c : r) c /= norm;
+  b.rotation = r;
+  b.force = b.torque = V3{0.0, 0.0, 0.0};
+}
+
+}  // namespace
+
+Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledScene& compiled) {
+  colliders = compiled.colliders;
+  targets = compiled.targets;
+  if (colliders.size() < kHeaderFloats) {  // no collider buffer compiled: an empty header
+    colliders.assign(kHeaderFloats, 0.0f);
+    store(colliders, 0, ColliderHeader{0, 0, 1.0f, 0});
+  }
+  const auto header = load<ColliderHeader>(colliders, 0);
+  if (header.colliders != scene.colliders.size() || header.tools != scene.tools.size() ||
+      colliders.size() != device_floats(colliders))
+    return Error("internal: the compiled collider buffer does not match the scene's colliders and tools");
+
+  const std::size_t tools = scene.tools.size();
+  const std::size_t impulse_floats = std::size_t{compiled.contact_impulse_slots} * 4;
+  colliders.resize(impulses_at(colliders, tools) + impulse_floats, 0.0f);
+  store(colliders, book_at(colliders),
+        Book{header.colliders, header.tools, static_cast<std::uint32_t>(impulse_floats), 0, 0,
+             static_cast<std::uint32_t>(scene.solver.substeps), static_cast<std::uint32_t>(scene.solver.iterations),
+             0});
+  for (std::size_t t = 0; t < tools; ++t) {
+    const ToolDesc& d = scene.tools[t];
+    ToolBody b{};
+    b.position = d.position;
+    b.rotation = d.rotation;
+    if (d.gravity) b.gravity = scene.gravity;
+    b.inertia = d.inertia;
+    b.mass = d.mass;
+    store(colliders, tool_at(colliders, t), b);
+  }
+  return {};
+}
+
+Status Simulation::Impl::before_frame() {
+  Book book = load<Book>(colliders, book_at(colliders));
+  for (std::uint32_t t = 0; t < book.tools; ++t) {
+    auto b = load<ToolBody>(colliders, tool_at(colliders, t));
+    const std::size_t at = entry_at(book.colliders + t);
+    auto e = load<ColliderEntry>(colliders, at);
+    integrate(b, time_step, double(book.iterations) * book.substeps * book.substeps);
+    settle(e);  // the frame starts where the last one ended
+    set_end_pose(e, b.position, b.rotation);
+    store(colliders, at, e);
+    store(colliders, tool_at(colliders, t), b);
+    book.colliders_dirty = 1;
+  }
+  if (book.colliders_dirty) {
+    const std::size_t bytes = device_floats(colliders) * sizeof(float);
+    if (Status s = device->write_buffer(buffers.colliders, 0, colliders.data(), bytes); !s) return s;
+    book.colliders_dirty = 0;
+  }
+  if (book.targets_dirty && !targets.empty()) {
+    if (Status s = device->write_buffer(buffers.targets, 0, targets.data(), targets.size() * sizeof(float)); !s)
+      return s;
+  }
+  book.targets_dirty = 0;
+  store(colliders, book_at(colliders), book);
+  return {};
+}
+
+Status Simulation::Impl::after_frame() {
+  Book book = load<Book>(colliders, book_at(colliders));
+  // What moved during this frame stays at its end pose from now on.
+  for (std::uint32_t k = 0; k < book.colliders; ++k) {
+    auto e = load<ColliderEntry>(colliders, entry_at(k));
+    if (settle(e)) {
+      store(colliders, entry_at(k), e);
+      book.colliders_dirty = 1;
+    }
+  }
+  for (std::size_t at = 0; at + kTargetFloats <= targets.size(); at += kTargetFloats) {
+    auto e = load<TargetEntry>(targets, at);
+    if (e.start_x != e.end_x || e.start_y != e.end_y || e.start_z != e.end_z) {
+      e.start_x = e.end_x;
+      e.start_y = e.end_y;
+      e.start_z = e.end_z;
+      store(targets, at, e);
+      book.targets_dirty = 1;
+    }
+  }
+  store(colliders, book_at(colliders), book);
+  if (book.tools == 0) return {};
+
+  // The tissue's reaction on each tool: the frame's impulse sums, reduced
+  // in particle order in double precision.
+  float* impulses = colliders.data() + impulses_at(colliders, book.tools);
+  if (book.impulse_floats > 0)
+    if (Status s = device->read_buffer(buffers.contact_impulses, 0, impulses, book.impulse_floats * sizeof(float)); !s)
+      return s;
+  const std::size_t particles = book.impulse_floats / (4 * SINEW_CONTACT_IMPULSE_FLOAT4S * std::size_t{book.tools});
+  const double h = time_step / book.substeps;
+  for (std::uint32_t t = 0; t < book.tools; ++t) {
+    double sums[4][3] = {};  // frame impulse, its moment, last substep's impulse, its moment
+    double mass = 0.0;
+    std::array<double, 9> inertia{};
+    for (std::size_t p = 0; p < particles; ++p) {
+      const float* slot = impulses + (p * book.tools + t) * SINEW_CONTACT_IMPULSE_FLOAT4S * 4;
+      for (int s = 0; s < 4; ++s)
+        for (int k = 0; k < 3; ++k) sums[s][k] += slot[4 * s + k];
+      const double m = slot[19];
+      if (m > 0.0) {  // touching at the end of the frame: lever r = slot[16..18]
+        const V3 r{slot[16], slot[17], slot[18]};
+        const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        mass += m;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) inertia[3 * i + j] += m * ((i == j ? r2 : 0.0) - r[i] * r[j]);
+      }
+    }
+    auto b = load<ToolBody>(colliders, tool_at(colliders, t));
+    for (int k = 0; k < 3; ++k) {
+      b.contact_force[k] = sums[0][k] / time_step;
+      b.contact_torque[k] = sums[1][k] / time_step;
+      b.coupling_force[k] = sums[2][k] / h;
+      b.coupling_torque[k] = sums[3][k] / h;
+    }
+    b.touching_mass = mass;
+    b.touching_inertia = inertia;
+    store(colliders, tool_at(colliders, t), b);
+  }
+  return {};
+}
+
+Status Simulation::set_collider_pose(std::size_t index, const std::array<double, 3>& position,
+                                     const std::array<double, 4>& rotation) {
+  constexpr const char* call = "set_collider_pose";
+  std::vector<float>& c = impl_->colliders;
+  Book book = load<Book>(c, book_at(c));
+  if (Status s = check_index(call, "collider", index, book.colliders); !s) return s;
+  if (Status s = check_finite(call, "position", position); !s) return s;
+  if (Status s = check_rotation(call, rotation); !s) return s;
+  auto e = load<ColliderEntry>(c, entry_at(index));
+  set_end_pose(e, position, rotation);
+  store(c, entry_at(index), e);
+  book.colliders_dirty = 1;
+  store(c, book_at(c), book);
+  return {};
+}
+
+Status Simulation::set_target(std::size_t index, const std::array<double, 3>& position) {
+  constexpr const char* call = "set_target";
+  std::vector<float>& targets = impl_->targets;
+  if (Status s = check_index(call, "target", index, targets.size() / kTargetFloats); !s) return s;
+  if (Status s = check_finite(call, "position", position); !s) return s;
+  auto e = load<TargetEntry>(targets, index * kTargetFloats);
+  e.end_x = static_cast<float>(position[0]);
+  e.end_y = static_cast<float>(position[1]);
+  e.end_z = static_cast<float>(position[2]);
+  store(targets, index * kTargetFloats, e);
+  std::vector<float>& c = impl_->colliders;
+  Book book = load<Book>(c, book_at(c));
+  book.targets_dirty = 1;
+  store(c, book_at(c), book);
+  return {};
+}
+
+Status Simulation::apply_tool_force(std::size_t index, const std::array<double, 3>& force,
+                                    const std::array<double, 3>& torque) {
+  constexpr const char* call = "apply_tool_force";
+  std::vector<float>& c = impl_->colliders;
+  const Book book = load<Book>(c, book_at(c));
+  if (Status s = check_index(call, "tool", index, book.tools); !s) return s;
+  if (Status s = check_finite(call, "force", force); !s) return s;
+  if (Status s = check_finite(call, "torque", torque); !s) return s;
+  auto b = load<ToolBody>(c, tool_at(c, index));
+  for (int k = 0; k < 3; ++k) {  // calls before one frame add up
+    b.force[k] += force[k];
+    b.torque[k] += torque[k];
+  }
+  store(c, tool_at(c, index), b);
+  return {};
 }
 
 Result<Simulation::ToolState> Simulation::tool_state(std::size_t index) const {
-  return Error("tool_state: tool " + std::to_string(index) + " does not exist");
+  const std::vector<float>& c = impl_->colliders;
+  const Book book = load<Book>(c, book_at(c));
+  if (Status s = check_index("tool_state", "tool", index, book.tools); !s) return s.error();
+  const auto b = load<ToolBody>(c, tool_at(c, index));
+  ToolState state;
+  state.position = b.position;
+  state.rotation = b.rotation;
+  state.velocity = b.velocity;
+  state.angular_velocity = b.angular_velocity;
+  state.contact_force = b.contact_force;
+  state.contact_torque = b.contact_torque;
+  return state;
 }
 
 }  // namespace sinew

@@ -2,6 +2,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "xpbd_params.h"
+#include "contact_params.h"
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { SolveParams p; };
 layout(std430, binding = 0) buffer Positions { vec4 x[]; };
