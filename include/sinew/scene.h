@@ -31,6 +31,10 @@ namespace sinew {
 ///    (det R = +1, so inverted tets are pushed back): C_D = |F - R|_F,
 ///    alpha = 1/(2 mu V); C_H = tr(R^T F) - 3, alpha = 1/(lambda V).
 /// Every model is invertible: its hydrostatic constraint pushes det F > 0.
+/// stvk and corotational need nu > 0 (lambda > 0; Simulation::create names
+/// poisson_ratio otherwise). neo_hookean needs small steps: its shear acts
+/// explicitly, so keep h sqrt(mu / rho) / (edge length) below ~0.2 (above
+/// ~0.75 it is unstable); see README, "FEM materials".
 enum class TetMaterial { none, neo_hookean, stvk, corotational };
 
 /// A volumetric body simulated on a tet mesh with xPBD constraints.

@@ -26,12 +26,15 @@ struct SceneInfo {
   std::uint32_t volume_constraints = 0;
   std::uint32_t distance_colors = 0;  ///< colours of the distance constraints
   std::uint32_t volume_colors = 0;    ///< colours of the volume constraints
+  std::uint32_t other_constraints = 0;  ///< every other kind (FEM tets, thin bodies, contacts, attachments)
   std::uint32_t colors = 0;           ///< dependent sweeps per iteration (sum of the above)
   std::uint32_t dispatches_per_frame = 0;
   std::uint32_t barriers_per_frame = 0;
   std::vector<std::uint32_t> tet_body_first_particle;   ///< body i's vertex 0 is this particle
   std::vector<std::uint32_t> line_body_first_particle;
-  [[nodiscard]] std::uint32_t constraints() const { return distance_constraints + volume_constraints; }
+  [[nodiscard]] std::uint32_t constraints() const {
+    return distance_constraints + volume_constraints + other_constraints;
+  }
 };
 
 /// Timing and error of the last frame. The errors are measured when

@@ -99,6 +99,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     } else if (block.kernel == Kernel::xpbd_solve_volume) {
       info.volume_constraints += block.size();
       info.volume_colors += block.colors();
+    } else {
+      info.other_constraints += block.size();
     }
     info.colors += block.colors();
   }

@@ -3,10 +3,11 @@
 #extension GL_GOOGLE_include_directive : require
 #include "xpbd_params.h"
 #include "contact_params.h"
+#include "fem_params.h"
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { SolveParams p; };
 layout(std430, binding = 0) buffer Positions { vec4 x[]; };
 void main() {
   uint i = gl_GlobalInvocationID.x;
-  if (i < p.count) x[p.first + i].x += p.inv_h2 * p.h;
+  if (i < p.count) x[p.first + i].x += p.inv_h2 * p.h * SINEW_FEM_DATA_STRIDE;
 }
