@@ -64,6 +64,22 @@ std::vector<ExtremeCase> cases() {
                  return with(b);
                },
                kCubeEnergy, -0.01, 0.01});
+  for (auto [name, model] : {std::pair{"Corotational", TetMaterial::corotational}, std::pair{"StVK", TetMaterial::stvk}}) {
+    c.push_back({std::string(name) + "E1e9",
+                 [model] {
+                   TetBodyDesc b = hanging_cube();
+                   (void)b.set_material(model, 1e9, 0.3);
+                   return with(b);
+                 },
+                 kCubeEnergy, -0.01, 0.01});
+    c.push_back({std::string(name) + "Nu0499",
+                 [model] {
+                   TetBodyDesc b = hanging_cube();
+                   (void)b.set_material(model, 3e4, 0.499);
+                   return with(b);
+                 },
+                 kCubeEnergy, -0.01, 0.01});
+  }
   c.push_back({"LargeStepOneSubstep",
                [] {
                  TetBodyDesc b = hanging_cube();
