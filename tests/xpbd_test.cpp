@@ -251,6 +251,41 @@ TEST_P(Xpbd, BodyStartingCompressedRecoversItsRestVolume) {
   EXPECT_NEAR(sim.last_frame().volume_change, 0.0, 0.05);
 }
 
+TEST_P(Xpbd, ConvergedStepDampsLikeImplicitEuler) {
+  // A mass on a spring (one distance constraint of compliance alpha to a
+  // pinned particle), released stretched, no gravity. One constraint is
+  // solved exactly by one iteration, so each substep is an implicit Euler
+  // step; in the scaled state (omega x, v) implicit Euler is a rotation
+  // shrunk by 1/sqrt(1 + omega^2 h^2), so the energy after n substeps is
+  // exactly E0 / (1 + omega^2 h^2)^n.
+  const double m = 1.0, alpha = 0.01, rest = 0.5, stretch = 0.05;
+  const double omega = std::sqrt(1.0 / (alpha * m));
+  for (int substeps : {1, 4}) {
+    LineBodyDesc spring;
+    spring.vertices = {{0.0, 0.0, 0.0}, {rest, 0.0, 0.0}};
+    spring.initial_vertices = {{0.0, 0.0, 0.0}, {rest + stretch, 0.0, 0.0}};
+    spring.masses = {1.0, m};
+    spring.segments = {{0, 1}};
+    spring.compliance = alpha;
+    spring.pinned = {0};
+    SceneDesc scene;
+    scene.gravity = {0.0, 0.0, 0.0};
+    scene.solver = {.time_step = 1.0 / 60.0, .substeps = substeps, .iterations = 1};
+    scene.line_bodies.push_back(spring);
+    Simulation sim = make(scene, GetParam());
+    const double e0 = 0.5 * stretch * stretch / alpha;
+    const int frames = 30;
+    for (int f = 0; f < frames; ++f) SINEW_ASSERT_OK(sim.step());
+    const std::vector<float> x = positions(sim);
+    const double c = std::hypot(double(x[4]), double(x[5]), double(x[6])) - rest;
+    const double energy = sim.last_frame().kinetic_energy + 0.5 * c * c / alpha;
+    const double h = scene.solver.time_step / substeps;
+    const double expected = e0 * std::pow(1.0 + omega * omega * h * h, -frames * substeps);
+    EXPECT_NEAR(energy, expected, 0.01 * expected) << substeps << " substeps";
+    EXPECT_LT(energy, 0.9 * e0) << "the oscillator must have lost energy";
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, Xpbd, ::testing::ValuesIn(test::backends()), test::backend_name);
 
 TEST(XpbdCpu, SameResultWithOneAndTwoThreads) {
