@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <ostream>
 
 #include "test_support.h"
 
@@ -19,6 +20,9 @@ struct ExtremeCase {
   double max_kinetic_energy;          // [J]
   double min_volume_change, max_volume_change;  // band for FrameStats::volume_change, every frame
 };
+
+// gtest prints parameters in test names: the case's name, not its bytes.
+void PrintTo(const ExtremeCase& c, std::ostream* os) { *os << c.name; }
 
 // A 4 cm cube of soft tissue hanging from its top face.
 TetBodyDesc hanging_cube(int cells = 4) {
