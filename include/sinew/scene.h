@@ -95,11 +95,14 @@ struct LineBodyDesc {
 ///  - distance constraints on the edges: alpha_e = c_d * L^2 / (A_e * t)
 ///    [m/N], A_e the edge's share of its triangles' areas (A/3 each), t the
 ///    thickness: the membrane analogue of TetBodyDesc's edges;
-///  - area constraints: C = A - A0 [m^2], alpha = c_a / (A0 t) [m^2/N... per
-///    the energy (K/2) (dA/A0)^2 A0 t with K = 1/c_a];
-///  - dihedral bending on every interior edge (two triangles): C = angle -
-///    rest angle [rad], alpha = bending_compliance [1/(N m)]
-///    (Müller et al., "Position Based Dynamics", 2007, section 4.2).
+///  - area constraints: C = A - A0 [m^2], alpha = c_a A0 / t [m^3/N], i.e.
+///    the energy (K/2) (dA/A0)^2 A0 t with K = 1/c_a;
+///  - dihedral bending on every interior edge (exactly two triangles; an
+///    edge of three or more gets none): C = angle - rest angle [rad], the
+///    signed angle between the two normals (0 flat) wrapped to [-pi, pi],
+///    alpha = bending_compliance [1/(N m)] per hinge (Müller et al.,
+///    "Position Based Dynamics", 2007, section 4.2; gradients of Bridson
+///    et al., SCA 2003).
 struct TriBodyDesc {
   TriMesh mesh;                           ///< rest shape [m]
   std::vector<Vec3d> initial_vertices;    ///< start positions [m] if not the rest shape (empty: rest)

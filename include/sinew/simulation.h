@@ -31,6 +31,7 @@ struct SceneInfo {
   std::uint32_t dispatches_per_frame = 0;
   std::uint32_t barriers_per_frame = 0;
   std::vector<std::uint32_t> tet_body_first_particle;   ///< body i's vertex 0 is this particle
+  std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;
   [[nodiscard]] std::uint32_t constraints() const {
     return distance_constraints + volume_constraints + other_constraints;

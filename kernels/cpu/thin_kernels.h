@@ -1,8 +1,33 @@
-// thin_kernels.h — CPU reference kernels of thin bodies and threads. (Stage in progress: the kernels are stubs until it lands.)
+// thin_kernels.h — CPU reference kernels of thin bodies (triangle meshes)
+// and threads, and the constraint functions they share with the scene
+// compiler (which computes rest values with the very same code, so a body at
+// rest has C == 0 exactly). The functions are templates: the kernels run
+// them in float, the tests differentiate them in double.
+//
+// Data layouts and residuals: kernels/shared/thin_params.h; compliances:
+// include/sinew/scene.h (TriBodyDesc, LineBodyDesc).
+//  - area:     C = A - A0, A = |(x1 - x0) x (x2 - x0)| / 2;
+//  - dihedral: C = theta - theta0 (wrapped into [-pi, pi]), theta the signed
+//    angle between the two triangles' normals about their shared edge
+//    (0 when flat). Müller, Heidelberger, Hennix, Ratcliff, "Position Based
+//    Dynamics", VRIPHYS 2006 / JVCIR 2007, section 4.2 uses
+//    acos(n1 . n2), whose derivative 1 / sqrt(1 - d^2) is singular at 0 (a
+//    flat sheet, the common rest state) and pi, and which has no sign; here
+//    theta = atan2(sin, cos) of the normals (see dihedral_angle), with the
+//    closed-form gradients of Bridson, Marino, Fedkiw, "Simulation of
+//    Clothing with Folds and Wrinkles", SCA 2003, section 4 (also Tamstorf,
+//    Grinspun, "Discrete bending forces and their Jacobians", GM 2013),
+//    which are smooth through 0 and pi;
+//  - line bending: Kelager, Niebe, Erleben, "A Triangle Bending Constraint
+//    Model for Position-Based Dynamics", VRIPHYS 2010:
+//    C = |x_v - c| - h0, c = (x_b0 + x_v + x_b1) / 3.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+
+#include "cpu/cpu_math.h"
 
 namespace sinew::kernels {
 
@@ -10,4 +35,127 @@ void xpbd_solve_area(const void* params, std::byte* const* bindings, std::uint32
 void xpbd_solve_dihedral(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 void xpbd_solve_line_bending(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 
+namespace thin {
+
+template <class T>
+inline constexpr T pi = T(3.14159265358979323846);
+
+/// Triangle area A = |(x1 - x0) x (x2 - x0)| / 2 [m^2] (unsigned: a
+/// membrane in 3D has no inside-out); the area constraint is C = A - A0.
+template <class T>
+inline T triangle_area(vec4<T> x0, vec4<T> x1, vec4<T> x2) {
+  const vec4<T> n = cross3(x1 - x0, x2 - x0);
+  return T(0.5) * std::sqrt(dot3(n, n));
+}
+
+/// [out] g[k] = grad_{x_k} A. With N = (x1 - x0) x (x2 - x0) and
+/// n = N / |N|: g1 = (x2 - x0) x n / 2, g2 = n x (x1 - x0) / 2,
+/// g0 = -(g1 + g2) (each is half the opposite edge turned in-plane,
+/// pointing away from it). Returns false, with g zero, when N == 0 (a
+/// triangle collapsed to a line: no direction).
+template <class T>
+inline bool triangle_area_gradients(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> g[3]) {
+  const vec4<T> e1 = x1 - x0, e2 = x2 - x0;
+  const vec4<T> nn = cross3(e1, e2);
+  const T len = std::sqrt(dot3(nn, nn));
+  if (!(len > T(0))) {
+    g[0] = g[1] = g[2] = vec4<T>{T(0), T(0), T(0), T(0)};
+    return false;
+  }
+  const vec4<T> n = (T(1) / len) * nn;
+  g[1] = T(0.5) * cross3(e2, n);
+  g[2] = T(0.5) * cross3(n, e1);
+  g[0] = vec4<T>{T(0), T(0), T(0), T(0)} - (g[1] + g[2]);
+  return true;
+}
+
+/// The signed dihedral angle theta [rad] in (-pi, pi] of the hinge x0-x1
+/// (the shared edge, e = x1 - x0) with wing vertices x2 and x3:
+/// N1 = e x (x2 - x0) (the normal of triangle (x0, x1, x2)),
+/// N2 = (x3 - x0) x e (of (x1, x0, x3): both triangles wound alike across
+/// the edge), theta = atan2((n1 x n2) . e / |e|, n1 . n2) with n = N / |N|.
+/// theta = 0 when the hinge is flat, +-pi when folded shut; moving the wing
+/// x2 along +N1 (or x3 along +N2) decreases it.
+/// atan2 keeps full precision near 0 and pi, where acos(n1 . n2) loses half
+/// its digits. Returns 0 when the edge or a wing is degenerate.
+template <class T>
+inline T dihedral_angle(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> x3) {
+  const vec4<T> e = x1 - x0;
+  const vec4<T> n1 = cross3(e, x2 - x0), n2 = cross3(x3 - x0, e);
+  const T l1 = std::sqrt(dot3(n1, n1)), l2 = std::sqrt(dot3(n2, n2)), le = std::sqrt(dot3(e, e));
+  if (!(l1 > T(0)) || !(l2 > T(0)) || !(le > T(0))) return T(0);
+  const vec4<T> u1 = (T(1) / l1) * n1, u2 = (T(1) / l2) * n2;
+  const T s = dot3(cross3(u1, u2), e) / le;  // sin theta
+  const T c = dot3(u1, u2);                  // cos theta
+  return std::atan2(s, c);
+}
+
+/// d wrapped into [-pi, pi] (d in (-2 pi, 2 pi], a difference of two
+/// dihedral angles): the dihedral constraint is C = wrap(theta - theta0), so
+/// that a hinge whose rest angle is near +-pi has no jump where theta
+/// crosses from +pi to -pi.
+template <class T>
+inline T wrap_angle(T d) {
+  if (d > pi<T>) return d - T(2) * pi<T>;
+  if (d < -pi<T>) return d + T(2) * pi<T>;
+  return d;
+}
+
+/// [out] g[k] = grad_{x_k} theta (Bridson et al. 2003, in the notation of
+/// dihedral_angle): with |e| the edge length, a wing's gradient is normal to
+/// its triangle and inversely proportional to its height h = |N| / |e|,
+///   g2 = -|e| N1 / |N1|^2,  g3 = -|e| N2 / |N2|^2,
+/// and the edge vertices take the balancing share by where the wings'
+/// projections fall on the edge, s_k = (x_k - x0) . e / |e|^2:
+///   g1 = -(s2 g2 + s3 g3),  g0 = -((1 - s2) g2 + (1 - s3) g3),
+/// so that the gradients sum to zero (translation) and have no moment
+/// (rotation). Smooth for every theta, including 0 and +-pi. Returns false,
+/// with g zero, when the edge or a wing is degenerate (|e| or |N| zero).
+template <class T>
+inline bool dihedral_angle_gradients(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> x3, vec4<T> g[4]) {
+  const vec4<T> e = x1 - x0, a = x2 - x0, b = x3 - x0;
+  const vec4<T> n1 = cross3(e, a), n2 = cross3(b, e);
+  const T q1 = dot3(n1, n1), q2 = dot3(n2, n2), qe = dot3(e, e);
+  if (!(q1 > T(0)) || !(q2 > T(0)) || !(qe > T(0))) {
+    g[0] = g[1] = g[2] = g[3] = vec4<T>{T(0), T(0), T(0), T(0)};
+    return false;
+  }
+  const T le = std::sqrt(qe);
+  g[2] = (-le / q1) * n1;
+  g[3] = (-le / q2) * n2;
+  const T s2 = dot3(a, e) / qe, s3 = dot3(b, e) / qe;
+  const vec4<T> zero{T(0), T(0), T(0), T(0)};
+  g[1] = zero - (s2 * g[2] + s3 * g[3]);
+  g[0] = zero - ((T(1) - s2) * g[2] + (T(1) - s3) * g[3]);
+  return true;
+}
+
+/// Kelager et al. 2010: the distance |x_v - c| [m] of the middle vertex x_v
+/// of a thread from the centroid c = (x_b0 + x_v + x_b1) / 3 of the triangle
+/// it forms with its neighbours x_b0, x_b1; 0 when the thread is straight
+/// and evenly divided there. The bending constraint is C = |x_v - c| - h0.
+template <class T>
+inline T line_bending_offset(vec4<T> b0, vec4<T> v, vec4<T> b1) {
+  const vec4<T> d = v - (T(1) / T(3)) * (b0 + v + b1);
+  return std::sqrt(dot3(d, d));
+}
+
+/// [out] g = (grad_b0, grad_v, grad_b1) of |x_v - c|: with n = (x_v - c) /
+/// |x_v - c|, grad_v = 2 n / 3 and grad_b0 = grad_b1 = -n / 3. Returns false,
+/// with g zero, when x_v is at the centroid (no direction).
+template <class T>
+inline bool line_bending_gradients(vec4<T> b0, vec4<T> v, vec4<T> b1, vec4<T> g[3]) {
+  const vec4<T> d = v - (T(1) / T(3)) * (b0 + v + b1);
+  const T len = std::sqrt(dot3(d, d));
+  if (!(len > T(0))) {
+    g[0] = g[1] = g[2] = vec4<T>{T(0), T(0), T(0), T(0)};
+    return false;
+  }
+  const vec4<T> n = (T(1) / len) * d;
+  g[1] = (T(2) / T(3)) * n;
+  g[0] = g[2] = (T(-1) / T(3)) * n;
+  return true;
+}
+
+}  // namespace thin
 }  // namespace sinew::kernels

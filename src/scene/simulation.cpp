@@ -107,6 +107,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   info.dispatches_per_frame = static_cast<std::uint32_t>(impl->program.dispatch_count());
   info.barriers_per_frame = static_cast<std::uint32_t>(impl->program.barrier_count());
   info.tet_body_first_particle = compiled->tet_body_first_particle;
+  info.tri_body_first_particle = compiled->tri_body_first_particle;
   info.line_body_first_particle = compiled->line_body_first_particle;
   return Simulation(std::move(impl));
 }

@@ -2,6 +2,7 @@
 #include "xpbd_params.h"
 #include "contact_params.h"
 #include "fem_params.h"
+#include "thin_params.h"
 kernel void uses_params(global float4* x, SolveParams p, PredictParams q) {
   uint i = get_global_id(0);
   if (i < p.count) x[p.first + i].x += p.inv_h2 * q.h * SINEW_FEM_DATA_STRIDE;

@@ -4,6 +4,7 @@
 #include "xpbd_params.h"
 #include "contact_params.h"
 #include "fem_params.h"
+#include "thin_params.h"
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { SolveParams p; };
 layout(std430, binding = 0) buffer Positions { vec4 x[]; };
