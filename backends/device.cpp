@@ -9,6 +9,9 @@
 #if SINEW_HAS_OPENCL
 #include "backends/opencl/opencl_device.h"
 #endif
+#if SINEW_HAS_VULKAN
+#include "backends/vulkan/vulkan_device.h"
+#endif
 #include "backends/kernel_table.h"
 #include "xpbd_params.h"
 
@@ -95,6 +98,9 @@ std::vector<std::string> built_backends() {
 #if SINEW_HAS_OPENCL
   names.push_back("opencl");
 #endif
+#if SINEW_HAS_VULKAN
+  names.push_back("vulkan");
+#endif
   return names;
 }
 
@@ -123,6 +129,22 @@ Result<std::unique_ptr<Device>> create_auto_device(const DeviceOptions& options)
     why = devices.error().message();
   }
 #endif
+#if SINEW_HAS_VULKAN
+  // A Vulkan GPU (discrete or integrated), never a CPU device such as lavapipe.
+  std::string vulkan_why = "Vulkan found no GPU";
+  if (auto devices = list_vulkan_devices(); devices) {
+    for (std::size_t i = 0; i < devices->size(); ++i) {
+      if (!(*devices)[i].gpu) continue;
+      DeviceOptions gpu = options;
+      gpu.backend = "vulkan";
+      if (gpu.device.empty()) gpu.device = std::to_string(i);
+      return make_vulkan_device(gpu);
+    }
+  } else {
+    vulkan_why = devices.error().message();
+  }
+  why = (SINEW_HAS_OPENCL ? why + "; " : std::string()) + vulkan_why;
+#endif
   static std::once_flag said;  // "saying so once"
   if (!options.quiet) std::call_once(said, [&] { std::fprintf(stderr, "sinew: backend auto -> cpu (%s)\n", why.c_str()); });
   return make_cpu_device(options);
@@ -136,6 +158,11 @@ Result<std::unique_ptr<Device>> create_device(const DeviceOptions& options) {
   if (name == "opencl") {
 #if SINEW_HAS_OPENCL
     return make_opencl_device(options);
+#endif
+  }
+  if (name == "vulkan") {
+#if SINEW_HAS_VULKAN
+    return make_vulkan_device(options);
 #endif
   }
   if (name == "opencl" || name == "vulkan")
