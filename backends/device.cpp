@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include <charconv>
 #include <mutex>
 
 #include "backends/cpu/cpu_device.h"
@@ -91,6 +92,19 @@ Status check_buffer_range(const std::string& label, std::size_t size, std::size_
     return Error(std::string(what) + " '" + label + "': bytes [" + std::to_string(offset) + ", " +
                  std::to_string(offset + bytes) + ") outside the buffer's " + std::to_string(size) + " bytes");
   return {};
+}
+
+Result<std::size_t> match_device_selector(const std::vector<std::string>& names,
+                                          const std::vector<std::string>& labels, const std::string& selector,
+                                          const char* api) {
+  std::size_t index = 0;
+  const auto [end, ec] = std::from_chars(selector.data(), selector.data() + selector.size(), index);
+  if (ec == std::errc() && end == selector.data() + selector.size() && index < names.size()) return index;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i].find(selector) != std::string::npos) return i;
+  std::string list;
+  for (std::size_t i = 0; i < labels.size(); ++i) list += "\n  " + std::to_string(i) + ": " + labels[i];
+  return Error(std::string("no ") + api + " device matches '" + selector + "'; devices:" + list);
 }
 
 std::vector<std::string> built_backends() {

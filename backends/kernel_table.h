@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "sinew/device.h"
 
@@ -24,6 +25,14 @@ const KernelSignature& kernel_signature(Kernel kernel);
 /// Checks a program's dispatches against the kernel table and the number of
 /// buffers the device has. Errors name the dispatch by position and kernel.
 Status check_program(const FrameProgram& program, std::uint32_t buffer_count);
+
+/// The device a GPU backend's selector names: an index into `names`, or the
+/// first name containing it as a substring. Errors list every device as
+/// "index: label" (`labels[i]`), naming the API ("OpenCL", "Vulkan").
+/// [pre] selector is not empty (callers apply their default choice first).
+Result<std::size_t> match_device_selector(const std::vector<std::string>& names,
+                                          const std::vector<std::string>& labels, const std::string& selector,
+                                          const char* api);
 
 /// Checks that bytes [offset, offset + bytes) lie in a buffer of `size`
 /// bytes named `label`; `what` names the call in the error.

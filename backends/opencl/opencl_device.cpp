@@ -93,14 +93,9 @@ Result<std::size_t> choose(const std::vector<Found>& found, std::string selector
       if (found[i].info.gpu) return i;
     return std::size_t{0};
   }
-  std::size_t index = 0;
-  const auto [end, ec] = std::from_chars(selector.data(), selector.data() + selector.size(), index);
-  if (ec == std::errc() && end == selector.data() + selector.size() && index < found.size()) return index;
-  for (std::size_t i = 0; i < found.size(); ++i)
-    if (found[i].info.name.find(selector) != std::string::npos) return i;
-  std::string names;
-  for (std::size_t i = 0; i < found.size(); ++i) names += "\n  " + std::to_string(i) + ": " + found[i].info.name;
-  return Error("no OpenCL device matches '" + selector + "'; devices:" + names);
+  std::vector<std::string> names;
+  for (const Found& f : found) names.push_back(f.info.name);
+  return match_device_selector(names, names, selector, "OpenCL");
 }
 
 std::uint64_t fnv1a(std::uint64_t h, const std::string& s) {
@@ -327,6 +322,23 @@ Result<ContextAndQueue> make_context(const Found& f) {
   return ContextAndQueue{ctx, queue};
 }
 
+// The selected device with a fresh context and queue.
+struct Opened {
+  Found found;
+  ContextAndQueue cq;
+};
+
+Result<Opened> open_selected(const DeviceOptions& options) {
+  auto found = find_devices();
+  if (!found) return found.error();
+  auto index = choose(*found, options.device);
+  if (!index) return index.error();
+  const Found& f = (*found)[*index];
+  auto cq = make_context(f);
+  if (!cq) return cq.error();
+  return Opened{f, *cq};
+}
+
 }  // namespace
 
 Result<std::vector<OpenclDeviceInfo>> list_opencl_devices() {
@@ -338,34 +350,26 @@ Result<std::vector<OpenclDeviceInfo>> list_opencl_devices() {
 }
 
 Result<std::unique_ptr<Device>> make_opencl_device(const DeviceOptions& options) {
-  auto found = find_devices();
-  if (!found) return found.error();
-  auto index = choose(*found, options.device);
-  if (!index) return index.error();
-  const Found& f = (*found)[*index];
-  auto cq = make_context(f);
-  if (!cq) return cq.error();
-  auto program = build_cached(cq->ctx, f, opencl::kProgramSource);
+  auto opened = open_selected(options);
+  if (!opened) return opened.error();
+  auto& [f, cq] = *opened;
+  auto program = build_cached(cq.ctx, f, opencl::kProgramSource);
   if (!program) {
-    clReleaseCommandQueue(cq->queue);
-    clReleaseContext(cq->ctx);
+    clReleaseCommandQueue(cq.queue);
+    clReleaseContext(cq.ctx);
     return program.error();
   }
-  return std::unique_ptr<Device>(std::make_unique<OpenclDevice>(f, cq->ctx, cq->queue, *program));
+  return std::unique_ptr<Device>(std::make_unique<OpenclDevice>(f, cq.ctx, cq.queue, *program));
 }
 
 Status try_build_opencl_source(const std::string& source, const DeviceOptions& options) {
-  auto found = find_devices();
-  if (!found) return found.error();
-  auto index = choose(*found, options.device);
-  if (!index) return index.error();
-  const Found& f = (*found)[*index];
-  auto cq = make_context(f);
-  if (!cq) return cq.error();
-  auto program = build_from_source(cq->ctx, f, source);
+  auto opened = open_selected(options);
+  if (!opened) return opened.error();
+  auto& [f, cq] = *opened;
+  auto program = build_from_source(cq.ctx, f, source);
   if (program) clReleaseProgram(*program);
-  clReleaseCommandQueue(cq->queue);
-  clReleaseContext(cq->ctx);
+  clReleaseCommandQueue(cq.queue);
+  clReleaseContext(cq.ctx);
   return program.status();
 }
 

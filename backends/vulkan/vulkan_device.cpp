@@ -274,15 +274,12 @@ Result<std::size_t> choose(const std::vector<Found>& found, std::string selector
         if (found[i].properties.deviceType == type) return i;
     return std::size_t{0};
   }
-  std::size_t index = 0;
-  const auto [end, ec] = std::from_chars(selector.data(), selector.data() + selector.size(), index);
-  if (ec == std::errc() && end == selector.data() + selector.size() && index < found.size()) return index;
-  for (std::size_t i = 0; i < found.size(); ++i)
-    if (found[i].info.name.find(selector) != std::string::npos) return i;
-  std::string names;
-  for (std::size_t i = 0; i < found.size(); ++i)
-    names += "\n  " + std::to_string(i) + ": " + found[i].info.name + " (" + found[i].info.type + ")";
-  return Error("no Vulkan device matches '" + selector + "'; devices:" + names);
+  std::vector<std::string> names, labels;
+  for (const Found& f : found) {
+    names.push_back(f.info.name);
+    labels.push_back(f.info.name + " (" + f.info.type + ")");
+  }
+  return match_device_selector(names, labels, selector, "Vulkan");
 }
 
 // ------------------------------------------------------------ the device
