@@ -8,159 +8,10 @@
 //  - scene by scene: after 100 frames positions agree within 1e-4 of the
 //    bounding-box diagonal.
 // A backend that is built but has no device here is skipped.
-#include <gtest/gtest.h>
+#include "agreement_support.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstring>
-#include <limits>
-#include <numeric>
-#include <random>
-
-#include "cpu/cpu_math.h"
-#include "test_support.h"
-#include "xpbd_params.h"
-
-namespace sinew {
+namespace sinew::test {
 namespace {
-
-using kernels::float4;
-
-std::vector<std::string> gpu_backends() {
-  std::vector<std::string> out;
-  for (const std::string& b : test::backends())
-    if (b != "cpu") out.push_back(b);
-  if (out.empty()) out.push_back("none-built");  // keeps the suites instantiated; skipped below
-  return out;
-}
-
-class Agreement : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (GetParam() == "none-built") GTEST_SKIP() << "no GPU backend is built";
-    if (const std::string why = test::missing_device(GetParam()); !why.empty())
-      GTEST_SKIP() << "backend " << GetParam() << " has no device here: " << why;
-  }
-};
-
-// One buffer of a kernel case: its bytes, and whether the kernel only
-// writes it (then both devices get it poisoned with NaN).
-struct Binding {
-  std::vector<float> data;  // every buffer viewed as 4-byte words
-  bool output_only = false;
-};
-
-struct KernelCase {
-  Kernel kernel;
-  std::uint32_t count;
-  std::vector<Binding> bindings;
-  std::vector<std::byte> params;
-};
-
-template <class P>
-std::vector<std::byte> bytes_of(const P& p) {
-  std::vector<std::byte> b(sizeof(P));
-  std::memcpy(b.data(), &p, sizeof(P));
-  return b;
-}
-
-std::vector<float> as_words(const std::vector<std::uint32_t>& v) {
-  std::vector<float> w(v.size());
-  std::memcpy(w.data(), v.data(), v.size() * 4);
-  return w;
-}
-
-// Runs one dispatch of `c` on a device and returns every buffer after it.
-std::vector<std::vector<float>> run_on(const std::string& backend, const KernelCase& c) {
-  auto made = create_device({.backend = backend, .quiet = true});
-  EXPECT_TRUE(made.ok()) << made.error().message();
-  if (!made.ok()) return {};
-  Device& device = **made;
-  Dispatch d;
-  d.kernel = c.kernel;
-  d.count = c.count;
-  d.binding_count = static_cast<std::uint32_t>(c.bindings.size());
-  for (std::size_t b = 0; b < c.bindings.size(); ++b) {
-    std::vector<float> data = c.bindings[b].data;
-    if (c.bindings[b].output_only) std::fill(data.begin(), data.end(), std::numeric_limits<float>::quiet_NaN());
-    auto buffer = device.create_buffer(data.size() * 4, "case");
-    EXPECT_TRUE(buffer.ok());
-    EXPECT_TRUE(device.write_buffer(*buffer, 0, data.data(), data.size() * 4).ok());
-    d.bindings[b] = *buffer;
-  }
-  d.params_bytes = static_cast<std::uint32_t>(c.params.size());
-  std::memcpy(d.params, c.params.data(), c.params.size());
-  FrameProgram program;
-  // FrameProgram::dispatch takes a typed struct; a raw Dispatch goes in by copy.
-  program.dispatch_raw(d);
-  auto prepared = device.create_program(program);
-  EXPECT_TRUE(prepared.ok()) << prepared.error().message();
-  if (!prepared.ok()) return {};
-  EXPECT_TRUE(device.run_program(*prepared).ok());
-  std::vector<std::vector<float>> out;
-  for (std::size_t b = 0; b < c.bindings.size(); ++b) {
-    out.emplace_back(c.bindings[b].data.size());
-    EXPECT_TRUE(device.read_buffer(d.bindings[b], 0, out.back().data(), out.back().size() * 4).ok());
-  }
-  return out;
-}
-
-// Compares float words; index buffers (bitwise ints) compare exactly.
-void expect_agree(const KernelCase& c, const std::vector<std::vector<float>>& ref,
-                  const std::vector<std::vector<float>>& gpu, const std::string& what) {
-  ASSERT_EQ(ref.size(), gpu.size());
-  for (std::size_t b = 0; b < ref.size(); ++b) {
-    float scale = 0.0f;
-    for (float v : ref[b])
-      if (std::isfinite(v)) scale = std::max(scale, std::abs(v));
-    for (std::size_t i = 0; i < ref[b].size(); ++i) {
-      const float r = ref[b][i], g = gpu[b][i];
-      if (std::isnan(r) && std::isnan(g)) continue;  // untouched poison on both
-      ASSERT_FALSE(std::isnan(g)) << what << ": binding " << b << " word " << i << " left poisoned by the GPU kernel";
-      ASSERT_NEAR(g, r, 1e-5f * std::max(scale, 1e-6f) + 1e-5f * std::abs(r))
-          << what << " (" << kernel_name(c.kernel) << "): binding " << b << " word " << i;
-    }
-  }
-}
-
-// Particles in a unit box with inverse masses; a few immovable ones.
-std::vector<float> random_particles(std::mt19937& rng, std::uint32_t n, std::uint32_t pinned_every = 7) {
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f), w(0.5f, 2.0f);
-  std::vector<float> x;
-  for (std::uint32_t p = 0; p < n; ++p) {
-    x.insert(x.end(), {u(rng), u(rng), u(rng), p % pinned_every == 3 ? 0.0f : w(rng)});
-  }
-  return x;
-}
-
-// `count` constraints of `arity` particles, none sharing a movable one.
-std::vector<std::uint32_t> one_colour(std::mt19937& rng, std::uint32_t count, std::uint32_t arity) {
-  std::vector<std::uint32_t> order(count * arity);
-  std::iota(order.begin(), order.end(), 0u);
-  std::shuffle(order.begin(), order.end(), rng);
-  return order;
-}
-
-KernelCase solve_case(std::mt19937& rng, Kernel kernel, std::uint32_t arity, std::uint32_t count, bool reset,
-                      bool measure) {
-  std::uniform_real_distribution<float> rest(0.05f, 0.5f), alpha(0.0f, 1e-4f), lam(-1e-3f, 1e-3f);
-  KernelCase c{kernel, count, {}, {}};
-  const std::uint32_t first = 3, total = first + count + 5;
-  c.bindings.push_back({random_particles(rng, total * arity), false});
-  std::vector<std::uint32_t> idx = one_colour(rng, total, arity);
-  c.bindings.push_back({as_words(idx), false});
-  std::vector<float> data, lambda, residual(total, 0.0f);
-  for (std::uint32_t k = 0; k < total; ++k) {
-    data.insert(data.end(), {rest(rng), k % 3 == 0 ? 0.0f : alpha(rng)});
-    lambda.push_back(lam(rng));
-  }
-  c.bindings.push_back({data, false});
-  c.bindings.push_back({lambda, reset && !measure});
-  c.bindings.push_back({residual, measure});
-  kernels::SolveParams p{first, count, 3600.0f, reset ? 1u : 0u, 1.0f / 60.0f, 1.0f, measure ? 1u : 0u, 0};
-  c.params = bytes_of(p);
-  return c;
-}
 
 TEST_P(Agreement, PredictAndUpdateVelocityKernels) {
   std::mt19937 rng(std::random_device{}());
@@ -218,7 +69,9 @@ TEST_P(Agreement, CubeAfter100Frames) {
               GetParam().c_str(), worst, worst / diagonal);
 }
 
-INSTANTIATE_TEST_SUITE_P(GpuBackends, Agreement, ::testing::ValuesIn(gpu_backends()), test::backend_name);
-
 }  // namespace
-}  // namespace sinew
+
+// The one instantiation of the Agreement suite (its TEST_Ps live in several files).
+INSTANTIATE_TEST_SUITE_P(GpuBackends, Agreement, ::testing::ValuesIn(gpu_backends()), backend_name);
+
+}  // namespace sinew::test

@@ -1,0 +1,3 @@
+// thin_agreement_test.cpp — the thin kernels on every GPU backend against the
+// CPU reference, kernel by kernel (see agreement_support.h).
+#include "agreement_support.h"
