@@ -6,7 +6,9 @@
 // crosses 5 ms per frame.
 //
 // Each run reports the real time per frame and the user counters
-// `constraints`, `colors` (dependent sweeps per iteration) and `particles`.
+// `constraints`, `colors` (dependent sweeps per iteration) and `particles`;
+// on Vulkan with timestamps also `device_ms` (GPU time per frame) and
+// `solve_device_ms` (of it, in the constraint solves).
 //   bench_cube --benchmark_out=cube.csv --benchmark_out_format=csv
 //   SINEW_BACKEND=cpu|opencl|vulkan|auto (default auto) picks the backend;
 //   SINEW_THREADS=N sets the CPU backend's threads (default: all);
@@ -61,11 +63,20 @@ void BM_Cube(benchmark::State& state) {
     return;
   }
   for (int warm = 0; warm < 3; ++warm) (void)sim->step();
+  double device_ms = 0.0, solve_ms = 0.0;
   for (auto _ : state) {
     if (auto s = sim->step(); !s) {
       state.SkipWithError(s.error().message().c_str());
       return;
     }
+    const sinew::DeviceTimes& t = sim->last_frame().device;
+    device_ms += t.span_ms;
+    for (std::size_t k = 0; k < sinew::kernel_count; ++k)
+      if (sinew::kernel_name(static_cast<sinew::Kernel>(k)).starts_with("xpbd_solve")) solve_ms += t.kernel_ms[k];
+  }
+  if (sim->last_frame().device.timed) {  // Vulkan with timestamps: GPU time per frame, all and in solves
+    state.counters["device_ms"] = benchmark::Counter(device_ms, benchmark::Counter::kAvgIterations);
+    state.counters["solve_device_ms"] = benchmark::Counter(solve_ms, benchmark::Counter::kAvgIterations);
   }
   const auto& info = sim->info();
   state.counters["constraints"] = info.constraints();

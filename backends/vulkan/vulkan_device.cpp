@@ -27,7 +27,7 @@
 // submits the command buffer and waits on the fence once.
 //
 // Timestamps (when the queue has them) are written before and after every
-// dispatch and read only when asked (last_run_kernel_times). On a CPU device
+// dispatch and read only when asked (last_run_times). On a CPU device
 // (lavapipe) each one costs a flush of the rasterizer threads, tens of
 // microseconds, so there they are off unless SINEW_VULKAN_TIMESTAMPS=1;
 // SINEW_VULKAN_TIMESTAMPS=0 turns them off everywhere.
@@ -305,7 +305,7 @@ struct Program {
   std::vector<Kernel> timed;             // the kernel of each timed dispatch
 };
 
-class VulkanDeviceImpl final : public VulkanDevice {
+class VulkanDeviceImpl final : public Device {
  public:
   VulkanDeviceImpl() = default;
   VulkanDeviceImpl(const VulkanDeviceImpl&) = delete;
@@ -509,28 +509,25 @@ class VulkanDeviceImpl final : public VulkanDevice {
     return {};
   }
 
-  Result<std::vector<VulkanKernelTime>> last_run_kernel_times() const override {
-    auto t = timestamps();
-    if (!t) return t.error();
-    std::vector<VulkanKernelTime> out;
-    if (t->empty()) return out;
+  Status last_run_times(DeviceTimes& out) const override {
+    out = {};
+    if (last_run_ >= programs_.size() || !programs_[last_run_].queries) return {};
     const Program& p = programs_[last_run_];
-    std::array<VulkanKernelTime, static_cast<std::size_t>(Kernel::count_)> by_kernel{};
+    // Two timestamps per dispatch, read into storage kept between frames.
+    stamps_.resize(2 * p.timed.size());
+    if (stamps_.empty()) return {};
+    const VkResult r = vkGetQueryPoolResults(device_, p.queries, 0, static_cast<std::uint32_t>(stamps_.size()),
+                                             stamps_.size() * sizeof(std::uint64_t), stamps_.data(),
+                                             sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+    if (r != VK_SUCCESS) return vk_error("vkGetQueryPoolResults", r);
+    out.timed = true;
+    out.span_ms = ticks_to_ms(stamps_.back() - stamps_.front());
     for (std::size_t i = 0; i < p.timed.size(); ++i) {
-      VulkanKernelTime& k = by_kernel[static_cast<std::size_t>(p.timed[i])];
-      k.kernel = p.timed[i];
-      ++k.dispatches;
-      k.milliseconds += ticks_to_ms((*t)[2 * i + 1] - (*t)[2 * i]);
+      const auto k = static_cast<std::size_t>(p.timed[i]);
+      out.kernel_ms[k] += ticks_to_ms(stamps_[2 * i + 1] - stamps_[2 * i]);
+      ++out.dispatches[k];
     }
-    for (const VulkanKernelTime& k : by_kernel)
-      if (k.dispatches) out.push_back(k);
-    return out;
-  }
-
-  Result<double> last_run_milliseconds() const override {
-    auto t = timestamps();
-    if (!t) return t.error();
-    return t->empty() ? 0.0 : ticks_to_ms(t->back() - t->front());
+    return {};
   }
 
   bool validation() const { return instance_->validation; }
@@ -841,19 +838,6 @@ class VulkanDeviceImpl final : public VulkanDevice {
     return {};
   }
 
-  // The timestamps of the last run, two per dispatch; empty without any.
-  Result<std::vector<std::uint64_t>> timestamps() const {
-    std::vector<std::uint64_t> t;
-    if (last_run_ >= programs_.size() || !programs_[last_run_].queries) return t;
-    const Program& p = programs_[last_run_];
-    t.resize(2 * p.timed.size());
-    const VkResult r = vkGetQueryPoolResults(device_, p.queries, 0, static_cast<std::uint32_t>(t.size()),
-                                             t.size() * sizeof(std::uint64_t), t.data(), sizeof(std::uint64_t),
-                                             VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
-    if (r != VK_SUCCESS) return vk_error("vkGetQueryPoolResults", r);
-    return t;
-  }
-
   // [in] ticks: a difference of two timestamps (wraps at the counter's valid bits).
   double ticks_to_ms(std::uint64_t ticks) const {
     if (found_.timestamp_bits < 64) ticks &= (std::uint64_t{1} << found_.timestamp_bits) - 1;
@@ -871,6 +855,7 @@ class VulkanDeviceImpl final : public VulkanDevice {
   VkPhysicalDeviceMemoryProperties memory_{};
   bool unified_ = false;     // buffers in host-visible device memory, mapped
   bool timestamps_ = false;  // timestamps around every dispatch
+  mutable std::vector<std::uint64_t> stamps_;  // last_run_times' read-back, reused
   bool lost_ = false;
   std::array<VkDescriptorSetLayout, Dispatch::max_bindings + 1> set_layouts_{};  // by binding count
   std::array<Pipeline, static_cast<std::size_t>(Kernel::count_)> pipelines_{};

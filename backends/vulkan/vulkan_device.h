@@ -11,7 +11,8 @@
 //                              Add VK_LAYER_ENABLES=VK_VALIDATION_FEATURE_ENABLE_
 //                              SYNCHRONIZATION_VALIDATION_EXT to check barriers.
 //   SINEW_VULKAN_DEVICE        the device, when DeviceOptions::device is empty.
-//   SINEW_VULKAN_TIMESTAMPS    1: timestamps around every dispatch; 0: none;
+//   SINEW_VULKAN_TIMESTAMPS    1: timestamps around every dispatch (Device::last_run_times,
+//                              FrameStats::device); 0: none;
 //                              unset: on, except on CPU devices (lavapipe),
 //                              where each one costs a thread flush.
 //   SINEW_VULKAN_STAGING=1     staged copies even where memory is shared (tests).
@@ -38,26 +39,6 @@ struct VulkanDeviceInfo {
 /// Every Vulkan device that supports Vulkan 1.2 and has a compute queue, in
 /// the driver's order; an error when there is no Vulkan loader or driver.
 Result<std::vector<VulkanDeviceInfo>> list_vulkan_devices();
-
-/// GPU time of one kernel in the last run_program, from timestamps around
-/// each of its dispatches.
-struct VulkanKernelTime {
-  Kernel kernel = Kernel::count_;
-  std::uint32_t dispatches = 0;
-  double milliseconds = 0.0;  ///< summed over its dispatches
-};
-
-/// The device make_vulkan_device returns (reach it with dynamic_cast).
-class VulkanDevice : public Device {
- public:
-  /// Per kernel run by the last run_program, its summed GPU time. Empty when
-  /// nothing has run, the queue has no timestamps or they are off
-  /// (SINEW_VULKAN_TIMESTAMPS). Dispatches between two
-  /// barriers may overlap on the GPU, so the sums may exceed the frame's span.
-  virtual Result<std::vector<VulkanKernelTime>> last_run_kernel_times() const = 0;
-  /// GPU time of the last run_program [ms], first timestamp to last; 0 without timestamps.
-  virtual Result<double> last_run_milliseconds() const = 0;
-};
 
 /// [in] options.device: an index into list_vulkan_devices() or a substring
 /// of the device name; empty: $SINEW_VULKAN_DEVICE, else the first discrete

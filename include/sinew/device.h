@@ -11,6 +11,7 @@
 // available: a GPU backend with a device, else "cpu").
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -44,6 +45,21 @@ enum class Kernel : std::uint32_t {
   xpbd_solve_attachment,
   xpbd_solve_contacts,
   count_  ///< number of kernels, not a kernel
+};
+
+inline constexpr std::size_t kernel_count = static_cast<std::size_t>(Kernel::count_);
+
+/// Device time of one run of a frame program, from timestamps the device
+/// writes around each dispatch. The Vulkan backend records them where its
+/// queue has timestamps (on by default on GPUs; SINEW_VULKAN_TIMESTAMPS);
+/// the CPU and OpenCL backends record none (timed stays false).
+struct DeviceTimes {
+  bool timed = false;
+  double span_ms = 0.0;  ///< first timestamp to last [ms]: the program's time on the device
+  /// Per kernel (indexed by Kernel), summed over its dispatches [ms].
+  /// Dispatches between two barriers may overlap, so the sum may exceed span_ms.
+  std::array<double, kernel_count> kernel_ms{};
+  std::array<std::uint32_t, kernel_count> dispatches{};  ///< timed dispatches per kernel
 };
 
 /// The kernel's name, the same in every kernel language ("xpbd_predict").
@@ -151,6 +167,12 @@ class Device {
   virtual Result<ProgramHandle> create_program(const FrameProgram& program) = 0;
   /// Runs a prepared program once and waits for it to finish.
   virtual Status run_program(ProgramHandle program) = 0;
+  /// [out] times: device time of the last run_program; timed = false (and
+  /// no error) where the device records no timestamps. Allocates nothing.
+  virtual Status last_run_times(DeviceTimes& times) const {
+    times = {};
+    return {};
+  }
 };
 
 /// Makes a device. Asking for a backend that is not built, or that has no

@@ -53,6 +53,9 @@ struct FrameStats {
   double max_residual = 0.0;     ///< the largest of those normalised residuals
   double kinetic_energy = 0.0;   ///< sum of m |v|^2 / 2 over movable particles [J]
   double volume_change = 0.0;    ///< total tet volume / rest total - 1 (0 without tet bodies)
+  /// Device time of the frame's program per kernel (stage) and in all, from
+  /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
+  DeviceTimes device;
 };
 
 class Simulation {

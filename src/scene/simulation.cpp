@@ -116,6 +116,7 @@ Status Simulation::step() {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = impl_->before_frame(); !s) return s;
   if (Status s = impl_->device->run_program(impl_->prepared); !s) return s;
+  if (Status s = impl_->device->last_run_times(impl_->stats.device); !s) return s;
   if (Status s = impl_->after_frame(); !s) return s;
   const auto end = std::chrono::steady_clock::now();
   impl_->stats.frame += 1;
