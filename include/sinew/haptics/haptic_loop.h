@@ -1,0 +1,180 @@
+// sinew/haptics/haptic_loop.h — the haptic servo loop: its own thread at
+// 1 kHz (configurable), paced by absolute-time sleeps, SCHED_FIFO where the
+// system grants it; each tick reads the newest snapshot and device sample,
+// evaluates the virtual coupling through the safety chain, commands the
+// device and publishes the feedback for the physics thread.
+//
+//   sinew::haptics::MonotonicClock clock;
+//   sinew::haptics::SnapshotChannel snapshots;   // physics -> haptics
+//   sinew::haptics::FeedbackChannel feedback;    // haptics -> physics
+//   auto loop = sinew::haptics::HapticLoop::create({}, device, snapshots, feedback, clock);
+//   if (auto s = (*loop)->start(); !s) ...;       // then (*loop)->scheduling() says what was obtained
+//   ... physics thread: HapticToolBridge (tool_bridge.h) around Simulation::step() ...
+//   (*loop)->stop();
+//
+// A tick allocates nothing, takes no lock, does no I/O and logs nothing:
+// telemetry goes into a ring preallocated by create(), counters are relaxed
+// atomics. The thread's own stack is touched before the first tick.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "sinew/haptics/clock.h"
+#include "sinew/haptics/haptic_device.h"
+#include "sinew/haptics/snapshot_channel.h"
+#include "sinew/haptics/snapshot_interpolator.h"
+#include "sinew/haptics/virtual_coupling.h"
+#include "sinew/haptics/watchdog.h"
+#include "sinew/result.h"
+
+namespace sinew::haptics {
+
+struct HapticLoopSettings {
+  double rate_hz = 1000.0;          ///< tick rate [Hz], > 0
+  bool realtime = true;             ///< request SCHED_FIFO for the loop thread
+  int realtime_priority = 80;       ///< SCHED_FIFO priority, 1..99
+  int cpu = -1;                     ///< pin the loop thread to this CPU; -1: no pinning
+  std::size_t telemetry_capacity = 1u << 16;  ///< ticks kept in the telemetry ring (the newest), >= 1
+  unsigned snapshot_read_attempts = 4;        ///< bounded seqlock retries per tick, >= 1
+  CouplingParams coupling;
+  WatchdogParams watchdog;
+  InterpolationParams interpolation;
+  /// Called once on the loop thread before its first tick (outside the
+  /// tick: it may allocate); e.g. to mark the thread for an allocation counter.
+  std::function<void()> on_thread_start;
+};
+/// Errors name the bad parameter.
+Status check(const HapticLoopSettings& settings);
+
+/// What the loop thread asked for and what it got; never assumed.
+struct SchedulingReport {
+  std::string requested;   ///< "SCHED_FIFO priority 80" or "SCHED_OTHER (not requested)"
+  std::string policy;      ///< obtained: "SCHED_FIFO", "SCHED_RR", "SCHED_OTHER", ...
+  int priority = 0;        ///< obtained
+  int cpu = -1;            ///< pinned CPU obtained (-1: none)
+  std::string error;       ///< why the request failed ("" when it did not)
+  [[nodiscard]] bool realtime() const { return policy == "SCHED_FIFO" || policy == "SCHED_RR"; }
+  [[nodiscard]] std::string describe() const;
+};
+
+/// One tick, as kept in the telemetry ring.
+struct TickRecord {
+  std::uint64_t tick = 0;        ///< 1, 2, ...
+  std::int64_t scheduled_ns = 0;  ///< the absolute deadline it was woken for [ns] (= start for manual ticks)
+  std::int64_t start_ns = 0;     ///< when it started [ns]
+  std::int64_t end_ns = 0;       ///< when it finished [ns]
+  double snapshot_age = 0.0;     ///< age of the newest snapshot at start [s] (infinity: none)
+  double render_age = 0.0;       ///< age of the state rendered [s]
+  Vec3 device_position{};        ///< [m]
+  Vec3 tool_position{};          ///< rendered [m]
+  Vec3 raw_force{};              ///< coupling before the safety chain [N]
+  Vec3 force{};                  ///< commanded to the device [N]
+  double gain = 0.0;             ///< watchdog gain
+  std::uint32_t flags = 0;       ///< TickFlags
+  std::uint32_t device_buttons = 0;
+};
+
+/// Counters, readable from any thread while the loop runs.
+struct HapticCounters {
+  std::uint64_t ticks = 0;
+  std::uint64_t missed_deadlines = 0;  ///< tick-to-tick intervals > 2 periods
+  std::uint64_t skipped_slots = 0;     ///< periods skipped to catch up after a long stall
+  std::uint64_t non_finite = 0;        ///< ticks whose raw force/torque had NaN/Inf
+  std::uint64_t clamped = 0;
+  std::uint64_t slew_limited = 0;
+  std::uint64_t stale_ticks = 0;
+  std::uint64_t stalls = 0;            ///< fresh -> stale transitions
+  std::uint64_t snapshot_read_failures = 0;  ///< ticks whose bounded seqlock read gave up
+  std::uint64_t device_failures = 0;   ///< ticks without a device sample
+  std::uint64_t snapshots_received = 0;
+};
+
+class HapticLoop {
+ public:
+  /// Checks the settings and preallocates everything a tick uses. The
+  /// device, channels and clock must outlive the loop.
+  static Result<std::unique_ptr<HapticLoop>> create(const HapticLoopSettings& settings, HapticDevice& device,
+                                                   SnapshotChannel& snapshots, FeedbackChannel& feedback,
+                                                   Clock& clock);
+  ~HapticLoop();  ///< stops the thread if running
+  HapticLoop(const HapticLoop&) = delete;
+  HapticLoop& operator=(const HapticLoop&) = delete;
+
+  /// Starts the device and the loop thread; returns once the thread has
+  /// set its scheduling (see scheduling()). Errors: already running, the
+  /// device failed to start, the thread could not be created.
+  Status start();
+  /// Stops the thread and the device (the device's force goes to zero). Idempotent.
+  void stop() noexcept;
+  [[nodiscard]] bool running() const { return running_.load(std::memory_order_acquire); }
+  /// What the loop thread obtained; filled by start().
+  [[nodiscard]] const SchedulingReport& scheduling() const { return scheduling_; }
+
+  /// One tick at clock.now_ns(), on the calling thread: for virtual-clock
+  /// tests and for devices whose SDK runs its own servo scheduler (call it
+  /// from that callback; the device must then be started by the caller).
+  /// Not while the loop thread runs (returns a record with tick == 0).
+  TickRecord tick() noexcept;
+
+  [[nodiscard]] HapticCounters counters() const;
+  /// [out] out: the telemetry ring, oldest first (at most telemetry_capacity
+  /// ticks). Only while the loop thread is not running (error otherwise).
+  Status copy_telemetry(std::vector<TickRecord>& out) const;
+  [[nodiscard]] const HapticLoopSettings& settings() const { return settings_; }
+  /// The newest rendered tool state (loop thread / manual ticker only).
+  [[nodiscard]] const RenderedTool& rendered_tool() const { return tool_; }
+
+ private:
+  HapticLoop(const HapticLoopSettings& settings, HapticDevice& device, SnapshotChannel& snapshots,
+             FeedbackChannel& feedback, Clock& clock);
+  TickRecord tick_at(std::int64_t scheduled_ns, bool use_scheduled) noexcept;
+  void run();
+  struct AtomicCounters {
+    std::atomic<std::uint64_t> ticks{0}, missed{0}, skipped{0}, non_finite{0}, clamped{0}, slewed{0}, stale{0},
+        stalls{0}, read_failures{0}, device_failures{0}, snapshots{0};
+  };
+
+  HapticLoopSettings settings_;
+  HapticDevice& device_;
+  SnapshotChannel& snapshots_;
+  FeedbackChannel& feedback_;
+  Clock& clock_;
+  std::int64_t period_ns_ = 0;
+
+  // Tick state (loop thread or manual ticker only).
+  SnapshotHistory history_;
+  HapticSnapshot scratch_{};
+  std::uint64_t last_version_ = 0;
+  DeviceSample sample_{};
+  bool have_sample_ = false;
+  RenderedTool tool_{};
+  VirtualCoupling coupling_;
+  Watchdog watchdog_;
+  bool have_prev_tick_ = false;
+  std::int64_t prev_start_ns_ = 0;
+  Vec3 prev_force_{}, prev_torque_{};
+  CouplingFeedback fb_{};
+  std::vector<TickRecord> ring_;  // preallocated
+  std::uint64_t recorded_ = 0;
+
+  AtomicCounters counters_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> ready_{false};
+  SchedulingReport scheduling_;
+  std::thread thread_;
+};
+
+/// Sets the calling thread's scheduling: SCHED_FIFO at `priority` when
+/// `realtime`, pinned to `cpu` when >= 0; reports what it obtained
+/// (pthread_getschedparam after the request) and why a request failed.
+SchedulingReport set_thread_scheduling(bool realtime, int priority, int cpu);
+
+}  // namespace sinew::haptics

@@ -1,0 +1,60 @@
+// sinew/haptics/tool_bridge.h — the physics thread's side of the haptic
+// loop: publishes the tool's state after each frame, and drives the tool
+// with the coupling force the haptic loop produced.
+//
+//   HapticToolBridge bridge(0, snapshots, feedback, clock);   // tool 0
+//   loop:  bridge.apply_feedback(sim);   // apply_tool_force(-mean device force over the last frame)
+//          sim.step();
+//          bridge.publish(sim);          // a HapticSnapshot into the channel
+//
+// Sign convention: the feedback's force is what the coupling applies to the
+// device; the tool gets the opposite, -(mean over the interval since the
+// previous apply_feedback), i.e. (I_b - I_a) / (t_b - t_a) from the impulse
+// integral of two readings (snapshot_channel.h). A tool driven this way
+// should have gravity off (the hand carries the instrument's weight).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "sinew/haptics/clock.h"
+#include "sinew/haptics/snapshot_channel.h"
+#include "sinew/result.h"
+#include "sinew/simulation.h"
+
+namespace sinew::haptics {
+
+class HapticToolBridge {
+ public:
+  /// [in] tool: index of the tool in the scene; channels and clock must outlive the bridge.
+  HapticToolBridge(std::size_t tool, SnapshotChannel& snapshots, FeedbackChannel& feedback, Clock& clock)
+      : tool_(tool), snapshots_(snapshots), feedback_(feedback), clock_(clock) {}
+
+  /// Before Simulation::step(): reads the newest feedback and applies minus
+  /// its mean device force and torque since the previous call to the tool.
+  /// No new tick since then (the haptic loop stopped or has not started):
+  /// nothing is applied (counted in frames_without_feedback()).
+  Status apply_feedback(Simulation& sim);
+  /// After Simulation::step(): publishes the tool's state as a HapticSnapshot
+  /// stamped with the clock's now.
+  Status publish(const Simulation& sim);
+
+  [[nodiscard]] const Vec3& last_tool_force() const { return force_; }    ///< applied to the tool [N]
+  [[nodiscard]] const Vec3& last_tool_torque() const { return torque_; }  ///< [N m]
+  [[nodiscard]] const CouplingFeedback& last_feedback() const { return prev_; }
+  [[nodiscard]] std::uint64_t frames_without_feedback() const { return missing_; }
+  [[nodiscard]] std::uint64_t published() const { return sequence_; }
+
+ private:
+  std::size_t tool_;
+  SnapshotChannel& snapshots_;
+  FeedbackChannel& feedback_;
+  Clock& clock_;
+  CouplingFeedback prev_{};
+  bool have_prev_ = false;
+  Vec3 force_{}, torque_{};
+  std::uint64_t missing_ = 0;
+  std::uint64_t sequence_ = 0;
+};
+
+}  // namespace sinew::haptics

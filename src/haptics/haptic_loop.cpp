@@ -1,0 +1,227 @@
+// src/haptics/haptic_loop.cpp — the haptic servo loop: absolute-time paced
+// thread (clock_nanosleep TIMER_ABSTIME through MonotonicClock), and the
+// tick: newest snapshot -> interpolated tool -> watchdog -> virtual coupling
+// (Colgate, Stanley, Brown, IROS 1995) -> safety chain -> device command ->
+// feedback for the physics thread -> telemetry. A tick allocates nothing,
+// takes no lock and does no I/O.
+#include "sinew/haptics/haptic_loop.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "haptics/vec_math.h"
+
+namespace sinew::haptics {
+
+Status check(const HapticLoopSettings& s) {
+  if (!(s.rate_hz > 0.0) || !std::isfinite(s.rate_hz) || s.rate_hz > 1e6)
+    return Error("rate_hz must be > 0 and at most 1e6 [Hz] (got " + std::to_string(s.rate_hz) + ")");
+  if (s.realtime && (s.realtime_priority < 1 || s.realtime_priority > 99))
+    return Error("realtime_priority must be in 1..99 (got " + std::to_string(s.realtime_priority) + ")");
+  if (s.cpu < -1) return Error("cpu must be -1 (no pinning) or a CPU index (got " + std::to_string(s.cpu) + ")");
+  if (s.telemetry_capacity < 1) return Error("telemetry_capacity must be >= 1");
+  if (s.snapshot_read_attempts < 1) return Error("snapshot_read_attempts must be >= 1");
+  if (auto st = check(s.coupling); !st) return st;
+  if (auto st = check(s.watchdog); !st) return st;
+  return check(s.interpolation);
+}
+
+Result<std::unique_ptr<HapticLoop>> HapticLoop::create(const HapticLoopSettings& settings, HapticDevice& device,
+                                                       SnapshotChannel& snapshots, FeedbackChannel& feedback,
+                                                       Clock& clock) {
+  if (auto s = check(settings); !s) return s.error();
+  return std::unique_ptr<HapticLoop>(new HapticLoop(settings, device, snapshots, feedback, clock));
+}
+
+HapticLoop::HapticLoop(const HapticLoopSettings& settings, HapticDevice& device, SnapshotChannel& snapshots,
+                       FeedbackChannel& feedback, Clock& clock)
+    : settings_(settings), device_(device), snapshots_(snapshots), feedback_(feedback), clock_(clock),
+      period_ns_(std::max<std::int64_t>(1, seconds_to_ns(1.0 / settings.rate_hz))), coupling_(settings.coupling),
+      watchdog_(settings.watchdog), ring_(settings.telemetry_capacity) {}  // value-initialised: pages touched
+
+HapticLoop::~HapticLoop() { stop(); }
+
+HapticCounters HapticLoop::counters() const {
+  const auto r = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
+  const AtomicCounters& c = counters_;
+  return {r(c.ticks),      r(c.missed),        r(c.skipped),         r(c.non_finite),
+          r(c.clamped),    r(c.slewed),        r(c.stale),           r(c.stalls),
+          r(c.read_failures), r(c.device_failures), r(c.snapshots)};
+}
+
+Status HapticLoop::copy_telemetry(std::vector<TickRecord>& out) const {
+  if (running()) return Error("copy_telemetry: stop the haptic loop first (the ring is written without locks)");
+  const std::size_t cap = ring_.size();
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(recorded_, cap));
+  out.resize(n);
+  const std::size_t first = recorded_ > cap ? static_cast<std::size_t>(recorded_ % cap) : 0;
+  for (std::size_t i = 0; i < n; ++i) out[i] = ring_[(first + i) % cap];
+  return {};
+}
+
+TickRecord HapticLoop::tick() noexcept {
+  if (running()) return {};
+  return tick_at(0, false);
+}
+
+namespace {
+// Relaxed increment by the single writing thread (no read-modify-write needed).
+inline void bump(std::atomic<std::uint64_t>& a, std::uint64_t by = 1) {
+  a.store(a.load(std::memory_order_relaxed) + by, std::memory_order_relaxed);
+}
+}  // namespace
+
+TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) noexcept {
+  const std::int64_t start = clock_.now_ns();
+  TickRecord rec;
+  rec.scheduled_ns = use_scheduled ? scheduled_ns : start;
+  rec.start_ns = start;
+  std::uint32_t flags = 0;
+  const double dt = have_prev_tick_ ? ns_to_seconds(start - prev_start_ns_) : ns_to_seconds(period_ns_);
+  if (have_prev_tick_ && start - prev_start_ns_ > 2 * period_ns_) {
+    flags |= kMissedDeadline;
+    bump(counters_.missed);
+  }
+
+  // 1. The newest snapshot (bounded seqlock read: never waits for the writer).
+  std::uint64_t version = 0;
+  if (snapshots_.try_read(scratch_, settings_.snapshot_read_attempts, &version)) {
+    if (version != last_version_) {
+      history_.push(scratch_);
+      last_version_ = version;
+      bump(counters_.snapshots);
+    }
+  } else if (snapshots_.published() > 0) {
+    bump(counters_.read_failures);
+  }
+
+  // 2. The newest device sample.
+  if (device_.sample(start, sample_)) {
+    have_sample_ = true;
+  } else {
+    flags |= kNoDeviceSample;
+    bump(counters_.device_failures);
+  }
+
+  // 3. The tool state at this tick's time.
+  tool_ = history_.render(start, settings_.interpolation);
+  if (!tool_.valid()) flags |= kNoSnapshot;
+  if (tool_.mode == RenderMode::extrapolated) flags |= kExtrapolated;
+  if (tool_.mode == RenderMode::held) flags |= kHeld;
+
+  // 4. Watchdog: stale snapshots or device samples fade the force.
+  const double inf = std::numeric_limits<double>::infinity();
+  const double device_age = have_sample_ ? ns_to_seconds(start - sample_.time_ns) : inf;
+  const double gain = watchdog_.update(tool_.valid() ? tool_.snapshot_age : inf, device_age, dt);
+  if (watchdog_.stale()) {
+    flags |= kStale;
+    bump(counters_.stale);
+  }
+  if (gain < 1.0) flags |= kFading;
+
+  // 5. Virtual coupling through the safety chain; 6. the device.
+  const CouplingOutput out = have_sample_ ? coupling_.evaluate(sample_, tool_, gain)
+                                          : coupling_.evaluate(DeviceSample{}, RenderedTool{}, gain);
+  flags |= out.flags;
+  if (out.flags & kNonFinite) bump(counters_.non_finite);
+  if (out.flags & kClamped) bump(counters_.clamped);
+  if (out.flags & kSlewLimited) bump(counters_.slewed);
+  device_.command(out.force, out.torque, start);
+
+  // 7. Feedback: the impulse integral (zero-order hold of the previous tick's
+  // output up to now), then this tick's output.
+  if (have_prev_tick_) {
+    fb_.impulse = vm::add(fb_.impulse, vm::mul(prev_force_, dt));
+    fb_.angular_impulse = vm::add(fb_.angular_impulse, vm::mul(prev_torque_, dt));
+  }
+  const std::uint64_t tick_no = counters_.ticks.load(std::memory_order_relaxed) + 1;
+  fb_.ticks = tick_no;
+  fb_.time_ns = start;
+  fb_.force = out.force;
+  fb_.torque = out.torque;
+  fb_.device_position = sample_.position;
+  fb_.device_rotation = sample_.rotation;
+  fb_.gain = gain;
+  fb_.flags = flags;
+  feedback_.publish(fb_);
+  prev_force_ = out.force;
+  prev_torque_ = out.torque;
+  prev_start_ns_ = start;
+  have_prev_tick_ = true;
+  if (watchdog_.stalls() != counters_.stalls.load(std::memory_order_relaxed))
+    counters_.stalls.store(watchdog_.stalls(), std::memory_order_relaxed);
+
+  // 8. Telemetry into the preallocated ring.
+  rec.tick = tick_no;
+  rec.snapshot_age = tool_.valid() ? tool_.snapshot_age : inf;
+  rec.render_age = tool_.valid() ? tool_.render_age : inf;
+  rec.device_position = sample_.position;
+  rec.tool_position = tool_.position;
+  rec.raw_force = out.raw_force;
+  rec.force = out.force;
+  rec.gain = gain;
+  rec.flags = flags;
+  rec.device_buttons = sample_.buttons;
+  rec.end_ns = clock_.now_ns();
+  ring_[static_cast<std::size_t>(recorded_ % ring_.size())] = rec;
+  ++recorded_;
+  counters_.ticks.store(tick_no, std::memory_order_release);
+  return rec;
+}
+
+Status HapticLoop::start() {
+  if (running()) return Error("the haptic loop is already running");
+  if (auto s = device_.start(clock_.now_ns()); !s) return Error("device " + device_.name() + ": " + s.error().message());
+  stop_.store(false, std::memory_order_relaxed);
+  ready_.store(false, std::memory_order_relaxed);
+  running_.store(true, std::memory_order_release);
+  try {
+    thread_ = std::thread([this] { run(); });
+  } catch (const std::exception& e) {
+    running_.store(false, std::memory_order_release);
+    device_.stop();
+    return Error(std::string("cannot create the haptic thread: ") + e.what());
+  }
+  ready_.wait(false, std::memory_order_acquire);  // scheduling_ is set
+  return {};
+}
+
+void HapticLoop::stop() noexcept {
+  if (!thread_.joinable()) return;
+  stop_.store(true, std::memory_order_release);
+  thread_.join();
+  device_.command({0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, clock_.now_ns());
+  device_.stop();
+  running_.store(false, std::memory_order_release);
+}
+
+void HapticLoop::run() {
+  scheduling_ = set_thread_scheduling(settings_.realtime, settings_.realtime_priority, settings_.cpu);
+  if (settings_.on_thread_start) settings_.on_thread_start();
+  {  // Touch the stack a tick may use, so the first ticks take no page faults.
+    volatile char stack[64 * 1024];
+    for (std::size_t i = 0; i < sizeof(stack); i += 4096) stack[i] = 0;
+  }
+  ready_.store(true, std::memory_order_release);
+  ready_.notify_all();
+
+  const std::int64_t period = period_ns_;
+  std::int64_t next = clock_.now_ns() + period;
+  while (!stop_.load(std::memory_order_acquire)) {
+    clock_.sleep_until(next);  // absolute deadline: no drift
+    tick_at(next, true);
+    next += period;
+    // More than a period behind (a long preemption): skip the slots already
+    // past instead of running them back to back.
+    const std::int64_t now = clock_.now_ns();
+    if (now > next + period) {
+      const std::int64_t behind = (now - next) / period;
+      next += behind * period;
+      bump(counters_.skipped, static_cast<std::uint64_t>(behind));
+    }
+  }
+}
+
+}  // namespace sinew::haptics

@@ -1,0 +1,62 @@
+// src/haptics/tool_bridge.cpp — the physics thread's side: the tool's state
+// out to the haptic loop after each frame, and minus the frame's mean
+// coupling force into the tool before the next (sign convention in
+// sinew/haptics/snapshot_channel.h).
+#include "sinew/haptics/tool_bridge.h"
+
+#include <cmath>
+
+#include "haptics/vec_math.h"
+
+namespace sinew::haptics {
+
+Status HapticToolBridge::apply_feedback(Simulation& sim) {
+  CouplingFeedback fb;
+  force_ = {0.0, 0.0, 0.0};
+  torque_ = {0.0, 0.0, 0.0};
+  const bool got = feedback_.try_read(fb, 64);
+  if (got && have_prev_ && fb.time_ns > prev_.time_ns) {
+    // Mean device force over the interval between the two readings (exact:
+    // the impulse integral is a zero-order hold of every tick's output).
+    const double dt = ns_to_seconds(fb.time_ns - prev_.time_ns);
+    force_ = vm::mul(vm::sub(fb.impulse, prev_.impulse), -1.0 / dt);
+    torque_ = vm::mul(vm::sub(fb.angular_impulse, prev_.angular_impulse), -1.0 / dt);
+  } else if (got && !have_prev_) {
+    // First reading: the newest tick's output (no interval to average over yet).
+    force_ = vm::mul(fb.force, -1.0);
+    torque_ = vm::mul(fb.torque, -1.0);
+  } else {
+    ++missing_;  // no tick since the previous frame: the tool gets nothing
+  }
+  if (got) {
+    prev_ = fb;
+    have_prev_ = true;
+  }
+  if (!vm::finite(force_) || !vm::finite(torque_)) {  // cannot happen with the safety chain; never pass it on
+    force_ = torque_ = {0.0, 0.0, 0.0};
+  }
+  return sim.apply_tool_force(tool_, force_, torque_);
+}
+
+Status HapticToolBridge::publish(const Simulation& sim) {
+  auto state = sim.tool_state(tool_);
+  if (!state) return state.error();
+  HapticSnapshot s;
+  s.sequence = ++sequence_;
+  s.stamp_ns = clock_.now_ns();
+  s.sim_time = sim.last_frame().time;
+  s.frame = sim.last_frame().frame;
+  s.position = state->position;
+  s.rotation = state->rotation;
+  s.velocity = state->velocity;
+  s.angular_velocity = state->angular_velocity;
+  s.contact_force = state->contact_force;
+  s.contact_torque = state->contact_torque;
+  const double f = vm::norm(s.contact_force);
+  s.in_contact = f > 0.0 ? 1u : 0u;
+  s.contact_normal = f > 0.0 ? vm::mul(s.contact_force, 1.0 / f) : Vec3{0.0, 0.0, 0.0};
+  snapshots_.publish(s);
+  return {};
+}
+
+}  // namespace sinew::haptics

@@ -1,0 +1,57 @@
+// src/haptics/vec_math.h — the few 3-vector and quaternion operations the
+// haptics code needs, inline and allocation-free (tick-safe).
+#pragma once
+
+#include <cmath>
+
+#include "sinew/haptics/snapshot_channel.h"
+
+namespace sinew::haptics::vm {
+
+inline Vec3 add(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+inline Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline Vec3 mul(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+inline double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+inline bool finite(const Vec3& a) { return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]); }
+inline bool finite(const Quat& q) {
+  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]) && std::isfinite(q[3]);
+}
+/// a + u (b - a)
+inline Vec3 lerp(const Vec3& a, const Vec3& b, double u) {
+  return {a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]), a[2] + u * (b[2] - a[2])};
+}
+
+inline Quat qmul(const Quat& a, const Quat& b) {
+  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3], a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1], a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+}
+inline Quat conj(const Quat& q) { return {q[0], -q[1], -q[2], -q[3]}; }
+inline double qdot(const Quat& a, const Quat& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+/// q / |q|; the identity when |q| is zero or not finite.
+inline Quat normalize(const Quat& q) {
+  const double n = std::sqrt(qdot(q, q));
+  if (!(n > 0.0) || !std::isfinite(n)) return {1.0, 0.0, 0.0, 0.0};
+  return {q[0] / n, q[1] / n, q[2] / n, q[3] / n};
+}
+/// Normalised lerp from a to b (b taken on a's hemisphere), u may exceed 1 (extrapolation).
+inline Quat nlerp(const Quat& a, const Quat& b, double u) {
+  const double s = qdot(a, b) < 0.0 ? -1.0 : 1.0;
+  return normalize({a[0] + u * (s * b[0] - a[0]), a[1] + u * (s * b[1] - a[1]), a[2] + u * (s * b[2] - a[2]),
+                    a[3] + u * (s * b[3] - a[3])});
+}
+/// The rotation vector (axis * angle, angle in [0, pi]) of a unit quaternion.
+inline Vec3 rotation_vector(const Quat& q_in) {
+  const Quat q = q_in[0] < 0.0 ? Quat{-q_in[0], -q_in[1], -q_in[2], -q_in[3]} : q_in;
+  const double s = std::sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (s < 1e-12) return {2.0 * q[1], 2.0 * q[2], 2.0 * q[3]};  // small angle: 2 v
+  const double angle = 2.0 * std::atan2(s, q[0]);
+  return {q[1] * angle / s, q[2] * angle / s, q[3] * angle / s};
+}
+/// The angular velocity [rad/s] that turns a into b in dt [s] (world frame).
+inline Vec3 angular_velocity(const Quat& a, const Quat& b, double dt) {
+  if (!(dt > 0.0)) return {0.0, 0.0, 0.0};
+  return mul(rotation_vector(qmul(b, conj(a))), 1.0 / dt);
+}
+
+}  // namespace sinew::haptics::vm
