@@ -18,6 +18,8 @@ Status check(const InterpolationParams& p) {
   if (!(p.extrapolation_horizon >= 0.0) || !std::isfinite(p.extrapolation_horizon))
     return Error("interpolation.extrapolation_horizon must be finite and >= 0 [s] (got " +
                  std::to_string(p.extrapolation_horizon) + ")");
+  if (!(p.max_interval > 0.0) || !std::isfinite(p.max_interval))
+    return Error("interpolation.max_interval must be finite and > 0 [s] (got " + std::to_string(p.max_interval) + ")");
   return {};
 }
 
@@ -50,7 +52,8 @@ RenderedTool SnapshotHistory::render(std::int64_t now_ns, const InterpolationPar
   r.contact_normal = b.contact_normal;
   r.in_contact = b.in_contact != 0;
   const double interval = count_ == 2 ? ns_to_seconds(b.stamp_ns - older_.stamp_ns) : 0.0;
-  if (count_ == 1 || !(interval > 0.0)) {  // one snapshot, or two stamped alike: hold the newest
+  if (count_ == 1 || !(interval > 0.0) || interval > params.max_interval) {
+    // One snapshot, two stamped alike, or a stall between them: hold the newest.
     r.mode = RenderMode::single;
     fill_single(b, r);
     r.u = 1.0;

@@ -13,7 +13,8 @@
 // next snapshot is late: the line through A and B is extrapolated, but only
 // for `extrapolation_horizon` seconds past B (u <= 1 + horizon / D); after
 // that the state holds there. u < 0 (a snapshot stamped after the tick
-// started) is taken as 0. Interpolating costs one physics frame of latency
+// started) is taken as 0. Snapshots more than max_interval apart (a stall)
+// are not interpolated: the newest is held. Interpolating costs one physics frame of latency
 // in the loop tool -> device -> tool: the coupled tool is stable when the
 // physics frame is short against the tool's coupled period (README).
 #pragma once
@@ -28,6 +29,10 @@ namespace sinew::haptics {
 struct InterpolationParams {
   /// How far past the newest snapshot the state may be extrapolated [s], >= 0.
   double extrapolation_horizon = 0.010;
+  /// Two snapshots further apart than this [s], > 0, are not interpolated
+  /// (a stall came between them): the newest is held until the next
+  /// arrives. Raise it for physics slower than 1 / max_interval frames/s.
+  double max_interval = 0.050;
 };
 /// Errors name the bad parameter.
 Status check(const InterpolationParams& params);
@@ -35,7 +40,7 @@ Status check(const InterpolationParams& params);
 /// How a rendered state was obtained.
 enum class RenderMode : std::uint32_t {
   none,          ///< no snapshot yet: no state
-  single,        ///< one snapshot: held as it is
+  single,        ///< one snapshot (or two further apart than max_interval): the newest held
   interpolated,  ///< between the two newest (0 <= u <= 1)
   extrapolated,  ///< past the newest, within the horizon
   held,          ///< past the horizon: held at the horizon
