@@ -148,6 +148,9 @@ TEST(HapticsLoop, BridgeAppliesNothingWithoutNewTicks) {
   ASSERT_TRUE(bridge.apply_feedback(*sim).ok());
   EXPECT_EQ(bridge.frames_without_feedback(), 1u);
   EXPECT_EQ(bridge.last_tool_force(), (Vec3{0, 0, 0}));
+  EXPECT_FALSE(bridge.set_damping(-1.0, 0.0).ok());
+  EXPECT_FALSE(bridge.set_damping(0.0, std::nan("")).ok());
+  EXPECT_TRUE(bridge.set_damping(2.0, 0.0).ok());
   HapticToolBridge wrong(3, snapshots, feedback, clock);
   EXPECT_FALSE(wrong.publish(*sim).ok()) << "a bad tool index is an error";
 }

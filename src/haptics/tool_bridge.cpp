@@ -5,10 +5,21 @@
 #include "sinew/haptics/tool_bridge.h"
 
 #include <cmath>
+#include <string>
 
 #include "haptics/vec_math.h"
 
 namespace sinew::haptics {
+
+Status HapticToolBridge::set_damping(double linear, double angular) {
+  if (!(linear >= 0.0) || !std::isfinite(linear))
+    return Error("tool damping must be finite and >= 0 [N s/m] (got " + std::to_string(linear) + ")");
+  if (!(angular >= 0.0) || !std::isfinite(angular))
+    return Error("tool angular damping must be finite and >= 0 [N m s/rad] (got " + std::to_string(angular) + ")");
+  damping_ = linear;
+  angular_damping_ = angular;
+  return {};
+}
 
 Status HapticToolBridge::apply_feedback(Simulation& sim) {
   CouplingFeedback fb;
@@ -35,7 +46,14 @@ Status HapticToolBridge::apply_feedback(Simulation& sim) {
   if (!vm::finite(force_) || !vm::finite(torque_)) {  // cannot happen with the safety chain; never pass it on
     force_ = torque_ = {0.0, 0.0, 0.0};
   }
-  return sim.apply_tool_force(tool_, force_, torque_);
+  Vec3 f = force_, t = torque_;
+  if (damping_ > 0.0 || angular_damping_ > 0.0) {
+    auto state = sim.tool_state(tool_);
+    if (!state) return state.error();
+    f = vm::sub(f, vm::mul(state->velocity, damping_));
+    t = vm::sub(t, vm::mul(state->angular_velocity, angular_damping_));
+  }
+  return sim.apply_tool_force(tool_, f, t);
 }
 
 Status HapticToolBridge::publish(const Simulation& sim) {

@@ -30,6 +30,18 @@ class HapticToolBridge {
   HapticToolBridge(std::size_t tool, SnapshotChannel& snapshots, FeedbackChannel& feedback, Clock& clock)
       : tool_(tool), snapshots_(snapshots), feedback_(feedback), clock_(clock) {}
 
+  /// Damping of the simulated tool's own motion, added by apply_feedback as
+  /// -linear v_tool and -angular w_tool from the tool's current state
+  /// [in] linear [N s/m], angular [N m s/rad], both >= 0 (default 0). It is
+  /// not rendered to the device. Why: the tool -> snapshot -> coupling ->
+  /// feedback -> tool loop holds about 1.5 physics frames of delay
+  /// (interpolation plus averaging), and a spring K seen through a delay tau
+  /// acts as a negative damper of about K tau, eating the coupling's own
+  /// damping (500 N/m x 6 ms = 3 N s/m at 250 Hz frames); a coupled tool
+  /// then rings at sqrt(K / M). Damping applied here has no such delay.
+  /// Explicit: keep linear x time_step / tool mass well below 2. Errors name the parameter.
+  Status set_damping(double linear, double angular);
+
   /// Before Simulation::step(): reads the newest feedback and applies minus
   /// its mean device force and torque since the previous call to the tool.
   /// No new tick since then (the haptic loop stopped or has not started):
@@ -39,8 +51,10 @@ class HapticToolBridge {
   /// stamped with the clock's now.
   Status publish(const Simulation& sim);
 
-  [[nodiscard]] const Vec3& last_tool_force() const { return force_; }    ///< applied to the tool [N]
-  [[nodiscard]] const Vec3& last_tool_torque() const { return torque_; }  ///< [N m]
+  /// Minus the mean device force (and torque) last applied to the tool
+  /// [N, N m], without the damping of set_damping.
+  [[nodiscard]] const Vec3& last_tool_force() const { return force_; }
+  [[nodiscard]] const Vec3& last_tool_torque() const { return torque_; }
   [[nodiscard]] const CouplingFeedback& last_feedback() const { return prev_; }
   [[nodiscard]] std::uint64_t frames_without_feedback() const { return missing_; }
   [[nodiscard]] std::uint64_t published() const { return sequence_; }
@@ -53,6 +67,7 @@ class HapticToolBridge {
   CouplingFeedback prev_{};
   bool have_prev_ = false;
   Vec3 force_{}, torque_{};
+  double damping_ = 0.0, angular_damping_ = 0.0;
   std::uint64_t missing_ = 0;
   std::uint64_t sequence_ = 0;
 };
