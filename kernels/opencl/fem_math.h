@@ -1,0 +1,290 @@
+/* fem_math.h — OpenCL twin of kernels/cpu/fem_kernels.h: the 3x3 matrix
+ * helpers and the constraint functions of the FEM tet materials, and the
+ * coupled 2x2 xPBD tet solve of kernels/cpu/fem_kernels.cpp (solve_tets),
+ * shared by xpbd_solve_neo_hookean.cl, xpbd_solve_stvk.cl and
+ * xpbd_solve_corotational.cl (every .cl file of kernels/opencl goes into one
+ * program: the guard keeps one definition of each).
+ *  - Macklin, Müller, Chentanez, "XPBD: Position-Based Simulation of
+ *    Compliant Constrained Dynamics", MIG 2016;
+ *  - Macklin, Müller, "A Constraint-based Formulation of Stable Neo-Hookean
+ *    Materials", MIG 2021: C_D = |F|_F, C_H = det F - gamma;
+ *  - St. Venant-Kirchhoff: C_D = |E|_F, E = (F^T F - I) / 2, C_H = det F - 1;
+ *  - corotational linear (Müller, Gross, "Interactive Virtual Materials",
+ *    GI 2004; inversion: Irving, Teran, Fedkiw, "Invertible Finite Elements
+ *    for Robust Simulation of Large Deformation", SCA 2004), with the
+ *    rotation of Horn, "Closed-form solution of absolute orientation using
+ *    unit quaternions", JOSA A 4(4), 1987, by cyclic Jacobi (Golub, Van
+ *    Loan, "Matrix Computations", 4th ed., section 8.5).
+ * Every operation in the CPU code's order, no fused multiply-add
+ * (FP_CONTRACT OFF in cl_math.h), correctly rounded sqrt and division as
+ * the CPU's, so that the results are bitwise those of the CPU kernels.
+ * Matrices are m[row][column] like fem::mat3. */
+#ifndef SINEW_FEM_MATH_H
+#define SINEW_FEM_MATH_H
+
+#include "cl_math.h"
+#include "fem_params.h"
+#include "xpbd_params.h"
+
+typedef struct fem_mat3 {
+  float m[3][3];
+} fem_mat3;
+
+/* The two constraints of a tet and their derivatives with respect to F. */
+typedef struct fem_constraints {
+  float c_d;      /* deviatoric constraint value */
+  float c_h;      /* hydrostatic constraint value */
+  fem_mat3 dc_d;  /* dC_D/dF */
+  fem_mat3 dc_h;  /* dC_H/dF */
+} fem_constraints;
+
+static inline float fem_frobenius_norm(const fem_mat3* a) {
+  float s = 0.0f;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) s += a->m[r][c] * a->m[r][c];
+  return sqrt(s);
+}
+
+static inline float fem_determinant(const fem_mat3* a) {
+  return a->m[0][0] * (a->m[1][1] * a->m[2][2] - a->m[1][2] * a->m[2][1]) -
+         a->m[0][1] * (a->m[1][0] * a->m[2][2] - a->m[1][2] * a->m[2][0]) +
+         a->m[0][2] * (a->m[1][0] * a->m[2][1] - a->m[1][1] * a->m[2][0]);
+}
+
+/* cof F = d(det F)/dF: column k is the cross product of the two other
+ * columns of F (cyclic). */
+static inline fem_mat3 fem_cofactor(const fem_mat3* a) {
+  fem_mat3 c;
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    c.m[0][k] = a->m[1][i] * a->m[2][j] - a->m[2][i] * a->m[1][j];
+    c.m[1][k] = a->m[2][i] * a->m[0][j] - a->m[0][i] * a->m[2][j];
+    c.m[2][k] = a->m[0][i] * a->m[1][j] - a->m[1][i] * a->m[0][j];
+  }
+  return c;
+}
+
+/* F = Ds Dm^-1, Ds = [x1 - x0, x2 - x0, x3 - x0] (columns). */
+static inline fem_mat3 fem_deformation_gradient(float4 x0, float4 x1, float4 x2, float4 x3, const fem_mat3* dm_inv) {
+  const float3 e1 = x1.xyz - x0.xyz, e2 = x2.xyz - x0.xyz, e3 = x3.xyz - x0.xyz;
+  const float ds[3][3] = {{e1.x, e2.x, e3.x}, {e1.y, e2.y, e3.y}, {e1.z, e2.z, e3.z}};
+  fem_mat3 f;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      f.m[r][c] = ds[r][0] * dm_inv->m[0][c] + ds[r][1] * dm_inv->m[1][c] + ds[r][2] * dm_inv->m[2][c];
+  return f;
+}
+
+/* g[i] = grad_{x_i} C from G = dC/dF: column i of G Dm^-T,
+ * g[0] = -(g[1] + g[2] + g[3]). */
+static inline void fem_position_gradients(const fem_mat3* g_f, const fem_mat3* dm_inv, float3 g[4]) {
+  for (int i = 1; i <= 3; ++i) {
+    const float d0 = dm_inv->m[i - 1][0], d1 = dm_inv->m[i - 1][1], d2 = dm_inv->m[i - 1][2];
+    g[i] = (float3)(g_f->m[0][0] * d0 + g_f->m[0][1] * d1 + g_f->m[0][2] * d2,
+                    g_f->m[1][0] * d0 + g_f->m[1][1] * d1 + g_f->m[1][2] * d2,
+                    g_f->m[2][0] * d0 + g_f->m[2][1] * d1 + g_f->m[2][2] * d2);
+  }
+  g[0] = (float3)(0.0f) - (g[1] + g[2] + g[3]);
+}
+
+/* The rotation R (det R = +1) maximising tr(R^T F): Horn's quaternion
+ * matrix N, whose eigenvector of largest eigenvalue is R's quaternion, by
+ * cyclic Jacobi (at most 12 sweeps); ties take the first; F = 0 gives I.
+ * Twin of fem::rotation_part. */
+static inline fem_mat3 fem_rotation_part(const fem_mat3* f) {
+  float n[4][4] = {
+      {f->m[0][0] + f->m[1][1] + f->m[2][2], f->m[2][1] - f->m[1][2], f->m[0][2] - f->m[2][0], f->m[1][0] - f->m[0][1]},
+      {f->m[2][1] - f->m[1][2], f->m[0][0] - f->m[1][1] - f->m[2][2], f->m[0][1] + f->m[1][0], f->m[0][2] + f->m[2][0]},
+      {f->m[0][2] - f->m[2][0], f->m[0][1] + f->m[1][0], -f->m[0][0] + f->m[1][1] - f->m[2][2], f->m[1][2] + f->m[2][1]},
+      {f->m[1][0] - f->m[0][1], f->m[0][2] + f->m[2][0], f->m[1][2] + f->m[2][1], -f->m[0][0] - f->m[1][1] + f->m[2][2]}};
+  float v[4][4] = {{1.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  const float eps = FLT_EPSILON;
+  for (int sweep = 0; sweep < 12; ++sweep) {
+    float off = 0.0f, total = 0.0f;
+    for (int p = 0; p < 4; ++p)
+      for (int q = 0; q < 4; ++q) {
+        if (p == q)
+          total += n[p][q] * n[p][q];
+        else
+          off += n[p][q] * n[p][q];
+      }
+    total += off;
+    if (off <= eps * eps * total) break;  /* also F = 0: total = 0 */
+    for (int p = 0; p < 3; ++p)
+      for (int q = p + 1; q < 4; ++q) {
+        const float apq = n[p][q];
+        if (apq == 0.0f) continue;
+        /* The rotation J (c, s) with (J^T N J)[p][q] = 0: t = tan of its
+         * angle, the smaller root of t^2 + 2 tau t - 1 = 0. */
+        const float tau = (n[q][q] - n[p][p]) / (2.0f * apq);
+        const float t = (tau >= 0.0f ? 1.0f : -1.0f) / (fabs(tau) + sqrt(1.0f + tau * tau));
+        const float c = 1.0f / sqrt(1.0f + t * t), sn = t * c;
+        for (int k = 0; k < 4; ++k) { /* N J (columns p, q) */
+          const float kp = n[k][p], kq = n[k][q];
+          n[k][p] = c * kp - sn * kq;
+          n[k][q] = sn * kp + c * kq;
+        }
+        for (int k = 0; k < 4; ++k) { /* J^T (N J) (rows p, q) */
+          const float pk = n[p][k], qk = n[q][k];
+          n[p][k] = c * pk - sn * qk;
+          n[q][k] = sn * pk + c * qk;
+        }
+        n[p][q] = n[q][p] = 0.0f;
+        for (int k = 0; k < 4; ++k) { /* V J */
+          const float kp = v[k][p], kq = v[k][q];
+          v[k][p] = c * kp - sn * kq;
+          v[k][q] = sn * kp + c * kq;
+        }
+      }
+  }
+  int best = 0;
+  for (int k = 1; k < 4; ++k)
+    if (n[k][k] > n[best][best]) best = k;
+  float w = v[0][best], x = v[1][best], y = v[2][best], z = v[3][best];
+  const float len = sqrt(w * w + x * x + y * y + z * z); /* 1 up to rounding */
+  w /= len;
+  x /= len;
+  y /= len;
+  z /= len;
+  fem_mat3 r;
+  r.m[0][0] = 1.0f - 2.0f * (y * y + z * z);
+  r.m[0][1] = 2.0f * (x * y - w * z);
+  r.m[0][2] = 2.0f * (x * z + w * y);
+  r.m[1][0] = 2.0f * (x * y + w * z);
+  r.m[1][1] = 1.0f - 2.0f * (x * x + z * z);
+  r.m[1][2] = 2.0f * (y * z - w * x);
+  r.m[2][0] = 2.0f * (x * z - w * y);
+  r.m[2][1] = 2.0f * (y * z + w * x);
+  r.m[2][2] = 1.0f - 2.0f * (x * x + y * y);
+  return r;
+}
+
+/* Stable Neo-Hookean (Macklin, Müller 2021): C_D = |F|_F, dC_D/dF = F / |F|_F
+ * (0 at F = 0); C_H = det F - h0, dC_H/dF = cof F. */
+static inline fem_constraints fem_neo_hookean_constraints(const fem_mat3* f, float h0) {
+  fem_constraints c;
+  c.c_d = fem_frobenius_norm(f);
+  const float inv = c.c_d > 0.0f ? 1.0f / c.c_d : 0.0f;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) c.dc_d.m[r][k] = f->m[r][k] * inv;
+  c.c_h = fem_determinant(f) - h0;
+  c.dc_h = fem_cofactor(f);
+  return c;
+}
+
+/* St. Venant-Kirchhoff: C_D = |E|_F, E = (F^T F - I) / 2, dC_D/dF = F E / |E|_F
+ * (0 at E = 0); C_H = det F - h0 (h0 = 1), dC_H/dF = cof F. */
+static inline fem_constraints fem_stvk_constraints(const fem_mat3* f, float h0) {
+  fem_constraints c;
+  fem_mat3 e;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      e.m[i][j] = 0.5f * (f->m[0][i] * f->m[0][j] + f->m[1][i] * f->m[1][j] + f->m[2][i] * f->m[2][j] -
+                          (i == j ? 1.0f : 0.0f));
+  c.c_d = fem_frobenius_norm(&e);
+  const float inv = c.c_d > 0.0f ? 1.0f / c.c_d : 0.0f;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k)
+      c.dc_d.m[r][k] = (f->m[r][0] * e.m[0][k] + f->m[r][1] * e.m[1][k] + f->m[r][2] * e.m[2][k]) * inv;
+  c.c_h = fem_determinant(f) - h0;
+  c.dc_h = fem_cofactor(f);
+  return c;
+}
+
+/* Corotational linear: R = rotation_part(F), C_D = |F - R|_F,
+ * dC_D/dF = (F - R) / |F - R|_F (0 at F = R); C_H = tr(R^T F) - h0 (h0 = 3),
+ * dC_H/dF = R. */
+static inline fem_constraints fem_corotational_constraints(const fem_mat3* f, float h0) {
+  fem_constraints c;
+  const fem_mat3 r = fem_rotation_part(f);
+  fem_mat3 d;
+  float trace = 0.0f;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      d.m[i][j] = f->m[i][j] - r.m[i][j];
+      trace += r.m[i][j] * f->m[i][j];
+    }
+  c.c_d = fem_frobenius_norm(&d);
+  const float inv = c.c_d > 0.0f ? 1.0f / c.c_d : 0.0f;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) c.dc_d.m[i][j] = d.m[i][j] * inv;
+  c.c_h = trace - h0;
+  c.dc_h = r;
+  return c;
+}
+
+#define FEM_MODEL_NEO_HOOKEAN 0
+#define FEM_MODEL_STVK 1
+#define FEM_MODEL_COROTATIONAL 2
+
+/* One tet's two constraints solved together as one 2x2 xPBD system in the
+ * W-orthogonal basis (a, b' = b - beta a) of fem_kernels.cpp: see there for
+ * the derivation, the scaling and the guards, all reproduced here. */
+static inline void fem_solve_tet(int model, global float4* x, global const uint4* idx, global const float* data,
+                                 global float* lambda, global float* residual, const SolveParams* p, uint i) {
+  const uint4 t = idx[i];
+  global const float* d = data + (size_t)i * SINEW_FEM_DATA_STRIDE;
+  fem_mat3 dm_inv;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) dm_inv.m[r][c] = d[SINEW_FEM_DM_INV + 3 * r + c];
+  const float4 xs[4] = {x[t.x], x[t.y], x[t.z], x[t.w]};
+  const fem_mat3 f = fem_deformation_gradient(xs[0], xs[1], xs[2], xs[3], &dm_inv);
+  const fem_constraints c = model == FEM_MODEL_NEO_HOOKEAN ? fem_neo_hookean_constraints(&f, d[SINEW_FEM_H0])
+                            : model == FEM_MODEL_STVK      ? fem_stvk_constraints(&f, d[SINEW_FEM_H0])
+                                                           : fem_corotational_constraints(&f, d[SINEW_FEM_H0]);
+
+  const float ad = d[SINEW_FEM_ALPHA_D] * p->inv_h2, ah = d[SINEW_FEM_ALPHA_H] * p->inv_h2;
+  global float* l = lambda + (size_t)i * SINEW_FEM_LAMBDA_STRIDE;
+  const float ld = p->reset_lambda ? 0.0f : l[0], lh = p->reset_lambda ? 0.0f : l[1];
+  const float rd = c.c_d + ad * ld, rh = c.c_h + ah * lh;
+  if (p->measure_only) {
+    residual[i] = sqrt(rd * rd + rh * rh);
+    return;
+  }
+
+  float3 a[4], b[4];
+  fem_position_gradients(&c.dc_d, &dm_inv, a);
+  fem_position_gradients(&c.dc_h, &dm_inv, b);
+  float aa = 0.0f, ab = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    aa += xs[k].w * dot3(a[k], a[k]);
+    ab += xs[k].w * dot3(a[k], b[k]);
+  }
+  const float beta = aa > 0.0f ? ab / aa : 0.0f;
+  float bb = 0.0f; /* <b', b'>_W */
+  for (int k = 0; k < 4; ++k) {
+    b[k] = b[k] - beta * a[k];
+    bb += xs[k].w * dot3(b[k], b[k]);
+  }
+  /* Scaled by 1 / (sum of the diagonal terms) against float overflow. */
+  const float total = aa + bb + ad + ah;
+  /* total == 0 or not finite (or det == 0 below): no direction to push along. */
+  if (!(total > 0.0f) || !isfinite(total)) {
+    l[0] = ld;
+    l[1] = lh;
+    return;
+  }
+  const float scale = 1.0f / total;
+  const float saa = scale * aa, sbb = scale * bb, sad = scale * ad, sah = scale * ah;
+  const float m11 = saa + sad, m12 = -beta * sad, m22 = sbb + beta * beta * sad + sah;
+  const float det = saa * sbb + saa * (beta * beta * sad + sah) + sad * sbb + sad * sah;
+  if (!(det > 0.0f)) {
+    l[0] = ld;
+    l[1] = lh;
+    return;
+  }
+  const float rhs1 = -scale * rd, rhs2 = -scale * (rh - beta * rd);
+  const float mu1 = (m22 * rhs1 - m12 * rhs2) / det;
+  const float mu2 = (m11 * rhs2 - m12 * rhs1) / det;
+  const uint ids[4] = {t.x, t.y, t.z, t.w};
+  for (int k = 0; k < 4; ++k) {
+    if (xs[k].w > 0.0f) {
+      const float3 dx = mu1 * a[k] + mu2 * b[k];
+      x[ids[k]] = (float4)(xs[k].xyz + xs[k].w * dx, xs[k].w);
+    }
+  }
+  l[0] = ld + (mu1 - beta * mu2);
+  l[1] = lh + mu2;
+}
+
+#endif /* SINEW_FEM_MATH_H */
