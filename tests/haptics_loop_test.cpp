@@ -162,6 +162,7 @@ TEST(HapticsLoop, ThreadRunsOnAVirtualClockAndReportsItsScheduling) {
   FeedbackChannel feedback;
   HapticLoopSettings settings;
   settings.realtime = false;
+  settings.zero_cpu_latency = false;  // a test leaves the machine's power management alone
   settings.telemetry_capacity = 100;
   bool started_on_loop_thread = false;
   std::thread::id loop_thread;
@@ -185,6 +186,7 @@ TEST(HapticsLoop, ThreadRunsOnAVirtualClockAndReportsItsScheduling) {
   const SchedulingReport& r = (*loop)->scheduling();
   EXPECT_NE(r.requested.find("SCHED_OTHER"), std::string::npos) << r.describe();
   EXPECT_FALSE(r.policy.empty());
+  EXPECT_EQ(r.cpu_latency, "not requested");
   // On a virtual clock every tick wakes exactly at its deadline, 1 ms apart.
   ASSERT_TRUE((*loop)->copy_telemetry(out).ok());
   ASSERT_EQ(out.size(), 100u);
@@ -205,6 +207,7 @@ TEST(HapticsLoop, RealtimeRequestIsReportedNotAssumed) {
   HapticLoopSettings settings;
   settings.realtime = true;
   settings.realtime_priority = 10;
+  settings.zero_cpu_latency = false;
   auto loop = HapticLoop::create(settings, device, snapshots, feedback, clock);
   ASSERT_TRUE(loop.ok());
   ASSERT_TRUE((*loop)->start().ok());

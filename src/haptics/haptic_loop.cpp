@@ -174,6 +174,8 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
 Status HapticLoop::start() {
   if (running()) return Error("the haptic loop is already running");
   if (auto s = device_.start(clock_.now_ns()); !s) return Error("device " + device_.name() + ": " + s.error().message());
+  std::string latency = "not requested";
+  if (settings_.zero_cpu_latency) qos_fd_ = hold_cpu_latency(0, latency);
   stop_.store(false, std::memory_order_relaxed);
   ready_.store(false, std::memory_order_relaxed);
   running_.store(true, std::memory_order_release);
@@ -181,10 +183,13 @@ Status HapticLoop::start() {
     thread_ = std::thread([this] { run(); });
   } catch (const std::exception& e) {
     running_.store(false, std::memory_order_release);
+    release_cpu_latency(qos_fd_);
+    qos_fd_ = -1;
     device_.stop();
     return Error(std::string("cannot create the haptic thread: ") + e.what());
   }
   ready_.wait(false, std::memory_order_acquire);  // scheduling_ is set
+  scheduling_.cpu_latency = latency;
   return {};
 }
 
@@ -194,6 +199,8 @@ void HapticLoop::stop() noexcept {
   thread_.join();
   device_.command({0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, clock_.now_ns());
   device_.stop();
+  release_cpu_latency(qos_fd_);
+  qos_fd_ = -1;
   running_.store(false, std::memory_order_release);
 }
 

@@ -1,7 +1,12 @@
 // src/haptics/realtime_thread.cpp — asking for SCHED_FIFO (and a CPU) for
 // the calling thread, and reporting what was obtained, never assuming it.
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdint>
 
 #include <string>
 #include <system_error>
@@ -68,7 +73,28 @@ std::string SchedulingReport::describe() const {
   std::string s = policy + " priority " + std::to_string(priority) + " (requested " + requested + ")";
   if (cpu >= 0) s += ", pinned to CPU " + std::to_string(cpu);
   if (!error.empty()) s += ": " + error;
+  s += "; CPU wake-up latency (PM QoS): " + cpu_latency;
   return s;
+}
+
+int hold_cpu_latency(int microseconds, std::string& report) {
+  const int fd = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (fd < 0) {
+    report = "cannot open /dev/cpu_dma_latency: " + std::system_category().message(errno);
+    return -1;
+  }
+  const std::int32_t value = microseconds;
+  if (::write(fd, &value, sizeof value) != static_cast<ssize_t>(sizeof value)) {
+    report = "cannot write /dev/cpu_dma_latency: " + std::system_category().message(errno);
+    ::close(fd);
+    return -1;
+  }
+  report = std::to_string(microseconds) + " us held";
+  return fd;
+}
+
+void release_cpu_latency(int fd) {
+  if (fd >= 0) ::close(fd);
 }
 
 }  // namespace sinew::haptics

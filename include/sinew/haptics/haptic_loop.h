@@ -41,6 +41,13 @@ struct HapticLoopSettings {
   bool realtime = true;             ///< request SCHED_FIFO for the loop thread
   int realtime_priority = 80;       ///< SCHED_FIFO priority, 1..99
   int cpu = -1;                     ///< pin the loop thread to this CPU; -1: no pinning
+  /// While the loop runs, hold a PM QoS request of 0 us CPU wake-up latency
+  /// (/dev/cpu_dma_latency, as cyclictest does): idle CPUs poll instead of
+  /// entering sleep states (halting, in a VM), whose wake-up delayed ticks by
+  /// up to 13 ms on our 2-vCPU VM (p99 jitter 8 ms -> 0.1 ms). Costs power
+  /// (idle CPUs spin) and needs write access to the device (root); what was
+  /// obtained is reported in SchedulingReport::cpu_latency.
+  bool zero_cpu_latency = true;
   std::size_t telemetry_capacity = 1u << 16;  ///< ticks kept in the telemetry ring (the newest), >= 1
   unsigned snapshot_read_attempts = 4;        ///< bounded seqlock retries per tick, >= 1
   CouplingParams coupling;
@@ -60,6 +67,7 @@ struct SchedulingReport {
   int priority = 0;        ///< obtained
   int cpu = -1;            ///< pinned CPU obtained (-1: none)
   std::string error;       ///< why the request failed ("" when it did not)
+  std::string cpu_latency = "not requested";  ///< the PM QoS request: "0 us held", or why not
   [[nodiscard]] bool realtime() const { return policy == "SCHED_FIFO" || policy == "SCHED_RR"; }
   [[nodiscard]] std::string describe() const;
 };
@@ -170,11 +178,19 @@ class HapticLoop {
   std::atomic<bool> ready_{false};
   SchedulingReport scheduling_;
   std::thread thread_;
+  int qos_fd_ = -1;  // /dev/cpu_dma_latency while held
 };
 
 /// Sets the calling thread's scheduling: SCHED_FIFO at `priority` when
 /// `realtime`, pinned to `cpu` when >= 0; reports what it obtained
 /// (pthread_getschedparam after the request) and why a request failed.
 SchedulingReport set_thread_scheduling(bool realtime, int priority, int cpu);
+
+/// Opens /dev/cpu_dma_latency and requests `microseconds` of CPU wake-up
+/// latency; the request holds while the returned descriptor is open.
+/// [out] report: "<n> us held" or why it failed. Returns -1 on failure.
+int hold_cpu_latency(int microseconds, std::string& report);
+/// Releases a request made by hold_cpu_latency (closes the descriptor; -1 is ignored).
+void release_cpu_latency(int fd);
 
 }  // namespace sinew::haptics
