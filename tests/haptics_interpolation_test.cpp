@@ -26,7 +26,7 @@ HapticSnapshot snap(std::int64_t stamp, Vec3 x, Vec3 v, Quat q, std::uint64_t se
   return s;
 }
 
-class Interpolation : public ::testing::Test {
+class HapticsInterpolation : public ::testing::Test {
  protected:
   void SetUp() override {
     const double h = std::sqrt(0.5);
@@ -38,14 +38,14 @@ class Interpolation : public ::testing::Test {
   InterpolationParams params;
 };
 
-TEST_F(Interpolation, NothingBeforeTheFirstSnapshot) {
+TEST_F(HapticsInterpolation, NothingBeforeTheFirstSnapshot) {
   SnapshotHistory empty;
   const RenderedTool r = empty.render(5 * ms, params);
   EXPECT_FALSE(r.valid());
   EXPECT_TRUE(std::isinf(r.snapshot_age));
 }
 
-TEST_F(Interpolation, OneSnapshotIsHeld) {
+TEST_F(HapticsInterpolation, OneSnapshotIsHeld) {
   SnapshotHistory one;
   one.push(snap(100 * ms, {1, 2, 3}, {4, 5, 6}, {1, 0, 0, 0}, 1));
   const RenderedTool r = one.render(130 * ms, params);
@@ -55,7 +55,7 @@ TEST_F(Interpolation, OneSnapshotIsHeld) {
   EXPECT_DOUBLE_EQ(r.snapshot_age, 0.030);
 }
 
-TEST_F(Interpolation, AtArrivalTheOlderSnapshotIsRendered) {
+TEST_F(HapticsInterpolation, AtArrivalTheOlderSnapshotIsRendered) {
   const RenderedTool r = history.render(110 * ms, params);  // u = 0
   EXPECT_EQ(r.mode, RenderMode::interpolated);
   EXPECT_DOUBLE_EQ(r.u, 0.0);
@@ -64,7 +64,7 @@ TEST_F(Interpolation, AtArrivalTheOlderSnapshotIsRendered) {
   EXPECT_DOUBLE_EQ(r.snapshot_age, 0.0);
 }
 
-TEST_F(Interpolation, HalfwayByHand) {
+TEST_F(HapticsInterpolation, HalfwayByHand) {
   const RenderedTool r = history.render(115 * ms, params);  // u = 0.5
   EXPECT_EQ(r.mode, RenderMode::interpolated);
   EXPECT_DOUBLE_EQ(r.u, 0.5);
@@ -83,7 +83,7 @@ TEST_F(Interpolation, HalfwayByHand) {
   EXPECT_DOUBLE_EQ(e.position[1], 0.02);
 }
 
-TEST_F(Interpolation, ExtrapolatesWithinTheHorizon) {
+TEST_F(HapticsInterpolation, ExtrapolatesWithinTheHorizon) {
   const RenderedTool r = history.render(123 * ms, params);  // u = 1.3: 3 ms past B, horizon 5 ms
   EXPECT_EQ(r.mode, RenderMode::extrapolated);
   EXPECT_NEAR(r.u, 1.3, 1e-12);
@@ -93,7 +93,7 @@ TEST_F(Interpolation, ExtrapolatesWithinTheHorizon) {
   EXPECT_NEAR(r.render_age, 0.010, 1e-12) << "still one interval: the line is extended at the same delay";
 }
 
-TEST_F(Interpolation, TheHorizonHolds) {
+TEST_F(HapticsInterpolation, TheHorizonHolds) {
   // 5 ms past B is the last extrapolated instant (u = 1.5); later it holds there.
   const RenderedTool edge = history.render(125 * ms, params);
   EXPECT_EQ(edge.mode, RenderMode::extrapolated);
@@ -114,13 +114,13 @@ TEST_F(Interpolation, TheHorizonHolds) {
   EXPECT_DOUBLE_EQ(z.position[0], 0.01);
 }
 
-TEST_F(Interpolation, ASnapshotStampedAfterTheTickIsNotExtrapolatedBackwards) {
+TEST_F(HapticsInterpolation, ASnapshotStampedAfterTheTickIsNotExtrapolatedBackwards) {
   const RenderedTool r = history.render(108 * ms, params);  // before b: u < 0 taken as 0
   EXPECT_DOUBLE_EQ(r.u, 0.0);
   EXPECT_EQ(r.position, (Vec3{0, 0, 0}));
 }
 
-TEST_F(Interpolation, AGapLongerThanMaxIntervalIsNotInterpolated) {
+TEST_F(HapticsInterpolation, AGapLongerThanMaxIntervalIsNotInterpolated) {
   // After a stall, the first fresh snapshot is held rather than slid towards
   // from a state the stall made old.
   params.max_interval = 0.05;
@@ -134,7 +134,7 @@ TEST_F(Interpolation, AGapLongerThanMaxIntervalIsNotInterpolated) {
   EXPECT_DOUBLE_EQ(s.position[0], 1.5);
 }
 
-TEST(InterpolationParamsCheck, NamesTheParameter) {
+TEST(HapticsInterpolationParams, NamesTheParameter) {
   InterpolationParams p;
   p.extrapolation_horizon = -1;
   auto s = check(p);

@@ -199,6 +199,10 @@ void HapticLoop::stop() noexcept {
   thread_.join();
   device_.command({0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, clock_.now_ns());
   device_.stop();
+  // The device held zero force since; a restart ramps up from zero again.
+  prev_force_ = prev_torque_ = {0.0, 0.0, 0.0};
+  coupling_.reset();
+  watchdog_.reset();
   release_cpu_latency(qos_fd_);
   qos_fd_ = -1;
   running_.store(false, std::memory_order_release);

@@ -119,7 +119,8 @@ class HapticLoop {
   /// set its scheduling (see scheduling()). Errors: already running, the
   /// device failed to start, the thread could not be created.
   Status start();
-  /// Stops the thread and the device (the device's force goes to zero). Idempotent.
+  /// Stops the thread and the device (the device is commanded zero force;
+  /// a later start() ramps the force up again through the watchdog). Idempotent.
   void stop() noexcept;
   [[nodiscard]] bool running() const { return running_.load(std::memory_order_acquire); }
   /// What the loop thread obtained; filled by start().
