@@ -47,6 +47,10 @@ class Agreement : public ::testing::TestWithParam<std::string> {
 struct Binding {
   std::vector<float> data;  // every buffer viewed as 4-byte words
   bool output_only = false;
+  // Words per element (4 for xyzw particles): expect_agree scales its
+  // tolerance per lane, so inverse masses (up to 1e8) do not hide position
+  // errors.
+  std::uint32_t lanes = 1;
 };
 
 struct KernelCase {
@@ -109,14 +113,15 @@ inline void expect_agree(const KernelCase& c, const std::vector<std::vector<floa
                   const std::vector<std::vector<float>>& gpu, const std::string& what) {
   ASSERT_EQ(ref.size(), gpu.size());
   for (std::size_t b = 0; b < ref.size(); ++b) {
-    float scale = 0.0f;
-    for (float v : ref[b])
-      if (std::isfinite(v)) scale = std::max(scale, std::abs(v));
+    const std::uint32_t lanes = std::max(c.bindings[b].lanes, 1u);
+    std::vector<float> scale(lanes, 0.0f);  // largest finite magnitude per lane
+    for (std::size_t i = 0; i < ref[b].size(); ++i)
+      if (std::isfinite(ref[b][i])) scale[i % lanes] = std::max(scale[i % lanes], std::abs(ref[b][i]));
     for (std::size_t i = 0; i < ref[b].size(); ++i) {
       const float r = ref[b][i], g = gpu[b][i];
       if (std::isnan(r) && std::isnan(g)) continue;  // untouched poison on both
       ASSERT_FALSE(std::isnan(g)) << what << ": binding " << b << " word " << i << " left poisoned by the GPU kernel";
-      ASSERT_NEAR(g, r, 1e-5f * std::max(scale, 1e-6f) + 1e-5f * std::abs(r))
+      ASSERT_NEAR(g, r, 1e-5f * std::max(scale[i % lanes], 1e-6f) + 1e-5f * std::abs(r))
           << what << " (" << kernel_name(c.kernel) << "): binding " << b << " word " << i;
     }
   }
@@ -145,7 +150,7 @@ inline KernelCase solve_case(std::mt19937& rng, Kernel kernel, std::uint32_t ari
   std::uniform_real_distribution<float> rest(0.05f, 0.5f), alpha(0.0f, 1e-4f), lam(-1e-3f, 1e-3f);
   KernelCase c{kernel, count, {}, {}};
   const std::uint32_t first = 3, total = first + count + 5;
-  c.bindings.push_back({random_particles(rng, total * arity), false});
+  c.bindings.push_back({random_particles(rng, total * arity), false, 4});
   std::vector<std::uint32_t> idx = one_colour(rng, total, arity);
   c.bindings.push_back({as_words(idx), false});
   std::vector<float> data, lambda, residual(total, 0.0f);

@@ -19,12 +19,12 @@ TEST_P(Agreement, PredictAndUpdateVelocityKernels) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   std::vector<float> v(4 * n);
   for (float& c : v) c = u(rng);
-  KernelCase predict{Kernel::xpbd_predict, n, {{random_particles(rng, n), false}, {std::vector<float>(4 * n), true}, {v, false}}, {}};
+  KernelCase predict{Kernel::xpbd_predict, n, {{random_particles(rng, n), false, 4}, {std::vector<float>(4 * n), true, 4}, {v, false, 4}}, {}};
   predict.params = bytes_of(kernels::PredictParams{1.0f / 240.0f, 0.1f, -9.81f, 0.3f, n, 0, 0, 0});
   expect_agree(predict, run_on("cpu", predict), run_on(GetParam(), predict), "predict");
 
   KernelCase update{Kernel::xpbd_update_velocity, n,
-                    {{random_particles(rng, n), false}, {random_particles(rng, n), false}, {std::vector<float>(4 * n), true}}, {}};
+                    {{random_particles(rng, n), false, 4}, {random_particles(rng, n), false, 4}, {std::vector<float>(4 * n), true, 4}}, {}};
   update.params = bytes_of(kernels::UpdateVelocityParams{240.0f, n, 0, 0});
   expect_agree(update, run_on("cpu", update), run_on(GetParam(), update), "update_velocity");
 }

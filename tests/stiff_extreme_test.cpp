@@ -171,9 +171,6 @@ TEST_P(Extreme, StaysFiniteBoundedAndKeepsItsVolume) {
   const auto& [backend, c] = GetParam();
   if (const std::string why = test::missing_device(backend); !why.empty()) GTEST_SKIP() << why;
   auto sim = test::create_or_skip(c.scene(), backend);
-  if (!sim.ok() && sim.error().message().find("has no " ) != std::string::npos &&
-      sim.error().message().find("implementation") != std::string::npos)
-    GTEST_SKIP() << sim.error().message();  // a kernel without a twin on this backend yet (issue 4/5)
   ASSERT_TRUE(sim.ok()) << sim.error().message();
   double max_ke = 0.0, min_dv = 0.0, max_dv = 0.0;
   std::vector<float> x;

@@ -699,7 +699,9 @@ class VulkanDeviceImpl final : public Device {
     const KernelSignature& sig = kernel_signature(kernel);
     const std::string name(sig.name);
     const std::span<const std::uint32_t> spirv = vulkan::embedded_spirv(sig.name);
-    if (spirv.empty()) return Error("kernel " + name + " has no Vulkan implementation in this build");
+    // Only when kernels/glsl is out of step with the kernel table (a test
+    // makes every kernel's pipeline): an error, not a skipped test.
+    if (spirv.empty()) return Error("internal: the embedded SPIR-V has no kernel " + name);
     if (sig.bindings > found_.properties.limits.maxPerStageDescriptorStorageBuffers)
       return Error("kernel " + name + " binds " + std::to_string(sig.bindings) + " storage buffers; " + found_.info.name +
                    " allows " + std::to_string(found_.properties.limits.maxPerStageDescriptorStorageBuffers));
