@@ -14,7 +14,9 @@
 // --trace <out>/<name>_ticks.csv (every tick). Default out: benchmarks/results.
 //
 //   bench_haptic_loop [--seconds S] [--rate HZ] [--no-realtime] [--no-cpu-latency] [--priority P] [--cpu N]
-//                     [--physics saturate|paced] [--cells N] [--out DIR] [--name NAME] [--trace]
+//                     [--physics saturate|paced] [--cells N] [--out DIR] [--name NAME] [--trace] [--mlock]
+// --mlock locks the process's memory (mlockall) before the run.
+#include <sys/mman.h>
 #include <sys/utsname.h>
 #include <unistd.h>
 
@@ -23,7 +25,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <new>
@@ -101,6 +105,7 @@ struct Options {
   std::string out = SINEW_BENCH_RESULTS_DIR;
   std::string name = "haptic_loop";
   bool trace = false;
+  bool mlock = false;
 };
 
 bool parse(int argc, char** argv, Options& o) {
@@ -109,6 +114,7 @@ bool parse(int argc, char** argv, Options& o) {
     if (a == "--no-realtime") { o.realtime = false; continue; }
     if (a == "--no-cpu-latency") { o.zero_cpu_latency = false; continue; }
     if (a == "--trace") { o.trace = true; continue; }
+    if (a == "--mlock") { o.mlock = true; continue; }
     const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
     if (!v) { std::fprintf(stderr, "missing value after %s\n", a.c_str()); return false; }
     if (a == "--seconds") o.seconds = std::atof(v);
@@ -199,6 +205,9 @@ int main(int argc, char** argv) {
   Options opt;
   if (!parse(argc, argv, opt)) return 2;
   std::filesystem::create_directories(opt.out);
+  std::string mlock_report = "not requested";
+  if (opt.mlock)
+    mlock_report = mlockall(MCL_CURRENT | MCL_FUTURE) == 0 ? "locked" : std::string("failed: ") + std::strerror(errno);
 
   // The tissue scene (as examples/haptic_drag): a block pinned at its bottom, a probe.
   const int n = opt.cells;
@@ -311,6 +320,7 @@ int main(int argc, char** argv) {
                     "\"error\": \"%s\", \"cpu_wakeup_latency_pm_qos\": \"%s\"},\n",
                  escape(sched.requested).c_str(), sched.policy.c_str(), sched.priority, sched.cpu,
                  escape(sched.error).c_str(), escape(sched.cpu_latency).c_str());
+    std::fprintf(f, "  \"mlockall\": \"%s\",\n", escape(mlock_report).c_str());
     std::fprintf(f, "  \"physics\": {\"mode\": \"%s\", \"particles\": %u, \"frames\": %llu, \"step_ms_mean\": %.3f, "
                     "\"frame_s\": %.4f},\n",
                  opt.physics.c_str(), sim->info().particles, static_cast<unsigned long long>(frames),
