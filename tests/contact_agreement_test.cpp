@@ -42,23 +42,25 @@ void append(std::vector<float>& out, const T& value) {
 }
 
 // How far the GPU's words are from the CPU's, printed per case: words not
-// bitwise equal and the largest difference relative to the buffer's scale.
-void print_difference(const std::string& backend, const std::string& what, const std::vector<std::vector<float>>& ref,
-                      const std::vector<std::vector<float>>& gpu) {
+// bitwise equal and the largest difference relative to its lane's scale
+// (the largest magnitude of that lane in the buffer, as expect_agree).
+void print_difference(const KernelCase& c, const std::string& backend, const std::string& what,
+                      const std::vector<std::vector<float>>& ref, const std::vector<std::vector<float>>& gpu) {
   std::size_t words = 0, differ = 0;
   double worst = 0.0;
-  for (std::size_t b = 0; b < ref.size() && b < gpu.size(); ++b) {
-    float scale = 0.0f;
-    for (float v : ref[b])
-      if (std::isfinite(v)) scale = std::max(scale, std::abs(v));
+  for (std::size_t b = 0; b < ref.size() && b < gpu.size() && b < c.bindings.size(); ++b) {
+    const std::uint32_t lanes = std::max(c.bindings[b].lanes, 1u);
+    std::vector<double> scale(lanes, 0.0);
+    for (std::size_t i = 0; i < ref[b].size(); ++i)
+      if (std::isfinite(ref[b][i])) scale[i % lanes] = std::max(scale[i % lanes], double(std::abs(ref[b][i])));
     for (std::size_t i = 0; i < ref[b].size(); ++i) {
       ++words;
       if (std::memcmp(&ref[b][i], &gpu[b][i], 4) == 0 || (std::isnan(ref[b][i]) && std::isnan(gpu[b][i]))) continue;
       ++differ;
-      worst = std::max(worst, std::abs(double(gpu[b][i]) - ref[b][i]) / std::max(double(scale), 1e-30));
+      worst = std::max(worst, std::abs(double(gpu[b][i]) - ref[b][i]) / std::max(scale[i % lanes], 1e-30));
     }
   }
-  std::printf("[ agree    ] %s, %s vs cpu: %zu of %zu words differ, largest difference %.3g of the buffer's scale\n",
+  std::printf("[ agree    ] %s, %s vs cpu: %zu of %zu words differ, largest difference %.3g of the lane's scale\n",
               what.c_str(), backend.c_str(), differ, words, worst);
 }
 
@@ -226,14 +228,14 @@ ContactSetup contact_setup(std::mt19937& rng, bool friction, float substep_fract
 KernelCase contact_case(const ContactSetup& c, float substep_end, bool reset, bool measure) {
   const std::uint32_t first = 3, count = c.constraints - 8;  // items outside [first, first + count) untouched
   KernelCase k{Kernel::xpbd_solve_contacts, count, {}, {}};
-  k.bindings.push_back({c.x, false});
+  k.bindings.push_back({c.x, false, 4});
   k.bindings.push_back({as_words(c.idx), false});
   k.bindings.push_back({c.margin, false});
-  k.bindings.push_back({c.lambda, reset && !measure});
+  k.bindings.push_back({c.lambda, reset && !measure, 4});  // lambda_n, lambda_t per surface
   k.bindings.push_back({std::vector<float>(c.constraints, 0.0f), measure});
-  k.bindings.push_back({c.prev, false});
+  k.bindings.push_back({c.prev, false, 4});
   k.bindings.push_back({c.colliders, false});
-  k.bindings.push_back({c.impulses, false});
+  k.bindings.push_back({c.impulses, false, 4});
   const float h = 1.0f / 240.0f;
   k.params = bytes_of(SolveParams{first, count, 1.0f / (h * h), reset ? 1u : 0u, h, substep_end, measure ? 1u : 0u, 0});
   return k;
@@ -264,7 +266,7 @@ TEST_P(Agreement, ContactKernel) {
       const auto ref = run_on("cpu", c);
       const auto gpu = run_on(GetParam(), c);
       expect_agree(c, ref, gpu, what);
-      print_difference(GetParam(), what, ref, gpu);
+      print_difference(c, GetParam(), what, ref, gpu);
       if (pass.measure || ref.size() != c.bindings.size()) continue;
       // The case reaches what it should: every surface touched; with
       // friction, particles held in the static cone and sliding in the
@@ -326,12 +328,12 @@ TEST_P(Agreement, AttachmentKernel) {
             for (int k = 0; k < 3; ++k) p[k] = e[k];
         }
         KernelCase c{Kernel::xpbd_solve_attachment, count, {}, {}};
-        c.bindings.push_back({x, false});
+        c.bindings.push_back({x, false, 4});
         c.bindings.push_back({as_words(idx), false});
-        c.bindings.push_back({data, false});
+        c.bindings.push_back({data, false, 2});
         c.bindings.push_back({lambda, reset && !measure});
         c.bindings.push_back({std::vector<float>(total, 0.0f), measure});
-        c.bindings.push_back({target_data, false});
+        c.bindings.push_back({target_data, false, 4});
         c.params = bytes_of(SolveParams{first, count, 3600.0f, reset ? 1u : 0u, 1.0f / 60.0f, substep_end,
                                         measure ? 1u : 0u, 0});
         const std::string what = std::string("attachment t ") + std::to_string(substep_end) +
@@ -339,7 +341,7 @@ TEST_P(Agreement, AttachmentKernel) {
         const auto ref = run_on("cpu", c);
         const auto gpu = run_on(GetParam(), c);
         expect_agree(c, ref, gpu, what);
-        print_difference(GetParam(), what, ref, gpu);
+        print_difference(c, GetParam(), what, ref, gpu);
       }
     }
   }

@@ -10,72 +10,13 @@
  *
  * Every .cl file is pasted into one program, so the helpers live here, once,
  * behind the include guard, with the prefix contact_. Quaternions are float4
- * (x, y, z, w), w the scalar part, as in the CPU Pose.
- *
- * The collider and target buffers are read as float4 (the layouts of
- * kernels/shared/contact_params.h: a 16-byte ColliderHeader, then 112-byte
- * ColliderEntry, 7 float4 each; 32-byte TargetEntry, 2 float4 each), and the
- * constants below repeat that header's: contact_params.h cannot be pasted
- * into the OpenCL program as it is, because cmake/EmbedKernelSources.cmake
- * splits lines as a CMake list, where an opening square bracket without its
- * closing one (its comments write half-open ranges of entries) glues every
- * following line into one and loses its #endif. The agreement tests (tests/contact_agreement_test.cpp) cover
- * every shape, both friction regimes and every impulse slot, so a layout
- * that drifts from the shared header fails them. */
+ * (x, y, z, w), w the scalar part, as in the CPU Pose. The collider and
+ * target layouts are the shared ones of kernels/shared/contact_params.h. */
 #ifndef SINEW_CONTACT_MATH_CL_H
 #define SINEW_CONTACT_MATH_CL_H
 
 #include "cl_math.h"
-
-/* = SINEW_SHAPE_*, SINEW_CONTACT_LAMBDA_PER_COLLIDER and
- * SINEW_CONTACT_IMPULSE_FLOAT4S of contact_params.h. */
-#define CONTACT_SHAPE_PLANE 0u
-#define CONTACT_SHAPE_SPHERE 1u
-#define CONTACT_SHAPE_CAPSULE 2u
-#define CONTACT_SHAPE_BOX 3u
-#define CONTACT_LAMBDA_PER_COLLIDER 4u
-#define CONTACT_IMPULSE_FLOAT4S 5u
-#define CONTACT_HEADER_FLOAT4S 1u /* sizeof(ColliderHeader) / 16 */
-#define CONTACT_ENTRY_FLOAT4S 7u  /* sizeof(ColliderEntry) / 16 */
-#define CONTACT_TARGET_FLOAT4S 2u /* sizeof(TargetEntry) / 16 */
-
-/* ColliderHeader: (colliders, tools, substep_fraction, pad0). */
-inline uint contact_collider_count(global const float4* buffer) { return as_uint(buffer[0].x); }
-inline uint contact_tool_count(global const float4* buffer) { return as_uint(buffer[0].y); }
-inline float contact_substep_fraction(global const float4* buffer) { return buffer[0].z; }
-
-/* One ColliderEntry, unpacked. */
-typedef struct ContactCollider {
-  uint shape;
-  float radius, half_height, compliance;
-  float half_x, half_y, half_z;
-  float static_friction, dynamic_friction;
-  float3 start_p, end_p;  /* positions at the start and at the end of the frame */
-  float4 start_q, end_q;  /* rotations, (x, y, z, w) */
-} ContactCollider;
-
-/* Entry k of the collider buffer. Its float4s: (shape, radius, half_height,
- * compliance), (half_x, half_y, half_z, static_friction), (dynamic_friction,
- * pad x3), (start p, pad), (start q as w, x, y, z), (end p, pad), (end q). */
-inline ContactCollider contact_load_collider(global const float4* buffer, uint k) {
-  global const float4* f = buffer + CONTACT_HEADER_FLOAT4S + k * CONTACT_ENTRY_FLOAT4S;
-  ContactCollider e;
-  const float4 f0 = f[0], f1 = f[1], f2 = f[2], f3 = f[3], f4 = f[4], f5 = f[5], f6 = f[6];
-  e.shape = as_uint(f0.x);
-  e.radius = f0.y;
-  e.half_height = f0.z;
-  e.compliance = f0.w;
-  e.half_x = f1.x;
-  e.half_y = f1.y;
-  e.half_z = f1.z;
-  e.static_friction = f1.w;
-  e.dynamic_friction = f2.x;
-  e.start_p = f3.xyz;
-  e.start_q = (float4)(f4.y, f4.z, f4.w, f4.x);
-  e.end_p = f5.xyz;
-  e.end_q = (float4)(f6.y, f6.z, f6.w, f6.x);
-  return e;
-}
+#include "contact_params.h"
 
 typedef struct ContactPose {
   float3 p;
@@ -109,10 +50,11 @@ inline float3 contact_rotate_inverse(float4 q, float3 v) {
 
 /* The collider's pose at fraction t of the frame: position lerped, rotation
  * nlerped on the shorter arc (CPU: collider_pose). */
-inline ContactPose contact_collider_pose(const ContactCollider* e, float t) {
-  const float3 p0 = e->start_p, p1 = e->end_p;
-  const float4 q0 = e->start_q;
-  float4 q1 = e->end_q;
+inline ContactPose contact_collider_pose(global const ColliderEntry* e, float t) {
+  const float3 p0 = (float3)(e->start_px, e->start_py, e->start_pz);
+  const float3 p1 = (float3)(e->end_px, e->end_py, e->end_pz);
+  const float4 q0 = (float4)(e->start_qx, e->start_qy, e->start_qz, e->start_qw);
+  float4 q1 = (float4)(e->end_qx, e->end_qy, e->end_qz, e->end_qw);
   ContactPose pose;
   if (t >= 1.0f) {
     pose.p = p1;
@@ -134,10 +76,10 @@ inline ContactPose contact_collider_pose(const ContactCollider* e, float t) {
 
 /* Signed distance of a point in the collider's frame (negative inside) and
  * the outward unit normal there, in that frame (CPU: collider_distance). */
-inline ContactDistance contact_collider_distance(const ContactCollider* e, float3 point) {
+inline ContactDistance contact_collider_distance(global const ColliderEntry* e, float3 point) {
   ContactDistance sd;
   switch (e->shape) {
-    case CONTACT_SHAPE_SPHERE: {
+    case SINEW_SHAPE_SPHERE: {
       const float r = contact_length3(point);
       if (r > 0.0f) {
         sd.distance = r - e->radius;
@@ -148,7 +90,7 @@ inline ContactDistance contact_collider_distance(const ContactCollider* e, float
       }
       return sd;
     }
-    case CONTACT_SHAPE_CAPSULE: {
+    case SINEW_SHAPE_CAPSULE: {
       const float s = contact_clamp(point.y, -e->half_height, e->half_height);
       const float3 v = (float3)(point.x, point.y - s, point.z);
       const float r = contact_length3(v);
@@ -161,7 +103,7 @@ inline ContactDistance contact_collider_distance(const ContactCollider* e, float
       }
       return sd;
     }
-    case CONTACT_SHAPE_BOX: {
+    case SINEW_SHAPE_BOX: {
       const float p[3] = {point.x, point.y, point.z};
       const float half_extent[3] = {e->half_x, e->half_y, e->half_z};
       float q[3], out[3], outside = 0.0f;
@@ -184,7 +126,7 @@ inline ContactDistance contact_collider_distance(const ContactCollider* e, float
       sd.normal = (float3)(n[0], n[1], n[2]);
       return sd;
     }
-    case CONTACT_SHAPE_PLANE:
+    case SINEW_SHAPE_PLANE:
     default:
       sd.distance = point.y;
       sd.normal = (float3)(0.0f, 1.0f, 0.0f);

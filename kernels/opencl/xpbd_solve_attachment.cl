@@ -8,15 +8,16 @@
 #include "xpbd_params.h"
 
 kernel void xpbd_solve_attachment(global float4* x, global const uint* idx, global const float2* data,
-                                  global float* lambda, global float* residual, global const float4* targets,
+                                  global float* lambda, global float* residual, global const TargetEntry* targets,
                                   SolveParams p) {
   const uint gid = get_global_id(0);
   if (gid >= p.count) return;
   const uint i = p.first + gid;
   const float4 xi = x[idx[i]];
   const float2 di = data[i];  // (target index, alpha)
-  global const float4* target = targets + (uint)di.x * CONTACT_TARGET_FLOAT4S;  // TargetEntry: start, end
-  const float3 goal = contact_lerp3(target[0].xyz, target[1].xyz, p.substep_end);
+  global const TargetEntry* target = targets + (uint)di.x;
+  const float3 goal = contact_lerp3((float3)(target->start_x, target->start_y, target->start_z),
+                                    (float3)(target->end_x, target->end_y, target->end_z), p.substep_end);
   const float3 d = xi.xyz - goal;
   const float c = contact_length3(d);  // zero rest length
   const float alpha_t = di.y * p.inv_h2;

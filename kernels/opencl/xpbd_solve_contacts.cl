@@ -21,9 +21,12 @@ kernel void xpbd_solve_contacts(global float4* x, global const uint* idx, global
   const uint gid = get_global_id(0);
   if (gid >= p.count) return;
   const uint i = p.first + gid;
-  const uint colliders = contact_collider_count(collider_data);  // ColliderHeader
-  const uint tools = contact_tool_count(collider_data);
-  const float substep_fraction = contact_substep_fraction(collider_data);
+  // The collider buffer: a ColliderHeader, then ColliderEntry[colliders + tools].
+  global const ColliderHeader* header = (global const ColliderHeader*)collider_data;
+  global const ColliderEntry* entries =
+      (global const ColliderEntry*)((global const uchar*)collider_data + sizeof(ColliderHeader));
+  const uint colliders = header->colliders, tools = header->tools;
+  const float substep_fraction = header->substep_fraction;
 
   const uint count = colliders + tools;
   const float t1 = p.substep_end;                             // the substep's end, as a frame fraction
@@ -38,19 +41,18 @@ kernel void xpbd_solve_contacts(global float4* x, global const uint* idx, global
   const float4 x_start = x[particle];
   float3 xi = x_start.xyz;
   const float w = x_start.w;
-  global float* lam = lambda + (size_t)i * count * CONTACT_LAMBDA_PER_COLLIDER;
-  global float4* slots = impulses + (size_t)particle * tools * CONTACT_IMPULSE_FLOAT4S;
+  global float* lam = lambda + (size_t)i * count * SINEW_CONTACT_LAMBDA_PER_COLLIDER;
+  global float4* slots = impulses + (size_t)particle * tools * SINEW_CONTACT_IMPULSE_FLOAT4S;
   for (uint t = 0; t < tools; ++t) {
-    global float4* slot = slots + t * CONTACT_IMPULSE_FLOAT4S;
+    global float4* slot = slots + t * SINEW_CONTACT_IMPULSE_FLOAT4S;
     if (restart_impulses) slot[0] = slot[1] = (float4)(0.0f);
     if (restart_last) slot[2] = slot[3] = slot[4] = (float4)(0.0f);
   }
   float worst = 0.0f;
 
   for (uint k = 0; k < count; ++k) {
-    const ContactCollider collider = contact_load_collider(collider_data, k);
-    const ContactCollider* e = &collider;
-    global float* lk = lam + k * CONTACT_LAMBDA_PER_COLLIDER;
+    global const ColliderEntry* e = entries + k;
+    global float* lk = lam + k * SINEW_CONTACT_LAMBDA_PER_COLLIDER;
     const float lambda_n = p.reset_lambda ? 0.0f : lk[0];
     float3 lambda_t = p.reset_lambda ? (float3)(0.0f) : (float3)(lk[1], lk[2], lk[3]);
 
@@ -98,7 +100,7 @@ kernel void xpbd_solve_contacts(global float4* x, global const uint* idx, global
     lk[3] = lambda_t_new.z;
 
     if (k >= colliders) {  // a tool: it receives the opposite of the impulse
-      global float4* slot = slots + (k - colliders) * CONTACT_IMPULSE_FLOAT4S;
+      global float4* slot = slots + (k - colliders) * SINEW_CONTACT_IMPULSE_FLOAT4S;
       const float3 lever = xi - pose.p;
       const float3 j = (-inv_h) * (dlambda_n * n + dlambda_t);
       const float3 moment = cross3(lever, j);
