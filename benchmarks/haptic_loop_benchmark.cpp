@@ -8,13 +8,14 @@
 // The physics thread steps a tissue block with a probe coupled to a scripted
 // device that presses and strokes back and forth; by default it steps back
 // to back (`--physics saturate`: with TBB on every core, the harshest load),
-// or paced to the wall clock (`--physics paced`).
+// or paced to the wall clock (`--physics paced`); `--physics none` only
+// republishes the tool's state at 250 Hz (the platform's own timing, no solver).
 //
 // Writes <out>/<name>.json and <out>/<name>.csv (one summary row), and with
 // --trace <out>/<name>_ticks.csv (every tick). Default out: benchmarks/results.
 //
 //   bench_haptic_loop [--seconds S] [--rate HZ] [--no-realtime] [--no-cpu-latency] [--priority P] [--cpu N]
-//                     [--physics saturate|paced] [--cells N] [--out DIR] [--name NAME] [--trace] [--mlock]
+//                     [--physics saturate|paced|none] [--cells N] [--out DIR] [--name NAME] [--trace] [--mlock]
 // --mlock locks the process's memory (mlockall) before the run.
 #include <sys/mman.h>
 #include <sys/utsname.h>
@@ -128,8 +129,8 @@ bool parse(int argc, char** argv, Options& o) {
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return false; }
     ++i;
   }
-  if (o.seconds < 2.0 || o.cells < 2 || (o.physics != "saturate" && o.physics != "paced")) {
-    std::fprintf(stderr, "--seconds >= 2, --cells >= 2, --physics saturate|paced\n");
+  if (o.seconds < 2.0 || o.cells < 2 || (o.physics != "saturate" && o.physics != "paced" && o.physics != "none")) {
+    std::fprintf(stderr, "--seconds >= 2, --cells >= 2, --physics saturate|paced|none\n");
     return false;
   }
   return true;
@@ -182,6 +183,14 @@ std::string cpu_model() {
   return "unknown";
 }
 
+// The 1-minute load average (other processes competing for the cores).
+std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::string one;
+  in >> one;
+  return one.empty() ? "unknown" : one;
+}
+
 int fail(const std::string& what) {
   std::fprintf(stderr, "bench_haptic_loop: %s\n", what.c_str());
   return 1;
@@ -205,6 +214,7 @@ int main(int argc, char** argv) {
   Options opt;
   if (!parse(argc, argv, opt)) return 2;
   std::filesystem::create_directories(opt.out);
+  const std::string load_at_start = load_average();
   std::string mlock_report = "not requested";
   if (opt.mlock)
     mlock_report = mlockall(MCL_CURRENT | MCL_FUTURE) == 0 ? "locked" : std::string("failed: ") + std::strerror(errno);
@@ -267,12 +277,14 @@ int main(int argc, char** argv) {
   double step_ms = 0.0;
   while (clock.now_ns() < end) {
     if (!g_counting.load() && clock.now_ns() >= count_from) g_counting.store(true);
-    if (auto s = bridge.apply_feedback(*sim); !s) return fail(s.error().message());
-    if (auto s = sim->step(); !s) return fail(s.error().message());
+    if (opt.physics != "none") {
+      if (auto s = bridge.apply_feedback(*sim); !s) return fail(s.error().message());
+      if (auto s = sim->step(); !s) return fail(s.error().message());
+      step_ms += sim->last_frame().wall_ms;
+    }
     if (auto s = bridge.publish(*sim); !s) return fail(s.error().message());
-    step_ms += sim->last_frame().wall_ms;
     ++frames;
-    if (opt.physics == "paced") clock.sleep_until(t0 + seconds_to_ns(double(frames) * scene.solver.time_step));
+    if (opt.physics != "saturate") clock.sleep_until(t0 + seconds_to_ns(double(frames) * scene.solver.time_step));
   }
   (*loop)->stop();
   g_counting.store(false);
@@ -314,8 +326,9 @@ int main(int argc, char** argv) {
     if (!f) return fail("cannot write " + base + ".json");
     std::fprintf(f, "{\n");
     std::fprintf(f, "  \"benchmark\": \"bench_haptic_loop\",\n");
-    std::fprintf(f, "  \"machine\": {\"cpu\": \"%s\", \"cores\": %ld, \"kernel\": \"%s %s\"},\n",
-                 escape(cpu_model()).c_str(), cores, u.sysname, u.release);
+    std::fprintf(f, "  \"machine\": {\"cpu\": \"%s\", \"cores\": %ld, \"kernel\": \"%s %s\", "
+                    "\"load_average_1min_at_start\": \"%s\"},\n",
+                 escape(cpu_model()).c_str(), cores, u.sysname, u.release, load_at_start.c_str());
     std::fprintf(f, "  \"scheduling\": {\"requested\": \"%s\", \"policy\": \"%s\", \"priority\": %d, \"cpu\": %d, "
                     "\"error\": \"%s\", \"cpu_wakeup_latency_pm_qos\": \"%s\"},\n",
                  escape(sched.requested).c_str(), sched.policy.c_str(), sched.priority, sched.cpu,
