@@ -14,7 +14,7 @@
 // Writes <out>/<name>.json and <out>/<name>.csv (one summary row), and with
 // --trace <out>/<name>_ticks.csv (every tick). Default out: benchmarks/results.
 //
-//   bench_haptic_loop [--seconds S] [--rate HZ] [--no-realtime] [--no-cpu-latency] [--priority P] [--cpu N]
+//   bench_haptic_loop [--seconds S] [--rate HZ] [--no-realtime] [--zero-cpu-latency] [--priority P] [--cpu N]
 //                     [--physics saturate|paced|none] [--cells N] [--out DIR] [--name NAME] [--trace] [--mlock]
 // --mlock locks the process's memory (mlockall) before the run.
 #include <sys/mman.h>
@@ -98,7 +98,7 @@ struct Options {
   double seconds = 20.0;
   double rate = 1000.0;
   bool realtime = true;
-  bool zero_cpu_latency = true;
+  bool zero_cpu_latency = false;
   int priority = 80;
   int cpu = -1;
   std::string physics = "saturate";
@@ -113,7 +113,7 @@ bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--no-realtime") { o.realtime = false; continue; }
-    if (a == "--no-cpu-latency") { o.zero_cpu_latency = false; continue; }
+    if (a == "--zero-cpu-latency") { o.zero_cpu_latency = true; continue; }
     if (a == "--trace") { o.trace = true; continue; }
     if (a == "--mlock") { o.mlock = true; continue; }
     const char* v = i + 1 < argc ? argv[i + 1] : nullptr;

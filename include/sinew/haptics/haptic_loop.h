@@ -43,11 +43,14 @@ struct HapticLoopSettings {
   int cpu = -1;                     ///< pin the loop thread to this CPU; -1: no pinning
   /// While the loop runs, hold a PM QoS request of 0 us CPU wake-up latency
   /// (/dev/cpu_dma_latency, as cyclictest does): idle CPUs poll instead of
-  /// entering sleep states (halting, in a VM), whose wake-up delayed ticks by
-  /// up to 13 ms on our 2-vCPU VM (p99 jitter 8 ms -> 0.1 ms). Costs power
-  /// (idle CPUs spin) and needs write access to the device (root); what was
+  /// entering sleep states, so a timer wakes the loop without leaving a
+  /// sleep state first. Off by default: it makes every idle CPU spin
+  /// (power, heat), and in a VM whose host caps its CPU time the spinning
+  /// vCPUs use up the cap and the host pauses the whole VM (measured here:
+  /// 35 ms pauses every 100 ms; benchmarks/README.md). Turn it on for a
+  /// dedicated machine. Needs write access to the device (root); what was
   /// obtained is reported in SchedulingReport::cpu_latency.
-  bool zero_cpu_latency = true;
+  bool zero_cpu_latency = false;
   std::size_t telemetry_capacity = 1u << 16;  ///< ticks kept in the telemetry ring (the newest), >= 1
   unsigned snapshot_read_attempts = 4;        ///< bounded seqlock retries per tick, >= 1
   CouplingParams coupling;
