@@ -1,0 +1,59 @@
+// xpbd_solve_line_bending.comp — GLSL twin of
+// kernels/cpu/thin_kernels.cpp:xpbd_solve_line_bending (and the OpenCL one).
+// Kelager, Niebe, Erleben, "A Triangle Bending Constraint Model for
+// Position-Based Dynamics", VRIPHYS 2010, solved as in Macklin, Müller,
+// Chentanez, "XPBD", MIG 2016, eq. 18. One invocation per thread vertex
+// (b0, v, b1) of one colour: C = |x_v - c| - h0 with
+// c = (x_b0 + x_v + x_b1) / 3, data (h0 [m], alpha [m/N], L [m], 0).
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "thin_math.h"
+#include "thin_params.h"
+#include "xpbd_params.h"
+
+layout(local_size_x = 64) in;
+layout(push_constant) uniform Push { SolveParams p; };
+layout(std430, binding = 0) buffer Position { vec4 x[]; };
+layout(std430, binding = 1) readonly buffer Indices { uint idx[]; };
+layout(std430, binding = 2) readonly buffer Data { vec4 data[]; };
+layout(std430, binding = 3) buffer Lambda { float lambda[]; };
+layout(std430, binding = 4) writeonly buffer Residual { float residual[]; };
+
+void main() {
+  const uint gid = gl_GlobalInvocationID.x;
+  if (gid >= p.count) return;
+  const uint i = p.first + gid;
+  const uint i0 = idx[3u * i], i1 = idx[3u * i + 1u], i2 = idx[3u * i + 2u];
+  const vec4 x0 = x[i0], x1 = x[i1], x2 = x[i2];
+  const vec4 d = data[i];
+  precise float alpha_t = d.y * p.inv_h2;
+  const float lambda_i = p.reset_lambda != 0u ? 0.0 : lambda[i];
+  precise float c = thin_line_bending_offset(x0.xyz, x1.xyz, x2.xyz) - d.x;
+  if (p.measure_only != 0u) {
+    precise float r = abs(c + alpha_t * lambda_i) / d.z;  // per segment rest length
+    residual[i] = r;
+    return;
+  }
+  // Guards as positive conditions (see thin_math.h): a collapsed element has no
+  // direction, and a step needs a positive, finite denominator; else lambda is
+  // kept and nothing moves.
+  vec3 g0, g1, g2;
+  if (thin_line_bending_gradients(x0.xyz, x1.xyz, x2.xyz, g0, g1, g2)) {
+    precise float w = 0.0;
+    w += x0.w * dot3(g0, g0);
+    w += x1.w * dot3(g1, g1);
+    w += x2.w * dot3(g2, g2);
+    precise float total = w + alpha_t;
+    if (thin_step_usable(total)) {
+      precise float dlambda = (-c - alpha_t * lambda_i) / total;
+      // Immovable particles are never written (several constraints of a colour may share one).
+      if (x0.w > 0.0) { precise vec3 y = x0.xyz + (x0.w * dlambda) * g0; x[i0] = vec4(y, x0.w); }
+      if (x1.w > 0.0) { precise vec3 y = x1.xyz + (x1.w * dlambda) * g1; x[i1] = vec4(y, x1.w); }
+      if (x2.w > 0.0) { precise vec3 y = x2.xyz + (x2.w * dlambda) * g2; x[i2] = vec4(y, x2.w); }
+      precise float lambda_n = lambda_i + dlambda;
+      lambda[i] = lambda_n;
+      return;
+    }
+  }
+  lambda[i] = lambda_i;
+}
