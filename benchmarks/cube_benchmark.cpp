@@ -12,7 +12,9 @@
 //   bench_cube --benchmark_out=cube.csv --benchmark_out_format=csv
 //   SINEW_BACKEND=cpu|opencl|vulkan|auto (default auto) picks the backend;
 //   SINEW_THREADS=N sets the CPU backend's threads (default: all);
-//   SINEW_CPU_SIMD=0 runs the scalar reference solves instead of AVX2.
+//   SINEW_CPU_SIMD=0 runs the scalar reference solves instead of AVX2;
+//   SINEW_MATERIAL=neo_hookean|stvk|corotational solves FEM tets instead of
+//   distance + volume constraints (default xpbd).
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -33,18 +35,33 @@ int threads_from_env() {
   return t ? std::atoi(t) : 0;
 }
 
+// SINEW_MATERIAL: xpbd (distance + volume, the iMSTK setup), neo_hookean,
+// stvk or corotational (one FEM tet constraint pair per tet instead).
+sinew::Result<sinew::TetMaterial> material_from_env() {
+  const char* m = std::getenv("SINEW_MATERIAL");
+  const std::string name = m ? m : "xpbd";
+  if (name == "xpbd") return sinew::TetMaterial::none;
+  if (name == "neo_hookean") return sinew::TetMaterial::neo_hookean;
+  if (name == "stvk") return sinew::TetMaterial::stvk;
+  if (name == "corotational") return sinew::TetMaterial::corotational;
+  return sinew::Error("SINEW_MATERIAL must be xpbd, neo_hookean, stvk or corotational (got " + name + ")");
+}
+
 bool simd_from_env() {
   const char* s = std::getenv("SINEW_CPU_SIMD");
   return !(s && std::string(s) == "0");
 }
 
 // A 1 m cube of n^3 cells (6 tets each), hanging from its top face.
-sinew::SceneDesc cube_scene(int n, int iterations) {
+sinew::SceneDesc cube_scene(int n, int iterations, sinew::TetMaterial material) {
   sinew::TetBodyDesc body;
   const double h = 1.0 / n;
   body.mesh = *sinew::make_tet_grid({.nx = n, .ny = n, .nz = n, .origin = {0, 0, 0}, .cell_size = {h, h, h}});
   body.density = 1000.0;
-  (void)body.set_elastic(1e5, 0.4);
+  if (material == sinew::TetMaterial::none)
+    (void)body.set_elastic(1e5, 0.4);
+  else
+    (void)body.set_material(material, 1e5, 0.4);
   for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
     if (body.mesh.vertices[v][1] >= 1.0 - 1e-9) body.pinned.push_back(v);
   sinew::SceneDesc scene;
@@ -57,7 +74,12 @@ sinew::SceneDesc cube_scene(int n, int iterations) {
 void BM_Cube(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int iterations = static_cast<int>(state.range(1));
-  auto sim = sinew::Simulation::create(cube_scene(n, iterations), {.backend = backend_from_env(), .threads = threads_from_env(), .cpu_simd = simd_from_env(), .quiet = true});
+  const auto material = material_from_env();
+  if (!material) {
+    state.SkipWithError(material.error().message().c_str());
+    return;
+  }
+  auto sim = sinew::Simulation::create(cube_scene(n, iterations, *material), {.backend = backend_from_env(), .threads = threads_from_env(), .cpu_simd = simd_from_env(), .quiet = true});
   if (!sim) {
     state.SkipWithError(sim.error().message().c_str());
     return;
