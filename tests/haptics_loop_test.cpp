@@ -200,8 +200,10 @@ TEST(HapticsLoop, ThreadRunsOnAVirtualClockAndReportsItsScheduling) {
 }
 
 TEST(HapticsLoop, RealtimeRequestIsReportedNotAssumed) {
+  // A real clock here (nothing is timed): on a virtual clock the loop never
+  // sleeps, and a SCHED_FIFO thread that never sleeps would hog a core.
   NullDevice device;
-  VirtualClock clock;
+  MonotonicClock clock;
   SnapshotChannel snapshots;
   FeedbackChannel feedback;
   HapticLoopSettings settings;
