@@ -5,11 +5,14 @@
 // the haptic display of tool use", IROS 1995. The device is never connected
 // to the environment directly but through a spring-damper to a simulated
 // tool; a passive environment plus a coupling chosen for the device keeps
-// the whole loop passive. For a sampled spring-damper of period T on a
-// device with physical damping b, J. E. Colgate and G. Schenkel, "Passivity
-// of a class of sampled-data systems", 1997: b > K T / 2 + |B| (of the
-// environment); here the coupling's own damper B covers the K T / 2 the
-// sampling adds (B > K T / 2 = 0.25 N s/m with the defaults).
+// the whole loop passive. Sampling matters: a spring held for a period T
+// delivers about (K T / 2) * integral |v|^2 dt of energy per closed cycle
+// (J. E. Colgate, G. Schenkel, "Passivity of a class of sampled-data
+// systems", J. Robotic Systems 1997: with velocities from differences, the
+// device's own damping b must exceed K T / 2 + |B|). With the device's
+// velocity sampled, as here, the coupling's damper removes B * integral
+// |v|^2 dt, so the coupling is passive when B > K T / 2 (0.25 N s/m with
+// the defaults at 1 kHz); tests/haptics_coupling_test.cpp measures both terms.
 //
 // Force and torque on the DEVICE (the user's hand) [N, N m]:
 //   F = K (x_tool - x_dev) + B (v_tool - v_dev)
