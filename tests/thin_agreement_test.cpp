@@ -21,12 +21,13 @@
 // Seeds are fresh each run.
 //
 // Tolerance: expect_agree's 1e-5 relative. The twins use the CPU kernels'
-// operation order without contraction, and the dihedral angle's atan2 is the
-// algorithm of glibc's atan2f (fdlibm, see kernels/opencl/thin_math.h), so
-// on PoCL and lavapipe with glibc every word is bitwise equal; the tolerance
-// is left for a C library with another atan2f and for devices whose
-// division and sqrt are not correctly rounded (Vulkan allows 2.5 ulp). Each
-// case prints how many words differ and by how much.
+// operation order without contraction, and the dihedral angle's atan2 is
+// our own thin::atan2_portable (kernels/cpu/thin_kernels.h: + - * / and
+// sqrt only), which the twins repeat operation for operation, so on PoCL and
+// lavapipe every word is bitwise equal whatever the C library; the
+// tolerance is left for devices whose division and sqrt are not correctly
+// rounded (Vulkan allows 2.5 ulp). Each case prints how many words differ
+// and by how much.
 #include <cinttypes>
 #include <cstdio>
 #include <functional>
@@ -287,8 +288,9 @@ Thin dihedral_edge_cases() {
   // |e| / |N1|^2 overflows: the gradient has inf and NaN, total NaN; theta = atan2(-1, +0).
   // (No subnormal input: devices that flush them to zero would see a degenerate wing.)
   hinge(p3(0, 0, 0), p3(1e18f, 0, 0), p3(0, 1e-30f, 0), p3(0, 0, 1e-10f), 0.3f, 1e-3f);
-  // The same with |e|^2 overflowing too: theta = atan2(-0, +0), which is -0 in C and
-  // undefined for GLSL's atan (lavapipe's gives about -3 pi / 4).
+  // The same with |e|^2 overflowing too: theta = atan2(-0, +0), which is -0 by C's
+  // convention (atan2_portable's too) and undefined for GLSL's atan (lavapipe's gives
+  // about -3 pi / 4).
   hinge(p3(0, 0, 0), p3(1e20f, 0, 0), p3(0, 1e-31f, 0), p3(0, 0, 1e-10f), 0.3f, 1e-3f);
   hinge(p3(0, 0, 0), p3(1, 0, 0), p3(0.3f, 0.5f, 0), p3(0.6f, -0.4f, 0.2f), 0.3f, 1e36f, 0.0f);  // total inf
   // Healthy, one wing pinned.

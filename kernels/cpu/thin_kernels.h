@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "cpu/cpu_math.h"
 
@@ -69,6 +70,77 @@ inline bool triangle_area_gradients(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> 
   return true;
 }
 
+/// atan2(y, x) in [-pi, pi]: the angle of the point (x, y), our own, used
+/// by dihedral_angle here and by its OpenCL and GLSL twins
+/// (thin_atan2_portable in kernels/opencl/thin_math.h and
+/// kernels/glsl/thin_math.h), which repeat it operation for operation.
+/// Why not std::atan2: the rest angles the scene compiler stores are
+/// computed on the host with this function, and a hinge at rest has
+/// C == 0 exactly only if every backend computes the very same bits. The C
+/// library's atan2f (glibc's, another libm's, a device builtin) differs
+/// from one implementation to the next in the last bits or more, and the
+/// devices have no C library; + - * / and sqrt are correctly rounded
+/// (IEEE 754) on every backend we run, so a fixed sequence of them gives
+/// the same result everywhere. The project compiles without contraction
+/// (-ffp-contract=off, FP_CONTRACT OFF, GLSL `precise`): no fused
+/// multiply-add changes a rounding.
+///
+/// Algorithm (each step exact or one rounding of + - * / sqrt):
+///  1. NaN in, NaN out (x + y). Otherwise the angle a in [0, pi/2] of
+///     (|x|, |y|), with the quadrant restored at the end: a -> pi - a when
+///     x is negative (sign bit, so x = -0 counts), a -> -a when y is.
+///  2. |x| == |y|: a = pi/4 rounded (both infinite included), or 0 when both
+///     are zero. Otherwise a = atan(r), r = min/max in [0, 1) (0 when one is
+///     zero or infinite), or pi/2 - atan(r) when |y| > |x|: r never
+///     overflows, and zeros and infinities need no case of their own.
+///  3. atan(r) = 2 atan(t), t = r / (1 + sqrt(1 + r^2)) <= tan(pi/8): the
+///     half-angle identity tan(u/2) = sin u / (1 + cos u) with tan u = r,
+///     cos u = 1 / sqrt(1 + r^2) (on argument reduction: J.-M. Muller,
+///     "Elementary Functions: Algorithms and Implementation", Birkhauser,
+///     chapter "Range reduction"). A
+///     second halving (t <= tan(pi/16)) would shorten the series but
+///     repeats the reduction's roundings: about 4.6 ulp in float instead
+///     of 3.9, 3.3 eps in double instead of 2.2.
+///  4. atan(t) = t - t^3/3 + t^5/5 - ... (Gregory's series,
+///     Abramowitz & Stegun 4.4.42), in Horner form in z = t^2 as
+///     t + t (z q), q = -1/3 + z (1/5 + z (-1/7 + ...)), each coefficient
+///     (-1)^k / (2k + 1) rounded to T. The series alternates with
+///     decreasing terms, so cutting it after n terms errs by less than
+///     the first term left out, t^(2n+1) / (2n+1), relative t^(2n) / (2n+1)
+///     <= 0.1716^n / (2n+1) (tan^2(pi/8) = 0.1716); half an ulp is at least
+///     2^-(p+1) relative for p significand bits. float (p = 24): n = 9 gives
+///     6.8e-9 < 2^-25 = 3.0e-8 (n = 8: 4.4e-8, too much); double (p = 53):
+///     n = 20 gives 1.2e-17 < 2^-54 = 5.6e-17 (n = 19: 7.3e-17).
+/// Accuracy, measured (tests/thin_test.cpp, ThinMath; 2e8 random pairs):
+/// float within 3.9 ulp of the exact atan2 of its arguments, double within
+/// 2.2 eps relative; the roundings of r and t dominate (glibc's atan2f:
+/// about 1.5 ulp by the same measure). Plenty for an angle whose rest
+/// value is computed by the same function.
+/// C's conventions hold: atan2(+-0, +0) = +-0, atan2(+-0, -0) = +-pi,
+/// atan2(+-y, +inf) = +-0, atan2(+-y, -inf) = +-pi, atan2(+-inf, x) =
+/// +-pi/2, atan2(+-inf, +-inf) = +-pi/4 or +-3pi/4, exactly rounded; and
+/// atan2(-y, x) = -atan2(y, x) bit for bit.
+template <class T>
+inline T atan2_portable(T y, T x) {
+  static_assert(std::numeric_limits<T>::digits == 24 || std::numeric_limits<T>::digits == 53);
+  constexpr int terms = std::numeric_limits<T>::digits == 24 ? 9 : 20;  // see 4. above
+  if (std::isnan(x) || std::isnan(y)) return x + y;
+  const T ax = std::fabs(x), ay = std::fabs(y);
+  const auto atan01 = [](T r) {  // atan(r), r in [0, 1]
+    const T t = r / (T(1) + std::sqrt(T(1) + r * r));
+    const T z = t * t;
+    T q = T(0);
+    for (int k = terms - 1; k >= 1; --k) q = T(k % 2 ? -1 : 1) / T(2 * k + 1) + z * q;
+    return T(2) * (t + t * (z * q));
+  };
+  T a;
+  if (ax == ay) a = ax == T(0) ? T(0) : pi<T> / T(4);
+  else if (ay < ax) a = atan01(ay / ax);
+  else a = pi<T> / T(2) - atan01(ax / ay);
+  if (std::signbit(x)) a = pi<T> - a;
+  return std::signbit(y) ? -a : a;
+}
+
 /// The signed dihedral angle theta [rad] in (-pi, pi] of the hinge x0-x1
 /// (the shared edge, e = x1 - x0) with wing vertices x2 and x3:
 /// N1 = e x (x2 - x0) (the normal of triangle (x0, x1, x2)),
@@ -77,7 +149,9 @@ inline bool triangle_area_gradients(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> 
 /// theta = 0 when the hinge is flat, +-pi when folded shut; moving the wing
 /// x2 along +N1 (or x3 along +N2) decreases it.
 /// atan2 keeps full precision near 0 and pi, where acos(n1 . n2) loses half
-/// its digits. Returns 0 when the edge or a wing is degenerate.
+/// its digits; it is atan2_portable, so that every backend computes the same
+/// bits as the scene compiler's rest angle. Returns 0 when the edge or a
+/// wing is degenerate.
 template <class T>
 inline T dihedral_angle(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> x3) {
   const vec4<T> e = x1 - x0;
@@ -87,7 +161,7 @@ inline T dihedral_angle(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> x3) {
   const vec4<T> u1 = (T(1) / l1) * n1, u2 = (T(1) / l2) * n2;
   const T s = dot3(cross3(u1, u2), e) / le;  // sin theta
   const T c = dot3(u1, u2);                  // cos theta
-  return std::atan2(s, c);
+  return atan2_portable(s, c);
 }
 
 /// d wrapped into [-pi, pi] (d in (-2 pi, 2 pi], a difference of two

@@ -10,11 +10,12 @@
  *    Model for Position-Based Dynamics", VRIPHYS 2010.
  * Every expression is written in the CPU code's operation order and every
  * arithmetic result is `precise` (SPIR-V NoContraction: no fused
- * multiply-add), so the results round like the CPU kernels'. The one
- * library function, the CPU's std::atan2(float, float), is thin_atan2f
- * below: GLSL's atan(y, x) may be far less exact (lavapipe's differs from
- * the C library's by far more than an ulp), and then a hinge at its rest
- * angle would not have C == 0 exactly. Guards are written as positive
+ * multiply-add), so the results round like the CPU kernels'. The angle's
+ * atan2 is not GLSL's atan(y, x): the CPU's is thin::atan2_portable, our
+ * own from + - * / and sqrt, and thin_atan2_portable below repeats it
+ * operation for operation; GLSL's atan may be far less exact (lavapipe's
+ * is off by far more than an ulp), and then a hinge at its rest angle
+ * would not have C == 0 exactly. Guards are written as positive
  * conditions (`if (len > 0.0)`, not `if (!(len > 0.0))`), so that a NaN
  * takes the same branch as on the CPU even where a compiler turns
  * !(a > b) into a <= b. */
@@ -54,104 +55,54 @@ bool thin_triangle_area_gradients(vec3 x0, vec3 x1, vec3 x2, out vec3 g0, out ve
   return false;
 }
 
-/* ---- atan2, bit for bit as the C library of the CPU reference computes it
- *
- * thin_atanf and thin_atan2f are the float atan and atan2 of Sun's fdlibm
- * (s_atanf.c, e_atan2f.c; float version by Ian Lance Taylor, Cygnus
- * Support), which glibc's atanf and atan2f are (sysdeps/ieee754/flt-32),
- * as kernels/opencl/thin_math.h has them (see there): same constants (the
- * decimals below are the floats' exact values) and operation order, all in
- * float, every result `precise`. The fdlibm notice, which its license asks
- * to keep:
- *   Copyright (C) 1993 by Sun Microsystems, Inc. All rights reserved.
- *   Developed at SunPro, a Sun Microsystems, Inc. business.
- *   Permission to use, copy, modify, and distribute this software is
- *   freely granted, provided that this notice is preserved. */
+/* ---- atan2: thin::atan2_portable<float> of kernels/cpu/thin_kernels.h,
+ * operation for operation (the algorithm, its identities and the number of
+ * series terms are explained there), as kernels/opencl/thin_math.h has it:
+ * only + - * / and sqrt, correctly rounded here as on the CPU, in the CPU's
+ * order, every result `precise`. The constants below are the floats of the
+ * OpenCL twin's hexadecimal literals, in 17 significant digits: read as a
+ * double, each is that float exactly, so its conversion to float cannot
+ * round another way. */
 
-/* atan(c) for c = 1/2, 1, 3/2, infinity: high parts, low parts. */
-const float THIN_ATAN_HI[4] = float[4](0.46364760398864746, 0.78539812564849854, 0.98279368877410889,
-                                       1.5707962512969971);
-const float THIN_ATAN_LO[4] = float[4](5.0121582439999202e-09, 3.7748947079307982e-08, 3.4473217169761483e-08,
-                                       7.5497894158615964e-08);
-/* The polynomial atan(x) = x - x (aT0 z + aT1 z^2 + ... + aT10 z^11), z = x^2. */
-const float THIN_AT0 = 0.3333333432674408, THIN_AT1 = -0.20000000298023224, THIN_AT2 = 0.1428571492433548,
-            THIN_AT3 = -0.1111111044883728, THIN_AT4 = 0.090908870100975037, THIN_AT5 = -0.076918758451938629,
-            THIN_AT6 = 0.066610731184482574, THIN_AT7 = -0.058335702866315842, THIN_AT8 = 0.049768779426813126,
-            THIN_AT9 = -0.036531571298837662, THIN_AT10 = 0.016285819932818413;
-const float THIN_PI_LO = -8.7422776573475858e-08;  // pi - THIN_PI
-const float THIN_PI_2 = 1.5707963705062866;        // pi / 2 rounded
-const float THIN_PI_4 = 0.78539818525314331;       // pi / 4 rounded
-const float THIN_3PI_4 = 2.3561944961547852;       // 3 * THIN_PI_4 rounded
+const float THIN_PI_2 = 1.5707963705062866;   // THIN_PI / 2 (exact), as thin::pi<float> / 2
+const float THIN_PI_4 = 0.78539818525314331;  // THIN_PI / 4 (exact), as thin::pi<float> / 4
+// (-1)^k / (2k + 1) rounded to float, k = 1..8, as the CPU computes them.
+const float THIN_ATAN_C1 = -0.3333333432674408, THIN_ATAN_C2 = 0.20000000298023224,
+            THIN_ATAN_C3 = -0.1428571492433548, THIN_ATAN_C4 = 0.1111111119389534,
+            THIN_ATAN_C5 = -0.090909093618392944, THIN_ATAN_C6 = 0.076923079788684845,
+            THIN_ATAN_C7 = -0.066666670143604279, THIN_ATAN_C8 = 0.058823529630899429;
 
-precise float thin_atanf(float x_in) {
-  precise float x = x_in;
-  const int hx = floatBitsToInt(x), ix = hx & 0x7fffffff;
-  int id;
-  if (ix >= 0x4c000000) {  // |x| >= 2^25, or NaN
-    if (ix > 0x7f800000) {
-      precise float nan_out = x + x;
-      return nan_out;
-    }
-    precise float r = hx > 0 ? THIN_ATAN_HI[3] + THIN_ATAN_LO[3] : -THIN_ATAN_HI[3] - THIN_ATAN_LO[3];
-    return r;
-  }
-  if (ix < 0x3ee00000) {              // |x| < 7/16
-    if (ix < 0x31000000) return x;    // |x| < 2^-29
-    id = -1;
-  } else {
-    x = abs(x);
-    if (ix < 0x3f980000) {    // |x| < 19/16
-      if (ix < 0x3f300000) {  // 7/16 <= |x| < 11/16
-        id = 0;
-        x = (2.0 * x - 1.0) / (2.0 + x);
-      } else {  // 11/16 <= |x| < 19/16
-        id = 1;
-        x = (x - 1.0) / (x + 1.0);
-      }
-    } else if (ix < 0x401c0000) {  // 19/16 <= |x| < 39/16
-      id = 2;
-      x = (x - 1.5) / (1.0 + 1.5 * x);
-    } else {  // 39/16 <= |x| < 2^25
-      id = 3;
-      x = -1.0 / x;
-    }
-  }
-  precise float z = x * x, w = z * z;
-  // The odd and even halves of the sum over aT_k z^(k+1), in w = z^2.
-  precise float s1 = z * (THIN_AT0 + w * (THIN_AT2 + w * (THIN_AT4 + w * (THIN_AT6 + w * (THIN_AT8 + w * THIN_AT10)))));
-  precise float s2 = w * (THIN_AT1 + w * (THIN_AT3 + w * (THIN_AT5 + w * (THIN_AT7 + w * THIN_AT9))));
-  if (id < 0) {
-    precise float r = x - x * (s1 + s2);
-    return r;
-  }
-  precise float r = THIN_ATAN_HI[id] - ((x * (s1 + s2) - THIN_ATAN_LO[id]) - x);
-  return hx < 0 ? -r : r;
+/* atan(r) for r in [0, 1]: 2 atan(t), t = r / (1 + sqrt(1 + r^2)), and nine
+ * terms of atan(t) = t - t^3/3 + t^5/5 - ... in Horner form in z = t^2. */
+precise float thin_atan01(float r) {
+  precise float t = r / (1.0 + sqrt(1.0 + r * r));
+  precise float z = t * t;
+  precise float q =
+      THIN_ATAN_C1 +
+      z * (THIN_ATAN_C2 +
+           z * (THIN_ATAN_C3 +
+                z * (THIN_ATAN_C4 +
+                     z * (THIN_ATAN_C5 + z * (THIN_ATAN_C6 + z * (THIN_ATAN_C7 + z * THIN_ATAN_C8))))));
+  precise float a = 2.0 * (t + t * (z * q));
+  return a;
 }
 
-/* atan2(y, x) in -pi..pi, signs of zeros and infinities as C's atan2f. */
-precise float thin_atan2f(float y, float x) {
-  const int hx = floatBitsToInt(x), ix = hx & 0x7fffffff, hy = floatBitsToInt(y), iy = hy & 0x7fffffff;
-  if (ix > 0x7f800000 || iy > 0x7f800000) {  // NaN
+/* thin::atan2_portable(y, x) in -pi..pi, C's conventions for signed zeros,
+ * infinities and NaN. NaN and the signs are read from the bits, which no
+ * compiler assumption about NaN can change. */
+precise float thin_atan2_portable(float y, float x) {
+  const int hx = floatBitsToInt(x), hy = floatBitsToInt(y);
+  if ((hx & 0x7fffffff) > 0x7f800000 || (hy & 0x7fffffff) > 0x7f800000) {  // NaN
     precise float nan_out = x + y;
     return nan_out;
   }
-  if (hx == 0x3f800000) return thin_atanf(y);         // x == 1
-  const int m = (hy < 0 ? 1 : 0) | (hx < 0 ? 2 : 0);  // 2 sign(x) + sign(y)
-  if (iy == 0) return m < 2 ? y : (m == 2 ? THIN_PI : -THIN_PI);
-  if (ix == 0) return hy < 0 ? -THIN_PI_2 : THIN_PI_2;
-  if (ix == 0x7f800000) {
-    if (iy == 0x7f800000) return m == 0 ? THIN_PI_4 : m == 1 ? -THIN_PI_4 : m == 2 ? THIN_3PI_4 : -THIN_3PI_4;
-    return m == 0 ? 0.0 : m == 1 ? -0.0 : m == 2 ? THIN_PI : -THIN_PI;
-  }
-  if (iy == 0x7f800000) return hy < 0 ? -THIN_PI_2 : THIN_PI_2;
-  const int k = (iy - ix) >> 23;
-  precise float z;
-  if (k > 60) z = THIN_PI_2 + 0.5 * THIN_PI_LO;  // |y / x| > 2^60
-  else if (hx < 0 && k < -60) z = 0.0;           // |y| / x < -2^60
-  else z = thin_atanf(abs(y / x));
-  if (m == 0) return z;
-  if (m == 1) return -z;
-  precise float r = m == 2 ? THIN_PI - (z - THIN_PI_LO) : (z - THIN_PI_LO) - THIN_PI;
+  precise float ax = abs(x), ay = abs(y);
+  precise float a;
+  if (ax == ay) a = ax == 0.0 ? 0.0 : THIN_PI_4;
+  else if (ay < ax) a = thin_atan01(ay / ax);
+  else a = THIN_PI_2 - thin_atan01(ax / ay);
+  if (hx < 0) a = THIN_PI - a;
+  precise float r = hy < 0 ? -a : a;
   return r;
 }
 
@@ -165,7 +116,7 @@ precise float thin_dihedral_angle(vec3 x0, vec3 x1, vec3 x2, vec3 x3) {
     precise vec3 u1 = (1.0 / l1) * n1, u2 = (1.0 / l2) * n2;
     precise float s = dot3(cross3(u1, u2), e) / le;  // sin theta
     precise float c = dot3(u1, u2);                  // cos theta
-    precise float theta = thin_atan2f(s, c);  // std::atan2(s, c) of the CPU's C library
+    precise float theta = thin_atan2_portable(s, c);
     return theta;
   }
   return 0.0;
