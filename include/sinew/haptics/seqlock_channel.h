@@ -80,14 +80,19 @@ class SeqlockChannel {
   /// blocks the writer or waits for it). Lock-free with at most
   /// `max_attempts` copies: false when nothing was published yet, or when
   /// every attempt overlapped two publications (then `out` is unchanged).
-  /// [out] out: a whole value; [out] version: its publication number (1, 2, ...).
+  /// [out] out: a whole value; [out] version: its publication number (1, 2, ...),
+  /// never smaller than one an earlier read of this thread returned.
   bool try_read(T& out, unsigned max_attempts = 8, std::uint64_t* version = nullptr) const noexcept {
     for (unsigned attempt = 0; attempt < max_attempts; ++attempt) {
       const std::uint64_t n = published_.load(std::memory_order_acquire);
       if (n == 0) return false;
       const Slot& slot = slots_[n & 1u];
       const std::uint64_t s0 = slot.seq.load(std::memory_order_acquire);
-      if (s0 & 1u) continue;  // the writer lapped us and is rewriting this slot
+      // The slot must still hold publication n itself. Taking a newer one
+      // found there (n + 2, the writer lapped us) could hand out n + 2 and,
+      // on the next read, n + 1 (published_ is stored after the slot), so
+      // versions would go backwards; retry instead. Odd: being rewritten.
+      if (s0 != 2 * n) continue;
       Words words;
       for (std::size_t i = 0; i < kWords; ++i) words[i] = slot.words[i].load(std::memory_order_relaxed);
       std::atomic_thread_fence(std::memory_order_acquire);  // orders the payload loads before the re-check
