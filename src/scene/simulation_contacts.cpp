@@ -57,11 +57,10 @@
 //  - A resting tool keeps a small jitter (no damping is added); compare
 //    averages of tool_state over a few frames.
 //
-// State: Simulation::Impl holds no member for the tools yet, so their rigid
-// state (double precision) and the impulse read-back buffer are kept in
-// Impl::colliders after the part that is uploaded:
-//   [ColliderHeader][ColliderEntry x (colliders + tools)] | [Book][ToolBody x tools][impulses]
-// All memory is sized in init_contacts; nothing here allocates per frame.
+// State: Impl::colliders and Impl::targets are host copies of the device
+// buffers; the tools' rigid state and the impulse read-back live in
+// Impl::contacts (contact_state.h), all sized in init_contacts: nothing here
+// allocates per frame.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -84,30 +83,6 @@ constexpr std::size_t kHeaderFloats = sizeof(ColliderHeader) / sizeof(float);
 constexpr std::size_t kEntryFloats = sizeof(ColliderEntry) / sizeof(float);
 constexpr std::size_t kTargetFloats = sizeof(TargetEntry) / sizeof(float);
 
-// Host bookkeeping, after the uploaded part of Impl::colliders.
-struct Book {
-  std::uint32_t colliders, tools, impulse_floats;
-  std::uint32_t colliders_dirty, targets_dirty;
-  std::uint32_t substeps, iterations, pad0;
-};
-
-// A tool's rigid state.
-struct ToolBody {
-  V3 position, velocity, angular_velocity;  // [m], [m/s], world [rad/s]
-  Q4 rotation;                              // unit (w, x, y, z)
-  V3 force, torque;                         // applied during the next frame [N], [N m]
-  V3 contact_force, contact_torque;         // the tissue's reaction, last frame's average
-  V3 coupling_force, coupling_torque;       // the reaction in the last frame's last substep
-  // The particles touching it at the end of the last frame: their mass
-  // [kg] and their inertia about its centre, sum m (|r|^2 I - r r^T)
-  // [kg m^2], world frame, row-major.
-  double touching_mass;
-  std::array<double, 9> touching_inertia;
-  V3 gravity;                               // [m/s^2], zero when ToolDesc::gravity is off
-  V3 inertia;                               // principal moments, body frame [kg m^2]
-  double mass;                              // [kg]
-};
-
 template <class T>
 T load(const std::vector<float>& v, std::size_t at) {
   T t;
@@ -124,12 +99,6 @@ std::size_t device_floats(const std::vector<float>& c) {
   return kHeaderFloats + std::size_t{h.colliders + h.tools} * kEntryFloats;
 }
 std::size_t entry_at(std::size_t k) { return kHeaderFloats + k * kEntryFloats; }
-std::size_t book_at(const std::vector<float>& c) { return device_floats(c); }
-std::size_t tool_at(const std::vector<float>& c, std::size_t t) {
-  return book_at(c) + (sizeof(Book) + t * sizeof(ToolBody)) / sizeof(float);
-}
-std::size_t impulses_at(const std::vector<float>& c, std::size_t tools) { return tool_at(c, tools); }
-static_assert(sizeof(Book) % sizeof(float) == 0 && sizeof(ToolBody) % sizeof(float) == 0);
 
 std::string str(double v) {
   std::ostringstream s;
@@ -316,61 +285,55 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
       colliders.size() != device_floats(colliders))
     return Error("internal: the compiled collider buffer does not match the scene's colliders and tools");
 
-  const std::size_t tools = scene.tools.size();
-  const std::size_t impulse_floats = std::size_t{compiled.contact_impulse_slots} * 4;
-  colliders.resize(impulses_at(colliders, tools) + impulse_floats, 0.0f);
-  store(colliders, book_at(colliders),
-        Book{header.colliders, header.tools, static_cast<std::uint32_t>(impulse_floats), 0, 0,
-             static_cast<std::uint32_t>(scene.solver.substeps), static_cast<std::uint32_t>(scene.solver.iterations),
-             0});
-  for (std::size_t t = 0; t < tools; ++t) {
-    const ToolDesc& d = scene.tools[t];
-    ToolBody b{};
+  contacts = ContactState{};
+  contacts.colliders = header.colliders;
+  contacts.substeps = static_cast<std::uint32_t>(scene.solver.substeps);
+  contacts.iterations = static_cast<std::uint32_t>(scene.solver.iterations);
+  contacts.impulses.assign(std::size_t{compiled.contact_impulse_slots} * 4, 0.0f);
+  for (const ToolDesc& d : scene.tools) {
+    ToolBody& b = contacts.tools.emplace_back();
     b.position = d.position;
     b.rotation = d.rotation;
     if (d.gravity) b.gravity = scene.gravity;
     b.inertia = d.inertia;
     b.mass = d.mass;
-    store(colliders, tool_at(colliders, t), b);
   }
   return {};
 }
 
 Status Simulation::Impl::before_frame() {
-  Book book = load<Book>(colliders, book_at(colliders));
-  for (std::uint32_t t = 0; t < book.tools; ++t) {
-    auto b = load<ToolBody>(colliders, tool_at(colliders, t));
-    const std::size_t at = entry_at(book.colliders + t);
+  ContactState& c = contacts;
+  for (std::size_t t = 0; t < c.tools.size(); ++t) {
+    ToolBody& b = c.tools[t];
+    const std::size_t at = entry_at(c.colliders + t);
     auto e = load<ColliderEntry>(colliders, at);
-    integrate(b, time_step, double(book.iterations) * book.substeps * book.substeps);
+    integrate(b, time_step, double(c.iterations) * c.substeps * c.substeps);
     settle(e);  // the frame starts where the last one ended
     set_end_pose(e, b.position, b.rotation);
     store(colliders, at, e);
-    store(colliders, tool_at(colliders, t), b);
-    book.colliders_dirty = 1;
+    c.colliders_dirty = true;
   }
-  if (book.colliders_dirty) {
-    const std::size_t bytes = device_floats(colliders) * sizeof(float);
-    if (Status s = device->write_buffer(buffers.colliders, 0, colliders.data(), bytes); !s) return s;
-    book.colliders_dirty = 0;
+  if (c.colliders_dirty) {
+    if (Status s = device->write_buffer(buffers.colliders, 0, colliders.data(), colliders.size() * sizeof(float)); !s)
+      return s;
+    c.colliders_dirty = false;
   }
-  if (book.targets_dirty && !targets.empty()) {
+  if (c.targets_dirty && !targets.empty()) {
     if (Status s = device->write_buffer(buffers.targets, 0, targets.data(), targets.size() * sizeof(float)); !s)
       return s;
   }
-  book.targets_dirty = 0;
-  store(colliders, book_at(colliders), book);
+  c.targets_dirty = false;
   return {};
 }
 
 Status Simulation::Impl::after_frame() {
-  Book book = load<Book>(colliders, book_at(colliders));
+  ContactState& c = contacts;
   // What moved during this frame stays at its end pose from now on.
-  for (std::uint32_t k = 0; k < book.colliders; ++k) {
+  for (std::uint32_t k = 0; k < c.colliders; ++k) {
     auto e = load<ColliderEntry>(colliders, entry_at(k));
     if (settle(e)) {
       store(colliders, entry_at(k), e);
-      book.colliders_dirty = 1;
+      c.colliders_dirty = true;
     }
   }
   for (std::size_t at = 0; at + kTargetFloats <= targets.size(); at += kTargetFloats) {
@@ -380,26 +343,26 @@ Status Simulation::Impl::after_frame() {
       e.start_y = e.end_y;
       e.start_z = e.end_z;
       store(targets, at, e);
-      book.targets_dirty = 1;
+      c.targets_dirty = true;
     }
   }
-  store(colliders, book_at(colliders), book);
-  if (book.tools == 0) return {};
+  if (c.tools.empty()) return {};
 
   // The tissue's reaction on each tool: the frame's impulse sums, reduced
   // in particle order in double precision.
-  float* impulses = colliders.data() + impulses_at(colliders, book.tools);
-  if (book.impulse_floats > 0)
-    if (Status s = device->read_buffer(buffers.contact_impulses, 0, impulses, book.impulse_floats * sizeof(float)); !s)
+  if (!c.impulses.empty())
+    if (Status s = device->read_buffer(buffers.contact_impulses, 0, c.impulses.data(), c.impulses.size() * sizeof(float));
+        !s)
       return s;
-  const std::size_t particles = book.impulse_floats / (4 * SINEW_CONTACT_IMPULSE_FLOAT4S * std::size_t{book.tools});
-  const double h = time_step / book.substeps;
-  for (std::uint32_t t = 0; t < book.tools; ++t) {
+  const std::size_t tools = c.tools.size();
+  const std::size_t particles = c.impulses.size() / (4 * SINEW_CONTACT_IMPULSE_FLOAT4S * tools);
+  const double h = time_step / c.substeps;
+  for (std::size_t t = 0; t < tools; ++t) {
     double sums[4][3] = {};  // frame impulse, its moment, last substep's impulse, its moment
     double mass = 0.0;
     std::array<double, 9> inertia{};
     for (std::size_t p = 0; p < particles; ++p) {
-      const float* slot = impulses + (p * book.tools + t) * SINEW_CONTACT_IMPULSE_FLOAT4S * 4;
+      const float* slot = c.impulses.data() + (p * tools + t) * SINEW_CONTACT_IMPULSE_FLOAT4S * 4;
       for (int s = 0; s < 4; ++s)
         for (int k = 0; k < 3; ++k) sums[s][k] += slot[4 * s + k];
       const double m = slot[19];
@@ -411,7 +374,7 @@ Status Simulation::Impl::after_frame() {
           for (int j = 0; j < 3; ++j) inertia[3 * i + j] += m * ((i == j ? r2 : 0.0) - r[i] * r[j]);
       }
     }
-    auto b = load<ToolBody>(colliders, tool_at(colliders, t));
+    ToolBody& b = c.tools[t];
     for (int k = 0; k < 3; ++k) {
       b.contact_force[k] = sums[0][k] / time_step;
       b.contact_torque[k] = sums[1][k] / time_step;
@@ -420,7 +383,6 @@ Status Simulation::Impl::after_frame() {
     }
     b.touching_mass = mass;
     b.touching_inertia = inertia;
-    store(colliders, tool_at(colliders, t), b);
   }
   return {};
 }
@@ -428,16 +390,14 @@ Status Simulation::Impl::after_frame() {
 Status Simulation::set_collider_pose(std::size_t index, const std::array<double, 3>& position,
                                      const std::array<double, 4>& rotation) {
   constexpr const char* call = "set_collider_pose";
-  std::vector<float>& c = impl_->colliders;
-  Book book = load<Book>(c, book_at(c));
-  if (Status s = check_index(call, "collider", index, book.colliders); !s) return s;
+  if (Status s = check_index(call, "collider", index, impl_->contacts.colliders); !s) return s;
   if (Status s = check_finite(call, "position", position); !s) return s;
   if (Status s = check_rotation(call, rotation); !s) return s;
+  std::vector<float>& c = impl_->colliders;
   auto e = load<ColliderEntry>(c, entry_at(index));
   set_end_pose(e, position, rotation);
   store(c, entry_at(index), e);
-  book.colliders_dirty = 1;
-  store(c, book_at(c), book);
+  impl_->contacts.colliders_dirty = true;
   return {};
 }
 
@@ -451,35 +411,29 @@ Status Simulation::set_target(std::size_t index, const std::array<double, 3>& po
   e.end_y = static_cast<float>(position[1]);
   e.end_z = static_cast<float>(position[2]);
   store(targets, index * kTargetFloats, e);
-  std::vector<float>& c = impl_->colliders;
-  Book book = load<Book>(c, book_at(c));
-  book.targets_dirty = 1;
-  store(c, book_at(c), book);
+  impl_->contacts.targets_dirty = true;
   return {};
 }
 
 Status Simulation::apply_tool_force(std::size_t index, const std::array<double, 3>& force,
                                     const std::array<double, 3>& torque) {
   constexpr const char* call = "apply_tool_force";
-  std::vector<float>& c = impl_->colliders;
-  const Book book = load<Book>(c, book_at(c));
-  if (Status s = check_index(call, "tool", index, book.tools); !s) return s;
+  std::vector<ToolBody>& tools = impl_->contacts.tools;
+  if (Status s = check_index(call, "tool", index, tools.size()); !s) return s;
   if (Status s = check_finite(call, "force", force); !s) return s;
   if (Status s = check_finite(call, "torque", torque); !s) return s;
-  auto b = load<ToolBody>(c, tool_at(c, index));
+  ToolBody& b = tools[index];
   for (int k = 0; k < 3; ++k) {  // calls before one frame add up
     b.force[k] += force[k];
     b.torque[k] += torque[k];
   }
-  store(c, tool_at(c, index), b);
   return {};
 }
 
 Result<Simulation::ToolState> Simulation::tool_state(std::size_t index) const {
-  const std::vector<float>& c = impl_->colliders;
-  const Book book = load<Book>(c, book_at(c));
-  if (Status s = check_index("tool_state", "tool", index, book.tools); !s) return s.error();
-  const auto b = load<ToolBody>(c, tool_at(c, index));
+  const std::vector<ToolBody>& tools = impl_->contacts.tools;
+  if (Status s = check_index("tool_state", "tool", index, tools.size()); !s) return s.error();
+  const ToolBody& b = tools[index];
   ToolState state;
   state.position = b.position;
   state.rotation = b.rotation;

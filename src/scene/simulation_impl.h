@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "scene/contact_state.h"
 #include "scene/scene_compiler.h"
 #include "sinew/simulation.h"
 #include "xpbd/xpbd_program.h"
@@ -32,6 +33,7 @@ struct Simulation::Impl {
   // buffers (rewritten before each frame) and the tools' rigid state.
   std::vector<float> colliders;
   std::vector<float> targets;
+  ContactState contacts;
   Status init_contacts(const SceneDesc& scene, const CompiledScene& compiled);
   Status before_frame();  ///< uploads colliders/targets moved since the last frame
   Status after_frame();   ///< integrates tools from the tissue's reaction
