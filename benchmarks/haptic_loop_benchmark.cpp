@@ -40,51 +40,7 @@
 #include "sinew/haptics/tool_bridge.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
-
-// ------------------------------------------------------------ allocation counter
-// Counts allocations made on the haptic loop thread (marked by the loop's
-// on_thread_start hook) once counting is switched on after warm-up.
-namespace {
-thread_local bool t_on_haptic_thread = false;
-std::atomic<bool> g_counting{false};
-std::atomic<std::uint64_t> g_tick_allocations{0};
-
-void* counted_alloc(std::size_t size, std::size_t align = 0) {
-  if (t_on_haptic_thread && g_counting.load(std::memory_order_relaxed))
-    g_tick_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (size == 0) size = 1;
-  if (align <= alignof(std::max_align_t)) return std::malloc(size);
-  void* p = nullptr;
-  return posix_memalign(&p, align, size) == 0 ? p : nullptr;
-}
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (void* p = counted_alloc(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  if (void* p = counted_alloc(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t size, std::align_val_t align) {
-  if (void* p = counted_alloc(size, static_cast<std::size_t>(align))) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size, std::align_val_t align) {
-  if (void* p = counted_alloc(size, static_cast<std::size_t>(align))) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+#include "support/allocation_counter.h"
 
 namespace {
 
@@ -255,7 +211,7 @@ int main(int argc, char** argv) {
   settings.cpu = opt.cpu;
   settings.coupling.damping = 3.0;
   settings.telemetry_capacity = static_cast<std::size_t>((opt.seconds + 2.0) * opt.rate);
-  settings.on_thread_start = [] { t_on_haptic_thread = true; };
+  settings.on_thread_start = [] { sinew::support::track_this_thread(); };  // counts the ticks' allocations
   auto loop = HapticLoop::create(settings, device, snapshots, feedback, clock);
   if (!loop) return fail(loop.error().message());
   HapticToolBridge bridge(0, snapshots, feedback, clock);
@@ -276,7 +232,7 @@ int main(int argc, char** argv) {
   std::uint64_t frames = 0;
   double step_ms = 0.0;
   while (clock.now_ns() < end) {
-    if (!g_counting.load() && clock.now_ns() >= count_from) g_counting.store(true);
+    if (clock.now_ns() >= count_from) sinew::support::set_tracking(true);
     if (opt.physics != "none") {
       if (auto s = bridge.apply_feedback(*sim); !s) return fail(s.error().message());
       if (auto s = sim->step(); !s) return fail(s.error().message());
@@ -287,8 +243,8 @@ int main(int argc, char** argv) {
     if (opt.physics != "saturate") clock.sleep_until(t0 + seconds_to_ns(double(frames) * scene.solver.time_step));
   }
   (*loop)->stop();
-  g_counting.store(false);
-  const std::uint64_t tick_allocations = g_tick_allocations.load();
+  sinew::support::set_tracking(false);
+  const std::uint64_t tick_allocations = sinew::support::tracked_allocation_count();
 
   // ------------------------------------------------------------ statistics (after warm-up)
   std::vector<TickRecord> ticks;

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <thread>
 
-#include "haptics_alloc_counter.h"
+#include "support/allocation_counter.h"
 #include "haptics_test_support.h"
 #include "sinew/haptics/replay_device.h"
 #include "sinew/haptics/tool_bridge.h"
@@ -17,6 +17,7 @@
 namespace {
 
 using namespace sinew::test;
+using sinew::support::allocation_count;
 
 ScriptedPose wiggle(double t) {
   ScriptedPose p;
