@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <thread>
 
@@ -198,6 +199,76 @@ TEST(HapticsLoop, ThreadRunsOnAVirtualClockAndReportsItsScheduling) {
   }
   EXPECT_EQ((*loop)->counters().missed_deadlines, 0u);
   EXPECT_EQ(device.commands(), (*loop)->counters().ticks + 1) << "every tick, and zero force at stop";
+}
+
+// A device at a fixed pose that keeps the first kKept forces commanded
+// after arm() (preallocated: the loop thread writes, the test reads after stop()).
+class RecordingDevice final : public HapticDevice {
+ public:
+  static constexpr int kKept = 64;
+  explicit RecordingDevice(const Vec3& position) : position_(position) {}
+  [[nodiscard]] std::string name() const override { return "recording"; }
+  [[nodiscard]] double update_rate_hz() const override { return 1000.0; }
+  bool sample(std::int64_t now_ns, DeviceSample& out) noexcept override {
+    out = {};
+    out.sequence = ++sequence_;
+    out.time_ns = now_ns;
+    out.position = position_;
+    return true;
+  }
+  void command(const Vec3& force, const Vec3&, std::int64_t) noexcept override {
+    if (kept_ < kKept) forces_[kept_++] = force;
+  }
+  void arm() { kept_ = 0; }
+  [[nodiscard]] int kept() const { return kept_; }
+  [[nodiscard]] const Vec3& force(int i) const { return forces_[i]; }
+
+ private:
+  Vec3 position_;
+  std::uint64_t sequence_ = 0;
+  std::array<Vec3, kKept> forces_{};
+  int kept_ = 0;
+};
+
+TEST(HapticsLoop, RestartRampsTheGainUpAgainAfterAStop) {
+  // The loop thread on a virtual clock, stopped, 1 s of virtual time later
+  // restarted with a fresh snapshot: the first tick after the restart must
+  // not take the stopped second as its dt (gain straight to 1, a missed
+  // deadline). The device sits 4 mm below the tool: K x 4 mm = 2 N at full gain.
+  RecordingDevice device({0.0, -0.004, 0.0});
+  VirtualClock clock;
+  SnapshotChannel snapshots;
+  FeedbackChannel feedback;
+  HapticLoopSettings settings;
+  settings.realtime = false;
+  auto loop = HapticLoop::create(settings, device, snapshots, feedback, clock);
+  ASSERT_TRUE(loop.ok());
+  HapticSnapshot tool;
+  tool.sequence = 1;
+  tool.stamp_ns = clock.now_ns();
+  snapshots.publish(tool);
+  ASSERT_TRUE((*loop)->start().ok());
+  while ((*loop)->counters().ticks < 100) std::this_thread::yield();
+  (*loop)->stop();
+  const std::uint64_t before = (*loop)->counters().ticks;
+  ASSERT_EQ((*loop)->counters().missed_deadlines, 0u);
+
+  clock.advance(1000 * kMs);  // stopped for 1 s
+  tool.sequence = 2;
+  tool.stamp_ns = clock.now_ns();
+  snapshots.publish(tool);
+  device.arm();
+  ASSERT_TRUE((*loop)->start().ok());
+  while ((*loop)->counters().ticks < before + RecordingDevice::kKept) std::this_thread::yield();
+  (*loop)->stop();
+  EXPECT_EQ((*loop)->counters().missed_deadlines, 0u) << "the stopped time is no missed deadline";
+  ASSERT_EQ(device.kept(), RecordingDevice::kKept);
+  // The k-th tick after the restart (1 ms apart, the snapshot at most 40 ms
+  // old: fresh): gain k T / recover_time, force 2 N x gain.
+  const double full = settings.coupling.stiffness * 0.004;
+  for (int k = 1; k <= 40; ++k)
+    EXPECT_NEAR(device.force(k - 1)[1], full * k * 0.001 / settings.watchdog.recover_time, 1e-9)
+        << "tick " << k << " after the restart";
 }
 
 TEST(HapticsLoop, RealtimeRequestIsReportedNotAssumed) {

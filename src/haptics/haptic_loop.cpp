@@ -199,8 +199,11 @@ void HapticLoop::stop() noexcept {
   thread_.join();
   device_.command({0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, clock_.now_ns());
   device_.stop();
-  // The device held zero force since; a restart ramps up from zero again.
+  // The device held zero force since; a restart ramps up from zero again,
+  // and its first tick takes one period as its dt (not the stopped time:
+  // that would ramp the gain straight to 1 and count a missed deadline).
   prev_force_ = prev_torque_ = {0.0, 0.0, 0.0};
+  have_prev_tick_ = false;
   coupling_.reset();
   watchdog_.reset();
   release_cpu_latency(qos_fd_);
