@@ -138,6 +138,43 @@ TEST(HapticsLoop, BridgeDrivesTheToolWithMinusTheMeanDeviceForce) {
   EXPECT_EQ(bridge.published(), 1501u);
 }
 
+TEST(HapticsLoop, BridgeStaysWithinTheClampWhenTheLoopIsRecreated) {
+  // A static tool 4 mm above a null device: the coupling holds 2 N for 2 s,
+  // so the feedback's impulse integral reaches about 3.5 N s. Then a new
+  // HapticLoop on the same feedback channel starts its integral at 0: the
+  // bridge must not difference the two loops' integrals (-875 N).
+  sinew::SceneDesc scene;
+  scene.gravity = {0, 0, 0};
+  scene.tools.push_back({});
+  auto sim = sinew::Simulation::create(scene, {.backend = "cpu", .threads = 1, .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  NullDevice device({.position = {0.0, -0.004, 0.0}});
+  HapticLoopSettings settings;
+  VirtualRig rig(device, settings);
+  HapticToolBridge bridge(0, rig.snapshots, rig.feedback, rig.clock);
+  const double clamp = settings.coupling.max_force;
+  auto frames = [&](int n) {
+    for (int frame = 0; frame < n; ++frame) {
+      rig.run(4);  // 4 ticks, snapshots at 60 Hz: the tool stays put
+      ASSERT_TRUE(bridge.apply_feedback(*sim).ok());
+      ASSERT_LE(norm3(bridge.last_tool_force()), clamp + 1e-9) << "frame " << frame;
+    }
+  };
+  frames(500);  // 2 s
+  ASSERT_NEAR(bridge.last_tool_force()[1], -settings.coupling.stiffness * 0.004, 1e-9) << "2 N held";
+  ASSERT_GT(bridge.last_feedback().impulse[1], 3.0);
+
+  rig.loop.reset();
+  HapticLoopSettings again = settings;
+  again.realtime = false;
+  auto made = HapticLoop::create(again, device, rig.snapshots, rig.feedback, rig.clock);
+  ASSERT_TRUE(made.ok());
+  rig.loop = std::move(*made);
+  frames(500);  // the new loop ramps up to 2 N again
+  EXPECT_NEAR(bridge.last_tool_force()[1], -settings.coupling.stiffness * 0.004, 1e-9);
+  EXPECT_EQ(bridge.frames_without_feedback(), 0u);
+}
+
 TEST(HapticsLoop, BridgeAppliesNothingWithoutNewTicks) {
   sinew::SceneDesc scene;
   scene.tools.push_back({});

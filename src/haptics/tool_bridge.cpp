@@ -26,14 +26,18 @@ Status HapticToolBridge::apply_feedback(Simulation& sim) {
   force_ = {0.0, 0.0, 0.0};
   torque_ = {0.0, 0.0, 0.0};
   const bool got = feedback_.try_read(fb, 64);
-  if (got && have_prev_ && fb.time_ns > prev_.time_ns) {
+  // A reading from another loop than the previous one (a HapticLoop
+  // recreated on the same channel) starts over as a first reading: the two
+  // impulse integrals have different origins.
+  const bool same_loop = have_prev_ && fb.loop == prev_.loop;
+  if (got && same_loop && fb.time_ns > prev_.time_ns) {
     // Mean device force over the interval between the two readings (exact:
     // the impulse integral is a zero-order hold of every tick's output).
     const double dt = ns_to_seconds(fb.time_ns - prev_.time_ns);
     force_ = vm::mul(vm::sub(fb.impulse, prev_.impulse), -1.0 / dt);
     torque_ = vm::mul(vm::sub(fb.angular_impulse, prev_.angular_impulse), -1.0 / dt);
-  } else if (got && !have_prev_) {
-    // First reading: the newest tick's output (no interval to average over yet).
+  } else if (got && !same_loop) {
+    // First reading (of this loop): the newest tick's output (no interval to average over yet).
     force_ = vm::mul(fb.force, -1.0);
     torque_ = vm::mul(fb.torque, -1.0);
   } else {

@@ -46,8 +46,11 @@ struct HapticSnapshot {
 /// What the haptic loop produced (haptics -> physics), published every tick.
 /// The physics thread averages the device force over its frame from two
 /// readings a and b: (b.impulse - a.impulse) / (b.time - a.time), which is
-/// exact (zero-order hold) however many ticks fell between the readings.
+/// exact (zero-order hold) however many ticks fell between the readings,
+/// provided both come from the same loop (same `loop`): each HapticLoop
+/// integrates from its own zero.
 struct CouplingFeedback {
+  std::uint64_t loop = 0;       ///< which HapticLoop published it: 1, 2, ... one per loop created in the process
   std::uint64_t ticks = 0;      ///< ticks done (the newest tick's number)
   std::int64_t time_ns = 0;     ///< start of the newest tick, on the loop's clock [ns]
   Vec3 impulse{};               ///< integral of the device force up to time_ns [N s]

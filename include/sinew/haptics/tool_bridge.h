@@ -45,7 +45,10 @@ class HapticToolBridge {
   /// Before Simulation::step(): reads the newest feedback and applies minus
   /// its mean device force and torque since the previous call to the tool.
   /// No new tick since then (the haptic loop stopped or has not started):
-  /// nothing is applied (counted in frames_without_feedback()).
+  /// nothing is applied (counted in frames_without_feedback()). The first
+  /// reading, and the first from a loop other than the previous reading's
+  /// (CouplingFeedback::loop: a HapticLoop recreated on the same channel),
+  /// apply minus that tick's force and torque.
   Status apply_feedback(Simulation& sim);
   /// After Simulation::step(): publishes the tool's state as a HapticSnapshot
   /// stamped with the clock's now.
