@@ -92,6 +92,72 @@ TEST(HapticsSafety, NaNFromTheDeviceGivesZeroForceThroughTheLoop) {
   EXPECT_EQ(rig.loop->counters().non_finite, static_cast<std::uint64_t>(nan_ticks)) << "counted";
 }
 
+// 1 rad about z.
+constexpr Quat kTurned{0.8775825618903728, 0.0, 0.0, 0.479425538604203};
+
+// Ticks after a NaN rotation reached the loop: zero force and torque at
+// once, every one of them flagged and counted as non-finite.
+void expect_zero_and_counted(VirtualRig& rig, ScriptedDevice& device) {
+  const std::uint64_t before = rig.loop->counters().non_finite;
+  for (int i = 0; i < 100; ++i) {
+    const TickRecord r = rig.step();
+    EXPECT_TRUE(r.flags & kNonFinite) << "tick " << r.tick;
+    EXPECT_EQ(r.force, (Vec3{0, 0, 0})) << "tick " << r.tick;
+    EXPECT_EQ(device.last_force(), (Vec3{0, 0, 0})) << "tick " << r.tick;
+    EXPECT_EQ(device.last_torque(), (Vec3{0, 0, 0})) << "tick " << r.tick;
+  }
+  EXPECT_EQ(rig.loop->counters().non_finite - before, 100u) << "counted";
+}
+
+TEST(HapticsSafety, NaNToolRotationGivesZeroForceAndTorque) {
+  // The device turned 1 rad from the tool and 4 mm below it: 2 N and
+  // K_r x 1 rad of torque. Then the physics publishes a NaN rotation: the
+  // interpolated rotation must stay NaN (not become the identity, which
+  // would be a 1 rad twist) so the chain zeroes force and torque.
+  ScriptedDevice device([](double) {
+    ScriptedPose p;
+    p.position = {0.0, -0.004, 0.0};
+    p.rotation = kTurned;
+    return p;
+  });
+  VirtualRig rig(device);
+  rig.run(400);
+  ASSERT_GT(norm3(device.last_torque()), 0.01) << "the twist is rendered";
+  ASSERT_EQ(rig.loop->counters().non_finite, 0u);
+  rig.tool.rotation = {std::nan(""), 0.0, 0.0, 0.0};
+  rig.run(20);  // a frame with the NaN rotation is published (60 Hz)
+  expect_zero_and_counted(rig, device);
+}
+
+TEST(HapticsSafety, NaNDeviceRotationGivesZeroForceAndTorque) {
+  // The tool turned 1 rad and 4 mm above the device; the device's
+  // rotation turns NaN after 0.4 s (a scripted device, and a null device
+  // with a NaN pose): not the identity, zero force and torque.
+  ScriptedDevice device([](double t) {
+    ScriptedPose p;
+    p.position = {0.0, -0.004, 0.0};
+    if (t > 0.4) p.rotation = {0.0, std::nan(""), 0.0, 0.0};
+    return p;
+  });
+  VirtualRig rig(device);
+  rig.tool.rotation = kTurned;
+  rig.run(400);
+  ASSERT_GT(norm3(device.last_torque()), 0.01) << "the twist is rendered";
+  ASSERT_EQ(rig.loop->counters().non_finite, 0u);
+  rig.run(2);
+  expect_zero_and_counted(rig, device);
+
+  NullDevice null_device({.position = {0.0, -0.004, 0.0}, .rotation = {std::nan(""), 0.0, 0.0, 0.0}});
+  VirtualRig null_rig(null_device);
+  null_rig.tool.rotation = kTurned;
+  for (int i = 0; i < 400; ++i) {
+    const TickRecord r = null_rig.step();
+    EXPECT_TRUE(r.flags & kNonFinite) << "tick " << r.tick;
+    EXPECT_EQ(r.force, (Vec3{0, 0, 0})) << "tick " << r.tick;
+  }
+  EXPECT_EQ(null_rig.loop->counters().non_finite, 400u);
+}
+
 TEST(HapticsWatchdog, FadesAndRecoversLinearly) {
   WatchdogParams p;
   p.stale_after = 0.05;

@@ -15,7 +15,7 @@ bool ScriptedDevice::sample(std::int64_t now_ns, DeviceSample& out) noexcept {
   out.sequence = ++sequence_;
   out.time_ns = now_ns;
   out.position = p.position;
-  out.rotation = vm::normalize(p.rotation);
+  out.rotation = vm::normalize(p.rotation);  // NaN stays NaN: the coupling zeroes force and torque
   out.velocity = vm::mul(vm::sub(after.position, before.position), 0.5 / h_);
   out.angular_velocity = vm::angular_velocity(vm::normalize(before.rotation), vm::normalize(after.rotation), 2.0 * h_);
   out.buttons = p.buttons;

@@ -2,6 +2,7 @@
 // haptics code needs, inline and allocation-free (tick-safe).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "sinew/haptics/snapshot_channel.h"
@@ -28,11 +29,21 @@ inline Quat qmul(const Quat& a, const Quat& b) {
 }
 inline Quat conj(const Quat& q) { return {q[0], -q[1], -q[2], -q[3]}; }
 inline double qdot(const Quat& a, const Quat& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
-/// q / |q|; the identity when |q| is zero or not finite.
+/// q / |q|; the identity only for an exactly zero q. A NaN or Inf
+/// component gives all NaN: a bad rotation must stay non-finite so the
+/// coupling's finite check zeroes force and torque (mapped to the identity
+/// it would be rendered as a real twist).
 inline Quat normalize(const Quat& q) {
-  const double n = std::sqrt(qdot(q, q));
-  if (!(n > 0.0) || !std::isfinite(n)) return {1.0, 0.0, 0.0, 0.0};
-  return {q[0] / n, q[1] / n, q[2] / n, q[3] / n};
+  if (!finite(q)) {
+    const double nan = std::nan("");
+    return {nan, nan, nan, nan};
+  }
+  // Scaled by the largest component first: |q|^2 neither overflows nor underflows.
+  const double m = std::max(std::max(std::abs(q[0]), std::abs(q[1])), std::max(std::abs(q[2]), std::abs(q[3])));
+  if (m == 0.0) return {1.0, 0.0, 0.0, 0.0};
+  const Quat s{q[0] / m, q[1] / m, q[2] / m, q[3] / m};
+  const double n = std::sqrt(qdot(s, s));
+  return {s[0] / n, s[1] / n, s[2] / n, s[3] / n};
 }
 /// Normalised lerp from a to b (b taken on a's hemisphere), u may exceed 1 (extrapolation).
 inline Quat nlerp(const Quat& a, const Quat& b, double u) {

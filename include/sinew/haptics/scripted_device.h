@@ -13,7 +13,7 @@ namespace sinew::haptics {
 /// A pose given by a script.
 struct ScriptedPose {
   Vec3 position{};                    ///< [m]
-  Quat rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
+  Quat rotation{1.0, 0.0, 0.0, 0.0};  ///< quaternion (w, x, y, z), normalised when sampled; NaN/Inf stays non-finite
   std::uint32_t buttons = 0;
 };
 

@@ -9,6 +9,7 @@
 //   u = (now - b) / D                    (u = 0 when B arrives, 1 one interval later)
 //   state(u) = A + u (B - A)             positions, velocities, contact force, angular velocity
 //   rotation(u) = normalise(qA + u (qB' - qA)), qB' = +-qB on qA's hemisphere
+//                 (a NaN/Inf rotation stays non-finite: the coupling then zeroes force and torque)
 // 0 <= u <= 1 interpolates (the rendered state is D old). u > 1 means the
 // next snapshot is late: the line through A and B is extrapolated, but only
 // for `extrapolation_horizon` seconds past B (u <= 1 + horizon / D); after
