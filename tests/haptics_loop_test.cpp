@@ -308,6 +308,56 @@ TEST(HapticsLoop, RestartRampsTheGainUpAgainAfterAStop) {
         << "tick " << k << " after the restart";
 }
 
+// A device that, from inside the tick (its sample()), tries what an SDK
+// servo callback racing the application thread would: copy the telemetry
+// ring and tick again while a tick is writing it.
+class MeddlingDevice final : public HapticDevice {
+ public:
+  [[nodiscard]] std::string name() const override { return "meddling"; }
+  [[nodiscard]] double update_rate_hz() const override { return 1000.0; }
+  bool sample(std::int64_t now_ns, DeviceSample& out) noexcept override {
+    if (loop && !inside) {
+      inside = true;
+      copied = loop->copy_telemetry(telemetry);
+      nested_tick = loop->tick().tick;
+      inside = false;
+    }
+    out = {};
+    out.sequence = ++sequence_;
+    out.time_ns = now_ns;
+    return true;
+  }
+  void command(const Vec3&, const Vec3&, std::int64_t) noexcept override {}
+  HapticLoop* loop = nullptr;
+  bool inside = false;
+  sinew::Status copied;
+  std::uint64_t nested_tick = 99;
+  std::vector<TickRecord> telemetry;
+
+ private:
+  std::uint64_t sequence_ = 0;
+};
+
+TEST(HapticsLoop, CopyTelemetryAndTickAreRefusedWhileATickIsInProgress) {
+  MeddlingDevice device;
+  VirtualRig rig(device);
+  device.loop = rig.loop.get();
+  const TickRecord r = rig.step();
+  EXPECT_EQ(r.tick, 1u);
+  EXPECT_FALSE(device.copied.ok()) << "no copy of the ring while a tick writes it";
+  if (!device.copied.ok()) {
+    EXPECT_NE(device.copied.error().message().find("tick() is in progress"), std::string::npos);
+  }
+  EXPECT_EQ(device.nested_tick, 0u) << "an overlapping tick is skipped";
+  EXPECT_EQ(rig.loop->counters().ticks, 1u);
+  device.loop = nullptr;
+  std::vector<TickRecord> out;
+  ASSERT_TRUE(rig.loop->copy_telemetry(out).ok()) << "between ticks the copy is allowed";
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].tick, 1u);
+  EXPECT_EQ(rig.loop->tick().tick, 2u) << "and ticks go on after a copy";
+}
+
 TEST(HapticsLoop, RealtimeRequestIsReportedNotAssumed) {
   // A real clock here (nothing is timed): on a virtual clock the loop never
   // sleeps, and a SCHED_FIFO thread that never sleeps would hog a core.

@@ -58,6 +58,13 @@ HapticCounters HapticLoop::counters() const {
 
 Status HapticLoop::copy_telemetry(std::vector<TickRecord>& out) const {
   if (running()) return Error("copy_telemetry: stop the haptic loop first (the ring is written without locks)");
+  int idle = kIdle;
+  if (!access_.compare_exchange_strong(idle, kCopying, std::memory_order_acquire, std::memory_order_relaxed))
+    return Error("copy_telemetry: a tick() is in progress on another thread (stop calling tick() first)");
+  struct Release {
+    std::atomic<int>& a;
+    ~Release() { a.store(kIdle, std::memory_order_release); }
+  } release{access_};
   const std::size_t cap = ring_.size();
   const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(recorded_, cap));
   out.resize(n);
@@ -68,7 +75,12 @@ Status HapticLoop::copy_telemetry(std::vector<TickRecord>& out) const {
 
 TickRecord HapticLoop::tick() noexcept {
   if (running()) return {};
-  return tick_at(0, false);
+  // Never waits: a copy_telemetry() (or another tick()) in progress skips this tick.
+  int idle = kIdle;
+  if (!access_.compare_exchange_strong(idle, kTicking, std::memory_order_acquire, std::memory_order_relaxed)) return {};
+  const TickRecord rec = tick_at(0, false);
+  access_.store(kIdle, std::memory_order_release);
+  return rec;
 }
 
 namespace {

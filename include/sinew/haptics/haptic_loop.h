@@ -133,11 +133,18 @@ class HapticLoop {
   /// tests and for devices whose SDK runs its own servo scheduler (call it
   /// from that callback; the device must then be started by the caller).
   /// Not while the loop thread runs (returns a record with tick == 0).
+  /// From one thread at a time. A tick() that would overlap a
+  /// copy_telemetry() on another thread (or another tick()) is skipped: it
+  /// returns a record with tick == 0 at once and commands nothing, so an
+  /// SDK callback should stop calling tick() before the telemetry is copied.
   TickRecord tick() noexcept;
 
   [[nodiscard]] HapticCounters counters() const;
   /// [out] out: the telemetry ring, oldest first (at most telemetry_capacity
-  /// ticks). Only while the loop thread is not running (error otherwise).
+  /// ticks). Only while the loop thread is not running and no tick() is in
+  /// progress on another thread (an error otherwise, out unchanged): the
+  /// ring is written without locks; a lock-free guard keeps an externally
+  /// driven tick() (SDK servo callback) and the copy apart.
   Status copy_telemetry(std::vector<TickRecord>& out) const;
   [[nodiscard]] const HapticLoopSettings& settings() const { return settings_; }
   /// The newest rendered tool state (loop thread / manual ticker only).
@@ -175,6 +182,9 @@ class HapticLoop {
   CouplingFeedback fb_{};
   std::vector<TickRecord> ring_;  // preallocated
   std::uint64_t recorded_ = 0;
+  // tick() vs copy_telemetry() from different threads: kIdle, kTicking or kCopying.
+  enum : int { kIdle, kTicking, kCopying };
+  mutable std::atomic<int> access_{kIdle};
 
   AtomicCounters counters_;
   std::atomic<bool> running_{false};
