@@ -65,6 +65,19 @@ struct Options {
   bool mlock = false;
 };
 
+// --rate: a finite number of Hz in [1, 1e6] (the haptic loop's range),
+// the whole argument parsed; false (with a message) otherwise.
+bool parse_rate(const char* v, double& rate) {
+  char* end = nullptr;
+  const double r = std::strtod(v, &end);
+  if (end == v || *end != '\0' || !std::isfinite(r) || r < 1.0 || r > 1e6) {
+    std::fprintf(stderr, "--rate must be a finite number of Hz in [1, 1e6] (got '%s')\n", v);
+    return false;
+  }
+  rate = r;
+  return true;
+}
+
 bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -75,7 +88,7 @@ bool parse(int argc, char** argv, Options& o) {
     const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
     if (!v) { std::fprintf(stderr, "missing value after %s\n", a.c_str()); return false; }
     if (a == "--seconds") o.seconds = std::atof(v);
-    else if (a == "--rate") o.rate = std::atof(v);
+    else if (a == "--rate") { if (!parse_rate(v, o.rate)) return false; }
     else if (a == "--priority") o.priority = std::atoi(v);
     else if (a == "--cpu") o.cpu = std::atoi(v);
     else if (a == "--physics") o.physics = v;
@@ -85,7 +98,8 @@ bool parse(int argc, char** argv, Options& o) {
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return false; }
     ++i;
   }
-  if (o.seconds < 2.0 || o.cells < 2 || (o.physics != "saturate" && o.physics != "paced" && o.physics != "none")) {
+  if (!(o.seconds >= 2.0) || !std::isfinite(o.seconds) || o.cells < 2 ||
+      (o.physics != "saturate" && o.physics != "paced" && o.physics != "none")) {
     std::fprintf(stderr, "--seconds >= 2, --cells >= 2, --physics saturate|paced|none\n");
     return false;
   }

@@ -44,6 +44,19 @@ struct Options {
   bool realtime = true;
 };
 
+// --rate: a finite number of Hz in [1, 1e6] (the haptic loop's range),
+// the whole argument parsed; false (with a message) otherwise.
+bool parse_rate(const char* v, double& rate) {
+  char* end = nullptr;
+  const double r = std::strtod(v, &end);
+  if (end == v || *end != '\0' || !std::isfinite(r) || r < 1.0 || r > 1e6) {
+    std::fprintf(stderr, "--rate must be a finite number of Hz in [1, 1e6] (got '%s')\n", v);
+    return false;
+  }
+  rate = r;
+  return true;
+}
+
 bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -52,7 +65,7 @@ bool parse(int argc, char** argv, Options& o) {
     if (!v) { std::fprintf(stderr, "missing value after %s\n", a.c_str()); return false; }
     if (a == "--out") o.out = v;
     else if (a == "--backend") o.backend = v;
-    else if (a == "--rate") o.rate = std::atof(v);
+    else if (a == "--rate") { if (!parse_rate(v, o.rate)) return false; }
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return false; }
     ++i;
   }

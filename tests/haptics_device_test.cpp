@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "sinew/haptics/clock.h"
 #include "sinew/haptics/replay_device.h"
@@ -55,6 +56,36 @@ TEST(HapticsDevice, ScriptedPoseVelocityAndStamps) {
   d.command({1, 2, 3}, {0, 0, 0}, 1751 * ms);
   EXPECT_EQ(d.last_force(), (Vec3{1, 2, 3}));
   EXPECT_EQ(d.commands(), 1u);
+}
+
+TEST(HapticsDevice, ScriptedDeviceParametersAreChecked) {
+  const ScriptedDevice::Script still = [](double) { return ScriptedPose{}; };
+  for (double h : {0.0, -1e-4, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    auto made = ScriptedDevice::create(still, 0, 1000.0, h);
+    EXPECT_FALSE(made.ok()) << h;
+    if (!made.ok()) {
+      EXPECT_NE(made.error().message().find("difference_step"), std::string::npos) << made.error().message();
+    }
+  }
+  for (double rate : {0.0, -1000.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    auto made = ScriptedDevice::create(still, 0, rate);
+    EXPECT_FALSE(made.ok()) << rate;
+    if (!made.ok()) {
+      EXPECT_NE(made.error().message().find("rate_hz"), std::string::npos) << made.error().message();
+    }
+  }
+  EXPECT_FALSE(ScriptedDevice::create(ScriptedDevice::Script{}).ok()) << "no script";
+  auto good = ScriptedDevice::create(still, 0, 500.0, 1e-3);
+  ASSERT_TRUE(good.ok());
+  EXPECT_EQ(good->update_rate_hz(), 500.0);
+  EXPECT_TRUE(good->start(0).ok());
+  // Built by the constructor (unchecked): start() reports the bad parameter.
+  ScriptedDevice unchecked(still, 0, 1000.0, 0.0);
+  auto st = unchecked.start(0);
+  EXPECT_FALSE(st.ok());
+  if (!st.ok()) {
+    EXPECT_NE(st.error().message().find("difference_step"), std::string::npos);
+  }
 }
 
 TEST(HapticsDevice, NullDeviceHoldsItsPose) {

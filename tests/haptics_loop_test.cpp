@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include "support/allocation_counter.h"
@@ -411,6 +412,15 @@ TEST(HapticsLoop, ImpossibleSettingsAreErrors) {
   EXPECT_TRUE(says(s, "rate_hz"));
   s.rate_hz = std::nan("");
   EXPECT_TRUE(says(s, "rate_hz"));
+  s.rate_hz = 0.5;  // below 1 Hz
+  EXPECT_TRUE(says(s, "rate_hz"));
+  s.rate_hz = 1e-12;  // a period of 10^21 ns does not fit the int64 clock
+  EXPECT_TRUE(says(s, "rate_hz"));
+  s.rate_hz = 2e6;
+  EXPECT_TRUE(says(s, "rate_hz"));
+  s = {};
+  s.rate_hz = 1.0;
+  EXPECT_TRUE(HapticLoop::create(s, device, snapshots, feedback, clock).ok()) << "1 Hz is the lowest rate";
   s = {};
   s.realtime_priority = 0;
   EXPECT_TRUE(says(s, "realtime_priority"));
@@ -426,6 +436,11 @@ TEST(HapticsLoop, ImpossibleSettingsAreErrors) {
   s = {};
   s.telemetry_capacity = 0;
   EXPECT_TRUE(says(s, "telemetry_capacity"));
+  // Too large to allocate: an error, not an exception out of create().
+  for (std::size_t too_many : {kMaxTelemetryCapacity + 1, std::numeric_limits<std::size_t>::max()}) {
+    s.telemetry_capacity = too_many;
+    EXPECT_NO_THROW(EXPECT_TRUE(says(s, "telemetry_capacity")) << too_many);
+  }
   s = {};
   s.interpolation.extrapolation_horizon = -0.1;
   EXPECT_TRUE(says(s, "extrapolation_horizon"));

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <string>
 
@@ -16,12 +17,15 @@
 namespace sinew::haptics {
 
 Status check(const HapticLoopSettings& s) {
-  if (!(s.rate_hz > 0.0) || !std::isfinite(s.rate_hz) || s.rate_hz > 1e6)
-    return Error("rate_hz must be > 0 and at most 1e6 [Hz] (got " + std::to_string(s.rate_hz) + ")");
+  // >= 1 Hz: the period is an int64 count of nanoseconds.
+  if (!(s.rate_hz >= 1.0) || !std::isfinite(s.rate_hz) || s.rate_hz > 1e6)
+    return Error("rate_hz must be >= 1 and at most 1e6 [Hz] (got " + std::to_string(s.rate_hz) + ")");
   if (s.realtime && (s.realtime_priority < 1 || s.realtime_priority > 99))
     return Error("realtime_priority must be in 1..99 (got " + std::to_string(s.realtime_priority) + ")");
   if (s.cpu < -1) return Error("cpu must be -1 (no pinning) or a CPU index (got " + std::to_string(s.cpu) + ")");
-  if (s.telemetry_capacity < 1) return Error("telemetry_capacity must be >= 1");
+  if (s.telemetry_capacity < 1 || s.telemetry_capacity > kMaxTelemetryCapacity)
+    return Error("telemetry_capacity must be in 1.." + std::to_string(kMaxTelemetryCapacity) + " ticks (got " +
+                 std::to_string(s.telemetry_capacity) + ")");
   if (s.snapshot_read_attempts < 1) return Error("snapshot_read_attempts must be >= 1");
   if (auto st = check(s.coupling); !st) return st;
   if (auto st = check(s.watchdog); !st) return st;
@@ -32,7 +36,12 @@ Result<std::unique_ptr<HapticLoop>> HapticLoop::create(const HapticLoopSettings&
                                                        SnapshotChannel& snapshots, FeedbackChannel& feedback,
                                                        Clock& clock) {
   if (auto s = check(settings); !s) return s.error();
-  return std::unique_ptr<HapticLoop>(new HapticLoop(settings, device, snapshots, feedback, clock));
+  try {
+    return std::unique_ptr<HapticLoop>(new HapticLoop(settings, device, snapshots, feedback, clock));
+  } catch (const std::exception& e) {  // the telemetry ring (or the settings' copy) could not be allocated
+    return Error("cannot create the haptic loop (telemetry_capacity " + std::to_string(settings.telemetry_capacity) +
+                 "): " + e.what());
+  }
 }
 
 HapticLoop::HapticLoop(const HapticLoopSettings& settings, HapticDevice& device, SnapshotChannel& snapshots,

@@ -2,10 +2,33 @@
 // and a device that never moves.
 #include "sinew/haptics/scripted_device.h"
 
+#include <cmath>
+#include <string>
+
 #include "haptics/vec_math.h"
 #include "sinew/haptics/clock.h"
 
 namespace sinew::haptics {
+
+namespace {
+Status check_scripted(const ScriptedDevice::Script& script, double rate_hz, double difference_step) {
+  if (!script) return Error("scripted device: the script is empty");
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
+    return Error("scripted device: rate_hz must be finite and > 0 [Hz] (got " + std::to_string(rate_hz) + ")");
+  if (!(difference_step > 0.0) || !std::isfinite(difference_step))
+    return Error("scripted device: difference_step must be finite and > 0 [s] (got " +
+                 std::to_string(difference_step) + ")");
+  return {};
+}
+}  // namespace
+
+Result<ScriptedDevice> ScriptedDevice::create(Script script, std::int64_t origin_ns, double rate_hz,
+                                              double difference_step) {
+  if (auto s = check_scripted(script, rate_hz, difference_step); !s) return s.error();
+  return ScriptedDevice(std::move(script), origin_ns, rate_hz, difference_step);
+}
+
+Status ScriptedDevice::start(std::int64_t) { return check_scripted(script_, rate_hz_, h_); }
 
 bool ScriptedDevice::sample(std::int64_t now_ns, DeviceSample& out) noexcept {
   const double t = ns_to_seconds(now_ns - origin_ns_);

@@ -36,8 +36,15 @@
 
 namespace sinew::haptics {
 
+/// The largest HapticLoopSettings::telemetry_capacity: 2^24 ticks (4.6 h
+/// at 1 kHz), 2.5 GiB of TickRecords.
+inline constexpr std::size_t kMaxTelemetryCapacity = std::size_t{1} << 24;
+
 struct HapticLoopSettings {
-  double rate_hz = 1000.0;          ///< tick rate [Hz], > 0
+  /// Tick rate [Hz], 1..1e6. At least 1 Hz: the period is an int64 count
+  /// of nanoseconds (and twice it the missed-deadline threshold), which a
+  /// rate of 1e-10 Hz would overflow; a loop slower than 1 Hz renders no force.
+  double rate_hz = 1000.0;
   bool realtime = true;             ///< request SCHED_FIFO for the loop thread
   int realtime_priority = 80;       ///< SCHED_FIFO priority, 1..99
   int cpu = -1;                     ///< pin the loop thread to this CPU; -1: no pinning
@@ -51,7 +58,7 @@ struct HapticLoopSettings {
   /// dedicated machine. Needs write access to the device (root); what was
   /// obtained is reported in SchedulingReport::cpu_latency.
   bool zero_cpu_latency = false;
-  std::size_t telemetry_capacity = 1u << 16;  ///< ticks kept in the telemetry ring (the newest), >= 1
+  std::size_t telemetry_capacity = 1u << 16;  ///< ticks kept in the telemetry ring (the newest), 1..kMaxTelemetryCapacity
   unsigned snapshot_read_attempts = 4;        ///< bounded seqlock retries per tick, >= 1
   CouplingParams coupling;
   WatchdogParams watchdog;
@@ -110,7 +117,8 @@ struct HapticCounters {
 class HapticLoop {
  public:
   /// Checks the settings and preallocates everything a tick uses. The
-  /// device, channels and clock must outlive the loop.
+  /// device, channels and clock must outlive the loop. Never throws: a
+  /// failed allocation is an Error too.
   static Result<std::unique_ptr<HapticLoop>> create(const HapticLoopSettings& settings, HapticDevice& device,
                                                    SnapshotChannel& snapshots, FeedbackChannel& feedback,
                                                    Clock& clock);

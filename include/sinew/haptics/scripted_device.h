@@ -24,15 +24,23 @@ struct ScriptedPose {
 class ScriptedDevice final : public HapticDevice {
  public:
   using Script = std::function<ScriptedPose(double t)>;
-  /// [in] script: the pose at time t [s] since `origin_ns`;
+  /// [in] script: the pose at time t [s] since `origin_ns`, not empty;
   /// [in] origin_ns: the loop clock's time at t = 0 [ns];
-  /// [in] rate_hz: the nominal update rate reported [Hz].
+  /// [in] rate_hz: the nominal update rate reported [Hz], finite and > 0;
+  /// [in] difference_step: the central difference's half step [s], finite and > 0.
+  /// Errors name the bad parameter.
+  static Result<ScriptedDevice> create(Script script, std::int64_t origin_ns = 0, double rate_hz = 1000.0,
+                                       double difference_step = 1e-4);
+  /// The same parameters, unchecked: start() (HapticLoop::start()) reports
+  /// a bad one; ticked by hand without start(), prefer create().
   explicit ScriptedDevice(Script script, std::int64_t origin_ns = 0, double rate_hz = 1000.0,
                           double difference_step = 1e-4)
       : script_(std::move(script)), origin_ns_(origin_ns), rate_hz_(rate_hz), h_(difference_step) {}
 
   [[nodiscard]] std::string name() const override { return "scripted"; }
   [[nodiscard]] double update_rate_hz() const override { return rate_hz_; }
+  /// Checks the parameters (as create() does); errors name the bad one.
+  Status start(std::int64_t now_ns) override;
   bool sample(std::int64_t now_ns, DeviceSample& out) noexcept override;
   void command(const Vec3& force, const Vec3& torque, std::int64_t now_ns) noexcept override;
 
