@@ -134,6 +134,33 @@ TEST_F(HapticsInterpolation, AGapLongerThanMaxIntervalIsNotInterpolated) {
   EXPECT_DOUBLE_EQ(s.position[0], 1.5);
 }
 
+TEST(HapticsInterpolationMinInterval, PublicationsMicrosecondsApartAreNotExtrapolated) {
+  // Two physics frames 4 mm apart published 10 us apart on the loop clock
+  // (a frame finished late, the next one at once): their spacing is not the
+  // tool's speed. Extrapolated, 5 ms later the tool would be 500 x 4 mm = 2 m
+  // away (speed 400 m/s); the newest is held instead.
+  SnapshotHistory history;
+  const InterpolationParams params;  // min_interval 1 ms
+  history.push(snap(100 * ms, {0, 0, 0}, {1, 0, 0}, {1, 0, 0, 0}, 1));
+  history.push(snap(100 * ms + 10'000, {0.004, 0, 0}, {1, 0, 0}, {1, 0, 0, 0}, 2));
+  for (std::int64_t t : {100 * ms + 10'000, 100 * ms + 20'000, 105 * ms, 200 * ms}) {
+    const RenderedTool r = history.render(t, params);
+    EXPECT_EQ(r.mode, RenderMode::single) << t;
+    EXPECT_EQ(r.position, (Vec3{0.004, 0, 0})) << t;
+    EXPECT_DOUBLE_EQ(r.render_age, r.snapshot_age);
+  }
+  // At exactly min_interval apart, interpolation resumes.
+  SnapshotHistory edge;
+  edge.push(snap(100 * ms, {0, 0, 0}, {0, 0, 0}, {1, 0, 0, 0}, 1));
+  edge.push(snap(101 * ms, {0.004, 0, 0}, {0, 0, 0}, {1, 0, 0, 0}, 2));
+  EXPECT_EQ(edge.render(101 * ms + 500'000, params).mode, RenderMode::interpolated);
+  // The next publication a regular interval later interpolates again.
+  history.push(snap(104 * ms + 10'000, {0.008, 0, 0}, {1, 0, 0}, {1, 0, 0, 0}, 3));
+  const RenderedTool r = history.render(106 * ms + 10'000, params);
+  EXPECT_EQ(r.mode, RenderMode::interpolated);
+  EXPECT_NEAR(r.position[0], 0.006, 1e-15);
+}
+
 TEST(HapticsInterpolationParams, NamesTheParameter) {
   InterpolationParams p;
   p.extrapolation_horizon = -1;
@@ -145,6 +172,16 @@ TEST(HapticsInterpolationParams, NamesTheParameter) {
   s = check(p);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message().find("max_interval"), std::string::npos);
+  for (double bad : {-0.001, std::nan(""), 0.051}) {  // negative, NaN, above max_interval (0.05)
+    p = {};
+    p.min_interval = bad;
+    s = check(p);
+    ASSERT_FALSE(s.ok()) << bad;
+    EXPECT_NE(s.error().message().find("min_interval"), std::string::npos);
+  }
+  p = {};
+  p.min_interval = 0.0;
+  EXPECT_TRUE(check(p).ok()) << "0: every interval is used";
 }
 
 }  // namespace

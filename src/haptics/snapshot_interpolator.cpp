@@ -20,6 +20,9 @@ Status check(const InterpolationParams& p) {
                  std::to_string(p.extrapolation_horizon) + ")");
   if (!(p.max_interval > 0.0) || !std::isfinite(p.max_interval))
     return Error("interpolation.max_interval must be finite and > 0 [s] (got " + std::to_string(p.max_interval) + ")");
+  if (!(p.min_interval >= 0.0) || !(p.min_interval <= p.max_interval))
+    return Error("interpolation.min_interval must be >= 0 and <= max_interval [s] (got " +
+                 std::to_string(p.min_interval) + ")");
   return {};
 }
 
@@ -52,8 +55,9 @@ RenderedTool SnapshotHistory::render(std::int64_t now_ns, const InterpolationPar
   r.contact_normal = b.contact_normal;
   r.in_contact = b.in_contact != 0;
   const double interval = count_ == 2 ? ns_to_seconds(b.stamp_ns - older_.stamp_ns) : 0.0;
-  if (count_ == 1 || !(interval > 0.0) || interval > params.max_interval) {
-    // One snapshot, two stamped alike, or a stall between them: hold the newest.
+  if (count_ == 1 || !(interval > 0.0) || interval > params.max_interval || interval < params.min_interval) {
+    // One snapshot, two stamped alike or closer than min_interval (their
+    // spacing is no measure of the tool's speed), or a stall between them: hold the newest.
     r.mode = RenderMode::single;
     fill_single(b, r);
     r.u = 1.0;

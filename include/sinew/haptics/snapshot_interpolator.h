@@ -15,7 +15,11 @@
 // for `extrapolation_horizon` seconds past B (u <= 1 + horizon / D); after
 // that the state holds there. u < 0 (a snapshot stamped after the tick
 // started) is taken as 0. Snapshots more than max_interval apart (a stall)
-// are not interpolated: the newest is held. Interpolating costs one physics frame of latency
+// are not interpolated: the newest is held. Nor are snapshots less than
+// min_interval apart: D is when they were published, not how much
+// simulated time lies between them, so a frame published late and the next
+// at once (microseconds apart) would multiply the extrapolated speed by
+// frame time / D. Interpolating costs one physics frame of latency
 // in the loop tool -> device -> tool: the coupled tool is stable when the
 // physics frame is short against the tool's coupled period (README).
 #pragma once
@@ -34,6 +38,10 @@ struct InterpolationParams {
   /// (a stall came between them): the newest is held until the next
   /// arrives. Raise it for physics slower than 1 / max_interval frames/s.
   double max_interval = 0.050;
+  /// Two snapshots closer than this [s], 0 <= min_interval <= max_interval,
+  /// are not interpolated or extrapolated: the newest is held until the next
+  /// arrives. Lower it for physics faster than 1 / min_interval frames/s.
+  double min_interval = 0.001;
 };
 /// Errors name the bad parameter.
 Status check(const InterpolationParams& params);
@@ -41,7 +49,7 @@ Status check(const InterpolationParams& params);
 /// How a rendered state was obtained.
 enum class RenderMode : std::uint32_t {
   none,          ///< no snapshot yet: no state
-  single,        ///< one snapshot (or two further apart than max_interval): the newest held
+  single,        ///< one snapshot (or two further apart than max_interval, or closer than min_interval): the newest held
   interpolated,  ///< between the two newest (0 <= u <= 1)
   extrapolated,  ///< past the newest, within the horizon
   held,          ///< past the horizon: held at the horizon
