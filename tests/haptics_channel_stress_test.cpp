@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <thread>
 
 #include "sinew/haptics/snapshot_channel.h"
@@ -89,11 +90,12 @@ TEST(HapticsChannelStress, TwoReadersAndAWriterAtPhysicsRate) {
   SnapshotChannel channel;
   std::atomic<bool> done{false};
   std::atomic<std::uint64_t> bad{0};
-  auto reader = [&] {
+  auto reader = [&](std::uint64_t& good) {  // [out] good: successful reads
     HapticSnapshot s;
     std::uint64_t last = 0;
     for (int i = 0; i < 200'000; ++i)
       if (channel.try_read(s, 64)) {
+        ++good;
         if (!consistent(s) || s.sequence < last) bad.fetch_add(1);
         last = s.sequence;
       }
@@ -105,12 +107,17 @@ TEST(HapticsChannelStress, TwoReadersAndAWriterAtPhysicsRate) {
       std::this_thread::yield();
     }
   });
-  std::thread r1(reader), r2(reader);
+  while (channel.published() == 0) std::this_thread::yield();  // every read after this one has a value
+  std::uint64_t good1 = 0, good2 = 0;
+  std::thread r1(reader, std::ref(good1)), r2(reader, std::ref(good2));
   r1.join();
   r2.join();
   done.store(true);
   writer.join();
   EXPECT_EQ(bad.load(), 0u);
+  // Without these the test passes with no read at all.
+  EXPECT_GT(good1, 0u) << "reader 1 read nothing";
+  EXPECT_GT(good2, 0u) << "reader 2 read nothing";
 }
 
 }  // namespace
