@@ -44,19 +44,6 @@ struct Options {
   bool realtime = true;
 };
 
-// --rate: a finite number of Hz in [1, 1e6] (the haptic loop's range),
-// the whole argument parsed; false (with a message) otherwise.
-bool parse_rate(const char* v, double& rate) {
-  char* end = nullptr;
-  const double r = std::strtod(v, &end);
-  if (end == v || *end != '\0' || !std::isfinite(r) || r < 1.0 || r > 1e6) {
-    std::fprintf(stderr, "--rate must be a finite number of Hz in [1, 1e6] (got '%s')\n", v);
-    return false;
-  }
-  rate = r;
-  return true;
-}
-
 bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -65,7 +52,7 @@ bool parse(int argc, char** argv, Options& o) {
     if (!v) { std::fprintf(stderr, "missing value after %s\n", a.c_str()); return false; }
     if (a == "--out") o.out = v;
     else if (a == "--backend") o.backend = v;
-    else if (a == "--rate") { if (!parse_rate(v, o.rate)) return false; }
+    else if (a == "--rate") o.rate = std::atof(v);  // checked with the loop settings
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return false; }
     ++i;
   }
@@ -152,6 +139,8 @@ int main(int argc, char** argv) {
   settings.rate_hz = opt.rate;
   settings.realtime = opt.realtime;
   settings.coupling.damping = 3.0;  // [N s/m]: damps the probe's free swing, still passive (> K T / 2)
+  // The rate sizes the telemetry below: the loop's own check first (a clear error for --rate nan, 0, ...).
+  if (auto s = check(settings); !s) return fail(s.error().message());
   settings.telemetry_capacity = static_cast<std::size_t>((kDuration + 1.0) * opt.rate);
   auto loop = HapticLoop::create(settings, device, snapshots, feedback, clock);
   if (!loop) return fail(loop.error().message());
