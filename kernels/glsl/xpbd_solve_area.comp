@@ -17,6 +17,7 @@ layout(std430, binding = 1) readonly buffer Indices { uint idx[]; };
 layout(std430, binding = 2) readonly buffer Data { vec2 data[]; };
 layout(std430, binding = 3) buffer Lambda { float lambda[]; };
 layout(std430, binding = 4) writeonly buffer Residual { float residual[]; };
+#include "thin_apply.h"
 
 void main() {
   const uint gid = gl_GlobalInvocationID.x;
@@ -38,21 +39,9 @@ void main() {
   // kept and nothing moves.
   vec3 g0, g1, g2;
   if (thin_triangle_area_gradients(x0.xyz, x1.xyz, x2.xyz, g0, g1, g2)) {
-    precise float w = 0.0;
-    w += x0.w * dot3(g0, g0);
-    w += x1.w * dot3(g1, g1);
-    w += x2.w * dot3(g2, g2);
-    precise float total = w + alpha_t;
-    if (thin_step_usable(total)) {
-      precise float dlambda = (-c - alpha_t * lambda_i) / total;
-      // Immovable particles are never written (several constraints of a colour may share one).
-      if (x0.w > 0.0) { precise vec3 y = x0.xyz + (x0.w * dlambda) * g0; x[i0] = vec4(y, x0.w); }
-      if (x1.w > 0.0) { precise vec3 y = x1.xyz + (x1.w * dlambda) * g1; x[i1] = vec4(y, x1.w); }
-      if (x2.w > 0.0) { precise vec3 y = x2.xyz + (x2.w * dlambda) * g2; x[i2] = vec4(y, x2.w); }
-      precise float lambda_n = lambda_i + dlambda;
-      lambda[i] = lambda_n;
-      return;
-    }
+    thin_apply(i, uint[4](i0, i1, i2, 0u), vec4[4](x0, x1, x2, vec4(0.0)),
+               vec3[4](g0, g1, g2, vec3(0.0)), 3, c, alpha_t, lambda_i);
+    return;
   }
   lambda[i] = lambda_i;
 }

@@ -149,4 +149,24 @@ inline bool thin_line_bending_gradients(float3 b0, float3 v, float3 b1, float3* 
  * rigid) or not finite (an overflowed gradient) gives no usable step. */
 inline bool thin_step_usable(float total) { return !(!(total > 0.0f) || !isfinite(total)); }
 
+/* The xPBD step of one constraint over n particles (ids, their positions xs,
+ * gradients g): twin of thin_kernels.cpp's apply<N>, the same sums in the
+ * same order. Without a usable step it stores lambda unchanged and moves
+ * nothing; immovable particles are never written (several constraints of a
+ * colour may share one). */
+inline void thin_apply(global float4* x, const uint* ids, const float4* xs, const float3* g, int n, float c,
+                       float alpha_t, float lambda_i, global float* lambda_out) {
+  float w = 0.0f;
+  for (int k = 0; k < n; ++k) w += xs[k].w * dot3(g[k], g[k]);
+  const float total = w + alpha_t;
+  if (!thin_step_usable(total)) {
+    *lambda_out = lambda_i;
+    return;
+  }
+  const float dlambda = (-c - alpha_t * lambda_i) / total;
+  for (int k = 0; k < n; ++k)
+    if (xs[k].w > 0.0f) x[ids[k]] = (float4)(xs[k].xyz + (xs[k].w * dlambda) * g[k], xs[k].w);
+  *lambda_out = lambda_i + dlambda;
+}
+
 #endif /* SINEW_THIN_MATH_H */

@@ -26,19 +26,7 @@ kernel void xpbd_solve_area(global float4* x, global const uint* idx, global con
     lambda[i] = lambda_i;
     return;
   }
-  float w = 0.0f;
-  w += x0.w * dot3(g[0], g[0]);
-  w += x1.w * dot3(g[1], g[1]);
-  w += x2.w * dot3(g[2], g[2]);
-  const float total = w + alpha_t;
-  if (!thin_step_usable(total)) {
-    lambda[i] = lambda_i;
-    return;
-  }
-  const float dlambda = (-c - alpha_t * lambda_i) / total;
-  // Immovable particles are never written (several constraints of a colour may share one).
-  if (x0.w > 0.0f) x[i0] = (float4)(x0.xyz + (x0.w * dlambda) * g[0], x0.w);
-  if (x1.w > 0.0f) x[i1] = (float4)(x1.xyz + (x1.w * dlambda) * g[1], x1.w);
-  if (x2.w > 0.0f) x[i2] = (float4)(x2.xyz + (x2.w * dlambda) * g[2], x2.w);
-  lambda[i] = lambda_i + dlambda;
+  const uint ids[3] = {i0, i1, i2};
+  const float4 xs[3] = {x0, x1, x2};
+  thin_apply(x, ids, xs, g, 3, c, alpha_t, lambda_i, &lambda[i]);
 }
