@@ -24,6 +24,7 @@
 #include <cstdio>
 
 #include "contact_params.h"
+#include "scene/float_words.h"
 
 namespace sinew::test {
 namespace {
@@ -32,14 +33,6 @@ using kernels::ColliderEntry;
 using kernels::ColliderHeader;
 using kernels::SolveParams;
 using kernels::TargetEntry;
-
-template <class T>
-void append(std::vector<float>& out, const T& value) {
-  static_assert(sizeof(T) % sizeof(float) == 0);
-  const std::size_t at = out.size();
-  out.resize(at + sizeof(T) / sizeof(float));
-  std::memcpy(out.data() + at, &value, sizeof(T));
-}
 
 // How far the GPU's words are from the CPU's, printed per case: words not
 // bitwise equal and the largest difference relative to its lane's scale
@@ -218,8 +211,8 @@ ContactSetup contact_setup(std::mt19937& rng, bool friction, float substep_fract
       c.lambda.insert(c.lambda.end(), {warm ? lam(rng) : 0.0f, 0.02f * uf(rng), 0.02f * uf(rng), 0.02f * uf(rng)});
     }
   }
-  append(c.colliders, ColliderHeader{s.colliders, s.tools, substep_fraction, 0});
-  for (const ColliderEntry& e : s.entries) append(c.colliders, e);
+  append_words(c.colliders, ColliderHeader{s.colliders, s.tools, substep_fraction, 0});
+  for (const ColliderEntry& e : s.entries) append_words(c.colliders, e);
   c.impulses.resize(std::size_t{n} * s.tools * SINEW_CONTACT_IMPULSE_FLOAT4S * 4);
   for (float& v : c.impulses) v = uf(rng);
   return c;
@@ -306,7 +299,7 @@ TEST_P(Agreement, AttachmentKernel) {
     e.end_x = still ? e.start_x : e.start_x + 0.1f * u(rng);
     e.end_y = still ? e.start_y : e.start_y + 0.1f * u(rng);
     e.end_z = still ? e.start_z : e.start_z + 0.1f * u(rng);
-    append(target_data, e);
+    append_words(target_data, e);
   }
   for (bool reset : {false, true}) {
     for (bool measure : {false, true}) {

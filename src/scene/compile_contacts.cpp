@@ -3,12 +3,12 @@
 // per movable particle and one attachment constraint per attached vertex.
 // Called after every body has been added, so the particle layout is final.
 #include <array>
-#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "contact_params.h"
+#include "scene/float_words.h"
 #include "scene/scene_compiler.h"
 
 namespace sinew {
@@ -17,14 +17,6 @@ namespace {
 using kernels::ColliderEntry;
 using kernels::ColliderHeader;
 using kernels::TargetEntry;
-
-template <class T>
-void append(std::vector<float>& out, const T& value) {
-  static_assert(sizeof(T) % sizeof(float) == 0);
-  const std::size_t at = out.size();
-  out.resize(at + sizeof(T) / sizeof(float));
-  std::memcpy(out.data() + at, &value, sizeof(T));
-}
 
 ColliderEntry entry(std::uint32_t shape, const std::array<double, 3>& position, const std::array<double, 4>& rotation) {
   ColliderEntry e{};
@@ -71,7 +63,7 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
   header.tools = tools;
   header.substep_fraction = static_cast<float>(1.0 / scene.solver.substeps);
   out.colliders.clear();
-  append(out.colliders, header);
+  append_words(out.colliders, header);
   for (const ColliderDesc& c : scene.colliders) {
     ColliderEntry e = entry(shape_code(c.shape), c.position, c.rotation);
     e.radius = static_cast<float>(c.radius);
@@ -82,7 +74,7 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     e.static_friction = static_cast<float>(c.static_friction);
     e.dynamic_friction = static_cast<float>(c.dynamic_friction);
     e.compliance = static_cast<float>(c.compliance);
-    append(out.colliders, e);
+    append_words(out.colliders, e);
   }
   for (const ToolDesc& t : scene.tools) {
     ColliderEntry e = entry(SINEW_SHAPE_CAPSULE, t.position, t.rotation);
@@ -91,7 +83,7 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     e.static_friction = static_cast<float>(t.static_friction);
     e.dynamic_friction = static_cast<float>(t.dynamic_friction);
     e.compliance = static_cast<float>(t.compliance);
-    append(out.colliders, e);
+    append_words(out.colliders, e);
   }
 
   out.targets.clear();
@@ -100,7 +92,7 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     e.start_x = e.end_x = static_cast<float>(t[0]);
     e.start_y = e.end_y = static_cast<float>(t[1]);
     e.start_z = e.end_z = static_cast<float>(t[2]);
-    append(out.targets, e);
+    append_words(out.targets, e);
   }
 
   // Contacts: every movable particle against every collider and tool.

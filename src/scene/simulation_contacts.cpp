@@ -63,11 +63,11 @@
 // allocates per frame.
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <sstream>
 #include <string>
 
 #include "contact_params.h"
+#include "scene/float_words.h"
 #include "scene/simulation_impl.h"
 
 namespace sinew {
@@ -83,19 +83,8 @@ constexpr std::size_t kHeaderFloats = sizeof(ColliderHeader) / sizeof(float);
 constexpr std::size_t kEntryFloats = sizeof(ColliderEntry) / sizeof(float);
 constexpr std::size_t kTargetFloats = sizeof(TargetEntry) / sizeof(float);
 
-template <class T>
-T load(const std::vector<float>& v, std::size_t at) {
-  T t;
-  std::memcpy(&t, v.data() + at, sizeof(T));
-  return t;
-}
-template <class T>
-void store(std::vector<float>& v, std::size_t at, const T& t) {
-  std::memcpy(v.data() + at, &t, sizeof(T));
-}
-
 std::size_t device_floats(const std::vector<float>& c) {
-  const auto h = load<ColliderHeader>(c, 0);
+  const auto h = load_words<ColliderHeader>(c, 0);
   return kHeaderFloats + std::size_t{h.colliders + h.tools} * kEntryFloats;
 }
 std::size_t entry_at(std::size_t k) { return kHeaderFloats + k * kEntryFloats; }
@@ -278,9 +267,9 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
   targets = compiled.targets;
   if (colliders.size() < kHeaderFloats) {  // no collider buffer compiled: an empty header
     colliders.assign(kHeaderFloats, 0.0f);
-    store(colliders, 0, ColliderHeader{0, 0, 1.0f, 0});
+    store_words(colliders, 0, ColliderHeader{0, 0, 1.0f, 0});
   }
-  const auto header = load<ColliderHeader>(colliders, 0);
+  const auto header = load_words<ColliderHeader>(colliders, 0);
   if (header.colliders != scene.colliders.size() || header.tools != scene.tools.size() ||
       colliders.size() != device_floats(colliders))
     return Error("internal: the compiled collider buffer does not match the scene's colliders and tools");
@@ -306,11 +295,11 @@ Status Simulation::Impl::before_frame() {
   for (std::size_t t = 0; t < c.tools.size(); ++t) {
     ToolBody& b = c.tools[t];
     const std::size_t at = entry_at(c.colliders + t);
-    auto e = load<ColliderEntry>(colliders, at);
+    auto e = load_words<ColliderEntry>(colliders, at);
     integrate(b, time_step, double(c.iterations) * c.substeps * c.substeps);
     settle(e);  // the frame starts where the last one ended
     set_end_pose(e, b.position, b.rotation);
-    store(colliders, at, e);
+    store_words(colliders, at, e);
     c.colliders_dirty = true;
   }
   if (c.colliders_dirty) {
@@ -330,19 +319,19 @@ Status Simulation::Impl::after_frame() {
   ContactState& c = contacts;
   // What moved during this frame stays at its end pose from now on.
   for (std::uint32_t k = 0; k < c.colliders; ++k) {
-    auto e = load<ColliderEntry>(colliders, entry_at(k));
+    auto e = load_words<ColliderEntry>(colliders, entry_at(k));
     if (settle(e)) {
-      store(colliders, entry_at(k), e);
+      store_words(colliders, entry_at(k), e);
       c.colliders_dirty = true;
     }
   }
   for (std::size_t at = 0; at + kTargetFloats <= targets.size(); at += kTargetFloats) {
-    auto e = load<TargetEntry>(targets, at);
+    auto e = load_words<TargetEntry>(targets, at);
     if (e.start_x != e.end_x || e.start_y != e.end_y || e.start_z != e.end_z) {
       e.start_x = e.end_x;
       e.start_y = e.end_y;
       e.start_z = e.end_z;
-      store(targets, at, e);
+      store_words(targets, at, e);
       c.targets_dirty = true;
     }
   }
@@ -394,9 +383,9 @@ Status Simulation::set_collider_pose(std::size_t index, const std::array<double,
   if (Status s = check_finite(call, "position", position); !s) return s;
   if (Status s = check_rotation(call, rotation); !s) return s;
   std::vector<float>& c = impl_->colliders;
-  auto e = load<ColliderEntry>(c, entry_at(index));
+  auto e = load_words<ColliderEntry>(c, entry_at(index));
   set_end_pose(e, position, rotation);
-  store(c, entry_at(index), e);
+  store_words(c, entry_at(index), e);
   impl_->contacts.colliders_dirty = true;
   return {};
 }
@@ -406,11 +395,11 @@ Status Simulation::set_target(std::size_t index, const std::array<double, 3>& po
   std::vector<float>& targets = impl_->targets;
   if (Status s = check_index(call, "target", index, targets.size() / kTargetFloats); !s) return s;
   if (Status s = check_finite(call, "position", position); !s) return s;
-  auto e = load<TargetEntry>(targets, index * kTargetFloats);
+  auto e = load_words<TargetEntry>(targets, index * kTargetFloats);
   e.end_x = static_cast<float>(position[0]);
   e.end_y = static_cast<float>(position[1]);
   e.end_z = static_cast<float>(position[2]);
-  store(targets, index * kTargetFloats, e);
+  store_words(targets, index * kTargetFloats, e);
   impl_->contacts.targets_dirty = true;
   return {};
 }
