@@ -4,7 +4,6 @@
 // or falls back to the CPU backend. Skipped where no OpenCL platform exists.
 #include <gtest/gtest.h>
 
-#include "backends/kernel_table.h"
 #include "backends/opencl/opencl_device.h"
 #include "test_support.h"
 #include "xpbd_params.h"
@@ -27,20 +26,13 @@ TEST_F(OpenclBackend, EmbeddedKernelsBuildOnEveryDevice) {
     auto device = create_device({.backend = "opencl", .device = std::to_string(i), .quiet = true});
     ASSERT_TRUE(device.ok()) << devices_[i].name << ": " << device.error().message();
     EXPECT_NE((*device)->device_name().find(devices_[i].name), std::string::npos);
-    // Every kernel of the table is in the program (creation fails otherwise)
-    // and usable: a program dispatching it is accepted.
+    // Every kernel of the table is in the program: create_program finds and
+    // accepts each one.
     auto buffer = (*device)->create_buffer(64, "x");
     ASSERT_TRUE(buffer.ok());
     for (std::size_t k = 0; k < kernel_count; ++k) {
       const auto kernel = static_cast<Kernel>(k);
-      Dispatch d;
-      d.kernel = kernel;
-      d.count = 1;
-      d.binding_count = kernel_signature(kernel).bindings;
-      for (std::uint32_t b = 0; b < d.binding_count; ++b) d.bindings[b] = *buffer;
-      d.params_bytes = kernel_signature(kernel).params_bytes;
-      FrameProgram p;
-      p.dispatch_raw(d);
+      const FrameProgram p = test::single_dispatch_program(kernel, *buffer);
       const auto made = (*device)->create_program(p);
       EXPECT_TRUE(made.ok()) << devices_[i].name << ", " << kernel_name(kernel) << ": " << made.error().message();
     }

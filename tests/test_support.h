@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "backends/kernel_table.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
 
@@ -41,6 +42,21 @@ class BackendTest : public ::testing::TestWithParam<std::string> {
 /// built but has no device here (e.g. no GPU), failing it on any other error.
 inline Result<Simulation> create_or_skip(const SceneDesc& scene, const std::string& backend, int threads = 0) {
   return Simulation::create(scene, {.backend = backend, .threads = threads, .quiet = true});
+}
+
+/// One dispatch of `kernel` over one item, every binding on `buffer`,
+/// parameters zeroed: enough for create_program to look the kernel up and
+/// build it (not meant to be run).
+inline FrameProgram single_dispatch_program(Kernel kernel, BufferHandle buffer) {
+  Dispatch d;
+  d.kernel = kernel;
+  d.count = 1;  // count-0 dispatches are dropped
+  d.binding_count = kernel_signature(kernel).bindings;
+  for (std::uint32_t b = 0; b < d.binding_count; ++b) d.bindings[b] = buffer;
+  d.params_bytes = kernel_signature(kernel).params_bytes;
+  FrameProgram p;
+  p.dispatch_raw(d);
+  return p;
 }
 
 inline std::string data_path(const std::string& relative) { return std::string(SINEW_DATA_DIR) + "/" + relative; }
