@@ -9,7 +9,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cinttypes>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -125,6 +127,43 @@ inline void expect_agree(const KernelCase& c, const std::vector<std::vector<floa
           << what << " (" << kernel_name(c.kernel) << "): binding " << b << " word " << i;
     }
   }
+}
+
+// Prints how close the GPU came, one line per case: how many words of
+// binding 0 (positions) the CPU kernel moved (so a case that moves nothing
+// shows), how many words differ bitwise (+0 and -0 count as equal), the
+// largest difference in units in the last place and relative to its lane's
+// scale (what expect_agree bounds by 1e-5).
+inline void report_difference(const KernelCase& c, const std::vector<std::vector<float>>& ref,
+                              const std::vector<std::vector<float>>& gpu, const std::string& what) {
+  auto ordered = [](float f) {  // sign-magnitude bits onto a monotonic integer line
+    std::int32_t i;
+    std::memcpy(&i, &f, 4);
+    return i < 0 ? -std::int64_t(i & 0x7fffffff) : std::int64_t(i);
+  };
+  std::size_t moved = 0, words = 0, differ = 0;
+  std::int64_t ulps = 0;
+  double relative = 0.0;
+  if (!c.bindings.empty() && !ref.empty())
+    for (std::size_t i = 0; i < c.bindings[0].data.size() && i < ref[0].size(); ++i)
+      moved += std::memcmp(&c.bindings[0].data[i], &ref[0][i], 4) != 0 ? 1 : 0;
+  for (std::size_t b = 0; b < ref.size() && b < gpu.size() && b < c.bindings.size(); ++b) {
+    const std::uint32_t lanes = std::max(c.bindings[b].lanes, 1u);
+    std::vector<double> scale(lanes, 0.0);
+    for (std::size_t i = 0; i < ref[b].size(); ++i)
+      if (std::isfinite(ref[b][i])) scale[i % lanes] = std::max(scale[i % lanes], double(std::abs(ref[b][i])));
+    for (std::size_t i = 0; i < ref[b].size() && i < gpu[b].size(); ++i) {
+      const float r = ref[b][i], g = gpu[b][i];
+      ++words;
+      if (r == g || (std::isnan(r) && std::isnan(g))) continue;
+      ++differ;
+      ulps = std::max(ulps, std::abs(ordered(r) - ordered(g)));
+      relative = std::max(relative, std::abs(double(g) - r) / std::max(scale[i % lanes], 1e-30));
+    }
+  }
+  std::printf("[ agree    ] %s: moved %zu words of x; %zu of %zu words differ (largest %" PRId64
+              " ulp, %.1e of the lane's scale)\n",
+              what.c_str(), moved, differ, words, ulps, relative);
 }
 
 // Particles in a unit box with inverse masses; a few immovable ones.

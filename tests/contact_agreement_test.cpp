@@ -34,29 +34,6 @@ using kernels::ColliderHeader;
 using kernels::SolveParams;
 using kernels::TargetEntry;
 
-// How far the GPU's words are from the CPU's, printed per case: words not
-// bitwise equal and the largest difference relative to its lane's scale
-// (the largest magnitude of that lane in the buffer, as expect_agree).
-void print_difference(const KernelCase& c, const std::string& backend, const std::string& what,
-                      const std::vector<std::vector<float>>& ref, const std::vector<std::vector<float>>& gpu) {
-  std::size_t words = 0, differ = 0;
-  double worst = 0.0;
-  for (std::size_t b = 0; b < ref.size() && b < gpu.size() && b < c.bindings.size(); ++b) {
-    const std::uint32_t lanes = std::max(c.bindings[b].lanes, 1u);
-    std::vector<double> scale(lanes, 0.0);
-    for (std::size_t i = 0; i < ref[b].size(); ++i)
-      if (std::isfinite(ref[b][i])) scale[i % lanes] = std::max(scale[i % lanes], double(std::abs(ref[b][i])));
-    for (std::size_t i = 0; i < ref[b].size(); ++i) {
-      ++words;
-      if (std::memcmp(&ref[b][i], &gpu[b][i], 4) == 0 || (std::isnan(ref[b][i]) && std::isnan(gpu[b][i]))) continue;
-      ++differ;
-      worst = std::max(worst, std::abs(double(gpu[b][i]) - ref[b][i]) / std::max(scale[i % lanes], 1e-30));
-    }
-  }
-  std::printf("[ agree    ] %s, %s vs cpu: %zu of %zu words differ, largest difference %.3g of the lane's scale\n",
-              what.c_str(), backend.c_str(), differ, words, worst);
-}
-
 struct Rigid {
   std::array<float, 3> p;
   std::array<float, 4> q;  // (w, x, y, z)
@@ -259,7 +236,7 @@ TEST_P(Agreement, ContactKernel) {
       const auto ref = run_on("cpu", c);
       const auto gpu = run_on(GetParam(), c);
       expect_agree(c, ref, gpu, what);
-      print_difference(c, GetParam(), what, ref, gpu);
+      report_difference(c, ref, gpu, GetParam() + " " + what);
       if (pass.measure || ref.size() != c.bindings.size()) continue;
       // The case reaches what it should: every surface touched; with
       // friction, particles held in the static cone and sliding in the
@@ -334,7 +311,7 @@ TEST_P(Agreement, AttachmentKernel) {
         const auto ref = run_on("cpu", c);
         const auto gpu = run_on(GetParam(), c);
         expect_agree(c, ref, gpu, what);
-        print_difference(c, GetParam(), what, ref, gpu);
+        report_difference(c, ref, gpu, GetParam() + " " + what);
       }
     }
   }

@@ -263,31 +263,6 @@ void expect_agree_per_word(const KernelCase& c, const std::vector<std::vector<fl
   }
 }
 
-// How many words differ bitwise (+0 and -0 count as equal), their largest
-// difference in units in the last place and relative to the CPU's value.
-void print_bitwise(const std::vector<std::vector<float>>& ref, const std::vector<std::vector<float>>& gpu,
-                   const std::string& what) {
-  std::size_t words = 0, differ = 0;
-  std::int64_t worst_ulp = 0;
-  double worst_rel = 0.0;
-  for (std::size_t b = 0; b < ref.size() && b < gpu.size(); ++b)
-    for (std::size_t i = 0; i < ref[b].size() && i < gpu[b].size(); ++i) {
-      const float r = ref[b][i], g = gpu[b][i];
-      ++words;
-      if ((std::isnan(r) && std::isnan(g)) || r == g) continue;
-      ++differ;
-      std::int32_t ri, gi;
-      std::memcpy(&ri, &r, 4);
-      std::memcpy(&gi, &g, 4);
-      // Signed-magnitude to a monotonic integer line.
-      const std::int64_t rl = ri < 0 ? -std::int64_t(ri & 0x7fffffff) : ri, gl = gi < 0 ? -std::int64_t(gi & 0x7fffffff) : gi;
-      worst_ulp = std::max(worst_ulp, std::abs(rl - gl));
-      if (r != 0.0f) worst_rel = std::max(worst_rel, std::abs(double(g) - double(r)) / std::abs(double(r)));
-    }
-  std::printf("[ agree    ] %s: %zu of %zu words differ bitwise (largest %lld ulp, relative %.3g)\n", what.c_str(),
-              differ, words, static_cast<long long>(worst_ulp), worst_rel);
-}
-
 TEST_P(Agreement, FemKernels) {
   std::mt19937 rng(std::random_device{}());
   for (Kernel kernel : {Kernel::xpbd_solve_neo_hookean, Kernel::xpbd_solve_stvk, Kernel::xpbd_solve_corotational}) {
@@ -299,7 +274,7 @@ TEST_P(Agreement, FemKernels) {
         const auto ref = run_on("cpu", c), gpu = run_on(GetParam(), c);
         expect_agree(c, ref, gpu, what);
         expect_agree_per_word(c, ref, gpu, what);
-        print_bitwise(ref, gpu, GetParam() + " " + what);
+        report_difference(c, ref, gpu, GetParam() + " " + what);
       }
     }
   }

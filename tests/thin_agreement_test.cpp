@@ -364,48 +364,6 @@ Thin padded(Thin t, std::uint32_t arity) {
   return t;
 }
 
-std::int64_t ordered(float f) {
-  std::int32_t i;
-  std::memcpy(&i, &f, 4);
-  return i < 0 ? -std::int64_t(i & 0x7fffffff) : std::int64_t(i);
-}
-
-// Prints how many position words the CPU kernel changed (so a case that
-// moves nothing shows), and per output binding how many words differ
-// bitwise, the largest difference in ulps and relative to the binding's
-// scale (what expect_agree bounds by 1e-5).
-void report(const std::string& what, const KernelCase& c, const std::vector<std::vector<float>>& ref,
-            const std::vector<std::vector<float>>& gpu) {
-  static const char* const names[] = {"x", "idx", "data", "lambda", "residual"};
-  std::size_t moved = 0;
-  for (std::size_t i = 0; i < c.bindings[0].data.size() && i < ref[0].size(); ++i)
-    moved += std::memcmp(&c.bindings[0].data[i], &ref[0][i], 4) != 0 ? 1 : 0;
-  std::string line = " moved " + std::to_string(moved) + " words of x;";
-  for (std::size_t b = 0; b < ref.size() && b < gpu.size() && b < 5; ++b) {
-    if (b == 1 || b == 2) continue;  // inputs
-    float scale = 0.0f;
-    for (float v : ref[b])
-      if (std::isfinite(v)) scale = std::max(scale, std::abs(v));
-    std::size_t differ = 0, compared = 0;
-    std::int64_t ulps = 0;
-    double rel = 0.0;
-    for (std::size_t i = 0; i < ref[b].size() && i < gpu[b].size(); ++i) {
-      const float r = ref[b][i], g = gpu[b][i];
-      if (std::isnan(r) && std::isnan(g)) continue;
-      ++compared;
-      if (std::memcmp(&r, &g, 4) == 0) continue;
-      ++differ;
-      ulps = std::max(ulps, std::abs(ordered(r) - ordered(g)));
-      rel = std::max(rel, std::abs(double(g) - r) / std::max(scale, 1e-6f));
-    }
-    char buf[160];
-    std::snprintf(buf, sizeof buf, " %s %zu/%zu differ (max %" PRId64 " ulp, %.1e of scale);", names[b], differ,
-                  compared, ulps, rel);
-    line += buf;
-  }
-  std::printf("[ agree    ] %s:%s\n", what.c_str(), line.c_str());
-}
-
 // Runs every reset/measure variant of the random set and of the edge cases.
 void agree_on(const std::string& backend, Kernel kernel, std::uint32_t arity,
               const std::function<Thin(std::mt19937&, std::uint32_t)>& make, const Thin& edge) {
@@ -417,11 +375,11 @@ void agree_on(const std::string& backend, Kernel kernel, std::uint32_t arity,
       const KernelCase random = thin_case(rng, kernel, arity, make(rng, 600 + rng() % 50), reset, measure);
       const auto ref = run_on("cpu", random), gpu = run_on(backend, random);
       expect_agree(random, ref, gpu, variant);
-      report(variant + " random", random, ref, gpu);
+      report_difference(random, ref, gpu, backend + " " + variant + " random");
       const KernelCase edges = thin_case(rng, kernel, arity, padded(edge, arity), reset, measure);
       const auto ref_e = run_on("cpu", edges), gpu_e = run_on(backend, edges);
       expect_agree(edges, ref_e, gpu_e, variant + " edge cases");
-      report(variant + " edge cases", edges, ref_e, gpu_e);
+      report_difference(edges, ref_e, gpu_e, backend + " " + variant + " edge cases");
     }
 }
 
