@@ -1,5 +1,5 @@
 // read_tetgen / read_gmsh / read_tet_mesh on the real meshes in
-// ../shared/data/meshes/tet and on small files written here (Gmsh 2.2, 4.0
+// data/meshes/tet and on small files written here (Gmsh 2.2, 4.0
 // and 4.1 with sparse shuffled tags and mixed element types; TetGen
 // 1-based with attributes, markers and comments; 10-node tets).
 #include <gtest/gtest.h>

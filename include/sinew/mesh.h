@@ -2,7 +2,7 @@
 // checking, boundary extraction and VTU output for ParaView.
 //
 // Units: positions are whatever the file holds; sinew is SI throughout, so a
-// mesh stored in millimetres (e.g. ../shared/data/meshes/tet/kidney_57k) is
+// mesh stored in millimetres (e.g. data/meshes/tet/kidney_57k) is
 // scaled with scale_mesh(mesh, 1e-3) before it is used in a scene.
 //
 // Orientation: a tet {a, b, c, d} is positively oriented when
