@@ -1,5 +1,7 @@
 // device.cpp — backend-independent parts of the device interface: the kernel
 // table, program checks and the choice of backend by name.
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <string>
 
@@ -14,6 +16,7 @@
 #include "backends/vulkan/vulkan_device.h"
 #endif
 #include "backends/kernel_table.h"
+#include "primitive_params.h"
 #include "xpbd_params.h"
 
 namespace sinew {
@@ -21,31 +24,50 @@ namespace {
 
 using namespace kernels;
 
+// The kernel registry (kernels/kernel_list.h) as a table.
 constexpr KernelSignature kSignatures[] = {
-    {"xpbd_predict", 3, sizeof(PredictParams)},
-    {"xpbd_update_velocity", 3, sizeof(UpdateVelocityParams)},
-    {"xpbd_solve_distance", 5, sizeof(SolveParams)},
-    {"xpbd_solve_volume", 5, sizeof(SolveParams)},
-    {"xpbd_solve_neo_hookean", 5, sizeof(SolveParams)},
-    {"xpbd_solve_stvk", 5, sizeof(SolveParams)},
-    {"xpbd_solve_corotational", 5, sizeof(SolveParams)},
-    {"xpbd_solve_area", 5, sizeof(SolveParams)},
-    {"xpbd_solve_dihedral", 5, sizeof(SolveParams)},
-    {"xpbd_solve_line_bending", 5, sizeof(SolveParams)},
-    {"xpbd_solve_attachment", 6, sizeof(SolveParams)},  // + targets
-    {"xpbd_solve_contacts", 8, sizeof(SolveParams)},    // + previous position, colliders, contact impulses
+#define SINEW_KERNEL_SIGNATURE(name, bindings, params, group) {#name, bindings, sizeof(params), group},
+    SINEW_KERNELS(SINEW_KERNEL_SIGNATURE)
+#undef SINEW_KERNEL_SIGNATURE
 };
-static_assert(std::size(kSignatures) == static_cast<std::size_t>(Kernel::count_),
-              "every Kernel needs a signature");
+static_assert(std::size(kSignatures) == kernel_count);
+
+constexpr std::array<std::string_view, kernel_count> kNames = [] {
+  std::array<std::string_view, kernel_count> names{};
+  for (std::size_t k = 0; k < kernel_count; ++k) names[k] = kSignatures[k].name;
+  return names;
+}();
+
+std::string range_text(std::uint32_t word, std::uint32_t words) {
+  return "words [" + std::to_string(word) + ", " + std::to_string(std::uint64_t{word} + words) + ")";
+}
+
+// Whether buffer `b` is live and holds words [word, word + words).
+Status check_words(const std::string& who, const char* role, BufferHandle b, std::uint64_t word, std::uint64_t words,
+                   std::span<const std::size_t> bytes) {
+  if (b.id >= bytes.size() || bytes[b.id] == 0)
+    return Error(ErrorCode::internal, who + ": " + role + " is not a buffer of this device");
+  if ((word + words) * 4 > bytes[b.id])
+    return Error(ErrorCode::internal, who + ": " + role + " " + range_text(std::uint32_t(word), std::uint32_t(words)) +
+                                          " past the buffer's " + std::to_string(bytes[b.id]) + " bytes");
+  return {};
+}
 
 }  // namespace
 
 const KernelSignature& kernel_signature(Kernel kernel) { return kSignatures[static_cast<std::size_t>(kernel)]; }
 
+std::uint32_t launch_group_size(Kernel kernel) {
+  const std::uint32_t g = kernel_signature(kernel).group_size;
+  return g ? g : kIndependentGroupSize;
+}
+
 std::string_view kernel_name(Kernel kernel) {
   if (kernel >= Kernel::count_) return "unknown";
   return kernel_signature(kernel).name;
 }
+
+std::span<const std::string_view> kernel_names() { return kNames; }
 
 std::size_t FrameProgram::dispatch_count() const {
   std::size_t n = 0;
@@ -53,7 +75,11 @@ std::size_t FrameProgram::dispatch_count() const {
   return n;
 }
 
-std::size_t FrameProgram::barrier_count() const { return commands_.size() - dispatch_count(); }
+std::size_t FrameProgram::barrier_count() const {
+  std::size_t n = 0;
+  for (const auto& c : commands_) n += std::holds_alternative<Barrier>(c) ? 1 : 0;
+  return n;
+}
 
 std::size_t FrameProgram::dispatch_count(Kernel kernel) const {
   std::size_t n = 0;
@@ -62,28 +88,73 @@ std::size_t FrameProgram::dispatch_count(Kernel kernel) const {
   return n;
 }
 
-Status check_program(const FrameProgram& program, std::uint32_t buffer_count) {
+Status check_program(const FrameProgram& program, std::span<const std::size_t> bytes) {
+  std::size_t index = 0;
+  for (const Counter& c : program.counters()) {
+    const std::string who = "frame program counter " + std::to_string(index++) + " ('" + c.label + "')";
+    if (Status s = check_words(who, "its buffer", c.buffer, c.word, 1, bytes); !s) return s;
+  }
   std::size_t position = 0;
   for (const auto& command : program.commands()) {
     ++position;
+    const std::string where = "frame program command " + std::to_string(position);
+    if (const auto* f = std::get_if<Fill>(&command)) {
+      if (Status s = check_words(where + " (fill)", "the buffer", f->buffer, f->word, f->words, bytes); !s) return s;
+      continue;
+    }
+    if (const auto* c = std::get_if<Copy>(&command)) {
+      const std::string who = where + " (copy)";
+      if (Status s = check_words(who, "the source", c->source, c->source_word, c->words, bytes); !s) return s;
+      if (Status s = check_words(who, "the target", c->target, c->target_word, c->words, bytes); !s) return s;
+      if (c->source == c->target && c->source_word < std::uint64_t{c->target_word} + c->words &&
+          c->target_word < std::uint64_t{c->source_word} + c->words)
+        return Error(ErrorCode::internal, who + ": source and target ranges overlap");
+      continue;
+    }
     const auto* d = std::get_if<Dispatch>(&command);
     if (!d) continue;
-    const std::string where = "frame program command " + std::to_string(position);
     if (d->kernel >= Kernel::count_)
-      return Error(where + ": unknown kernel id " + std::to_string(static_cast<std::uint32_t>(d->kernel)));
+      return Error(ErrorCode::internal,
+                   where + ": unknown kernel id " + std::to_string(static_cast<std::uint32_t>(d->kernel)));
     const KernelSignature& sig = kernel_signature(d->kernel);
     const std::string who = where + " (" + std::string(sig.name) + ")";
     if (d->binding_count != sig.bindings)
-      return Error(who + ": binds " + std::to_string(d->binding_count) + " buffers, the kernel takes " +
-                   std::to_string(sig.bindings));
+      return Error(ErrorCode::internal, who + ": binds " + std::to_string(d->binding_count) +
+                                            " buffers, the kernel takes " + std::to_string(sig.bindings));
     if (d->params_bytes != sig.params_bytes)
-      return Error(who + ": parameter block of " + std::to_string(d->params_bytes) +
-                   " bytes, the kernel takes " + std::to_string(sig.params_bytes));
+      return Error(ErrorCode::internal, who + ": parameter block of " + std::to_string(d->params_bytes) +
+                                            " bytes, the kernel takes " + std::to_string(sig.params_bytes));
     for (std::uint32_t b = 0; b < d->binding_count; ++b)
-      if (d->bindings[b].id >= buffer_count)
-        return Error(who + ": binding " + std::to_string(b) + " is not a buffer of this device");
+      if (d->bindings[b].id >= bytes.size() || bytes[d->bindings[b].id] == 0)
+        return Error(ErrorCode::internal, who + ": binding " + std::to_string(b) + " is not a buffer of this device");
+    if (d->indirect.buffer.valid()) {
+      const auto& counters = program.counters();
+      const bool declared = std::any_of(counters.begin(), counters.end(), [&](const Counter& c) {
+        return c.buffer == d->indirect.buffer && c.word == d->indirect.word && c.capacity == d->count;
+      });
+      if (!declared)
+        return Error(ErrorCode::internal, who + ": an indirect dispatch whose count (word " +
+                                              std::to_string(d->indirect.word) +
+                                              ") is not a declared counter of capacity " + std::to_string(d->count));
+    }
   }
   return {};
+}
+
+Status check_counters(const std::vector<Counter>& counters, std::span<const std::uint32_t> values) {
+  std::string over;
+  for (std::size_t i = 0; i < counters.size() && i < values.size(); ++i)
+    if (values[i] > counters[i].capacity)
+      over += (over.empty() ? "" : "; ") + ("'" + counters[i].label + "' reached " + std::to_string(values[i]) +
+                                           " of capacity " + std::to_string(counters[i].capacity));
+  if (over.empty()) return {};
+  return Error(ErrorCode::capacity_exceeded,
+               "capacity exceeded (work past it was dropped, the rest of the frame stands): " + over);
+}
+
+Status check_program(const FrameProgram& program, std::uint32_t buffer_count) {
+  const std::vector<std::size_t> bytes(buffer_count, SIZE_MAX / 8);
+  return check_program(program, bytes);
 }
 
 Status check_buffer_range(const std::string& label, std::size_t size, std::size_t offset, std::size_t bytes,
@@ -180,11 +251,11 @@ Result<std::unique_ptr<Device>> create_device(const DeviceOptions& options) {
 #endif
   }
   if (name == "opencl" || name == "vulkan")
-    return Error("backend '" + name + "' is not built into this sinew (built: " + joined(built_backends()) +
+    return Error(ErrorCode::backend_unavailable, "backend '" + name + "' is not built into this sinew (built: " + joined(built_backends()) +
                  "); configure with -DSINEW_" + (name == "opencl" ? "OPENCL" : "VULKAN") +
                  "=ON and its dependencies installed");
   if (name == "auto") return create_auto_device(options);
-  return Error("unknown backend '" + name + "' (choose cpu, opencl, vulkan or auto)");
+  return Error(ErrorCode::bad_parameter, "unknown backend '" + name + "' (choose cpu, opencl, vulkan or auto)");
 }
 
 }  // namespace sinew

@@ -2,8 +2,13 @@
 //
 // A program runs its commands in order. Each dispatch is split into chunks
 // that TBB runs on the device's own task arena; a barrier is implicit, since
-// a parallel_for returns only when all of its chunks are done. The kernels
-// (kernels/cpu) are plain scalar code and the test oracle for the GPU ones.
+// a parallel_for returns only when all of its chunks are done. Independent
+// kernels get ranges of items; cooperative kernels (a group size in the
+// registry) get ranges of groups and do each group's work in order, so the
+// CPU reference of a scan or a sort is plain sequential code per group.
+// Indirect dispatches read their count from the counter word when they run.
+// The kernels (kernels/cpu) are plain scalar code and the test oracle for
+// the GPU ones.
 #include "backends/cpu/cpu_device.h"
 
 #include <tbb/blocked_range.h>
@@ -18,6 +23,7 @@
 #include "backends/kernel_table.h"
 #include "cpu/contact_kernels.h"
 #include "cpu/fem_kernels.h"
+#include "cpu/primitive_kernels.h"
 #include "cpu/thin_kernels.h"
 #include "cpu/xpbd_kernels.h"
 
@@ -32,25 +38,18 @@ void solve_volume_simd(const void* params, std::byte* const* bindings, std::uint
   kernels::xpbd_solve_volume(params, bindings, kernels::xpbd_solve_volume_avx2(params, bindings, begin, end), end);
 }
 
+// The CPU reference of every registered kernel: kernels::NAME.
+constexpr kernels::CpuKernelFn kReference[] = {
+#define SINEW_CPU_KERNEL(name, bindings, params, group) kernels::name,
+    SINEW_KERNELS(SINEW_CPU_KERNEL)
+#undef SINEW_CPU_KERNEL
+};
+static_assert(std::size(kReference) == kernel_count);
+
 kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
   if (simd && kernel == Kernel::xpbd_solve_distance) return solve_distance_simd;
   if (simd && kernel == Kernel::xpbd_solve_volume) return solve_volume_simd;
-  switch (kernel) {
-    case Kernel::xpbd_predict: return kernels::xpbd_predict;
-    case Kernel::xpbd_update_velocity: return kernels::xpbd_update_velocity;
-    case Kernel::xpbd_solve_distance: return kernels::xpbd_solve_distance;
-    case Kernel::xpbd_solve_volume: return kernels::xpbd_solve_volume;
-    case Kernel::xpbd_solve_neo_hookean: return kernels::xpbd_solve_neo_hookean;
-    case Kernel::xpbd_solve_stvk: return kernels::xpbd_solve_stvk;
-    case Kernel::xpbd_solve_corotational: return kernels::xpbd_solve_corotational;
-    case Kernel::xpbd_solve_area: return kernels::xpbd_solve_area;
-    case Kernel::xpbd_solve_dihedral: return kernels::xpbd_solve_dihedral;
-    case Kernel::xpbd_solve_line_bending: return kernels::xpbd_solve_line_bending;
-    case Kernel::xpbd_solve_attachment: return kernels::xpbd_solve_attachment;
-    case Kernel::xpbd_solve_contacts: return kernels::xpbd_solve_contacts;
-    case Kernel::count_: break;
-  }
-  return nullptr;
+  return kReference[static_cast<std::size_t>(kernel)];
 }
 
 // 64-byte aligned, zero-filled host memory.
@@ -59,16 +58,38 @@ struct HostBuffer {
     void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t{64}); }
   };
   std::unique_ptr<std::byte[], Free> data;
-  std::size_t bytes = 0;
+  std::size_t bytes = 0;  // 0: destroyed
   std::string label;
 };
 
-// A dispatch resolved to raw pointers, ready to run.
-struct CpuDispatch {
-  kernels::CpuKernelFn fn;
-  std::uint32_t count;
-  std::byte* bindings[Dispatch::max_bindings];
-  alignas(16) std::byte params[Dispatch::max_params_bytes];
+// Round up so kernels may read whole float4s at the end of any buffer.
+std::unique_ptr<std::byte[], HostBuffer::Free> allocate(std::size_t bytes) {
+  const std::size_t rounded = (bytes + 63) / 64 * 64;
+  std::unique_ptr<std::byte[], HostBuffer::Free> p(static_cast<std::byte*>(::operator new[](rounded, std::align_val_t{64})));
+  std::fill_n(p.get(), rounded, std::byte{0});
+  return p;
+}
+
+// A command resolved to raw pointers, ready to run.
+struct CpuStep {
+  enum class Kind { dispatch, fill, copy } kind = Kind::dispatch;
+  kernels::CpuKernelFn fn = nullptr;
+  std::uint32_t count = 0;       // items (independent) or groups (cooperative), or the capacity when indirect
+  std::uint32_t group_size = 0;  // 0: independent items
+  const std::uint32_t* indirect = nullptr;  // the counter word of an indirect dispatch
+  std::byte* bindings[Dispatch::max_bindings] = {};
+  alignas(16) std::byte params[Dispatch::max_params_bytes] = {};
+  std::uint32_t* target = nullptr;  // fill, copy
+  const std::uint32_t* source = nullptr;
+  std::uint32_t words = 0, value = 0;
+};
+
+struct CpuProgram {
+  bool live = false;
+  FrameProgram source;            // kept to resolve again after a buffer is resized
+  std::uint64_t resolved_at = 0;  // the device's resize generation the pointers are from
+  std::vector<CpuStep> steps;
+  std::vector<const std::uint32_t*> counter_words;
 };
 
 class CpuDevice final : public Device {
@@ -82,16 +103,37 @@ class CpuDevice final : public Device {
   }
 
   Result<BufferHandle> create_buffer(std::size_t bytes, std::string_view label) override {
-    if (bytes == 0) return Error("create_buffer '" + std::string(label) + "': size must be > 0");
+    if (bytes == 0) return Error(ErrorCode::internal, "create_buffer '" + std::string(label) + "': size must be > 0");
     HostBuffer b;
-    // Round up so kernels may read whole float4s at the end of any buffer.
-    const std::size_t rounded = (bytes + 63) / 64 * 64;
-    b.data.reset(static_cast<std::byte*>(::operator new[](rounded, std::align_val_t{64})));
-    std::fill_n(b.data.get(), rounded, std::byte{0});
+    b.data = allocate(bytes);
     b.bytes = bytes;
     b.label = label;
     buffers_.push_back(std::move(b));
+    sizes_.push_back(bytes);
     return BufferHandle{static_cast<std::uint32_t>(buffers_.size() - 1)};
+  }
+
+  Status destroy_buffer(BufferHandle buffer) override {
+    auto b = live_buffer(buffer, "destroy_buffer");
+    if (!b) return b.status();
+    (*b)->data.reset();
+    (*b)->bytes = 0;
+    sizes_[buffer.id] = 0;
+    ++generation_;  // programs binding it fail at their next resolve
+    return {};
+  }
+
+  Status resize_buffer(BufferHandle buffer, std::size_t bytes) override {
+    auto b = live_buffer(buffer, "resize_buffer");
+    if (!b) return b.status();
+    if (bytes == 0) return Error(ErrorCode::internal, "resize_buffer '" + (*b)->label + "': size must be > 0");
+    auto data = allocate(bytes);
+    std::memcpy(data.get(), (*b)->data.get(), std::min(bytes, (*b)->bytes));
+    (*b)->data = std::move(data);
+    (*b)->bytes = bytes;
+    sizes_[buffer.id] = bytes;
+    ++generation_;
+    return {};
   }
 
   Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
@@ -109,29 +151,56 @@ class CpuDevice final : public Device {
   }
 
   Result<ProgramHandle> create_program(const FrameProgram& program) override {
-    if (Status s = check_program(program, static_cast<std::uint32_t>(buffers_.size())); !s) return s.error();
-    std::vector<CpuDispatch> steps;
-    for (const auto& command : program.commands()) {
-      const auto* d = std::get_if<Dispatch>(&command);
-      if (!d || d->count == 0) continue;  // barriers are implicit, see the top of this file
-      CpuDispatch c{};
-      c.fn = cpu_kernel(d->kernel, simd_);
-      c.count = d->count;
-      for (std::uint32_t b = 0; b < d->binding_count; ++b) c.bindings[b] = buffers_[d->bindings[b].id].data.get();
-      std::memcpy(c.params, d->params, d->params_bytes);
-      steps.push_back(c);
-    }
-    programs_.push_back(std::move(steps));
+    CpuProgram p;
+    p.live = true;
+    p.source = program;
+    if (Status s = resolve(p); !s) return s.error();
+    programs_.push_back(std::move(p));
     return ProgramHandle{static_cast<std::uint32_t>(programs_.size() - 1)};
   }
 
-  Status run_program(ProgramHandle program) override {
-    if (program.id >= programs_.size()) return Error("run_program: not a program of this device");
-    const auto& steps = programs_[program.id];
-    arena_.execute([&] {
-      for (const CpuDispatch& d : steps) run(d);
-    });
+  Status destroy_program(ProgramHandle program) override {
+    if (program.id >= programs_.size() || !programs_[program.id].live)
+      return Error(ErrorCode::internal, "destroy_program: not a live program of this device");
+    programs_[program.id] = CpuProgram{};
     return {};
+  }
+
+  // The CPU runs the program here; wait() only checks its counters.
+  Status submit(ProgramHandle program) override {
+    if (program.id >= programs_.size() || !programs_[program.id].live)
+      return Error(ErrorCode::internal, "submit: not a live program of this device");
+    CpuProgram& p = programs_[program.id];
+    if (p.resolved_at != generation_)
+      if (Status s = resolve(p); !s) return s;
+    arena_.execute([&] {
+      for (const CpuStep& step : p.steps) run(step);
+    });
+    counters_.resize(p.counter_words.size());
+    for (std::size_t c = 0; c < counters_.size(); ++c) counters_[c] = *p.counter_words[c];
+    submitted_ = program.id;
+    return {};
+  }
+
+  Status wait() override {
+    if (submitted_ == UINT32_MAX) return {};
+    const CpuProgram& p = programs_[submitted_];
+    submitted_ = UINT32_MAX;
+    return check_counters(p.source.counters(), counters_);
+  }
+
+  std::span<const std::uint32_t> counters() const override { return counters_; }
+
+  DeviceObjects objects() const override {
+    DeviceObjects o;
+    for (const HostBuffer& b : buffers_)
+      if (b.bytes) {
+        ++o.buffers;
+        o.buffer_bytes += b.bytes;
+      }
+    o.native = o.buffers;
+    for (const CpuProgram& p : programs_) o.programs += p.live ? 1 : 0;
+    return o;
   }
 
  private:
@@ -139,37 +208,99 @@ class CpuDevice final : public Device {
   // other threads exceeds the work.
   static constexpr std::uint32_t kSerialBelow = 1024;
 
-  void run(const CpuDispatch& d) {
-    if (d.count < kSerialBelow || threads_ == 1) {
-      d.fn(d.params, d.bindings, 0, d.count);
+  // Resolves a program's commands to pointers (at creation, and again
+  // after a buffer was resized or destroyed).
+  Status resolve(CpuProgram& p) {
+    if (Status s = check_program(p.source, sizes_); !s) return s;
+    std::vector<CpuStep> steps;
+    auto words = [&](BufferHandle b, std::uint32_t word) {
+      return reinterpret_cast<std::uint32_t*>(buffers_[b.id].data.get()) + word;
+    };
+    for (const auto& command : p.source.commands()) {
+      CpuStep c;
+      if (const auto* f = std::get_if<Fill>(&command)) {
+        c.kind = CpuStep::Kind::fill;
+        c.target = words(f->buffer, f->word);
+        c.words = f->words;
+        c.value = f->value;
+      } else if (const auto* k = std::get_if<Copy>(&command)) {
+        c.kind = CpuStep::Kind::copy;
+        c.source = words(k->source, k->source_word);
+        c.target = words(k->target, k->target_word);
+        c.words = k->words;
+      } else if (const auto* d = std::get_if<Dispatch>(&command)) {
+        if (d->count == 0) continue;  // barriers are implicit, see the top of this file
+        c.fn = cpu_kernel(d->kernel, simd_);
+        c.count = d->count;
+        c.group_size = kernel_signature(d->kernel).group_size;
+        if (d->indirect.buffer.valid()) c.indirect = words(d->indirect.buffer, d->indirect.word);
+        for (std::uint32_t b = 0; b < d->binding_count; ++b) c.bindings[b] = buffers_[d->bindings[b].id].data.get();
+        std::memcpy(c.params, d->params, d->params_bytes);
+      } else {
+        continue;
+      }
+      steps.push_back(c);
+    }
+    p.steps = std::move(steps);
+    p.counter_words.clear();
+    for (const Counter& c : p.source.counters()) p.counter_words.push_back(words(c.buffer, c.word));
+    p.resolved_at = generation_;
+    return {};
+  }
+
+  void run(const CpuStep& s) {
+    switch (s.kind) {
+      case CpuStep::Kind::fill: std::fill_n(s.target, s.words, s.value); return;
+      case CpuStep::Kind::copy: std::copy_n(s.source, s.words, s.target); return;
+      case CpuStep::Kind::dispatch: break;
+    }
+    std::uint32_t items = s.indirect ? std::min(*s.indirect, s.count) : s.count;
+    if (s.group_size > 0) items = static_cast<std::uint32_t>((std::uint64_t{items} + s.group_size - 1) / s.group_size);
+    const std::uint32_t work = s.group_size > 0 ? items * s.group_size : items;
+    if (items == 0) return;
+    if (work < kSerialBelow || threads_ == 1) {
+      s.fn(s.params, s.bindings, 0, items);
       return;
     }
     // Static partition: one contiguous chunk per thread, no stealing. The
-    // result does not depend on the split (a dispatch's items are independent).
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, d.count, 256),
-                      [&](const tbb::blocked_range<std::uint32_t>& r) { d.fn(d.params, d.bindings, r.begin(), r.end()); },
+    // result does not depend on the split (a dispatch's items, or groups,
+    // are independent).
+    const std::uint32_t grain = s.group_size > 0 ? 1 : 256;
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, items, grain),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) { s.fn(s.params, s.bindings, r.begin(), r.end()); },
                       tbb::static_partitioner());
   }
 
+  Result<HostBuffer*> live_buffer(BufferHandle buffer, const char* what) {
+    if (buffer.id >= buffers_.size() || buffers_[buffer.id].bytes == 0)
+      return Error(ErrorCode::internal, std::string(what) + ": not a live buffer of this device");
+    return &buffers_[buffer.id];
+  }
+
   Result<std::byte*> range(BufferHandle buffer, std::size_t offset, std::size_t bytes, const char* what) {
-    if (buffer.id >= buffers_.size()) return Error(std::string(what) + ": not a buffer of this device");
-    HostBuffer& b = buffers_[buffer.id];
-    if (Status s = check_buffer_range(b.label, b.bytes, offset, bytes, what); !s) return s.error();
-    return b.data.get() + offset;
+    auto b = live_buffer(buffer, what);
+    if (!b) return b.error();
+    if (Status s = check_buffer_range((*b)->label, (*b)->bytes, offset, bytes, what); !s) return s.error();
+    return (*b)->data.get() + offset;
   }
 
   int threads_;
   bool simd_;
   tbb::task_arena arena_;
   std::vector<HostBuffer> buffers_;
-  std::vector<std::vector<CpuDispatch>> programs_;
+  std::vector<std::size_t> sizes_;  // bytes per buffer id, 0 when destroyed (check_program)
+  std::uint64_t generation_ = 0;     // bumped by every resize and destroy
+  std::vector<CpuProgram> programs_;
+  std::vector<std::uint32_t> counters_;
+  std::uint32_t submitted_ = UINT32_MAX;
 };
 
 }  // namespace
 
 Result<std::unique_ptr<Device>> make_cpu_device(const DeviceOptions& options) {
-  if (options.threads < 0) return Error("DeviceOptions.threads must be >= 0 (0 = all hardware threads), got " +
-                                        std::to_string(options.threads));
+  if (options.threads < 0)
+    return Error(ErrorCode::bad_parameter, "DeviceOptions.threads must be >= 0 (0 = all hardware threads), got " +
+                                               std::to_string(options.threads));
   const int threads =
       options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const bool simd = options.cpu_simd && kernels::cpu_has_avx2();

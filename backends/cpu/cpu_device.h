@@ -4,7 +4,7 @@
 
 #include <memory>
 
-#include "sinew/device.h"
+#include "backends/backend.h"
 
 namespace sinew {
 

@@ -12,14 +12,45 @@
 
 namespace sinew {
 
-/// A human-readable description of what went wrong. Messages name the file
-/// and line, or the parameter, that caused the problem.
+/// What kind of failure an Error is, for callers that react to some kinds
+/// (retry on another backend, grow a capacity, report a bad file) and not others.
+enum class ErrorCode {
+  bad_parameter,        ///< a value given to sinew is out of its range, non-finite or inconsistent
+  bad_input_file,       ///< a file could not be read or is malformed
+  backend_unavailable,  ///< the backend is not built, or has no device or driver here
+  device_lost,          ///< the device stopped working (driver reset, hang, crash)
+  out_of_memory,        ///< host or device memory ran out
+  capacity_exceeded,    ///< data-dependent work outgrew a declared capacity (results were kept within it)
+  internal,             ///< a bug in sinew, or a device failure with no better description
+};
+
+/// The code's name, e.g. "capacity_exceeded".
+constexpr const char* error_code_name(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::bad_parameter: return "bad_parameter";
+    case ErrorCode::bad_input_file: return "bad_input_file";
+    case ErrorCode::backend_unavailable: return "backend_unavailable";
+    case ErrorCode::device_lost: return "device_lost";
+    case ErrorCode::out_of_memory: return "out_of_memory";
+    case ErrorCode::capacity_exceeded: return "capacity_exceeded";
+    case ErrorCode::internal: return "internal";
+  }
+  return "unknown";
+}
+
+/// A human-readable description of what went wrong, with its kind. Messages
+/// name the file and line, or the parameter, that caused the problem.
 class Error {
  public:
-  explicit Error(std::string message) : message_(std::move(message)) {}
+  Error(ErrorCode code, std::string message) : code_(code), message_(std::move(message)) {}
+  /// TRANSITION (issue 10): a message without a code is a bad parameter
+  /// until every call site names its code.
+  explicit Error(std::string message) : Error(ErrorCode::bad_parameter, std::move(message)) {}
+  [[nodiscard]] ErrorCode code() const { return code_; }
   [[nodiscard]] const std::string& message() const { return message_; }
 
  private:
+  ErrorCode code_;
   std::string message_;
 };
 
@@ -34,7 +65,7 @@ class [[nodiscard]] Status {
   [[nodiscard]] const Error& error() const { assert(!ok_); return error_; }
 
  private:
-  Error error_{""};
+  Error error_{ErrorCode::internal, ""};
   bool ok_ = true;
 };
 

@@ -19,6 +19,9 @@
 
 namespace sinew {
 
+class Device;        // internal (backends/backend.h)
+class FrameProgram;  // internal (backends/backend.h)
+
 /// What a compiled scene holds; fixed for the life of a Simulation.
 struct SceneInfo {
   std::uint32_t particles = 0;

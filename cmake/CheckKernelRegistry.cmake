@@ -1,0 +1,51 @@
+# Checks, at configure time, that every kernel of the registry
+# (kernels/kernel_list.h) has its CPU reference (a definition `void NAME(` in
+# some kernels/cpu/*.cpp) and its GPU source: kernels/gpu/NAME.gpu, or, for
+# kernels not yet moved to the single source, both kernels/opencl/NAME.cl and
+# kernels/glsl/NAME.comp. Also that no GPU source is left without a registry
+# entry. A missing one stops the configuration with the kernel's name.
+function(sinew_check_kernel_registry)
+  set(root ${PROJECT_SOURCE_DIR}/kernels)
+  file(READ ${root}/kernel_list.h list_text)
+  string(REGEX MATCHALL "SINEW_KERNEL\\(([a-z0-9_]+)," entries "${list_text}")
+  set(names "")
+  foreach(entry IN LISTS entries)
+    string(REGEX REPLACE "SINEW_KERNEL\\(([a-z0-9_]+)," "\\1" name "${entry}")
+    list(APPEND names ${name})
+  endforeach()
+  list(LENGTH names count)
+  if(count EQUAL 0)
+    message(FATAL_ERROR "CheckKernelRegistry: no SINEW_KERNEL entries found in ${root}/kernel_list.h")
+  endif()
+
+  file(GLOB cpu_sources ${root}/cpu/*.cpp)
+  set(cpu_text "")
+  foreach(src IN LISTS cpu_sources)
+    file(READ ${src} text)
+    string(APPEND cpu_text "${text}")
+  endforeach()
+
+  set(problems "")
+  foreach(name IN LISTS names)
+    string(REGEX MATCH "void ${name}\\(" defined "${cpu_text}")
+    if(NOT defined)
+      list(APPEND problems "${name}: no CPU reference (void ${name}( in kernels/cpu/*.cpp)")
+    endif()
+    if(NOT EXISTS ${root}/gpu/${name}.gpu AND
+       NOT (EXISTS ${root}/opencl/${name}.cl AND EXISTS ${root}/glsl/${name}.comp))
+      list(APPEND problems "${name}: no GPU source (kernels/gpu/${name}.gpu)")
+    endif()
+  endforeach()
+  file(GLOB gpu_sources ${root}/gpu/*.gpu ${root}/opencl/*.cl ${root}/glsl/*.comp)
+  foreach(src IN LISTS gpu_sources)
+    get_filename_component(name ${src} NAME_WE)
+    if(NOT name IN_LIST names)
+      list(APPEND problems "${src}: not in the kernel registry (kernels/kernel_list.h)")
+    endif()
+  endforeach()
+  if(problems)
+    string(REPLACE ";" "\n  " problems "${problems}")
+    message(FATAL_ERROR "Kernel registry check failed:\n  ${problems}")
+  endif()
+  message(STATUS "sinew: kernel registry: ${count} kernels, each with its CPU reference and GPU source")
+endfunction()

@@ -1,0 +1,57 @@
+/* kernel_list.h — the kernel registry: every kernel sinew runs, once.
+ *
+ * From this one list follow the Kernel enum (backends/backend.h), the
+ * signature table create_program checks dispatches against
+ * (backends/kernel_table.cpp), the CPU backend's dispatch table
+ * (backends/cpu/cpu_device.cpp: the CPU reference function kernels::NAME)
+ * and the GPU kernels looked up by name (the OpenCL kernel NAME and the
+ * SPIR-V module NAME, both built from kernels/gpu/NAME.gpu). CMake checks
+ * that every entry has its kernels/gpu/NAME.gpu and that some
+ * kernels/cpu/ *.cpp defines NAME (cmake/CheckKernelRegistry.cmake).
+ *
+ * SINEW_KERNEL(NAME, BINDINGS, PARAMS, GROUP)
+ *   NAME      the kernel's name in every language;
+ *   BINDINGS  how many storage buffers it binds, in the order its comment
+ *             in kernels/shared lists them;
+ *   PARAMS    its parameter struct (kernels/shared), passed by value
+ *             (OpenCL argument, Vulkan push constants, CPU pointer);
+ *   GROUP     0: independent work items (launched in groups of 64 that
+ *             never cooperate; the CPU runs any split of the items);
+ *             N > 0: a cooperative kernel of fixed work groups of N items
+ *             that share group memory and meet at group barriers. The CPU
+ *             reference is then called once per group, with the group's
+ *             index range [g, g + 1), and does the group's work in order.
+ *
+ * Adding a kernel: one line here, its PARAMS struct in kernels/shared, its
+ * CPU reference in kernels/cpu and its GPU source kernels/gpu/NAME.gpu. */
+#ifndef SINEW_KERNEL_LIST_H
+#define SINEW_KERNEL_LIST_H
+
+#define SINEW_KERNELS(SINEW_KERNEL)                                              \
+  /* xPBD solver (kernels/shared/xpbd_params.h) */                               \
+  SINEW_KERNEL(xpbd_predict, 3, PredictParams, 0)                                \
+  SINEW_KERNEL(xpbd_update_velocity, 3, UpdateVelocityParams, 0)                 \
+  SINEW_KERNEL(xpbd_solve_distance, 5, SolveParams, 0)                           \
+  SINEW_KERNEL(xpbd_solve_volume, 5, SolveParams, 0)                             \
+  /* FEM tets (kernels/shared/fem_params.h) */                                   \
+  SINEW_KERNEL(xpbd_solve_neo_hookean, 5, SolveParams, 0)                        \
+  SINEW_KERNEL(xpbd_solve_stvk, 5, SolveParams, 0)                               \
+  SINEW_KERNEL(xpbd_solve_corotational, 5, SolveParams, 0)                       \
+  /* thin tissue and threads (kernels/shared/thin_params.h) */                   \
+  SINEW_KERNEL(xpbd_solve_area, 5, SolveParams, 0)                               \
+  SINEW_KERNEL(xpbd_solve_dihedral, 5, SolveParams, 0)                           \
+  SINEW_KERNEL(xpbd_solve_line_bending, 5, SolveParams, 0)                       \
+  /* contacts (kernels/shared/contact_params.h): + targets; + previous position, \
+   * colliders, contact impulses */                                              \
+  SINEW_KERNEL(xpbd_solve_attachment, 6, SolveParams, 0)                         \
+  SINEW_KERNEL(xpbd_solve_contacts, 8, SolveParams, 0)                           \
+  /* device-side work of data-dependent size (kernels/shared/primitive_params.h) */ \
+  SINEW_KERNEL(indirect_args, 2, IndirectArgsParams, 0)                          \
+  SINEW_KERNEL(scan_blocks, 4, ScanParams, 256)                                  \
+  SINEW_KERNEL(scan_add, 3, ScanParams, 256)                                     \
+  SINEW_KERNEL(compact_scatter, 5, CompactParams, 0)                             \
+  SINEW_KERNEL(radix_histogram, 3, RadixParams, 256)                             \
+  SINEW_KERNEL(radix_scatter, 6, RadixParams, 256)                               \
+  SINEW_KERNEL(reduce_blocks, 3, ReduceParams, 256)
+
+#endif /* SINEW_KERNEL_LIST_H */
