@@ -17,6 +17,7 @@
 #endif
 #include "backends/kernel_table.h"
 #include "primitive_params.h"
+#include "stats_params.h"
 #include "xpbd_params.h"
 
 namespace sinew {

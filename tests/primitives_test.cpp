@@ -16,6 +16,7 @@
 #include <random>
 
 #include "program/primitives.h"
+#include "stats_params.h"
 #include "test_support.h"
 
 namespace sinew {
@@ -294,6 +295,52 @@ TEST_P(Primitives, FloatMinAndMaxFollowTheirNanRule) {
     v[where] = std::bit_cast<std::uint32_t>(nan);
     for (ReduceOp op : {ReduceOp::min_f32, ReduceOp::max_f32})
       EXPECT_EQ(reduce_on(rig, op, v, 299, 1), reduce_on(cpu, op, v, 299, 1)) << "NaN at " << where;
+  }
+}
+
+
+// Double-float sums (the per-frame statistics): the same bits as the CPU
+// reference on every backend, and within 1e-13 of the exact sum where a
+// float sum is off by 1e-7 (values of mixed sign and magnitude).
+TEST_P(Primitives, DoubleFloatSumsAgreeBitwiseAndKeepDoublePrecision) {
+  Rig rig(GetParam());
+  Rig cpu("cpu");
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> mantissa(-1.0f, 1.0f);
+  std::uniform_int_distribution<int> exponent(-10, 10);
+  auto run = [](Rig& r, DdItems items, const std::vector<std::uint32_t>& values, std::uint32_t n, std::uint32_t stride) {
+    const std::uint32_t capacity = std::max(n, 1u);
+    const BufferHandle counts = r.words({n});
+    const BufferHandle v = r.words(values);
+    const BufferHandle scratch = r.words({}, reduce_dd_scratch_words(capacity));
+    FrameProgram program;
+    const std::uint32_t at = append_reduce_dd(program, {counts, 0, capacity}, items, {v, 0}, stride, {scratch, 0});
+    EXPECT_TRUE(r.run(program).ok());
+    return r.read(scratch, 2, at);
+  };
+  for (std::uint32_t n : kSizes) {
+    std::vector<std::uint32_t> floats(std::max(n, 1u)), pairs(2 * std::size_t{std::max(n, 1u)});
+    long double exact = 0, exact_squares = 0, exact_pairs = 0;
+    for (std::uint32_t i = 0; i < floats.size(); ++i) {
+      const float f = std::ldexp(mantissa(rng), exponent(rng));
+      const float lo = std::ldexp(f, -30);  // a pair (f, lo): hi + lo with lo far below hi's last bit
+      floats[i] = std::bit_cast<std::uint32_t>(f);
+      pairs[2 * i] = floats[i];
+      pairs[2 * i + 1] = std::bit_cast<std::uint32_t>(lo);
+      if (i < n) {
+        exact += f;
+        exact_squares += (long double)f * f;
+        exact_pairs += (long double)f + lo;
+      }
+    }
+    for (auto [items, values, stride, want] :
+         {std::tuple{DdItems::floats, &floats, 1u, exact}, std::tuple{DdItems::squares, &floats, 1u, exact_squares},
+          std::tuple{DdItems::pairs, &pairs, 2u, exact_pairs}}) {
+      const auto got = run(rig, items, *values, n, stride);
+      EXPECT_EQ(got, run(cpu, items, *values, n, stride)) << "n = " << n << ", items " << static_cast<int>(items);
+      const double sum = double(as_float(got[0])) + double(as_float(got[1]));
+      EXPECT_NEAR(sum, double(want), 1e-13 * (1.0 + std::abs(double(want)))) << "n = " << n;
+    }
   }
 }
 

@@ -21,11 +21,8 @@
 #include <thread>
 
 #include "backends/kernel_table.h"
-#include "cpu/contact_kernels.h"
-#include "cpu/fem_kernels.h"
-#include "cpu/primitive_kernels.h"
-#include "cpu/thin_kernels.h"
-#include "cpu/xpbd_kernels.h"
+#include "cpu/cpu_kernels.h"
+#include "cpu/xpbd_kernels.h"  // the AVX2 solves
 
 namespace sinew {
 namespace {

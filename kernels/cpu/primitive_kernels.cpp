@@ -11,7 +11,7 @@
 // Radix sort: stable least-significant-digit passes of 4 bits, per-block
 // digit histograms scanned digit-major (Satish, Harris, Garland, "Designing
 // efficient sorting algorithms for manycore GPUs", IPDPS 2009).
-#include "cpu/primitive_kernels.h"
+#include "cpu/cpu_kernels.h"
 
 #include <algorithm>
 #include <cstring>

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "primitive_params.h"
+#include "stats_params.h"
 
 namespace sinew {
 namespace {
@@ -150,6 +151,32 @@ std::uint32_t append_reduce(FrameProgram& program, const DeviceCount& n, ReduceO
     p.in_stride = k == 0 ? stride : 1u;
     p.out_offset = partials.offset;
     program.dispatch(Kernel::reduce_blocks, std::max(blocks(levels[k]), 1u) * kBlock,
+                     {n.buffer, in.buffer, partials.buffer}, p);
+    program.barrier();
+    in = partials;
+  }
+  return in.offset;
+}
+
+std::uint32_t reduce_dd_scratch_words(std::uint32_t capacity) { return 2 * reduce_scratch_words(capacity); }
+
+std::uint32_t append_reduce_dd(FrameProgram& program, const DeviceCount& n, DdItems items, DeviceWords values,
+                               std::uint32_t stride, DeviceWords scratch) {
+  const std::vector<std::uint32_t> levels = level_capacities(n.capacity);
+  kernels::ReduceDdParams p{};
+  p.count_word = n.word;
+  p.capacity = n.capacity;
+  DeviceWords in = values;
+  std::uint32_t next = scratch.offset;
+  for (std::size_t k = 0; k < levels.size(); ++k) {
+    const DeviceWords partials{scratch.buffer, next};
+    next += 2 * std::max(blocks(levels[k]), 1u);
+    p.level_shift = static_cast<std::uint32_t>(8 * k);
+    p.mode = k == 0 ? static_cast<std::uint32_t>(items) : SINEW_DD_PAIRS;
+    p.in_offset = in.offset;
+    p.in_stride = k == 0 ? stride : 2u;
+    p.out_offset = partials.offset;
+    program.dispatch(Kernel::reduce_dd_blocks, std::max(blocks(levels[k]), 1u) * kBlock,
                      {n.buffer, in.buffer, partials.buffer}, p);
     program.barrier();
     in = partials;

@@ -88,4 +88,17 @@ std::uint32_t reduce_scratch_words(std::uint32_t capacity);
 std::uint32_t append_reduce(FrameProgram& program, const DeviceCount& n, ReduceOp op, DeviceWords values,
                             std::uint32_t stride, DeviceWords scratch);
 
+/// How reduce_dd_blocks reads the first level's items (SINEW_DD_* in stats_params.h).
+enum class DdItems : std::uint32_t { pairs = 0, floats = 1, squares = 2 };
+
+/// Scratch words a double-float reduction of `capacity` items needs.
+std::uint32_t reduce_dd_scratch_words(std::uint32_t capacity);
+
+/// Appends a double-float sum (~48 bits, fixed order, the same bits on
+/// every backend) of the items values[offset + i * stride], i < n, read as
+/// `items`; returns the scratch word of the result's (hi, lo) pair: the sum
+/// is double(hi) + double(lo).
+std::uint32_t append_reduce_dd(FrameProgram& program, const DeviceCount& n, DdItems items, DeviceWords values,
+                               std::uint32_t stride, DeviceWords scratch);
+
 }  // namespace sinew

@@ -1,0 +1,64 @@
+// stats_program.h — the per-frame statistics reduced on the device: the
+// FrameStats errors (residuals, kinetic energy, volume change) and the sums
+// the rigid tools need from the tissue (contact impulses and their moments,
+// touching mass and inertia). The frame program ends with map kernels that
+// write double-float terms and fixed-order reductions of them
+// (kernels/shared/stats_params.h); the results are copied into one small
+// buffer that the host reads after the frame: a few words instead of the
+// position, velocity, residual and contact-impulse buffers it read before.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "compiler/scene_compiler.h"
+#include "program/xpbd_program.h"
+
+namespace sinew {
+
+/// What the device reduced in the last frame, combined in double on the host.
+struct DeviceStats {
+  double residual_sum_squares = 0.0;  ///< over every constraint (normalised residuals)
+  double residual_max = 0.0;
+  std::uint64_t constraints = 0;
+  double kinetic_energy = 0.0;  ///< [J]
+  double volume = 0.0;          ///< total signed tet volume [m^3]
+  struct Tool {
+    double sums[4][3] = {};  ///< frame impulse, its moment, last substep's impulse, its moment (contact_params.h)
+    double mass = 0.0;       ///< mass of the particles touching it at the frame's end [kg]
+    std::array<double, 9> inertia{};  ///< their inertia about the tool's centre [kg m^2], row-major
+  };
+  std::vector<Tool> tools;
+};
+
+/// The buffers and result layout of the statistics of one scene.
+struct StatsPlan {
+  bool errors = false;             ///< residuals, kinetic energy and volume are reduced
+  std::uint32_t tools = 0;
+  std::vector<std::uint32_t> block_sizes;
+  std::uint32_t particles = 0, tet_count = 0;
+  BufferHandle constants, tets, terms, scratch, results;
+  std::uint32_t result_words = 0;
+  // Word offsets in `results`:
+  std::vector<std::uint32_t> residual_squares, residual_max;  ///< per block: a (hi, lo) pair, a float
+  std::uint32_t kinetic_energy = 0, volume = 0;               ///< pairs
+  std::uint32_t tool_first = 0;                               ///< per tool 19 pairs: 12 sums, mass, 6 inertia
+  std::vector<float> read_back;                               ///< the host copy, sized once
+};
+
+/// Creates the statistics' buffers. [in] tets: every tet body's tets as
+/// particle indices; errors: SolverSettings::measure_errors; tools: rigid tools.
+Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
+                                  const std::vector<std::array<std::uint32_t, 4>>& tets, bool errors,
+                                  std::uint32_t tools);
+
+/// Appends the statistics to the end of a frame program (after its last
+/// update of velocities). Nothing when the plan has neither errors nor tools.
+void append_stats(FrameProgram& program, const StatsPlan& plan, const CompiledScene& scene,
+                  const XpbdBuffers& buffers);
+
+/// Reads the results of the last frame (one read of result_words words) into `out`.
+Status read_stats(Device& device, StatsPlan& plan, DeviceStats& out);
+
+}  // namespace sinew
