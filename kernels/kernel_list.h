@@ -52,6 +52,11 @@
   SINEW_KERNEL(compact_scatter, 5, CompactParams, 0)                             \
   SINEW_KERNEL(radix_histogram, 3, RadixParams, 256)                             \
   SINEW_KERNEL(radix_scatter, 6, RadixParams, 256)                               \
-  SINEW_KERNEL(reduce_blocks, 3, ReduceParams, 256)
+  SINEW_KERNEL(reduce_blocks, 3, ReduceParams, 256)                              \
+  /* per-frame statistics (kernels/shared/stats_params.h) */                     \
+  SINEW_KERNEL(stats_kinetic_energy, 3, StatsParams, 0)                          \
+  SINEW_KERNEL(stats_tet_volume, 3, StatsParams, 0)                              \
+  SINEW_KERNEL(stats_tool_terms, 2, StatsParams, 0)                              \
+  SINEW_KERNEL(reduce_dd_blocks, 3, ReduceDdParams, 256)
 
 #endif /* SINEW_KERNEL_LIST_H */
