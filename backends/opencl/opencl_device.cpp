@@ -1,213 +1,126 @@
-// opencl_device.cpp — the OpenCL backend.
+// opencl_device.cpp — the OpenCL backend's device: buffers, frame programs,
+// submit and wait. (Platforms, contexts and the kernel build with its
+// binary cache: opencl_platform.cpp.)
 //
-// One context and one in-order queue per device: dispatches run in the
-// order they are enqueued and each sees the writes of the ones before, so a
-// frame program is enqueued whole with no host wait between colours or
-// stages, and the host waits once (clFinish) at the end of the frame.
-// The embedded kernel program (all of kernels/opencl, headers inlined) is
-// built once per device; the binary is cached under $XDG_CACHE_HOME/sinew
-// (else ~/.cache/sinew) keyed by a hash of platform, device, driver version,
-// build options and source. An unreadable or unwritable cache only costs the
-// build time.
-#define CL_TARGET_OPENCL_VERSION 120
+// One context and one in-order queue per device: every command runs after
+// the ones enqueued before it and sees their writes, so a frame program is
+// enqueued whole, barriers cost nothing (the queue already orders
+// everything) and the host does not wait between colours or stages.
+//
+// submit() enqueues the program's commands, then a non-blocking read of each
+// declared counter word into host memory the program owns, flushes and
+// returns. wait() is one clFinish: the counters arrived with the frame (no
+// extra round trip) and are checked against their capacities. Calls that
+// touch buffers, and the next submit, first finish a submission in flight.
+//
+// Work groups: independent kernels run in groups of kIndependentGroupSize
+// (64), cooperative kernels in their registry group size G (their sources
+// say reqd_work_group_size(G)). A dispatch of `count` items launches
+// ceil(count / G) * G work items; kernels return for items past their count.
+//
+// Indirect dispatches: OpenCL 1.2 has no indirect dispatch (no launch whose
+// size is read from a buffer), and reading the counter on the host in the
+// middle of the frame would cost a round trip per dispatch and make submit
+// wait. So an indirect dispatch is launched for its capacity rounded up to
+// the group size, relying on the contract of FrameProgram::dispatch_indirect:
+// the kernel reads the count itself and returns for items past it. The
+// results are those of an exact launch; the cost is the groups between the
+// count and the capacity, which start and return at once.
+//
+// A program keeps its FrameProgram. Resizing or destroying a buffer bumps
+// a generation counter, and a program prepared at an older generation is
+// checked and resolved again (new cl_mem handles, new sizes) at its next
+// submit, as on the CPU backend.
 #include "backends/opencl/opencl_device.h"
 
-#include <CL/cl.h>
-
+#include <algorithm>
 #include <array>
-#include <charconv>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "backends/kernel_table.h"
+#include "backends/opencl/opencl_platform.h"
 
 namespace sinew {
-namespace opencl {
-extern const char* const kProgramSource;  // generated from kernels/opencl (EmbedKernelSources.cmake)
-}
-
 namespace {
 
-constexpr const char* kBuildOptions = "-cl-std=CL1.2";
-constexpr std::size_t kLocalSize = 64;
-
-std::string cl_status(cl_int code) { return "OpenCL error " + std::to_string(code); }
-
-// A string property through one of OpenCL's two-call getters
-// (clGetDeviceInfo, clGetPlatformInfo): ask the size, then the bytes.
-template <class Getter, class Object, class Param>
-std::string info_string(Getter get, Object object, Param what) {
-  std::size_t n = 0;
-  if (get(object, what, 0, nullptr, &n) != CL_SUCCESS || n == 0) return "";
-  std::string s(n, '\0');
-  get(object, what, n, s.data(), nullptr);
-  while (!s.empty() && s.back() == '\0') s.pop_back();
-  return s;
-}
-std::string device_string(cl_device_id d, cl_device_info what) { return info_string(clGetDeviceInfo, d, what); }
-std::string platform_string(cl_platform_id p, cl_platform_info what) { return info_string(clGetPlatformInfo, p, what); }
-
-struct Found {
-  cl_platform_id platform;
-  cl_device_id device;
-  OpenclDeviceInfo info;
-};
-
-Result<std::vector<Found>> find_devices() {
-  cl_uint platform_count = 0;
-  const cl_int err = clGetPlatformIDs(0, nullptr, &platform_count);
-  if (err != CL_SUCCESS || platform_count == 0)
-    return Error("no OpenCL platform found (install an OpenCL driver, e.g. pocl-opencl-icd for the CPU; " +
-                 (err == CL_SUCCESS ? std::string("0 platforms") : cl_status(err)) + ")");
-  std::vector<cl_platform_id> platforms(platform_count);
-  clGetPlatformIDs(platform_count, platforms.data(), nullptr);
-  std::vector<Found> found;
-  for (cl_platform_id p : platforms) {
-    cl_uint n = 0;
-    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, 0, nullptr, &n) != CL_SUCCESS || n == 0) continue;
-    std::vector<cl_device_id> devices(n);
-    clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, n, devices.data(), nullptr);
-    for (cl_device_id d : devices) {
-      cl_device_type type = 0;
-      clGetDeviceInfo(d, CL_DEVICE_TYPE, sizeof type, &type, nullptr);
-      found.push_back({p, d,
-                       {platform_string(p, CL_PLATFORM_NAME), device_string(d, CL_DEVICE_NAME),
-                        device_string(d, CL_DRIVER_VERSION), (type & CL_DEVICE_TYPE_GPU) != 0}});
-    }
-  }
-  if (found.empty()) return Error("OpenCL platforms found, but no OpenCL device");
-  return found;
-}
-
-// The device named by `selector` (an index, or a substring of the name);
-// empty: the first GPU, else the first device.
-Result<std::size_t> choose(const std::vector<Found>& found, std::string selector) {
-  if (selector.empty())
-    if (const char* env = std::getenv("SINEW_OPENCL_DEVICE")) selector = env;
-  if (selector.empty()) {
-    for (std::size_t i = 0; i < found.size(); ++i)
-      if (found[i].info.gpu) return i;
-    return std::size_t{0};
-  }
-  std::vector<std::string> names;
-  for (const Found& f : found) names.push_back(f.info.name);
-  return match_device_selector(names, names, selector, "OpenCL");
-}
-
-std::uint64_t fnv1a(std::uint64_t h, const std::string& s) {
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-  return h;
-}
-
-std::filesystem::path cache_file(const Found& f, const std::string& source) {
-  std::uint64_t h = 14695981039346656037ull;
-  for (const std::string& part : {f.info.platform, f.info.name, f.info.driver_version, std::string(kBuildOptions), source})
-    h = fnv1a(h, part + '\n');
-  std::filesystem::path dir;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) dir = xdg;
-  else if (const char* home = std::getenv("HOME"); home && *home) dir = std::filesystem::path(home) / ".cache";
-  else return {};
-  char name[32];
-  std::snprintf(name, sizeof name, "%016llx.bin", static_cast<unsigned long long>(h));
-  return dir / "sinew" / "opencl" / name;
-}
-
-std::string build_log(cl_program program, cl_device_id device) {
-  std::size_t n = 0;
-  clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
-  std::string log(n, '\0');
-  if (n) clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, n, log.data(), nullptr);
-  while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
-  return log;
-}
-
-Result<cl_program> build_from_source(cl_context ctx, const Found& f, const std::string& source) {
-  const char* text = source.c_str();
-  cl_int err = CL_SUCCESS;
-  cl_program program = clCreateProgramWithSource(ctx, 1, &text, nullptr, &err);
-  if (err != CL_SUCCESS) return Error("clCreateProgramWithSource: " + cl_status(err));
-  err = clBuildProgram(program, 1, &f.device, kBuildOptions, nullptr, nullptr);
-  if (err != CL_SUCCESS) {
-    const std::string log = build_log(program, f.device);
-    clReleaseProgram(program);
-    return Error("OpenCL kernel build failed on " + f.info.name + " (" + cl_status(err) + "):\n" + log);
-  }
-  return program;
-}
-
-// Loads the cached binary, or builds from source and caches the binary.
-Result<cl_program> build_cached(cl_context ctx, const Found& f, const std::string& source) {
-  const std::filesystem::path file = cache_file(f, source);
-  if (!file.empty()) {
-    std::ifstream in(file, std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!bytes.empty()) {
-      const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-      const std::size_t size = bytes.size();
-      cl_int status = CL_SUCCESS, err = CL_SUCCESS;
-      cl_program program = clCreateProgramWithBinary(ctx, 1, &f.device, &size, &data, &status, &err);
-      if (err == CL_SUCCESS && status == CL_SUCCESS &&
-          clBuildProgram(program, 1, &f.device, kBuildOptions, nullptr, nullptr) == CL_SUCCESS)
-        return program;
-      if (program) clReleaseProgram(program);  // stale or foreign binary: rebuild below
-    }
-  }
-  auto program = build_from_source(ctx, f, source);
-  if (!program || file.empty()) return program;
-  std::size_t size = 0;
-  if (clGetProgramInfo(*program, CL_PROGRAM_BINARY_SIZES, sizeof size, &size, nullptr) == CL_SUCCESS && size > 0) {
-    std::vector<unsigned char> binary(size);
-    unsigned char* ptr = binary.data();
-    if (clGetProgramInfo(*program, CL_PROGRAM_BINARIES, sizeof ptr, &ptr, nullptr) == CL_SUCCESS) {
-      std::error_code ec;
-      std::filesystem::create_directories(file.parent_path(), ec);
-      const auto tmp = file.string() + ".tmp" + std::to_string(reinterpret_cast<std::uintptr_t>(&binary));
-      if (std::ofstream out(tmp, std::ios::binary); out.write(reinterpret_cast<const char*>(ptr), std::streamsize(size)))
-        std::filesystem::rename(tmp, file, ec);  // atomic: concurrent builds never see half a file
-      std::filesystem::remove(tmp, ec);
-    }
-  }
-  return program;
-}
+using opencl::cl_error;
 
 struct ClBuffer {
-  cl_mem mem = nullptr;
+  cl_mem mem = nullptr;  // nullptr: destroyed (ids are never reused)
   std::size_t bytes = 0;
   std::string label;
 };
 
-struct ClDispatch {
-  cl_kernel kernel;
-  std::size_t global;
-  std::uint32_t binding_count;
-  cl_mem bindings[Dispatch::max_bindings];
-  std::uint32_t params_bytes;
-  alignas(16) std::byte params[Dispatch::max_params_bytes];
+// Device memory is allocated in whole 64-byte blocks, so kernels may read a
+// float4 at the end of any buffer.
+std::size_t allocation_bytes(std::size_t bytes) { return (bytes + 63) / 64 * 64; }
+
+// A command resolved to OpenCL objects, ready to enqueue.
+struct ClStep {
+  enum class Kind { dispatch, fill, copy } kind = Kind::dispatch;
+  std::uint32_t command = 0;  // its position in the program (1-based), for errors
+  Kernel kernel_id = Kernel::count_;
+  cl_kernel kernel = nullptr;
+  std::size_t global = 0, local = 0;
+  std::uint32_t binding_count = 0;
+  cl_mem bindings[Dispatch::max_bindings] = {};
+  std::uint32_t params_bytes = 0;
+  alignas(16) std::byte params[Dispatch::max_params_bytes] = {};
+  cl_mem source = nullptr, target = nullptr;  // copy: both; fill: target
+  std::size_t source_offset = 0, target_offset = 0, bytes = 0;
+  cl_uint value = 0;  // fill pattern
 };
+
+struct CounterRead {
+  cl_mem mem = nullptr;
+  std::size_t offset = 0;
+};
+
+// Held through a unique_ptr: the non-blocking counter reads of a submission
+// write into counter_values, which must not move while it is in flight.
+struct ClProgram {
+  FrameProgram source;            // kept to resolve again after a buffer is resized or destroyed
+  std::uint64_t resolved_at = 0;  // the device's generation the steps are from
+  std::vector<ClStep> steps;
+  std::vector<CounterRead> counter_reads;
+  std::vector<std::uint32_t> counter_values;  // written by the reads of a submission
+};
+
+std::string step_name(const ClStep& s) {
+  const std::string where = "command " + std::to_string(s.command);
+  switch (s.kind) {
+    case ClStep::Kind::fill: return where + " (fill)";
+    case ClStep::Kind::copy: return where + " (copy)";
+    case ClStep::Kind::dispatch: break;
+  }
+  return where + " (" + std::string(kernel_name(s.kernel_id)) + ")";
+}
 
 class OpenclDevice final : public Device {
  public:
-  OpenclDevice(Found found, cl_context ctx, cl_command_queue queue, cl_program program)
-      : found_(std::move(found)), ctx_(ctx), queue_(queue), program_(program) {
-    for (std::size_t k = 0; k < kernels_.size(); ++k) {
+  OpenclDevice(opencl::Opened opened, cl_program program)
+      : found_(std::move(opened.found)), ctx_(opened.ctx), queue_(opened.queue), program_(program) {
+    for (std::size_t k = 0; k < kernel_count; ++k) {
       cl_int err = CL_SUCCESS;
       const std::string name(kernel_name(static_cast<Kernel>(k)));
       cl_kernel kernel = clCreateKernel(program_, name.c_str(), &err);
       kernels_[k] = err == CL_SUCCESS ? kernel : nullptr;  // a missing one is an error of create_program
+      if (kernels_[k])
+        clGetKernelWorkGroupInfo(kernel, found_.device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(std::size_t),
+                                 &max_group_[k], nullptr);
     }
   }
   ~OpenclDevice() override {
     clFinish(queue_);
     for (cl_kernel k : kernels_)
       if (k) clReleaseKernel(k);
-    for (ClBuffer& b : buffers_) clReleaseMemObject(b.mem);
+    for (ClBuffer& b : buffers_)
+      if (b.mem) clReleaseMemObject(b.mem);
     clReleaseProgram(program_);
-    clReleaseCommandQueue(queue_);
-    clReleaseContext(ctx_);
+    opencl::close({found_, ctx_, queue_});
   }
   OpenclDevice(const OpenclDevice&) = delete;
   OpenclDevice& operator=(const OpenclDevice&) = delete;
@@ -217,162 +130,299 @@ class OpenclDevice final : public Device {
     return "OpenCL: " + found_.info.name + " (" + found_.info.platform + ", driver " + found_.info.driver_version + ")";
   }
 
+  // ---------------------------------------------------------------- buffers
+
   Result<BufferHandle> create_buffer(std::size_t bytes, std::string_view label) override {
-    if (bytes == 0) return Error("create_buffer '" + std::string(label) + "': size must be > 0");
-    const std::size_t rounded = (bytes + 63) / 64 * 64;
-    cl_int err = CL_SUCCESS;
-    cl_mem mem = clCreateBuffer(ctx_, CL_MEM_READ_WRITE, rounded, nullptr, &err);
-    if (err != CL_SUCCESS)
-      return Error("create_buffer '" + std::string(label) + "' (" + std::to_string(bytes) + " bytes): " + cl_status(err));
-    const cl_uchar zero = 0;
-    err = clEnqueueFillBuffer(queue_, mem, &zero, 1, 0, rounded, 0, nullptr, nullptr);
-    if (err != CL_SUCCESS) {
-      clReleaseMemObject(mem);
-      return Error("create_buffer '" + std::string(label) + "': zero fill: " + cl_status(err));
-    }
-    buffers_.push_back({mem, bytes, std::string(label)});
+    const std::string name(label);
+    if (bytes == 0) return Error(ErrorCode::internal, "create_buffer '" + name + "': size must be > 0");
+    auto mem = allocate(bytes, "create_buffer '" + name + "'");
+    if (!mem) return mem.error();
+    buffers_.push_back({*mem, bytes, name});
+    sizes_.push_back(bytes);
     return BufferHandle{static_cast<std::uint32_t>(buffers_.size() - 1)};
   }
 
+  Status destroy_buffer(BufferHandle buffer) override {
+    if (Status s = drain(); !s) return s;
+    auto b = live_buffer(buffer, "destroy_buffer");
+    if (!b) return b.status();
+    clReleaseMemObject((*b)->mem);
+    **b = ClBuffer{};
+    sizes_[buffer.id] = 0;
+    ++generation_;  // programs binding it fail at their next resolve
+    return {};
+  }
+
+  Status resize_buffer(BufferHandle buffer, std::size_t bytes) override {
+    if (Status s = drain(); !s) return s;
+    auto b = live_buffer(buffer, "resize_buffer");
+    if (!b) return b.status();
+    ClBuffer& old = **b;
+    const std::string what = "resize_buffer '" + old.label + "'";
+    if (bytes == 0) return Error(ErrorCode::internal, what + ": size must be > 0");
+    auto mem = allocate(bytes, what, std::min(bytes, old.bytes));
+    if (!mem) return mem.error();
+    if (const cl_int err = clEnqueueCopyBuffer(queue_, old.mem, *mem, 0, 0, std::min(bytes, old.bytes), 0, nullptr, nullptr);
+        err != CL_SUCCESS) {
+      clReleaseMemObject(*mem);
+      return cl_error(err, what + ": copying the contents");
+    }
+    clReleaseMemObject(old.mem);  // freed once the copy is done
+    old.mem = *mem;
+    old.bytes = bytes;
+    sizes_[buffer.id] = bytes;
+    ++generation_;
+    return {};
+  }
+
   Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
-    if (Status s = check_range(buffer, offset, bytes, "write_buffer"); !s) return s;
+    if (Status s = drain(); !s) return s;
+    auto b = range(buffer, offset, bytes, "write_buffer");
+    if (!b) return b.status();
     if (bytes == 0) return {};
-    const cl_int err = clEnqueueWriteBuffer(queue_, buffers_[buffer.id].mem, CL_TRUE, offset, bytes, data, 0, nullptr, nullptr);
-    if (err != CL_SUCCESS) return Error("write_buffer '" + buffers_[buffer.id].label + "': " + cl_status(err));
+    const cl_int err = clEnqueueWriteBuffer(queue_, (*b)->mem, CL_TRUE, offset, bytes, data, 0, nullptr, nullptr);
+    if (err != CL_SUCCESS) return cl_error(err, "write_buffer '" + (*b)->label + "'");
     return {};
   }
 
   Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
-    if (Status s = check_range(buffer, offset, bytes, "read_buffer"); !s) return s;
+    if (Status s = drain(); !s) return s;
+    auto b = range(buffer, offset, bytes, "read_buffer");
+    if (!b) return b.status();
     if (bytes == 0) return {};
-    const cl_int err = clEnqueueReadBuffer(queue_, buffers_[buffer.id].mem, CL_TRUE, offset, bytes, data, 0, nullptr, nullptr);
-    if (err != CL_SUCCESS) return Error("read_buffer '" + buffers_[buffer.id].label + "': " + cl_status(err));
+    const cl_int err = clEnqueueReadBuffer(queue_, (*b)->mem, CL_TRUE, offset, bytes, data, 0, nullptr, nullptr);
+    if (err != CL_SUCCESS) return cl_error(err, "read_buffer '" + (*b)->label + "'");
     return {};
   }
 
+  // ---------------------------------------------------------------- programs
+
   Result<ProgramHandle> create_program(const FrameProgram& program) override {
-    if (Status s = check_program(program, static_cast<std::uint32_t>(buffers_.size())); !s) return s.error();
-    std::vector<ClDispatch> steps;
-    for (const auto& command : program.commands()) {
-      const auto* d = std::get_if<Dispatch>(&command);
-      if (!d || d->count == 0) continue;  // barriers: the in-order queue already orders every dispatch
-      cl_kernel kernel = kernels_[static_cast<std::size_t>(d->kernel)];
-      // Only when kernels/opencl is out of step with the kernel table (a test
-      // dispatches every kernel): an error, not a skipped test.
-      if (!kernel)
-        return Error("internal: the embedded OpenCL program has no kernel " + std::string(kernel_name(d->kernel)));
-      ClDispatch c{};
-      c.kernel = kernel;
-      c.global = (d->count + kLocalSize - 1) / kLocalSize * kLocalSize;
-      c.binding_count = d->binding_count;
-      for (std::uint32_t b = 0; b < d->binding_count; ++b) c.bindings[b] = buffers_[d->bindings[b].id].mem;
-      c.params_bytes = d->params_bytes;
-      std::memcpy(c.params, d->params, d->params_bytes);
-      steps.push_back(c);
-    }
-    programs_.push_back(std::move(steps));
+    auto p = std::make_unique<ClProgram>();
+    p->source = program;
+    if (Status s = resolve(*p); !s) return s.error();
+    programs_.push_back(std::move(p));
     return ProgramHandle{static_cast<std::uint32_t>(programs_.size() - 1)};
   }
 
-  Status run_program(ProgramHandle program) override {
-    if (program.id >= programs_.size()) return Error("run_program: not a program of this device");
-    const std::size_t local = kLocalSize;
-    for (const ClDispatch& d : programs_[program.id]) {
-      cl_int err = CL_SUCCESS;
-      for (std::uint32_t b = 0; b < d.binding_count && err == CL_SUCCESS; ++b)
-        err = clSetKernelArg(d.kernel, b, sizeof(cl_mem), &d.bindings[b]);
-      if (err == CL_SUCCESS) err = clSetKernelArg(d.kernel, d.binding_count, d.params_bytes, d.params);
-      if (err == CL_SUCCESS) err = clEnqueueNDRangeKernel(queue_, d.kernel, 1, nullptr, &d.global, &local, 0, nullptr, nullptr);
-      if (err != CL_SUCCESS) return Error("run_program: enqueue failed: " + cl_status(err));
-    }
-    const cl_int err = clFinish(queue_);
-    if (err != CL_SUCCESS) return Error("run_program: " + cl_status(err));
+  Status destroy_program(ProgramHandle program) override {
+    if (!live_program(program)) return Error(ErrorCode::internal, "destroy_program: not a live program of this device");
+    if (Status s = drain(); !s) return s;  // its counter reads may be in flight
+    programs_[program.id].reset();
     return {};
   }
 
- private:
-  Status check_range(BufferHandle buffer, std::size_t offset, std::size_t bytes, const char* what) const {
-    if (buffer.id >= buffers_.size()) return Error(std::string(what) + ": not a buffer of this device");
-    const ClBuffer& b = buffers_[buffer.id];
-    return check_buffer_range(b.label, b.bytes, offset, bytes, what);
+  Status submit(ProgramHandle program) override {
+    if (!live_program(program)) return Error(ErrorCode::internal, "submit: not a live program of this device");
+    if (Status s = drain(); !s) return s;
+    pending_ = false;  // one submission at a time: the previous one's counters are not checked
+    ClProgram& p = *programs_[program.id];
+    if (p.resolved_at != generation_)
+      if (Status s = resolve(p); !s) return s;
+    for (const ClStep& step : p.steps) {
+      if (const cl_int err = enqueue(step); err != CL_SUCCESS) {
+        clFinish(queue_);  // what was enqueued before it runs out; no counters to check
+        return cl_error(err, "submit: frame program " + step_name(step));
+      }
+    }
+    for (std::size_t c = 0; c < p.counter_reads.size(); ++c) {
+      const CounterRead& r = p.counter_reads[c];
+      if (const cl_int err = clEnqueueReadBuffer(queue_, r.mem, CL_FALSE, r.offset, sizeof(std::uint32_t),
+                                                 &p.counter_values[c], 0, nullptr, nullptr);
+          err != CL_SUCCESS) {
+        clFinish(queue_);
+        return cl_error(err, "submit: reading counter '" + p.source.counters()[c].label + "'");
+      }
+    }
+    if (const cl_int err = clFlush(queue_); err != CL_SUCCESS) {
+      clFinish(queue_);
+      return cl_error(err, "submit: clFlush", ErrorCode::device_lost);
+    }
+    in_flight_ = program.id;
+    return {};
   }
 
-  Found found_;
+  Status wait() override {
+    if (Status s = drain(); !s) return s;
+    if (!pending_) return {};
+    pending_ = false;
+    return pending_status_;
+  }
+
+  std::span<const std::uint32_t> counters() const override { return counters_; }
+
+  DeviceObjects objects() const override {
+    DeviceObjects o;
+    for (const ClBuffer& b : buffers_)
+      if (b.mem) {
+        ++o.buffers;
+        o.buffer_bytes += b.bytes;
+      }
+    o.native = o.buffers;  // one cl_mem per buffer; programs hold no OpenCL objects of their own
+    for (const auto& p : programs_) o.programs += p ? 1 : 0;
+    return o;
+  }
+
+ private:
+  // A zero-filled cl_mem of allocation_bytes(bytes), whose first `keep`
+  // bytes the caller fills (a resize copies the old contents there).
+  Result<cl_mem> allocate(std::size_t bytes, const std::string& what, std::size_t keep = 0) {
+    const std::size_t rounded = allocation_bytes(bytes);
+    cl_int err = CL_SUCCESS;
+    cl_mem mem = clCreateBuffer(ctx_, CL_MEM_READ_WRITE, rounded, nullptr, &err);
+    if (err != CL_SUCCESS) {
+      // Past the device's largest allocation is out of memory too.
+      const ErrorCode code = err == CL_INVALID_BUFFER_SIZE ? ErrorCode::out_of_memory : ErrorCode::internal;
+      return cl_error(err, what + " (" + std::to_string(bytes) + " bytes)", code);
+    }
+    if (keep < rounded) {
+      const cl_uchar zero = 0;
+      err = clEnqueueFillBuffer(queue_, mem, &zero, 1, keep, rounded - keep, 0, nullptr, nullptr);
+      if (err != CL_SUCCESS) {
+        clReleaseMemObject(mem);
+        return cl_error(err, what + ": zero fill");
+      }
+    }
+    return mem;
+  }
+
+  // Finishes the submission in flight, if any: its counters are then on the
+  // host, copied to counters_ and checked (wait() reports the result).
+  Status drain() {
+    if (in_flight_ == UINT32_MAX) return {};
+    const ClProgram& p = *programs_[in_flight_];
+    in_flight_ = UINT32_MAX;
+    if (const cl_int err = clFinish(queue_); err != CL_SUCCESS)
+      return cl_error(err, "waiting for the frame program", ErrorCode::device_lost);
+    counters_.assign(p.counter_values.begin(), p.counter_values.end());
+    pending_status_ = check_counters(p.source.counters(), counters_);
+    pending_ = true;
+    return {};
+  }
+
+  // Checks a program against the device's buffers and resolves its
+  // commands to OpenCL objects (at creation, and again after a buffer was
+  // resized or destroyed).
+  Status resolve(ClProgram& p) {
+    if (Status s = check_program(p.source, sizes_); !s) return s;
+    std::vector<ClStep> steps;
+    std::uint32_t position = 0;
+    for (const auto& command : p.source.commands()) {
+      ClStep c;
+      c.command = ++position;
+      if (const auto* f = std::get_if<Fill>(&command)) {
+        if (f->words == 0) continue;
+        c.kind = ClStep::Kind::fill;
+        c.target = buffers_[f->buffer.id].mem;
+        c.target_offset = std::size_t{f->word} * 4;
+        c.bytes = std::size_t{f->words} * 4;
+        c.value = f->value;
+      } else if (const auto* k = std::get_if<Copy>(&command)) {
+        if (k->words == 0) continue;
+        c.kind = ClStep::Kind::copy;
+        c.source = buffers_[k->source.id].mem;
+        c.source_offset = std::size_t{k->source_word} * 4;
+        c.target = buffers_[k->target.id].mem;
+        c.target_offset = std::size_t{k->target_word} * 4;
+        c.bytes = std::size_t{k->words} * 4;
+      } else if (const auto* d = std::get_if<Dispatch>(&command)) {
+        if (d->count == 0) continue;
+        const auto k_index = static_cast<std::size_t>(d->kernel);
+        c.kernel_id = d->kernel;
+        c.kernel = kernels_[k_index];
+        // Only when the embedded program is out of step with the kernel
+        // registry (a test dispatches every kernel): an error, not a skip.
+        if (!c.kernel)
+          return Error(ErrorCode::internal, "frame program " + step_name(c) + ": the embedded OpenCL program has no kernel " +
+                                                std::string(kernel_name(d->kernel)));
+        // Indirect: d->count is the capacity, see the top of this file.
+        const std::size_t group = launch_group_size(d->kernel);
+        if (group > max_group_[k_index])
+          return Error(ErrorCode::backend_unavailable,
+                       "frame program " + step_name(c) + ": the kernel runs in groups of " + std::to_string(group) +
+                           ", " + found_.info.name + " allows at most " + std::to_string(max_group_[k_index]));
+        c.local = group;
+        c.global = (std::size_t{d->count} + group - 1) / group * group;
+        c.binding_count = d->binding_count;
+        for (std::uint32_t b = 0; b < d->binding_count; ++b) c.bindings[b] = buffers_[d->bindings[b].id].mem;
+        c.params_bytes = d->params_bytes;
+        std::memcpy(c.params, d->params, d->params_bytes);
+      } else {
+        continue;  // a barrier: the in-order queue already orders every command
+      }
+      steps.push_back(c);
+    }
+    p.steps = std::move(steps);
+    p.counter_reads.clear();
+    for (const Counter& c : p.source.counters())
+      p.counter_reads.push_back({buffers_[c.buffer.id].mem, std::size_t{c.word} * 4});
+    p.counter_values.assign(p.counter_reads.size(), 0);
+    p.resolved_at = generation_;
+    return {};
+  }
+
+  cl_int enqueue(const ClStep& s) {
+    switch (s.kind) {
+      case ClStep::Kind::fill:
+        return clEnqueueFillBuffer(queue_, s.target, &s.value, sizeof s.value, s.target_offset, s.bytes, 0, nullptr,
+                                   nullptr);
+      case ClStep::Kind::copy:
+        return clEnqueueCopyBuffer(queue_, s.source, s.target, s.source_offset, s.target_offset, s.bytes, 0, nullptr,
+                                   nullptr);
+      case ClStep::Kind::dispatch: break;
+    }
+    // Arguments are captured at enqueue, so the shared cl_kernel of each
+    // kernel serves every dispatch of it.
+    cl_int err = CL_SUCCESS;
+    for (std::uint32_t b = 0; b < s.binding_count && err == CL_SUCCESS; ++b)
+      err = clSetKernelArg(s.kernel, b, sizeof(cl_mem), &s.bindings[b]);
+    if (err == CL_SUCCESS) err = clSetKernelArg(s.kernel, s.binding_count, s.params_bytes, s.params);
+    if (err == CL_SUCCESS) err = clEnqueueNDRangeKernel(queue_, s.kernel, 1, nullptr, &s.global, &s.local, 0, nullptr, nullptr);
+    return err;
+  }
+
+  bool live_program(ProgramHandle program) const { return program.id < programs_.size() && programs_[program.id]; }
+
+  Result<ClBuffer*> live_buffer(BufferHandle buffer, const char* what) {
+    if (buffer.id >= buffers_.size() || !buffers_[buffer.id].mem)
+      return Error(ErrorCode::internal, std::string(what) + ": not a live buffer of this device");
+    return &buffers_[buffer.id];
+  }
+
+  Result<ClBuffer*> range(BufferHandle buffer, std::size_t offset, std::size_t bytes, const char* what) {
+    auto b = live_buffer(buffer, what);
+    if (!b) return b.error();
+    if (Status s = check_buffer_range((*b)->label, (*b)->bytes, offset, bytes, what); !s) return s.error();
+    return b;
+  }
+
+  opencl::Found found_;
   cl_context ctx_;
   cl_command_queue queue_;
   cl_program program_;
-  std::array<cl_kernel, static_cast<std::size_t>(Kernel::count_)> kernels_{};
+  std::array<cl_kernel, kernel_count> kernels_{};
+  std::array<std::size_t, kernel_count> max_group_{};  // CL_KERNEL_WORK_GROUP_SIZE of each kernel
   std::vector<ClBuffer> buffers_;
-  std::vector<std::vector<ClDispatch>> programs_;
+  std::vector<std::size_t> sizes_;  // bytes per buffer id, 0 when destroyed (check_program)
+  std::uint64_t generation_ = 0;     // bumped by every resize and destroy
+  std::vector<std::unique_ptr<ClProgram>> programs_;  // nullptr: destroyed
+  std::uint32_t in_flight_ = UINT32_MAX;  // the program submitted and not yet finished
+  bool pending_ = false;                  // a finished submission whose counter check wait() has not returned
+  Status pending_status_;
+  std::vector<std::uint32_t> counters_;
 };
-
-struct ContextAndQueue {
-  cl_context ctx = nullptr;
-  cl_command_queue queue = nullptr;
-};
-
-Result<ContextAndQueue> make_context(const Found& f) {
-  cl_int err = CL_SUCCESS;
-  const cl_context_properties props[] = {CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(f.platform), 0};
-  cl_context ctx = clCreateContext(props, 1, &f.device, nullptr, nullptr, &err);
-  if (err != CL_SUCCESS) return Error("clCreateContext on " + f.info.name + ": " + cl_status(err));
-  cl_command_queue queue = clCreateCommandQueue(ctx, f.device, 0, &err);
-  if (err != CL_SUCCESS) {
-    clReleaseContext(ctx);
-    return Error("clCreateCommandQueue on " + f.info.name + ": " + cl_status(err));
-  }
-  return ContextAndQueue{ctx, queue};
-}
-
-// The selected device with a fresh context and queue.
-struct Opened {
-  Found found;
-  ContextAndQueue cq;
-};
-
-Result<Opened> open_selected(const DeviceOptions& options) {
-  auto found = find_devices();
-  if (!found) return found.error();
-  auto index = choose(*found, options.device);
-  if (!index) return index.error();
-  const Found& f = (*found)[*index];
-  auto cq = make_context(f);
-  if (!cq) return cq.error();
-  return Opened{f, *cq};
-}
 
 }  // namespace
 
-Result<std::vector<OpenclDeviceInfo>> list_opencl_devices() {
-  auto found = find_devices();
-  if (!found) return found.error();
-  std::vector<OpenclDeviceInfo> out;
-  for (const Found& f : *found) out.push_back(f.info);
-  return out;
-}
-
 Result<std::unique_ptr<Device>> make_opencl_device(const DeviceOptions& options) {
-  auto opened = open_selected(options);
+  auto opened = opencl::open_selected(options);
   if (!opened) return opened.error();
-  auto& [f, cq] = *opened;
-  auto program = build_cached(cq.ctx, f, opencl::kProgramSource);
+  auto program = opencl::build_cached(opened->ctx, opened->found, opencl::kProgramSource);
   if (!program) {
-    clReleaseCommandQueue(cq.queue);
-    clReleaseContext(cq.ctx);
+    opencl::close(*opened);
     return program.error();
   }
-  return std::unique_ptr<Device>(std::make_unique<OpenclDevice>(f, cq.ctx, cq.queue, *program));
-}
-
-Status try_build_opencl_source(const std::string& source, const DeviceOptions& options) {
-  auto opened = open_selected(options);
-  if (!opened) return opened.error();
-  auto& [f, cq] = *opened;
-  auto program = build_from_source(cq.ctx, f, source);
-  if (program) clReleaseProgram(*program);
-  clReleaseCommandQueue(cq.queue);
-  clReleaseContext(cq.ctx);
-  return program.status();
+  return std::unique_ptr<Device>(std::make_unique<OpenclDevice>(std::move(*opened), *program));
 }
 
 }  // namespace sinew
