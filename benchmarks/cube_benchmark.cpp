@@ -93,8 +93,8 @@ void BM_Cube(benchmark::State& state) {
     }
     const sinew::DeviceTimes& t = sim->last_frame().device;
     device_ms += t.span_ms;
-    for (std::size_t k = 0; k < sinew::kernel_count; ++k)
-      if (sinew::kernel_name(static_cast<sinew::Kernel>(k)).starts_with("xpbd_solve")) solve_ms += t.kernel_ms[k];
+    for (std::size_t k = 0; k < sinew::kernel_names().size(); ++k)
+      if (sinew::kernel_names()[k].starts_with("xpbd_solve")) solve_ms += t.kernel_ms[k];
   }
   if (sim->last_frame().device.timed) {  // Vulkan with timestamps: GPU time per frame, all and in solves
     state.counters["device_ms"] = benchmark::Counter(device_ms, benchmark::Counter::kAvgIterations);

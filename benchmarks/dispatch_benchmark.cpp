@@ -7,7 +7,7 @@
 //   bench_dispatch [--benchmark_out=d.csv --benchmark_out_format=csv]
 #include <benchmark/benchmark.h>
 
-#include "sinew/device.h"
+#include "backends/backend.h"
 #include "xpbd_params.h"
 
 namespace {
