@@ -23,8 +23,8 @@
 
 #include <cstdio>
 
+#include "compiler/float_words.h"
 #include "contact_params.h"
-#include "scene/float_words.h"
 
 namespace sinew::test {
 namespace {

@@ -3,8 +3,8 @@
 // stages a scene has constraints for are emitted.
 #pragma once
 
-#include "scene/scene_compiler.h"
-#include "sinew/device.h"
+#include "compiler/scene_compiler.h"
+#include "backends/backend.h"
 
 namespace sinew {
 

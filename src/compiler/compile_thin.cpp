@@ -29,9 +29,9 @@
 #include <tuple>
 #include <vector>
 
+#include "compiler/scene_compiler.h"
 #include "cpu/thin_kernels.h"
 #include "cpu/xpbd_kernels.h"
-#include "scene/scene_compiler.h"
 #include "thin_params.h"
 
 namespace sinew {

@@ -2,7 +2,7 @@
 // arrays. Rest lengths and volumes are computed from the float positions
 // with the very functions the kernels use, so a body at rest has C == 0
 // exactly and stays bitwise at rest.
-#include "scene/scene_compiler.h"
+#include "compiler/scene_compiler.h"
 
 #include <algorithm>
 #include <cmath>

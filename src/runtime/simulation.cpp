@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "compiler/scene_compiler.h"
 #include "cpu/xpbd_kernels.h"
-#include "scene/scene_compiler.h"
-#include "scene/simulation_impl.h"
-#include "xpbd/xpbd_program.h"
+#include "program/xpbd_program.h"
+#include "runtime/simulation_impl.h"
 
 namespace sinew {
 

@@ -66,9 +66,9 @@
 #include <sstream>
 #include <string>
 
+#include "compiler/float_words.h"
 #include "contact_params.h"
-#include "scene/float_words.h"
-#include "scene/simulation_impl.h"
+#include "runtime/simulation_impl.h"
 
 namespace sinew {
 namespace {

@@ -22,8 +22,8 @@
 #include <cstdio>
 #include <string>
 
+#include "compiler/scene_compiler.h"
 #include "fem_params.h"
-#include "scene/scene_compiler.h"
 
 namespace sinew {
 namespace {

@@ -7,7 +7,7 @@
 // Within an iteration the constraints are swept colour by colour
 // (Gauss-Seidel across colours, Jacobi-free within one since a colour's
 // constraints share no movable particle); each colour ends with a barrier.
-#include "xpbd/xpbd_program.h"
+#include "program/xpbd_program.h"
 
 #include <span>
 #include <string>

@@ -7,10 +7,10 @@
 #include <memory>
 #include <vector>
 
-#include "scene/contact_state.h"
-#include "scene/scene_compiler.h"
+#include "compiler/scene_compiler.h"
+#include "program/xpbd_program.h"
+#include "runtime/contact_state.h"
 #include "sinew/simulation.h"
-#include "xpbd/xpbd_program.h"
 
 namespace sinew {
 

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "compiler/float_words.h"
+#include "compiler/scene_compiler.h"
 #include "contact_params.h"
-#include "scene/float_words.h"
-#include "scene/scene_compiler.h"
 
 namespace sinew {
 namespace {

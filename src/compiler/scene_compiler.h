@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "cpu/cpu_math.h"
+#include "backends/backend.h"
 #include "sinew/scene.h"
-#include "sinew/simulation.h"
 
 namespace sinew {
 
