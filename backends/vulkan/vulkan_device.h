@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "sinew/device.h"
+#include "backends/backend.h"
 
 namespace sinew {
 
