@@ -19,9 +19,23 @@
  * Rules of the intersection (both compilers reject the rest):
  *  - buffers are reached only through their binding names, never passed to
  *    functions (GLSL has no pointers); helper functions take values;
- *  - vector types float2/float4/uint2/uint4 and make_float4(...) etc.;
- *    conversions with to_uint(x), to_int(x), to_float(x), bit casts with
- *    float_bits(f) and bits_float(u); no C casts (GLSL), no constructors (OpenCL);
+ *  - vector types float2/float3/float4/uint2/uint4 and make_float4(...)
+ *    etc. (make_float4_xyz(v, w): a float3 and a w); no splats: write
+ *    every component; conversions with to_uint(x), to_int(x), to_float(x),
+ *    bit casts with float_bits(f) and bits_float(u); no C casts (GLSL), no
+ *    constructors (OpenCL). float3 lives in registers only: buffers and
+ *    shared structs hold float4 (see kernels/shared/sinew_lang.h);
+ *  - float literals with the f suffix (1.0f: float in both; an unsuffixed
+ *    literal is a double in OpenCL C); fabs(x) for a float's magnitude (GLSL
+ *    abs; OpenCL's abs is for integers); sqrt, isnan, isinf alike in both;
+ *  - helper functions return values: a struct (SINEW_STRUCT_BEGIN/END of
+ *    kernels/shared/sinew_lang.h; any member types when only kernels use
+ *    it) instead of out parameters, which GLSL spells `out` and OpenCL as
+ *    pointers. Array parameters (float4 xs[4]) are read, never written: GLSL
+ *    copies them in, OpenCL passes a pointer. Arrays are initialised with
+ *    braces, {a, b, c}, never GLSL's float[3](...); no dynamic index into
+ *    a vector (OpenCL), use an array;
+ *  - no `inline` or `static` (reserved in GLSL); functions are plain;
  *  - declare float arithmetic results PRECISE (GLSL `precise`: no fused
  *    multiply-add; OpenCL: FP_CONTRACT OFF below), so kernels round like
  *    the CPU reference and agree bitwise;
@@ -53,7 +67,9 @@
  * it are visible to the group after it. */
 #define group_barrier() barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE)
 #define make_float2(a, b) ((float2)((a), (b)))
+#define make_float3(a, b, c) ((float3)((a), (b), (c)))
 #define make_float4(a, b, c, d) ((float4)((a), (b), (c), (d)))
+#define make_float4_xyz(v, w) ((float4)((v), (w)))
 #define make_uint2(a, b) ((uint2)((a), (b)))
 #define make_uint4(a, b, c, d) ((uint4)((a), (b), (c), (d)))
 #define to_uint(x) ((uint)(x))
@@ -68,6 +84,7 @@
 /* ------------------------------------------------------------ GLSL 4.50 (Vulkan) */
 #define PRECISE precise
 #define float2 vec2
+#define float3 vec3
 #define float4 vec4
 #define uint2 uvec2
 #define uint4 uvec4
@@ -89,7 +106,9 @@
   memoryBarrierBuffer();  \
   barrier()
 #define make_float2(a, b) vec2((a), (b))
+#define make_float3(a, b, c) vec3((a), (b), (c))
 #define make_float4(a, b, c, d) vec4((a), (b), (c), (d))
+#define make_float4_xyz(v, w) vec4((v), (w))
 #define make_uint2(a, b) uvec2((a), (b))
 #define make_uint4(a, b, c, d) uvec4((a), (b), (c), (d))
 #define to_uint(x) uint(x)
@@ -97,6 +116,7 @@
 #define to_float(x) float(x)
 #define float_bits(f) floatBitsToUint(f)
 #define bits_float(u) uintBitsToFloat(u)
+#define fabs(x) abs(x)
 #define atomic_add_u32(buf, index, value) atomicAdd((buf)[index], (value))
 #define atomic_max_u32(buf, index, value) atomicMax((buf)[index], (value))
 #endif
