@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu/cpu_math.h"
+#include "math/vec4.h"
 #include "test_support.h"
 #include "xpbd_params.h"
 

@@ -9,7 +9,7 @@
 #include <cstdint>
 
 #include "contact_params.h"
-#include "cpu/cpu_math.h"
+#include "math/vec4.h"
 
 namespace sinew::kernels {
 

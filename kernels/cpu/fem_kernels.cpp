@@ -3,7 +3,7 @@
 // Macklin, Müller, Chentanez, "XPBD: Position-Based Simulation of Compliant
 // Constrained Dynamics", MIG 2016; Macklin, Müller, "A Constraint-based
 // Formulation of Stable Neo-Hookean Materials", MIG 2021. The models'
-// constraints are in fem_kernels.h, the data layout in
+// constraints are in kernels/math/fem_math.h, the data layout in
 // kernels/shared/fem_params.h.
 //
 // Each work item solves one tet's two constraints C = (C_D, C_H) together,

@@ -9,8 +9,8 @@
 #include <algorithm>
 
 #include "contact_params.h"
-#include "cpu/cpu_math.h"
 #include "cpu/dd_math.h"
+#include "math/vec4.h"
 #include "primitive_params.h"
 #include "stats_params.h"
 

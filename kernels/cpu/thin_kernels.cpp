@@ -6,7 +6,7 @@
 //   dlambda = (-C - alpha~ lambda) / (sum_i w_i |grad_i C|^2 + alpha~),
 //   dx_i    = w_i grad_i C dlambda.
 // The constraints (area, dihedral angle, Kelager line bending) and their
-// gradients are in thin_kernels.h, the data layouts in
+// gradients are in kernels/math/thin_math.h, the data layouts in
 // kernels/shared/thin_params.h. Each work item solves one constraint; a
 // dispatch covers one colour, whose constraints share no movable particle.
 // All in float, like the GPU kernels; particles with w == 0 are never

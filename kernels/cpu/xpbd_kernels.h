@@ -1,6 +1,6 @@
-// xpbd_kernels.h — the CPU reference kernels of the xPBD solver and the
-// constraint functions they share with the scene compiler (which computes
-// rest values with the very same code, so a mesh at rest has C == 0 exactly).
+// xpbd_kernels.h — the CPU reference kernels of the xPBD solver. Their
+// constraint functions (edge length, tet volume and gradients) are in
+// kernels/math/xpbd_math.h, which the scene compiler shares.
 //
 // Macklin, Müller, Chentanez, "XPBD: Position-Based Simulation of Compliant
 // Constrained Dynamics", MIG 2016; Macklin et al., "Small Steps in Physics
@@ -10,42 +10,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "cpu/cpu_math.h"
+#include "math/xpbd_math.h"
 
 namespace sinew::kernels {
-
-/// Edge length |a - b| [m]; the distance constraint is C = |a - b| - rest.
-template <class T>
-inline T edge_length(vec4<T> a, vec4<T> b) {
-  const vec4<T> d = a - b;
-  return std::sqrt(dot3(d, d));
-}
-
-/// grad_a |a - b| = (a - b) / |a - b| (and grad_b = -grad_a).
-/// [in] len: |a - b| > 0, as returned by edge_length.
-template <class T>
-inline vec4<T> edge_length_gradient(vec4<T> a, vec4<T> b, T len) {
-  return (T(1) / len) * (a - b);
-}
-
-/// Signed tet volume V = dot(x1 - x0, cross(x2 - x0, x3 - x0)) / 6 [m^3];
-/// the volume constraint is C = V - rest.
-template <class T>
-inline T tet_volume(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> x3) {
-  return dot3(x1 - x0, cross3(x2 - x0, x3 - x0)) * (T(1) / T(6));
-}
-
-/// [out] g[k] = grad_{x_k} V: (1/6) the cross product of the two other
-/// edges from x0 (cyclic), and g[0] = -(g[1] + g[2] + g[3]).
-template <class T>
-inline void tet_volume_gradients(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> x3, vec4<T> g[4]) {
-  const vec4<T> e1 = x1 - x0, e2 = x2 - x0, e3 = x3 - x0;
-  const T sixth = T(1) / T(6);
-  g[1] = sixth * cross3(e2, e3);
-  g[2] = sixth * cross3(e3, e1);
-  g[3] = sixth * cross3(e1, e2);
-  g[0] = vec4<T>{T(0), T(0), T(0), T(0)} - (g[1] + g[2] + g[3]);
-}
 
 /// Signature of every CPU kernel: parameters (the struct from
 /// kernels/shared), the bound buffers in binding order, and the work items

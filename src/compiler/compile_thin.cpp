@@ -4,7 +4,7 @@
 //
 // Rest values (lengths, areas, dihedral angles, Kelager offsets) are
 // computed from the float particle positions with the very functions the
-// kernels use (kernels/cpu/xpbd_kernels.h, thin_kernels.h), so a body at
+// kernels use (kernels/math/xpbd_math.h, thin_math.h), so a body at
 // rest has C == 0 exactly and stays bitwise at rest.
 //
 // Triangle bodies:
@@ -30,8 +30,8 @@
 #include <vector>
 
 #include "compiler/scene_compiler.h"
-#include "cpu/thin_kernels.h"
-#include "cpu/xpbd_kernels.h"
+#include "math/thin_math.h"
+#include "math/xpbd_math.h"
 #include "thin_params.h"
 
 namespace sinew {

@@ -1,7 +1,7 @@
 // scene_compiler.cpp — from a scene description to flat, colour-sorted
 // arrays. Rest lengths and volumes are computed from the float positions
-// with the very functions the kernels use, so a body at rest has C == 0
-// exactly and stays bitwise at rest.
+// with the very functions the kernels use (kernels/math/xpbd_math.h), so a
+// body at rest has C == 0 exactly and stays bitwise at rest.
 #include "compiler/scene_compiler.h"
 
 #include <algorithm>
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "coloring/greedy_coloring.h"
-#include "cpu/xpbd_kernels.h"
+#include "math/xpbd_math.h"
 
 namespace sinew {
 namespace {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "cpu/cpu_math.h"
 #include "backends/backend.h"
+#include "math/vec4.h"
 #include "sinew/scene.h"
 
 namespace sinew {

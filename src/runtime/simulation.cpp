@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "compiler/scene_compiler.h"
-#include "cpu/xpbd_kernels.h"
+#include "math/xpbd_math.h"
 #include "program/xpbd_program.h"
 #include "runtime/simulation_impl.h"
 

@@ -1,4 +1,6 @@
-// cpu_math.h — the small vector type the CPU reference kernels use.
+// vec4.h — the small vector type of the constraint math (kernels/math/),
+// used by the CPU reference kernels (kernels/cpu/) and by the scene
+// compiler's rest values (src/compiler/).
 //
 // vec4 mirrors the buffers' layout (xyz + w, 16 bytes for float) and
 // OpenCL's float4, so a CPU kernel reads like its GPU twin. The kernels use
