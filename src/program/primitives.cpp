@@ -133,55 +133,67 @@ std::uint32_t reduce_scratch_words(std::uint32_t capacity) {
   return words;
 }
 
-std::uint32_t append_reduce(FrameProgram& program, const DeviceCount& n, ReduceOp op, DeviceWords values,
-                            std::uint32_t stride, DeviceWords scratch) {
-  const std::vector<std::uint32_t> levels = level_capacities(n.capacity);
-  kernels::ReduceParams p{};
-  p.count_word = n.word;
-  p.capacity = n.capacity;
+namespace {
+
+// The levels of a reduction: level 0 reduces the n values into one partial
+// per block of 256 (`partial_words` words each) in the scratch, each level
+// above reduces the partials below it, until one is left; `dispatch(k, in,
+// in_stride, out)` appends level k's kernel. Returns the result's scratch word.
+template <class Dispatch>
+std::uint32_t append_reduction_levels(FrameProgram& program, std::uint32_t capacity, DeviceWords values,
+                                      std::uint32_t stride, std::uint32_t partial_words, DeviceWords scratch,
+                                      Dispatch dispatch) {
+  const std::vector<std::uint32_t> levels = level_capacities(capacity);
   DeviceWords in = values;
   std::uint32_t next = scratch.offset;
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const DeviceWords partials{scratch.buffer, next};
-    next += std::max(blocks(levels[k]), 1u);
-    p.level_shift = static_cast<std::uint32_t>(8 * k);
-    // Sum of squares squares the inputs; the levels above add them up.
-    p.op = k > 0 && op == ReduceOp::sum_squares_f32 ? SINEW_REDUCE_SUM_F32 : static_cast<std::uint32_t>(op);
-    p.in_offset = in.offset;
-    p.in_stride = k == 0 ? stride : 1u;
-    p.out_offset = partials.offset;
-    program.dispatch(Kernel::reduce_blocks, std::max(blocks(levels[k]), 1u) * kBlock,
-                     {n.buffer, in.buffer, partials.buffer}, p);
+    next += partial_words * std::max(blocks(levels[k]), 1u);
+    dispatch(static_cast<std::uint32_t>(k), in, k == 0 ? stride : partial_words, partials,
+             std::max(blocks(levels[k]), 1u) * kBlock);
     program.barrier();
     in = partials;
   }
   return in.offset;
 }
 
+}  // namespace
+
+std::uint32_t append_reduce(FrameProgram& program, const DeviceCount& n, ReduceOp op, DeviceWords values,
+                            std::uint32_t stride, DeviceWords scratch) {
+  kernels::ReduceParams p{};
+  p.count_word = n.word;
+  p.capacity = n.capacity;
+  return append_reduction_levels(
+      program, n.capacity, values, stride, 1, scratch,
+      [&](std::uint32_t k, DeviceWords in, std::uint32_t in_stride, DeviceWords out, std::uint32_t items) {
+        p.level_shift = 8 * k;
+        // Sum of squares squares the inputs; the levels above add them up.
+        p.op = k > 0 && op == ReduceOp::sum_squares_f32 ? SINEW_REDUCE_SUM_F32 : static_cast<std::uint32_t>(op);
+        p.in_offset = in.offset;
+        p.in_stride = in_stride;
+        p.out_offset = out.offset;
+        program.dispatch(Kernel::reduce_blocks, items, {n.buffer, in.buffer, out.buffer}, p);
+      });
+}
+
 std::uint32_t reduce_dd_scratch_words(std::uint32_t capacity) { return 2 * reduce_scratch_words(capacity); }
 
 std::uint32_t append_reduce_dd(FrameProgram& program, const DeviceCount& n, DdItems items, DeviceWords values,
                                std::uint32_t stride, DeviceWords scratch) {
-  const std::vector<std::uint32_t> levels = level_capacities(n.capacity);
   kernels::ReduceDdParams p{};
   p.count_word = n.word;
   p.capacity = n.capacity;
-  DeviceWords in = values;
-  std::uint32_t next = scratch.offset;
-  for (std::size_t k = 0; k < levels.size(); ++k) {
-    const DeviceWords partials{scratch.buffer, next};
-    next += 2 * std::max(blocks(levels[k]), 1u);
-    p.level_shift = static_cast<std::uint32_t>(8 * k);
-    p.mode = k == 0 ? static_cast<std::uint32_t>(items) : SINEW_DD_PAIRS;
-    p.in_offset = in.offset;
-    p.in_stride = k == 0 ? stride : 2u;
-    p.out_offset = partials.offset;
-    program.dispatch(Kernel::reduce_dd_blocks, std::max(blocks(levels[k]), 1u) * kBlock,
-                     {n.buffer, in.buffer, partials.buffer}, p);
-    program.barrier();
-    in = partials;
-  }
-  return in.offset;
+  return append_reduction_levels(
+      program, n.capacity, values, stride, 2, scratch,
+      [&](std::uint32_t k, DeviceWords in, std::uint32_t in_stride, DeviceWords out, std::uint32_t launched) {
+        p.level_shift = 8 * k;
+        p.mode = k == 0 ? static_cast<std::uint32_t>(items) : SINEW_DD_PAIRS;
+        p.in_offset = in.offset;
+        p.in_stride = in_stride;
+        p.out_offset = out.offset;
+        program.dispatch(Kernel::reduce_dd_blocks, launched, {n.buffer, in.buffer, out.buffer}, p);
+      });
 }
 
 }  // namespace sinew
