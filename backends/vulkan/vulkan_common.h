@@ -1,8 +1,8 @@
 // vulkan_common.h — what every file of the Vulkan backend uses: VkResult
-// names for error messages, vk_struct (a zeroed struct with its sType) and
-// the one memory barrier the backend records. Small enough to be inline, so
-// each piece (instance, physical device, memory, pipelines, recording) needs
-// only this header and its own.
+// names and error codes for error messages, vk_struct (a zeroed struct with
+// its sType) and the global memory barriers the backend records. Small
+// enough to be inline, so each piece (instance, physical device, memory,
+// buffers, pipelines, program plans, recording) needs only this header and its own.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -38,8 +38,29 @@ inline std::string result_name(VkResult r) {
   }
 }
 
-/// "<call> failed: <result_name(r)>".
-inline Error vk_error(const std::string& call, VkResult r) { return Error(call + " failed: " + result_name(r)); }
+/// The ErrorCode of a failed call's VkResult: out of host or device memory
+/// -> out_of_memory, a lost device -> device_lost, no driver ->
+/// backend_unavailable, anything else (bad handles, a bug) -> internal.
+inline ErrorCode error_code(VkResult r) {
+  switch (r) {
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return ErrorCode::out_of_memory;
+    case VK_ERROR_DEVICE_LOST: return ErrorCode::device_lost;
+    case VK_ERROR_INCOMPATIBLE_DRIVER: return ErrorCode::backend_unavailable;
+    default: return ErrorCode::internal;
+  }
+}
+
+/// "<call> failed: <result_name(r)>", with error_code(r).
+inline Error vk_error(const std::string& call, VkResult r) {
+  return Error(error_code(r), call + " failed: " + result_name(r));
+}
+/// The same, with `code` where error_code(r) would say internal (e.g.
+/// backend_unavailable for a failure to open the device at all).
+inline Error vk_error(const std::string& call, VkResult r, ErrorCode code) {
+  const ErrorCode from_result = error_code(r);
+  return Error(from_result == ErrorCode::internal ? code : from_result, call + " failed: " + result_name(r));
+}
 
 /// A Vulkan struct, zeroed, with its sType set.
 template <class T>
@@ -56,6 +77,24 @@ inline void memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, 
   barrier.srcAccessMask = src_access;
   barrier.dstAccessMask = dst_access;
   vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+}
+
+/// The stages a frame program's commands run in: dispatches (their shaders,
+/// and the indirect-argument read of an indirect one), fills and copies.
+inline constexpr VkPipelineStageFlags kWorkStages =
+    VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
+/// Every write of those commands.
+inline constexpr VkAccessFlags kWorkWrites = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+/// Every access of those commands.
+inline constexpr VkAccessFlags kWorkAccesses = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
+                                               VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
+                                               VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+
+/// A frame program's Barrier: every earlier dispatch, fill and copy (and
+/// indirect-argument read) completes and its writes are visible to every
+/// later one, whichever of them reads or writes.
+inline void full_barrier(VkCommandBuffer cmd) {
+  memory_barrier(cmd, kWorkStages, kWorkWrites, kWorkStages, kWorkAccesses);
 }
 
 }  // namespace sinew::vulkan

@@ -1,30 +1,36 @@
 // vulkan_device.cpp — the Vulkan compute backend: the sinew Device that glues
 // the pieces together, and the backend's public functions.
 //
-// One instance, device and compute queue per sinew Device; every call that
-// waits does so on one fence, so at most one submission is in flight. The
-// pieces, each in the file named after its job:
+// One instance, device and compute queue per sinew Device; every submission
+// signals one fence, so at most one is in flight. submit() records the
+// program again if a buffer was resized or destroyed since it was recorded
+// (its descriptor sets point at VkBuffers), submits its command buffer and
+// returns; wait() waits for the fence, reads the counters the recording
+// copied into mapped memory and checks them against their capacities, and
+// reads the timestamps (last_run_times). Calls that touch buffers, and the
+// next submit, first finish a submission in flight. The pieces, each in the
+// file named after its job:
 //   vulkan_instance         the instance, the validation layer and its counter
 //   vulkan_physical_device  which devices there are, which one to use
-//   vulkan_memory           buffers, staging, the queue, fence and transfers
+//   vulkan_memory           memory types, allocation, staging; the queue, fence and transfers
+//   vulkan_buffers          the buffers the handles name: create, destroy, resize, host copies
 //   vulkan_pipelines        pipelines from the embedded SPIR-V, set layouts
-//   vulkan_recording        frame programs recorded into command buffers, timestamps
-// This file resolves a frame program into the steps to record and owns the
-// buffers and programs the handles name.
+//   vulkan_program          a frame program resolved into steps (indirect dispatches, sets)
+//   vulkan_recording        the steps recorded into a command buffer; counters, timestamps
 #include "backends/vulkan/vulkan_device.h"
 
 #include <vulkan/vulkan.h>
 
-#include <cstring>
-#include <map>
-#include <variant>
+#include <memory>
 
 #include "backends/kernel_table.h"
+#include "backends/vulkan/vulkan_buffers.h"
 #include "backends/vulkan/vulkan_common.h"
 #include "backends/vulkan/vulkan_instance.h"
 #include "backends/vulkan/vulkan_memory.h"
 #include "backends/vulkan/vulkan_physical_device.h"
 #include "backends/vulkan/vulkan_pipelines.h"
+#include "backends/vulkan/vulkan_program.h"
 #include "backends/vulkan/vulkan_recording.h"
 
 namespace sinew {
@@ -39,9 +45,10 @@ class VulkanDeviceImpl final : public Device {
   ~VulkanDeviceImpl() override {
     if (!device_) return;
     vkDeviceWaitIdle(device_);
-    for (Program& p : programs_) recorder_.destroy(p);
+    for (auto& p : programs_)
+      if (p) recorder_.destroy(p->recording);
     pipelines_.destroy();
-    for (Buffer& b : buffers_) memory_.destroy(b);
+    buffers_.destroy();
     memory_.destroy();
     queue_.destroy();
     recorder_.destroy();
@@ -69,12 +76,13 @@ class VulkanDeviceImpl final : public Device {
     device_info.pQueueCreateInfos = &queue_info;
     if (VkResult r = vkCreateDevice(found_.physical, &device_info, nullptr, &device_); r != VK_SUCCESS) {
       device_ = VK_NULL_HANDLE;
-      return vk_error("vkCreateDevice on " + found_.info.name, r);
+      return vk_error("vkCreateDevice on " + found_.info.name, r, ErrorCode::backend_unavailable);
     }
-    if (Status s = recorder_.init(found_, device_); !s) return s;  // the program command pool
-    if (Status s = queue_.init(device_, found_.queue_family); !s) return s;
     memory_.init(found_, device_);
+    if (Status s = recorder_.init(found_, device_, memory_); !s) return s;  // the program command pool
+    if (Status s = queue_.init(device_, found_.queue_family); !s) return s;
     pipelines_.init(found_, device_);
+    buffers_.init(found_, memory_, queue_);
     return {};
   }
 
@@ -85,132 +93,83 @@ class VulkanDeviceImpl final : public Device {
            (instance_->validation ? ", validation on)" : ")");
   }
 
+  // ---------------------------------------------------------------- buffers
+  // Each first finishes a submission in flight (its counters are then
+  // checked, and wait() reports them).
+
   Result<BufferHandle> create_buffer(std::size_t bytes, std::string_view label) override {
-    const std::string what = "create_buffer '" + std::string(label) + "'";
-    if (bytes == 0) return Error(what + ": size must be > 0");
-    if (Status s = check_lost(what); !s) return s.error();
-    Buffer b;
-    b.label = label;
-    b.bytes = bytes;
-    b.size = (bytes + 63) / 64 * 64;  // kernels may read whole float4s at the end of any buffer
-    if (b.size > found_.properties.limits.maxStorageBufferRange)
-      return Error(what + " (" + std::to_string(bytes) + " bytes): larger than the largest storage buffer of " +
-                   found_.info.name + " (" + std::to_string(found_.properties.limits.maxStorageBufferRange) + " bytes)");
-    const VkBufferUsageFlags usage =
-        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    const bool unified = memory_.unified();
-    Status s = unified ? memory_.make_buffer(b, usage, kUnified, kUnified | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, what)
-                       : memory_.make_buffer(b, usage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
-                                             VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, what);
-    if (s && unified) std::memset(b.mapped, 0, b.size);
-    if (s && !unified)
-      s = queue_.transfer(what + ": zero fill",
-                          [&](VkCommandBuffer cmd) { vkCmdFillBuffer(cmd, b.buffer, 0, VK_WHOLE_SIZE, 0); });
-    if (!s) {
-      memory_.destroy(b);
-      return s.error();
-    }
-    buffers_.push_back(std::move(b));
-    return BufferHandle{static_cast<std::uint32_t>(buffers_.size() - 1)};
+    if (Status s = ready("create_buffer '" + std::string(label) + "'"); !s) return s.error();
+    return buffers_.create(bytes, label);
   }
-
+  Status destroy_buffer(BufferHandle buffer) override {
+    if (Status s = ready("destroy_buffer"); !s) return s;
+    return buffers_.destroy(buffer);
+  }
+  Status resize_buffer(BufferHandle buffer, std::size_t bytes) override {
+    if (Status s = ready("resize_buffer"); !s) return s;
+    return buffers_.resize(buffer, bytes);
+  }
   Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
-    if (Status s = check_range(buffer, offset, bytes, "write_buffer"); !s) return s;
-    if (bytes == 0) return {};
-    const Buffer& b = buffers_[buffer.id];
-    const std::string what = "write_buffer '" + b.label + "'";
-    if (Status s = check_lost(what); !s) return s;
-    if (b.mapped) {  // no work is in flight between calls: every submission is waited for
-      std::memcpy(static_cast<std::byte*>(b.mapped) + offset, data, bytes);
-      return {};
-    }
-    if (Status s = memory_.ensure_staging(bytes, what); !s) return s;
-    const Buffer& staging = memory_.staging();
-    std::memcpy(staging.mapped, data, bytes);
-    const VkBufferCopy region{0, offset, bytes};
-    return queue_.transfer(what, [&](VkCommandBuffer cmd) { vkCmdCopyBuffer(cmd, staging.buffer, b.buffer, 1, &region); });
+    if (Status s = ready("write_buffer"); !s) return s;
+    return buffers_.write(buffer, offset, data, bytes);
+  }
+  Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
+    if (Status s = ready("read_buffer"); !s) return s;
+    return buffers_.read(buffer, offset, data, bytes);
   }
 
-  Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
-    if (Status s = check_range(buffer, offset, bytes, "read_buffer"); !s) return s;
-    if (bytes == 0) return {};
-    const Buffer& b = buffers_[buffer.id];
-    const std::string what = "read_buffer '" + b.label + "'";
-    if (Status s = check_lost(what); !s) return s;
-    if (b.mapped) {
-      std::memcpy(data, static_cast<const std::byte*>(b.mapped) + offset, bytes);
-      return {};
-    }
-    if (Status s = memory_.ensure_staging(bytes, what); !s) return s;
-    const Buffer& staging = memory_.staging();
-    const VkBufferCopy region{offset, 0, bytes};
-    if (Status s = queue_.transfer(what, [&](VkCommandBuffer cmd) { vkCmdCopyBuffer(cmd, b.buffer, staging.buffer, 1, &region); });
-        !s)
-      return s;
-    std::memcpy(data, staging.mapped, bytes);
-    return {};
-  }
+  // ---------------------------------------------------------------- programs
 
   Result<ProgramHandle> create_program(const FrameProgram& program) override {
-    if (Status s = check_program(program, static_cast<std::uint32_t>(buffers_.size())); !s) return s.error();
     if (Status s = check_lost("create_program"); !s) return s.error();
-    // Resolve the commands: pipelines (made on first use), one descriptor
-    // set per distinct tuple of bound buffers, barriers between dispatches only.
-    std::vector<Step> steps;
-    std::map<std::vector<std::uint32_t>, std::uint32_t> set_of;
-    std::vector<const std::vector<std::uint32_t>*> set_buffers;
-    std::uint32_t descriptors = 0;
-    std::size_t position = 0;
-    for (const auto& command : program.commands()) {
-      ++position;
-      const auto* d = std::get_if<Dispatch>(&command);
-      if (!d) {
-        if (!steps.empty() && steps.back().dispatch) steps.push_back({});
-        continue;
-      }
-      if (d->count == 0) continue;
-      auto pipe = pipelines_.pipeline(d->kernel);
-      if (!pipe) return pipe.error();
-      const std::uint32_t groups = (d->count + kLocalSize - 1) / kLocalSize;
-      if (groups > found_.properties.limits.maxComputeWorkGroupCount[0])
-        return Error("frame program command " + std::to_string(position) + " (" + std::string(kernel_name(d->kernel)) +
-                     "): " + std::to_string(d->count) + " work items exceed what " + found_.info.name +
-                     " dispatches at once (" + std::to_string(found_.properties.limits.maxComputeWorkGroupCount[0]) +
-                     " groups of " + std::to_string(kLocalSize) + ")");
-      std::vector<std::uint32_t> key;
-      for (std::uint32_t b = 0; b < d->binding_count; ++b) key.push_back(d->bindings[b].id);
-      auto [it, added] = set_of.emplace(std::move(key), static_cast<std::uint32_t>(set_buffers.size()));
-      if (added) {
-        set_buffers.push_back(&it->first);
-        descriptors += d->binding_count;
-      }
-      steps.push_back({d, it->second, groups});
-    }
-    if (!steps.empty() && !steps.back().dispatch) steps.pop_back();  // the closing barrier covers it
-
-    Program p;
-    Status s = recorder_.record(p, steps, set_buffers, descriptors, pipelines_, buffers_);
-    if (!s) {
-      recorder_.destroy(p);
-      return s.error();
-    }
+    auto p = std::make_unique<Program>();
+    p->source = program;
+    if (Status s = record(*p); !s) return s.error();
     programs_.push_back(std::move(p));
     return ProgramHandle{static_cast<std::uint32_t>(programs_.size() - 1)};
   }
 
-  Status run_program(ProgramHandle program) override {
-    if (program.id >= programs_.size()) return Error("run_program: not a program of this device");
-    if (Status s = check_lost("run_program"); !s) return s;
-    last_run_ = UINT32_MAX;
-    if (Status s = queue_.submit_and_wait(programs_[program.id].commands, "run_program"); !s) return s;
-    last_run_ = program.id;
+  Status destroy_program(ProgramHandle program) override {
+    if (!live_program(program)) return Error(ErrorCode::internal, "destroy_program: not a live program of this device");
+    if (Status s = drain(); !s) return s;  // it may be in flight
+    recorder_.destroy(programs_[program.id]->recording);
+    programs_[program.id].reset();
     return {};
   }
 
+  Status submit(ProgramHandle program) override {
+    if (!live_program(program)) return Error(ErrorCode::internal, "submit: not a live program of this device");
+    if (Status s = ready("submit"); !s) return s;
+    pending_ = false;  // one submission at a time: the previous one's counters are not checked
+    Program& p = *programs_[program.id];
+    if (p.recorded_at != buffers_.generation())
+      if (Status s = record(p); !s) return s;
+    if (Status s = queue_.submit(p.recording.commands, "submit"); !s) return s;
+    in_flight_ = program.id;
+    return {};
+  }
+
+  Status wait() override {
+    if (Status s = drain(); !s) return s;
+    if (!pending_) return {};
+    pending_ = false;
+    return pending_status_;
+  }
+
+  std::span<const std::uint32_t> counters() const override { return counters_; }
+
   Status last_run_times(DeviceTimes& out) const override {
-    out = {};
-    if (last_run_ >= programs_.size() || !programs_[last_run_].queries) return {};
-    return recorder_.read_times(programs_[last_run_], out);
+    out = times_;
+    return times_status_;
+  }
+
+  DeviceObjects objects() const override {
+    DeviceObjects o;
+    o.buffers = buffers_.live();
+    o.buffer_bytes = buffers_.live_bytes();
+    for (const auto& p : programs_) o.programs += p ? 1 : 0;
+    o.native = memory_.native() + recorder_.native();
+    return o;
   }
 
   bool validation() const { return instance_->validation; }
@@ -219,15 +178,57 @@ class VulkanDeviceImpl final : public Device {
   std::uint64_t make_deliberate_mistake() { return vulkan::make_deliberate_mistake(device_); }
 
  private:
-  Status check_range(BufferHandle buffer, std::size_t offset, std::size_t bytes, const char* what) const {
-    if (buffer.id >= buffers_.size()) return Error(std::string(what) + ": not a buffer of this device");
-    const Buffer& b = buffers_[buffer.id];
-    return check_buffer_range(b.label, b.bytes, offset, bytes, what);
+  // A frame program, its recording and the buffer generation it was recorded at.
+  struct Program {
+    FrameProgram source;  // kept to record again after a buffer is resized or destroyed
+    std::uint64_t recorded_at = 0;
+    Recording recording;
+  };
+
+  bool live_program(ProgramHandle program) const { return program.id < programs_.size() && programs_[program.id]; }
+
+  // Checks p against the device's buffers and records it afresh (at
+  // creation, and at a submit after a buffer was resized or destroyed: its
+  // descriptor sets point at VkBuffers). [pre] p is not in flight.
+  Status record(Program& p) {
+    recorder_.destroy(p.recording);
+    if (Status s = check_program(p.source, buffers_.sizes()); !s) return s;
+    auto plan = plan_program(p.source, pipelines_, found_.properties.limits, found_.info.name);
+    if (!plan) return plan.error();
+    Status s = recorder_.record(p.recording, *plan, p.source.counters(), pipelines_, buffers_.all());
+    if (!s) {
+      recorder_.destroy(p.recording);
+      return s;
+    }
+    p.recorded_at = buffers_.generation();
+    return {};
+  }
+
+  // Finishes the submission in flight, if any: reads its counters (checked
+  // against their capacities; wait() returns the result) and timestamps.
+  Status drain() {
+    if (in_flight_ == UINT32_MAX) return {};
+    const Program& p = *programs_[in_flight_];
+    in_flight_ = UINT32_MAX;
+    if (Status s = queue_.wait("waiting for the frame program"); !s) return s;
+    recorder_.read_counters(p.recording, counters_);
+    pending_status_ = check_counters(p.source.counters(), counters_);
+    pending_ = true;
+    times_status_ = recorder_.read_times(p.recording, times_);
+    return {};
+  }
+
+  // Nothing in flight and the device not lost: buffers may be touched and
+  // the queue used.
+  Status ready(const std::string& what) {
+    if (Status s = drain(); !s) return s;
+    return check_lost(what);
   }
 
   Status check_lost(const std::string& what) const {
     if (queue_.lost())
-      return Error(what + ": the Vulkan device " + found_.info.name + " was lost earlier (VK_ERROR_DEVICE_LOST)");
+      return Error(ErrorCode::device_lost,
+                   what + ": the Vulkan device " + found_.info.name + " was lost earlier (VK_ERROR_DEVICE_LOST)");
     return {};
   }
 
@@ -236,13 +237,18 @@ class VulkanDeviceImpl final : public Device {
   VkDevice device_ = VK_NULL_HANDLE;
   // The pieces release what they own when the destructor says so: after
   // vkDeviceWaitIdle, before vkDestroyDevice.
+  Memory memory_;            // the staging buffer
   Recorder recorder_;        // the program command pool
   Queue queue_;              // the queue, fence and transfer command buffer
-  Memory memory_;            // the staging buffer
   PipelineCache pipelines_;  // pipelines and set layouts
-  std::vector<Buffer> buffers_;
-  std::vector<Program> programs_;
-  std::uint32_t last_run_ = UINT32_MAX;
+  BufferTable buffers_;
+  std::vector<std::unique_ptr<Program>> programs_;  // nullptr: destroyed (ids are never reused)
+  std::uint32_t in_flight_ = UINT32_MAX;  // the program submitted and not yet waited for
+  bool pending_ = false;                  // a finished submission whose counter check wait() has not returned
+  Status pending_status_;
+  std::vector<std::uint32_t> counters_;  // of the last program waited for
+  DeviceTimes times_;                    // its timestamps, read when it was waited for
+  Status times_status_;
 };
 
 }  // namespace vulkan
@@ -266,11 +272,12 @@ Result<std::unique_ptr<Device>> make_vulkan_device(const DeviceOptions& options)
 std::uint64_t vulkan_validation_messages() { return vulkan::validation_messages(); }
 
 Result<std::uint64_t> vulkan_validation_self_test(const DeviceOptions& options) {
-  if (!vulkan::validation_requested()) return Error("Vulkan validation is off (set SINEW_VULKAN_VALIDATION=1)");
+  if (!vulkan::validation_requested()) return Error(ErrorCode::backend_unavailable, "Vulkan validation is off (set SINEW_VULKAN_VALIDATION=1)");
   auto device = std::make_unique<vulkan::VulkanDeviceImpl>();
   if (Status s = device->init(options); !s) return s.error();
   if (!device->validation())
-    return Error(std::string("Vulkan validation is off: ") + vulkan::kValidationLayer + " is not installed");
+    return Error(ErrorCode::backend_unavailable,
+                 std::string("Vulkan validation is off: ") + vulkan::kValidationLayer + " is not installed");
   return device->make_deliberate_mistake();
 }
 

@@ -1,8 +1,11 @@
 // vulkan_device.h — the Vulkan compute backend: headless, compute only,
 // Vulkan 1.2 (any GPU driver; Mesa's lavapipe on a CPU). Kernels
-// (kernels/glsl/*.comp) are compiled to SPIR-V at build time and embedded.
-// A frame program is recorded once into a command buffer and replayed by
-// every run_program (one submit, one fence wait).
+// (kernels/gpu/*.gpu) are compiled to SPIR-V at build time and embedded.
+// A frame program is recorded once into a command buffer (again after a
+// buffer it may bind is resized or destroyed) and replayed by every submit;
+// wait() is one fence wait, after which the counters, copied at the end of
+// the frame into mapped memory, are checked. Indirect dispatches are true
+// vkCmdDispatchIndirect calls (vulkan_recording.cpp).
 //
 // Environment variables:
 //   SINEW_VULKAN_VALIDATION=1  every instance enables VK_LAYER_KHRONOS_validation

@@ -78,7 +78,7 @@ Instance::~Instance() {
 Result<std::unique_ptr<Instance>> make_instance() {
   std::uint32_t loader = 0;
   if (vkEnumerateInstanceVersion(&loader) != VK_SUCCESS || loader < VK_API_VERSION_1_2)
-    return Error("the Vulkan loader supports Vulkan " + std::to_string(VK_API_VERSION_MAJOR(loader)) + "." +
+    return Error(ErrorCode::backend_unavailable, "the Vulkan loader supports Vulkan " + std::to_string(VK_API_VERSION_MAJOR(loader)) + "." +
                  std::to_string(VK_API_VERSION_MINOR(loader)) + "; sinew needs 1.2");
   auto inst = std::make_unique<Instance>();
   inst->validation = validation_requested() && has_validation_layer();
@@ -111,12 +111,12 @@ Result<std::unique_ptr<Instance>> make_instance() {
   }
   if (VkResult r = vkCreateInstance(&info, nullptr, &inst->instance); r != VK_SUCCESS) {
     inst->instance = VK_NULL_HANDLE;
-    return vk_error("vkCreateInstance", r);
+    return vk_error("vkCreateInstance", r, ErrorCode::backend_unavailable);
   }
   if (inst->validation) {
     auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(inst->instance, "vkCreateDebugUtilsMessengerEXT"));
-    if (!create) return Error("vkGetInstanceProcAddr(vkCreateDebugUtilsMessengerEXT) found nothing");
+    if (!create) return Error(ErrorCode::internal, "vkGetInstanceProcAddr(vkCreateDebugUtilsMessengerEXT) found nothing");
     if (VkResult r = create(inst->instance, &messenger, nullptr, &inst->messenger); r != VK_SUCCESS) {
       inst->messenger = VK_NULL_HANDLE;
       return vk_error("vkCreateDebugUtilsMessengerEXT", r);

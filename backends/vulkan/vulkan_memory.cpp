@@ -34,7 +34,7 @@ Result<std::uint32_t> Memory::memory_type(std::uint32_t type_bits, VkMemoryPrope
   for (VkMemoryPropertyFlags want : {preferred, required})
     for (std::uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
       if ((type_bits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & want) == want) return i;
-  return Error("no memory type with properties " + std::to_string(required));
+  return Error(ErrorCode::internal, "no memory type with properties " + std::to_string(required));
 }
 
 Status Memory::make_buffer(Buffer& b, VkBufferUsageFlags usage, VkMemoryPropertyFlags required,
@@ -47,10 +47,11 @@ Status Memory::make_buffer(Buffer& b, VkBufferUsageFlags usage, VkMemoryProperty
     b.buffer = VK_NULL_HANDLE;
     return vk_error(what + ": vkCreateBuffer (" + std::to_string(b.size) + " bytes)", r);
   }
+  ++native_;
   VkMemoryRequirements needs{};
   vkGetBufferMemoryRequirements(device_, b.buffer, &needs);
   auto type = memory_type(needs.memoryTypeBits, required, preferred);
-  if (!type) return Error(what + ": " + type.error().message());
+  if (!type) return Error(ErrorCode::internal, what + ": " + type.error().message());
   auto alloc = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
   alloc.allocationSize = needs.size;
   alloc.memoryTypeIndex = *type;
@@ -58,6 +59,7 @@ Status Memory::make_buffer(Buffer& b, VkBufferUsageFlags usage, VkMemoryProperty
     b.memory = VK_NULL_HANDLE;
     return vk_error(what + ": vkAllocateMemory (" + std::to_string(needs.size) + " bytes)", r);
   }
+  ++native_;
   if (VkResult r = vkBindBufferMemory(device_, b.buffer, b.memory, 0); r != VK_SUCCESS)
     return vk_error(what + ": vkBindBufferMemory", r);
   if (required & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)
@@ -69,9 +71,19 @@ Status Memory::make_buffer(Buffer& b, VkBufferUsageFlags usage, VkMemoryProperty
 }
 
 void Memory::destroy(Buffer& b) {
-  if (b.buffer) vkDestroyBuffer(device_, b.buffer, nullptr);
-  if (b.memory) vkFreeMemory(device_, b.memory, nullptr);  // unmaps too
+  if (b.buffer) {
+    vkDestroyBuffer(device_, b.buffer, nullptr);
+    --native_;
+  }
+  if (b.memory) {
+    vkFreeMemory(device_, b.memory, nullptr);  // unmaps too
+    --native_;
+  }
   b = Buffer{};
+}
+
+std::uint32_t Memory::native() const {
+  return native_ - (staging_.buffer ? 1 : 0) - (staging_.memory ? 1 : 0);
 }
 
 Status Memory::ensure_staging(std::size_t bytes, const std::string& what) {
@@ -121,13 +133,18 @@ Status Queue::submit(VkCommandBuffer commands, const std::string& what) {
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &commands;
   const VkResult r = vkQueueSubmit(queue_, 1, &submit, fence_);
-  if (r == VK_SUCCESS) return {};
+  if (r == VK_SUCCESS) {
+    in_flight_ = true;
+    return {};
+  }
   lost_ = lost_ || r == VK_ERROR_DEVICE_LOST;
   return vk_error(what + ": vkQueueSubmit", r);
 }
 
 Status Queue::wait(const std::string& what) {
+  if (!in_flight_) return {};
   VkResult r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
+  in_flight_ = false;  // after a failure too: the device is lost, or the fence with it
   if (r != VK_SUCCESS) {
     lost_ = lost_ || r == VK_ERROR_DEVICE_LOST;
     return vk_error(what + ": vkWaitForFences", r);

@@ -1,7 +1,8 @@
 // vulkan_memory.h — device memory and moving data to and from it: buffers
-// (memory type choice, allocation, mapping), the staging buffer, the compute
-// queue with its one fence (every call that waits does so on it, so at most
-// one submission is in flight), and the one-shot transfer command buffer.
+// (memory type choice, allocation, mapping, and the count of what is
+// allocated), the staging buffer, the compute queue with its one fence
+// (every submission signals it, so at most one is in flight), and the
+// one-shot transfer command buffer.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -61,6 +62,10 @@ class Memory {
   /// Releases b's buffer and memory (unmapping it) and empties b.
   void destroy(Buffer& b);
 
+  /// VkBuffers and VkDeviceMemory allocations made and not yet released,
+  /// leaving out the staging buffer (the device's own).
+  std::uint32_t native() const;
+
   /// Grows the staging buffer to at least `bytes` (whole 64 KiB, at least 1 MiB).
   Status ensure_staging(std::size_t bytes, const std::string& what);
   const Buffer& staging() const { return staging_; }
@@ -69,6 +74,7 @@ class Memory {
   VkDevice device_ = VK_NULL_HANDLE;
   VkPhysicalDeviceMemoryProperties memory_{};
   bool unified_ = false;  // buffers in host-visible device memory, mapped
+  std::uint32_t native_ = 0;  // VkBuffer and VkDeviceMemory objects alive
   Buffer staging_;
 };
 
@@ -89,14 +95,17 @@ class Queue {
   /// A submission or wait returned VK_ERROR_DEVICE_LOST.
   bool lost() const { return lost_; }
 
-  /// Submits `commands`, signalling the fence. [pre] nothing in flight.
+  /// Submits `commands`, signalling the fence, and returns. [pre] nothing in flight.
   Status submit(VkCommandBuffer commands, const std::string& what);
-  /// Waits for the fence, then resets it.
+  /// A submission signals the fence and has not been waited for.
+  bool in_flight() const { return in_flight_; }
+  /// Waits for the fence, then resets it; nothing in flight: returns at once.
   Status wait(const std::string& what);
   Status submit_and_wait(VkCommandBuffer commands, const std::string& what);
 
   /// Records `copy` between barriers that order it after every earlier
   /// dispatch and transfer and before every later one, submits, waits.
+  /// [pre] nothing in flight.
   template <class Record>
   Status transfer(const std::string& what, Record copy) {
     auto cmd = begin_transfer(what);
@@ -115,6 +124,7 @@ class Queue {
   VkCommandPool transfer_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer transfer_commands_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
+  bool in_flight_ = false;
   bool lost_ = false;
 };
 

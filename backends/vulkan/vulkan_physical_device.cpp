@@ -29,10 +29,10 @@ std::string version_string(std::uint32_t v) {
 Result<std::vector<Found>> find_devices(VkInstance instance) {
   std::uint32_t n = 0;
   if (VkResult r = vkEnumeratePhysicalDevices(instance, &n, nullptr); r != VK_SUCCESS)
-    return vk_error("vkEnumeratePhysicalDevices", r);
+    return vk_error("vkEnumeratePhysicalDevices", r, ErrorCode::backend_unavailable);
   std::vector<VkPhysicalDevice> physical(n);
   if (VkResult r = vkEnumeratePhysicalDevices(instance, &n, physical.data()); r != VK_SUCCESS && r != VK_INCOMPLETE)
-    return vk_error("vkEnumeratePhysicalDevices", r);
+    return vk_error("vkEnumeratePhysicalDevices", r, ErrorCode::backend_unavailable);
   std::vector<Found> found;
   for (VkPhysicalDevice p : physical) {
     Found f;
@@ -59,7 +59,8 @@ Result<std::vector<Found>> find_devices(VkInstance instance) {
               type == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU || type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU};
     found.push_back(f);
   }
-  if (found.empty()) return Error("Vulkan found no device with Vulkan 1.2 and a compute queue");
+  if (found.empty())
+    return Error(ErrorCode::backend_unavailable, "Vulkan found no device with Vulkan 1.2 and a compute queue");
   return found;
 }
 

@@ -5,6 +5,8 @@
 // its parameter struct.
 #include "backends/vulkan/vulkan_pipelines.h"
 
+#include <algorithm>
+
 #include "backends/kernel_table.h"
 #include "backends/vulkan/vulkan_common.h"
 
@@ -13,6 +15,8 @@ namespace sinew::vulkan {
 void PipelineCache::init(const Found& found, VkDevice device) {
   device_ = device;
   max_storage_buffers_ = found.properties.limits.maxPerStageDescriptorStorageBuffers;
+  max_group_size_ = std::min(found.properties.limits.maxComputeWorkGroupSize[0],
+                             found.properties.limits.maxComputeWorkGroupInvocations);
   device_name_ = found.info.name;
 }
 
@@ -50,12 +54,17 @@ Result<const Pipeline*> PipelineCache::pipeline(Kernel kernel) {
   const KernelSignature& sig = kernel_signature(kernel);
   const std::string name(sig.name);
   const std::span<const std::uint32_t> spirv = embedded_spirv(sig.name);
-  // Only when kernels/glsl is out of step with the kernel table (a test
+  // Only when the build is out of step with the kernel registry (a test
   // makes every kernel's pipeline): an error, not a skipped test.
-  if (spirv.empty()) return Error("internal: the embedded SPIR-V has no kernel " + name);
+  if (spirv.empty()) return Error(ErrorCode::internal, "the embedded SPIR-V has no kernel " + name);
   if (sig.bindings > max_storage_buffers_)
-    return Error("kernel " + name + " binds " + std::to_string(sig.bindings) + " storage buffers; " + device_name_ +
-                 " allows " + std::to_string(max_storage_buffers_));
+    return Error(ErrorCode::backend_unavailable, "kernel " + name + " binds " + std::to_string(sig.bindings) +
+                                                     " storage buffers; " + device_name_ + " allows " +
+                                                     std::to_string(max_storage_buffers_));
+  if (launch_group_size(kernel) > max_group_size_)
+    return Error(ErrorCode::backend_unavailable, "kernel " + name + " runs in groups of " +
+                                                     std::to_string(launch_group_size(kernel)) + "; " + device_name_ +
+                                                     " allows at most " + std::to_string(max_group_size_));
   auto set = set_layout(sig.bindings);
   if (!set) return set.error();
   if (!p.layout) {

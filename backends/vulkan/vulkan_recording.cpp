@@ -1,31 +1,67 @@
-// vulkan_recording.cpp — recording frame programs, and their timestamps.
+// vulkan_recording.cpp — recording frame programs; their counters and timestamps.
 //
-// create_program records the whole frame once into a command buffer: per
-// dispatch bind pipeline, descriptor set and push constants, then
-// vkCmdDispatch(ceil(count / 64)); per Barrier one compute -> compute
-// memory barrier (shader writes -> shader reads and writes). Descriptor sets
-// are allocated and written at create_program time, one per distinct tuple
-// of bound buffers, from the program's own pool. The recording opens with a
-// barrier after earlier transfers and dispatches and closes with one that
-// makes the shader writes visible to the host and to transfers. run_program
-// submits the command buffer and waits on the fence once.
+// A frame program is recorded once into a command buffer (again only after
+// a buffer it may bind was resized or destroyed) and every submission
+// replays it. Descriptor sets are allocated and written at recording time,
+// one per distinct tuple of bound buffers (vulkan_program.cpp), from the
+// program's own descriptor pool.
+//
+// Commands. A dispatch binds its pipeline, descriptor set and push
+// constants (its parameter struct) and launches ceil(count /
+// launch_group_size(kernel)) groups; a Fill is vkCmdFillBuffer and a Copy
+// vkCmdCopyBuffer (offsets and sizes in words * 4). A Barrier is one global
+// memory barrier from every stage a command runs in (compute shader,
+// transfer, indirect-command read) to all of them, covering shader and
+// transfer writes against every later read or write (full_barrier). The
+// recording opens with the same barrier, which orders it after the previous
+// submission and the transfers of write_buffer (host writes are made
+// visible by the submission itself).
+//
+// Indirect dispatch (a dispatch whose count is a counter word, read when it
+// runs; `count` is its capacity) is a true vkCmdDispatchIndirect. Each
+// indirect dispatch of a program owns a 3-word slot of the program's
+// indirect-arguments buffer (STORAGE | INDIRECT_BUFFER usage). The segment
+// of the program holding it (the commands between two barriers) is
+// preceded by one dispatch of the built-in registry kernel indirect_args
+// per indirect dispatch: over one item, binding the counter's buffer and
+// the arguments buffer, with IndirectArgsParams {counter word, capacity,
+// launch_group_size(kernel), 3 * slot}; it writes (ceil(min(count,
+// capacity) / group size), 1, 1) into the slot. Then one barrier (shader
+// writes -> indirect-command reads, DRAW_INDIRECT stage), and in the
+// segment vkCmdDispatchIndirect(args, 12 * slot). So an indirect dispatch
+// launches exactly the groups that cover its count, never more than its
+// capacity's, and the kernel still guards items past the count itself.
+// The counter must have been written before the barrier that precedes the
+// segment (the contract of FrameProgram::dispatch_indirect).
+//
+// Counters. At the end of the recording a barrier (shader and transfer
+// writes -> transfer reads) precedes one vkCmdCopyBuffer per declared
+// counter word into the program's read-back buffer (host-visible, coherent,
+// mapped), and the closing barrier makes every write of the frame visible
+// to the host (transfer and shader writes -> host reads). So wait() reads
+// the counters from mapped memory once the fence has signalled, with no
+// extra submission.
 //
 // Timestamps (when the queue has them) are written before and after every
-// dispatch and read only when asked (last_run_times). On a CPU device
-// (lavapipe) each one costs a flush of the rasterizer threads, tens of
-// microseconds, so there they are off unless SINEW_VULKAN_TIMESTAMPS=1;
-// SINEW_VULKAN_TIMESTAMPS=0 turns them off everywhere.
+// dispatch of the program (not around the built-in indirect_args ones) and
+// read when a submission is waited for. On a CPU device (lavapipe) each one
+// costs a flush of the rasterizer threads, tens of microseconds, so there
+// they are off unless SINEW_VULKAN_TIMESTAMPS=1; SINEW_VULKAN_TIMESTAMPS=0
+// turns them off everywhere.
 #include "backends/vulkan/vulkan_recording.h"
 
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
+#include "backends/kernel_table.h"
 #include "backends/vulkan/vulkan_common.h"
 
 namespace sinew::vulkan {
 
-Status Recorder::init(const Found& found, VkDevice device) {
+Status Recorder::init(const Found& found, VkDevice device, Memory& memory) {
   device_ = device;
+  memory_ = &memory;
   const VkPhysicalDeviceType type = found.properties.deviceType;
   const char* stamps = std::getenv("SINEW_VULKAN_TIMESTAMPS");
   timestamps_ = found.timestamps && (stamps && *stamps ? std::string(stamps) != "0" : type != VK_PHYSICAL_DEVICE_TYPE_CPU);
@@ -43,132 +79,206 @@ void Recorder::destroy() {
   program_pool_ = VK_NULL_HANDLE;
 }
 
-void Recorder::destroy(Program& p) {
-  if (p.commands) vkFreeCommandBuffers(device_, program_pool_, 1, &p.commands);
-  if (p.pool) vkDestroyDescriptorPool(device_, p.pool, nullptr);
-  if (p.queries) vkDestroyQueryPool(device_, p.queries, nullptr);
-  p = Program{};
+void Recorder::destroy(Recording& r) {
+  if (r.commands) {
+    vkFreeCommandBuffers(device_, program_pool_, 1, &r.commands);
+    --native_;
+  }
+  if (r.pool) {
+    vkDestroyDescriptorPool(device_, r.pool, nullptr);  // frees its sets
+    --native_;
+  }
+  if (r.queries) {
+    vkDestroyQueryPool(device_, r.queries, nullptr);
+    --native_;
+  }
+  memory_->destroy(r.args);
+  memory_->destroy(r.readback);
+  r = Recording{};
 }
 
-Result<std::vector<VkDescriptorSet>> Recorder::descriptor_sets(Program& p,
-                                                               std::span<const std::vector<std::uint32_t>* const> set_buffers,
-                                                               std::uint32_t descriptors, const PipelineCache& pipelines,
-                                                               std::span<const Buffer> buffers) {
-  std::vector<VkDescriptorSet> sets(set_buffers.size());
-  if (!sets.empty()) {
-    const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, descriptors};
-    auto info = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
-    info.maxSets = static_cast<std::uint32_t>(sets.size());
-    info.poolSizeCount = 1;
-    info.pPoolSizes = &size;
-    if (VkResult r = vkCreateDescriptorPool(device_, &info, nullptr, &p.pool); r != VK_SUCCESS) {
-      p.pool = VK_NULL_HANDLE;
-      return vk_error("create_program: vkCreateDescriptorPool", r);
-    }
-    std::vector<VkDescriptorSetLayout> layouts;
-    for (const auto* bound : set_buffers) layouts.push_back(pipelines.made_set_layout(bound->size()));
-    auto alloc = vk_struct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
-    alloc.descriptorPool = p.pool;
-    alloc.descriptorSetCount = static_cast<std::uint32_t>(layouts.size());
-    alloc.pSetLayouts = layouts.data();
-    if (VkResult r = vkAllocateDescriptorSets(device_, &alloc, sets.data()); r != VK_SUCCESS)
-      return vk_error("create_program: vkAllocateDescriptorSets", r);
-    std::vector<VkDescriptorBufferInfo> infos;
-    infos.reserve(descriptors);  // the writes point into it
-    std::vector<VkWriteDescriptorSet> writes;
-    for (std::size_t s = 0; s < sets.size(); ++s) {
-      for (std::size_t b = 0; b < set_buffers[s]->size(); ++b) {
-        infos.push_back({buffers[(*set_buffers[s])[b]].buffer, 0, VK_WHOLE_SIZE});
-        auto w = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
-        w.dstSet = sets[s];
-        w.dstBinding = static_cast<std::uint32_t>(b);
-        w.descriptorCount = 1;
-        w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        w.pBufferInfo = &infos.back();
-        writes.push_back(w);
-      }
-    }
-    vkUpdateDescriptorSets(device_, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+Status Recorder::make_buffers(Recording& r, const Plan& plan, std::size_t counters) {
+  if (plan.slots > 0) {
+    r.args.label = "indirect arguments";
+    r.args.size = (std::uint64_t{plan.slots} * 12 + 63) / 64 * 64;
+    r.args.bytes = r.args.size;
+    if (Status s = memory_->make_buffer(r.args, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                                        0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "recording the frame program: indirect arguments");
+        !s)
+      return s;
   }
+  r.counters = static_cast<std::uint32_t>(counters);
+  if (counters > 0) {
+    r.readback.label = "counter read-back";
+    r.readback.size = (counters * 4 + 63) / 64 * 64;
+    r.readback.bytes = r.readback.size;
+    if (Status s = memory_->make_buffer(r.readback, VK_BUFFER_USAGE_TRANSFER_DST_BIT, kStaging,
+                                        kStaging | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, "recording the frame program: counter read-back");
+        !s)
+      return s;
+    std::memset(r.readback.mapped, 0, r.readback.size);
+  }
+  return {};
+}
+
+Result<std::vector<VkDescriptorSet>> Recorder::descriptor_sets(Recording& r, const Plan& plan,
+                                                               const PipelineCache& pipelines,
+                                                               std::span<const Buffer> buffers) {
+  std::vector<VkDescriptorSet> sets(plan.sets.size());
+  if (sets.empty()) return sets;
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, plan.descriptors};
+  auto info = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
+  info.maxSets = static_cast<std::uint32_t>(sets.size());
+  info.poolSizeCount = 1;
+  info.pPoolSizes = &size;
+  if (VkResult res = vkCreateDescriptorPool(device_, &info, nullptr, &r.pool); res != VK_SUCCESS) {
+    r.pool = VK_NULL_HANDLE;
+    return vk_error("recording the frame program: vkCreateDescriptorPool", res);
+  }
+  ++native_;
+  std::vector<VkDescriptorSetLayout> layouts;
+  for (const auto& bound : plan.sets) layouts.push_back(pipelines.made_set_layout(bound.size()));
+  auto alloc = vk_struct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
+  alloc.descriptorPool = r.pool;
+  alloc.descriptorSetCount = static_cast<std::uint32_t>(layouts.size());
+  alloc.pSetLayouts = layouts.data();
+  if (VkResult res = vkAllocateDescriptorSets(device_, &alloc, sets.data()); res != VK_SUCCESS)
+    return vk_error("recording the frame program: vkAllocateDescriptorSets", res);
+  std::vector<VkDescriptorBufferInfo> infos;
+  infos.reserve(plan.descriptors);  // the writes point into it
+  std::vector<VkWriteDescriptorSet> writes;
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    for (std::size_t b = 0; b < plan.sets[s].size(); ++b) {
+      const std::uint32_t id = plan.sets[s][b];
+      infos.push_back({id == kArgsBufferId ? r.args.buffer : buffers[id].buffer, 0, VK_WHOLE_SIZE});
+      auto w = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+      w.dstSet = sets[s];
+      w.dstBinding = static_cast<std::uint32_t>(b);
+      w.descriptorCount = 1;
+      w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      w.pBufferInfo = &infos.back();
+      writes.push_back(w);
+    }
+  }
+  vkUpdateDescriptorSets(device_, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
   return sets;
 }
 
-Status Recorder::record(Program& p, std::span<const Step> steps,
-                        std::span<const std::vector<std::uint32_t>* const> set_buffers, std::uint32_t descriptors,
+Status Recorder::record(Recording& r, const Plan& plan, std::span<const Counter> counters,
                         const PipelineCache& pipelines, std::span<const Buffer> buffers) {
-  auto made_sets = descriptor_sets(p, set_buffers, descriptors, pipelines, buffers);
+  if (Status s = make_buffers(r, plan, counters.size()); !s) return s;
+  auto made_sets = descriptor_sets(r, plan, pipelines, buffers);
   if (!made_sets) return made_sets.error();
-  const std::vector<VkDescriptorSet>& sets = *made_sets;
 
-  std::uint32_t dispatches = 0;
-  for (const Step& s : steps) dispatches += s.dispatch ? 1 : 0;
-  if (timestamps_ && dispatches > 0) {
+  if (timestamps_ && plan.dispatches > 0) {
     auto info = vk_struct<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
     info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    info.queryCount = 2 * dispatches;
-    if (VkResult r = vkCreateQueryPool(device_, &info, nullptr, &p.queries); r != VK_SUCCESS) {
-      p.queries = VK_NULL_HANDLE;
-      return vk_error("create_program: vkCreateQueryPool", r);
+    info.queryCount = 2 * plan.dispatches;
+    if (VkResult res = vkCreateQueryPool(device_, &info, nullptr, &r.queries); res != VK_SUCCESS) {
+      r.queries = VK_NULL_HANDLE;
+      return vk_error("recording the frame program: vkCreateQueryPool", res);
     }
+    ++native_;
   }
 
   auto alloc = vk_struct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
   alloc.commandPool = program_pool_;
   alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   alloc.commandBufferCount = 1;
-  if (VkResult r = vkAllocateCommandBuffers(device_, &alloc, &p.commands); r != VK_SUCCESS) {
-    p.commands = VK_NULL_HANDLE;
-    return vk_error("create_program: vkAllocateCommandBuffers", r);
+  if (VkResult res = vkAllocateCommandBuffers(device_, &alloc, &r.commands); res != VK_SUCCESS) {
+    r.commands = VK_NULL_HANDLE;
+    return vk_error("recording the frame program: vkAllocateCommandBuffers", res);
   }
-  const VkCommandBuffer cmd = p.commands;
+  ++native_;
+  const VkCommandBuffer cmd = r.commands;
   const auto begin = vk_struct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
-  if (VkResult r = vkBeginCommandBuffer(cmd, &begin); r != VK_SUCCESS)
-    return vk_error("create_program: vkBeginCommandBuffer", r);
-  if (p.queries) vkCmdResetQueryPool(cmd, p.queries, 0, 2 * dispatches);
-  // After the previous frame's dispatches and any transfer (host writes are
-  // made visible by the submission itself).
-  memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                 VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                 VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  VkPipeline bound = VK_NULL_HANDLE;
-  for (const Step& s : steps) {
-    if (!s.dispatch) {
-      memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-      continue;
-    }
-    const Dispatch& d = *s.dispatch;
-    const Pipeline& pipe = pipelines.made_pipeline(d.kernel);
-    if (pipe.pipeline != bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, bound = pipe.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.layout, 0, 1, &sets[s.set], 0, nullptr);
-    vkCmdPushConstants(cmd, pipe.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, d.params_bytes, d.params);
-    const auto query = static_cast<std::uint32_t>(2 * p.timed.size());
-    if (p.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.queries, query);
-    vkCmdDispatch(cmd, s.groups, 1, 1);
-    if (p.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.queries, query + 1);
-    p.timed.push_back(d.kernel);
-  }
-  // Shader writes visible to read_buffer: mapped memory (host) or a staged copy (transfer).
-  memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                 VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                 VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
-  if (VkResult r = vkEndCommandBuffer(cmd); r != VK_SUCCESS) return vk_error("create_program: vkEndCommandBuffer", r);
-  if (!p.queries) p.timed.clear();
+  if (VkResult res = vkBeginCommandBuffer(cmd, &begin); res != VK_SUCCESS)
+    return vk_error("recording the frame program: vkBeginCommandBuffer", res);
+  if (r.queries) vkCmdResetQueryPool(cmd, r.queries, 0, 2 * plan.dispatches);
+  full_barrier(cmd);  // after the previous submission and any transfer
+  std::vector<Kernel> timed;
+  record_steps(r, cmd, plan, *made_sets, pipelines, buffers, timed);
+  record_counter_reads(r, cmd, counters, buffers);
+  // Every write of the frame visible to the host: read_buffer of mapped
+  // memory, the counters (staged reads and later frames order themselves
+  // with their own opening barriers).
+  memory_barrier(cmd, kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+  if (VkResult res = vkEndCommandBuffer(cmd); res != VK_SUCCESS)
+    return vk_error("recording the frame program: vkEndCommandBuffer", res);
+  if (r.queries) r.timed = std::move(timed);
   return {};
 }
 
-Status Recorder::read_times(const Program& p, DeviceTimes& out) const {
+void Recorder::record_steps(const Recording& r, VkCommandBuffer cmd, const Plan& plan,
+                            std::span<const VkDescriptorSet> sets, const PipelineCache& pipelines,
+                            std::span<const Buffer> buffers, std::vector<Kernel>& timed) {
+  VkPipeline bound = VK_NULL_HANDLE;
+  auto bind = [&](Kernel kernel, std::uint32_t set, const void* params, std::uint32_t params_bytes) {
+    const Pipeline& pipe = pipelines.made_pipeline(kernel);
+    if (pipe.pipeline != bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, bound = pipe.pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.layout, 0, 1, &sets[set], 0, nullptr);
+    vkCmdPushConstants(cmd, pipe.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, params_bytes, params);
+  };
+  for (const Step& s : plan.steps) {
+    switch (s.kind) {
+      case Step::Kind::barrier: full_barrier(cmd); break;
+      case Step::Kind::args_barrier:
+        memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+        break;
+      case Step::Kind::fill: vkCmdFillBuffer(cmd, buffers[s.target].buffer, s.target_offset, s.bytes, s.value); break;
+      case Step::Kind::copy: {
+        const VkBufferCopy region{s.source_offset, s.target_offset, s.bytes};
+        vkCmdCopyBuffer(cmd, buffers[s.source].buffer, buffers[s.target].buffer, 1, &region);
+        break;
+      }
+      case Step::Kind::indirect_args:
+        bind(Kernel::indirect_args, s.set, &s.args, sizeof s.args);
+        vkCmdDispatch(cmd, 1, 1, 1);
+        break;
+      case Step::Kind::dispatch: {
+        const Dispatch& d = *s.dispatch;
+        bind(d.kernel, s.set, d.params, d.params_bytes);
+        const auto query = static_cast<std::uint32_t>(2 * timed.size());
+        if (r.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r.queries, query);
+        if (s.slot != UINT32_MAX) vkCmdDispatchIndirect(cmd, r.args.buffer, VkDeviceSize{12} * s.slot);
+        else vkCmdDispatch(cmd, s.groups, 1, 1);
+        if (r.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r.queries, query + 1);
+        timed.push_back(d.kernel);
+        break;
+      }
+    }
+  }
+}
+
+void Recorder::record_counter_reads(const Recording& r, VkCommandBuffer cmd, std::span<const Counter> counters,
+                                    std::span<const Buffer> buffers) {
+  if (counters.empty()) return;
+  memory_barrier(cmd, kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+  for (std::size_t c = 0; c < counters.size(); ++c) {
+    const VkBufferCopy region{VkDeviceSize{counters[c].word} * 4, VkDeviceSize{c} * 4, 4};
+    vkCmdCopyBuffer(cmd, buffers[counters[c].buffer.id].buffer, r.readback.buffer, 1, &region);
+  }
+}
+
+void Recorder::read_counters(const Recording& r, std::vector<std::uint32_t>& values) const {
+  values.resize(r.counters);
+  if (r.counters) std::memcpy(values.data(), r.readback.mapped, std::size_t{r.counters} * 4);
+}
+
+Status Recorder::read_times(const Recording& r, DeviceTimes& out) {
+  out = {};
+  if (!r.queries || r.timed.empty()) return {};
   // Two timestamps per dispatch, read into storage kept between frames.
-  stamps_.resize(2 * p.timed.size());
-  if (stamps_.empty()) return {};
-  const VkResult r = vkGetQueryPoolResults(device_, p.queries, 0, static_cast<std::uint32_t>(stamps_.size()),
-                                           stamps_.size() * sizeof(std::uint64_t), stamps_.data(),
-                                           sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
-  if (r != VK_SUCCESS) return vk_error("vkGetQueryPoolResults", r);
+  stamps_.resize(2 * r.timed.size());
+  const VkResult res = vkGetQueryPoolResults(device_, r.queries, 0, static_cast<std::uint32_t>(stamps_.size()),
+                                             stamps_.size() * sizeof(std::uint64_t), stamps_.data(),
+                                             sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+  if (res != VK_SUCCESS) return vk_error("vkGetQueryPoolResults", res);
   out.timed = true;
   out.span_ms = ticks_to_ms(stamps_.back() - stamps_.front());
-  for (std::size_t i = 0; i < p.timed.size(); ++i) {
-    const auto k = static_cast<std::size_t>(p.timed[i]);
+  for (std::size_t i = 0; i < r.timed.size(); ++i) {
+    const auto k = static_cast<std::size_t>(r.timed[i]);
     out.kernel_ms[k] += ticks_to_ms(stamps_[2 * i + 1] - stamps_[2 * i]);
     ++out.dispatches[k];
   }

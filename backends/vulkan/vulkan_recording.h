@@ -1,6 +1,7 @@
 // vulkan_recording.h — a frame program recorded once into a command buffer
-// (its descriptor pool and sets, barriers and dispatches) and replayed by
-// every run_program; and the timestamps written around its dispatches.
+// (its descriptor pool and sets, indirect-arguments and counter read-back
+// buffers, barriers, fills, copies and dispatches) and replayed by every
+// submission; the counters and timestamps read after it.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -9,30 +10,27 @@
 #include <span>
 #include <vector>
 
+#include "backends/backend.h"
 #include "backends/vulkan/vulkan_memory.h"
 #include "backends/vulkan/vulkan_physical_device.h"
 #include "backends/vulkan/vulkan_pipelines.h"
-#include "backends/backend.h"
+#include "backends/vulkan/vulkan_program.h"
 
 namespace sinew::vulkan {
 
-/// One step of a recording: a dispatch, or a barrier between dispatches.
-struct Step {
-  const Dispatch* dispatch = nullptr;  // nullptr: a barrier
-  std::uint32_t set = 0;               // index into the descriptor sets (set_buffers of record)
-  std::uint32_t groups = 0;            // work groups
-};
-
-/// A recorded frame program; released by Recorder::destroy.
-struct Program {
+/// What a recorded frame program holds; released by Recorder::destroy.
+struct Recording {
   VkCommandBuffer commands = VK_NULL_HANDLE;
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkQueryPool queries = VK_NULL_HANDLE;  // two timestamps per dispatch
   std::vector<Kernel> timed;             // the kernel of each timed dispatch
+  Buffer args;                           // indirect dispatch arguments: 3 words per slot
+  Buffer readback;                       // host-visible, mapped: one word per counter
+  std::uint32_t counters = 0;            // words of readback the recording writes
 };
 
 /// Owns the command pool of every program's command buffer; records
-/// programs, reads their timestamps.
+/// programs, reads their counters and timestamps.
 class Recorder {
  public:
   Recorder() = default;
@@ -41,43 +39,53 @@ class Recorder {
 
   /// Decides timestamps() ($SINEW_VULKAN_TIMESTAMPS, the device type, its
   /// queue) and makes the program command pool ([in] device: `found`'s
-  /// logical device; outlives every call).
-  Status init(const Found& found, VkDevice device);
-  /// Releases the command pool. [pre] every program destroyed, the device idle.
+  /// logical device; memory makes the recordings' buffers; both outlive
+  /// every call).
+  Status init(const Found& found, VkDevice device, Memory& memory);
+  /// Releases the command pool. [pre] every recording destroyed, the device idle.
   void destroy();
 
   /// Timestamps around every dispatch.
   bool timestamps() const { return timestamps_; }
 
-  /// Allocates and writes the program's descriptor sets and records its
-  /// command buffer. [in] steps: dispatches and the barriers between them,
-  /// their pipelines made by `pipelines`; set_buffers: per descriptor set, the
-  /// indices into `buffers` it binds (its layout made by `pipelines`);
-  /// descriptors: their total count. On error p may hold part of what it
-  /// needs: destroy it.
-  Status record(Program& p, std::span<const Step> steps, std::span<const std::vector<std::uint32_t>* const> set_buffers,
-                std::uint32_t descriptors, const PipelineCache& pipelines, std::span<const Buffer> buffers);
-  /// Releases p's command buffer, descriptor pool and query pool and empties p.
-  void destroy(Program& p);
+  /// Makes r's buffers, descriptor pool and sets and query pool, and
+  /// records its command buffer. [in] plan: from plan_program (its
+  /// pipelines made by `pipelines`); counters: the program's, read back at
+  /// the end of the recording; buffers: the device's, by id. On error r may
+  /// hold part of what it needs: destroy it.
+  Status record(Recording& r, const Plan& plan, std::span<const Counter> counters, const PipelineCache& pipelines,
+                std::span<const Buffer> buffers);
+  /// Releases everything r holds and empties it. [pre] r is not in flight.
+  void destroy(Recording& r);
 
-  /// [out] out: the device time of p's last run from its timestamps; [pre]
-  /// out zeroed, p.queries made, p's last submission waited for.
-  Status read_times(const Program& p, DeviceTimes& out) const;
+  /// [out] values: the counters as r's last run left them. [pre] that run waited for.
+  void read_counters(const Recording& r, std::vector<std::uint32_t>& values) const;
+  /// [out] out: the device time of r's last run from its timestamps (timed =
+  /// false where r has none). [pre] that run waited for.
+  Status read_times(const Recording& r, DeviceTimes& out);
   /// [in] ticks: a difference of two timestamps (wraps at the counter's valid bits).
   double ticks_to_ms(std::uint64_t ticks) const;
 
+  /// Command buffers, descriptor pools and query pools of live recordings.
+  std::uint32_t native() const { return native_; }
+
  private:
-  Result<std::vector<VkDescriptorSet>> descriptor_sets(Program& p,
-                                                       std::span<const std::vector<std::uint32_t>* const> set_buffers,
-                                                       std::uint32_t descriptors, const PipelineCache& pipelines,
+  Status make_buffers(Recording& r, const Plan& plan, std::size_t counters);
+  Result<std::vector<VkDescriptorSet>> descriptor_sets(Recording& r, const Plan& plan, const PipelineCache& pipelines,
                                                        std::span<const Buffer> buffers);
+  void record_steps(const Recording& r, VkCommandBuffer cmd, const Plan& plan, std::span<const VkDescriptorSet> sets,
+                    const PipelineCache& pipelines, std::span<const Buffer> buffers, std::vector<Kernel>& timed);
+  void record_counter_reads(const Recording& r, VkCommandBuffer cmd, std::span<const Counter> counters,
+                            std::span<const Buffer> buffers);
 
   VkDevice device_ = VK_NULL_HANDLE;
+  Memory* memory_ = nullptr;
   VkCommandPool program_pool_ = VK_NULL_HANDLE;
   bool timestamps_ = false;  // timestamps around every dispatch
   std::uint32_t timestamp_bits_ = 0;
-  float timestamp_period_ = 0.0f;              // ns per tick
-  mutable std::vector<std::uint64_t> stamps_;  // read_times' read-back, reused
+  float timestamp_period_ = 0.0f;      // ns per tick
+  std::uint32_t native_ = 0;           // see native()
+  std::vector<std::uint64_t> stamps_;  // read_times' read-back, reused
 };
 
 }  // namespace sinew::vulkan
