@@ -10,6 +10,7 @@
 #include <string>
 
 #include "coloring/greedy_coloring.h"
+#include "compiler/solve_order.h"
 #include "math/xpbd_math.h"
 
 namespace sinew {
@@ -189,9 +190,14 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
     b.positions[p].w = static_cast<float>(w);
     movable[p] = b.positions[p].w > 0.0f;
   }
-  // Gauss-Seidel order: the order of Kernel (contacts last, so they win).
-  std::stable_sort(b.raw.begin(), b.raw.end(),
-                   [](const RawConstraints& x, const RawConstraints& y) { return x.kernel < y.kernel; });
+  // Gauss-Seidel order: kSolveOrder (solve_order.h; contacts last, so they win).
+  for (const RawConstraints& raw : b.raw)
+    if (solve_rank(raw.kernel) == kNotSolved)
+      return Error("internal: kernel " + std::string(kernel_name(raw.kernel)) +
+                   " has no place in the solve order (src/compiler/solve_order.h)");
+  std::stable_sort(b.raw.begin(), b.raw.end(), [](const RawConstraints& x, const RawConstraints& y) {
+    return solve_rank(x.kernel) < solve_rank(y.kernel);
+  });
   for (const RawConstraints& raw : b.raw)
     if (!raw.particles.empty()) out.blocks.push_back(color_and_sort(raw, movable));
   out.positions = std::move(b.positions);

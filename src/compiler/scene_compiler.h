@@ -50,8 +50,8 @@ struct RawConstraints {
 
 struct CompiledScene {
   std::vector<kernels::float4> positions;  ///< xyz [m], w = inverse mass [1/kg]
-  /// Solved in this order (the order of Kernel) in every iteration; there
-  /// are no empty blocks.
+  /// Solved in this order (kSolveOrder, solve_order.h) in every
+  /// iteration; there are no empty blocks.
   std::vector<ConstraintBlock> blocks;
   /// Scene-wide buffers that blocks bind (SceneBuffer), as uploaded; the
   /// Simulation rewrites colliders and targets between frames.
