@@ -1,8 +1,8 @@
-/* fem_math.h — GLSL twin of kernels/cpu/fem_kernels.h: the 3x3 matrix
+/* fem_math.h — GPU twin of kernels/cpu/fem_kernels.h: the 3x3 matrix
  * helpers and the constraint functions of the FEM tet materials, and the
  * coupled 2x2 xPBD tet solve of kernels/cpu/fem_kernels.cpp (solve_tets),
- * shared by xpbd_solve_neo_hookean.comp, xpbd_solve_stvk.comp and
- * xpbd_solve_corotational.comp (and like kernels/opencl/fem_math.h).
+ * shared by xpbd_solve_neo_hookean.gpu, xpbd_solve_stvk.gpu and
+ * xpbd_solve_corotational.gpu.
  *  - Macklin, Müller, Chentanez, "XPBD: Position-Based Simulation of
  *    Compliant Constrained Dynamics", MIG 2016;
  *  - Macklin, Müller, "A Constraint-based Formulation of Stable Neo-Hookean
@@ -15,42 +15,57 @@
  *    unit quaternions", JOSA A 4(4), 1987, by cyclic Jacobi (Golub, Van
  *    Loan, "Matrix Computations", 4th ed., section 8.5).
  * Every operation in the CPU code's order and every arithmetic result
- * `precise` (SPIR-V NoContraction: no fused multiply-add, no inexact
- * rewrites such as 1 / sqrt -> inversesqrt), so that the results are those
- * of the CPU kernels. Matrices are m[row][column] like fem::mat3 (not GLSL's
- * column-major mat3).
+ * PRECISE (no fused multiply-add, and in GLSL no inexact rewrites such as
+ * 1 / sqrt -> inversesqrt); sqrt and division correctly rounded as the
+ * CPU's, so that the results are bitwise those of the CPU kernels. Matrices
+ * are m[row][column] like fem::mat3 (not GLSL's column-major mat3).
  *
- * fem_solve_tet reads and writes the kernel's buffers: the including .comp
- * declares them first, as x (binding 0, vec4), idx (1, uvec4), fem_data
- * (2, float), lambda (3, float), residual (4, float), and the push
- * constant p (SolveParams). */
+ * fem_solve_tet takes one tet's values and returns what to store: the
+ * kernels read and write their buffers (helpers cannot reach them). */
 #ifndef SINEW_FEM_MATH_H
 #define SINEW_FEM_MATH_H
 
+#include "vec_math.h"
+#include "sinew_lang.h"
 #include "fem_params.h"
-#include "glsl_math.h"
 
-struct FemMat3 {
+SINEW_STRUCT_BEGIN(FemMat3)
   float m[3][3];
-};
+SINEW_STRUCT_END(FemMat3)
 
 /* The two constraints of a tet and their derivatives with respect to F. */
-struct FemConstraints {
+SINEW_STRUCT_BEGIN(FemConstraints)
   float c_d;     /* deviatoric constraint value */
   float c_h;     /* hydrostatic constraint value */
   FemMat3 dc_d;  /* dC_D/dF */
   FemMat3 dc_h;  /* dC_H/dF */
-};
+SINEW_STRUCT_END(FemConstraints)
 
-precise float fem_frobenius_norm(FemMat3 a) {
-  precise float s = 0.0;
+/* The gradients of one constraint with respect to the tet's four particles. */
+SINEW_STRUCT_BEGIN(FemGradients)
+  float3 g[4];
+SINEW_STRUCT_END(FemGradients)
+
+/* What one tet's solve stores: the residual (measuring pass), or the new
+ * multipliers and, where moved, the new positions of the movable
+ * particles (x[k] is set only where xs[k].w > 0). */
+SINEW_STRUCT_BEGIN(FemTetStep)
+  float residual;
+  float lambda_d;
+  float lambda_h;
+  bool moved;
+  float4 x[4];
+SINEW_STRUCT_END(FemTetStep)
+
+PRECISE float fem_frobenius_norm(FemMat3 a) {
+  PRECISE float s = 0.0f;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) s += a.m[r][c] * a.m[r][c];
-  precise float norm = sqrt(s);
+  PRECISE float norm = sqrt(s);
   return norm;
 }
 
-precise float fem_determinant(FemMat3 a) {
+PRECISE float fem_determinant(FemMat3 a) {
   return a.m[0][0] * (a.m[1][1] * a.m[2][2] - a.m[1][2] * a.m[2][1]) -
          a.m[0][1] * (a.m[1][0] * a.m[2][2] - a.m[1][2] * a.m[2][0]) +
          a.m[0][2] * (a.m[1][0] * a.m[2][1] - a.m[1][1] * a.m[2][0]);
@@ -59,7 +74,7 @@ precise float fem_determinant(FemMat3 a) {
 /* cof F = d(det F)/dF: column k is the cross product of the two other
  * columns of F (cyclic). */
 FemMat3 fem_cofactor(FemMat3 a) {
-  precise FemMat3 c;
+  PRECISE FemMat3 c;
   for (int k = 0; k < 3; ++k) {
     const int i = (k + 1) % 3, j = (k + 2) % 3;
     c.m[0][k] = a.m[1][i] * a.m[2][j] - a.m[2][i] * a.m[1][j];
@@ -70,10 +85,10 @@ FemMat3 fem_cofactor(FemMat3 a) {
 }
 
 /* F = Ds Dm^-1, Ds = [x1 - x0, x2 - x0, x3 - x0] (columns). */
-FemMat3 fem_deformation_gradient(vec4 x0, vec4 x1, vec4 x2, vec4 x3, FemMat3 dm_inv) {
-  precise vec3 e1 = x1.xyz - x0.xyz, e2 = x2.xyz - x0.xyz, e3 = x3.xyz - x0.xyz;
-  const float ds[3][3] = float[3][3](float[3](e1.x, e2.x, e3.x), float[3](e1.y, e2.y, e3.y), float[3](e1.z, e2.z, e3.z));
-  precise FemMat3 f;
+FemMat3 fem_deformation_gradient(float4 x0, float4 x1, float4 x2, float4 x3, FemMat3 dm_inv) {
+  PRECISE float3 e1 = x1.xyz - x0.xyz, e2 = x2.xyz - x0.xyz, e3 = x3.xyz - x0.xyz;
+  const float ds[3][3] = {{e1.x, e2.x, e3.x}, {e1.y, e2.y, e3.y}, {e1.z, e2.z, e3.z}};
+  PRECISE FemMat3 f;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
       f.m[r][c] = ds[r][0] * dm_inv.m[0][c] + ds[r][1] * dm_inv.m[1][c] + ds[r][2] * dm_inv.m[2][c];
@@ -82,16 +97,18 @@ FemMat3 fem_deformation_gradient(vec4 x0, vec4 x1, vec4 x2, vec4 x3, FemMat3 dm_
 
 /* g[i] = grad_{x_i} C from G = dC/dF: column i of G Dm^-T,
  * g[0] = -(g[1] + g[2] + g[3]). */
-void fem_position_gradients(FemMat3 g_f, FemMat3 dm_inv, out vec3 g[4]) {
-  precise vec3 r[4];
+FemGradients fem_position_gradients(FemMat3 g_f, FemMat3 dm_inv) {
+  PRECISE float3 r[4];
   for (int i = 1; i <= 3; ++i) {
     const float d0 = dm_inv.m[i - 1][0], d1 = dm_inv.m[i - 1][1], d2 = dm_inv.m[i - 1][2];
-    r[i] = vec3(g_f.m[0][0] * d0 + g_f.m[0][1] * d1 + g_f.m[0][2] * d2,
-                g_f.m[1][0] * d0 + g_f.m[1][1] * d1 + g_f.m[1][2] * d2,
-                g_f.m[2][0] * d0 + g_f.m[2][1] * d1 + g_f.m[2][2] * d2);
+    r[i] = make_float3(g_f.m[0][0] * d0 + g_f.m[0][1] * d1 + g_f.m[0][2] * d2,
+                       g_f.m[1][0] * d0 + g_f.m[1][1] * d1 + g_f.m[1][2] * d2,
+                       g_f.m[2][0] * d0 + g_f.m[2][1] * d1 + g_f.m[2][2] * d2);
   }
-  r[0] = vec3(0.0) - ((r[1] + r[2]) + r[3]);
-  g = r;
+  r[0] = make_float3(0.0f, 0.0f, 0.0f) - (r[1] + r[2] + r[3]);
+  FemGradients g;
+  for (int i = 0; i < 4; ++i) g.g[i] = r[i];
+  return g;
 }
 
 /* The rotation R (det R = +1) maximising tr(R^T F): Horn's quaternion
@@ -99,29 +116,29 @@ void fem_position_gradients(FemMat3 g_f, FemMat3 dm_inv, out vec3 g[4]) {
  * cyclic Jacobi (at most 12 sweeps); ties take the first; F = 0 gives I.
  * Twin of fem::rotation_part. */
 FemMat3 fem_rotation_part(FemMat3 f) {
-  precise float n[4][4];
-  n[0][0] = (f.m[0][0] + f.m[1][1]) + f.m[2][2];
+  PRECISE float n[4][4];
+  n[0][0] = f.m[0][0] + f.m[1][1] + f.m[2][2];
   n[0][1] = f.m[2][1] - f.m[1][2];
   n[0][2] = f.m[0][2] - f.m[2][0];
   n[0][3] = f.m[1][0] - f.m[0][1];
   n[1][0] = f.m[2][1] - f.m[1][2];
-  n[1][1] = (f.m[0][0] - f.m[1][1]) - f.m[2][2];
+  n[1][1] = f.m[0][0] - f.m[1][1] - f.m[2][2];
   n[1][2] = f.m[0][1] + f.m[1][0];
   n[1][3] = f.m[0][2] + f.m[2][0];
   n[2][0] = f.m[0][2] - f.m[2][0];
   n[2][1] = f.m[0][1] + f.m[1][0];
-  n[2][2] = (-f.m[0][0] + f.m[1][1]) - f.m[2][2];
+  n[2][2] = -f.m[0][0] + f.m[1][1] - f.m[2][2];
   n[2][3] = f.m[1][2] + f.m[2][1];
   n[3][0] = f.m[1][0] - f.m[0][1];
   n[3][1] = f.m[0][2] + f.m[2][0];
   n[3][2] = f.m[1][2] + f.m[2][1];
-  n[3][3] = (-f.m[0][0] - f.m[1][1]) + f.m[2][2];
-  precise float v[4][4] = float[4][4](float[4](1.0, 0.0, 0.0, 0.0), float[4](0.0, 1.0, 0.0, 0.0),
-                                      float[4](0.0, 0.0, 1.0, 0.0), float[4](0.0, 0.0, 0.0, 1.0));
-  const float eps = 1.1920928955078125e-7;  // FLT_EPSILON = 2^-23, as std::numeric_limits<float>::epsilon()
-  precise float eps2 = eps * eps;
+  n[3][3] = -f.m[0][0] - f.m[1][1] + f.m[2][2];
+  PRECISE float v[4][4] = {{1.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f, 0.0f},
+                           {0.0f, 0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  const float eps = 1.1920928955078125e-7f;  // FLT_EPSILON = 2^-23, as std::numeric_limits<float>::epsilon()
+  PRECISE float eps2 = eps * eps;
   for (int sweep = 0; sweep < 12; ++sweep) {
-    precise float off = 0.0, total = 0.0;
+    PRECISE float off = 0.0f, total = 0.0f;
     for (int p = 0; p < 4; ++p)
       for (int q = 0; q < 4; ++q) {
         if (p == q)
@@ -130,18 +147,18 @@ FemMat3 fem_rotation_part(FemMat3 f) {
           off += n[p][q] * n[p][q];
       }
     total += off;
-    precise float bound = eps2 * total;
+    PRECISE float bound = eps2 * total;
     if (off <= bound) break;  // also F = 0: total = 0
     for (int p = 0; p < 3; ++p)
       for (int q = p + 1; q < 4; ++q) {
         const float apq = n[p][q];
-        if (apq == 0.0) continue;
+        if (apq == 0.0f) continue;
         // The rotation J (c, s) with (J^T N J)[p][q] = 0: t = tan of its
         // angle, the smaller root of t^2 + 2 tau t - 1 = 0.
-        precise float tau = (n[q][q] - n[p][p]) / (2.0 * apq);
-        precise float t = (tau >= 0.0 ? 1.0 : -1.0) / (abs(tau) + sqrt(1.0 + tau * tau));
-        precise float c = 1.0 / sqrt(1.0 + t * t);
-        precise float sn = t * c;
+        PRECISE float tau = (n[q][q] - n[p][p]) / (2.0f * apq);
+        PRECISE float t = (tau >= 0.0f ? 1.0f : -1.0f) / (fabs(tau) + sqrt(1.0f + tau * tau));
+        PRECISE float c = 1.0f / sqrt(1.0f + t * t);
+        PRECISE float sn = t * c;
         for (int k = 0; k < 4; ++k) {  // N J (columns p, q)
           const float kp = n[k][p], kq = n[k][q];
           n[k][p] = c * kp - sn * kq;
@@ -152,8 +169,8 @@ FemMat3 fem_rotation_part(FemMat3 f) {
           n[p][k] = c * pk - sn * qk;
           n[q][k] = sn * pk + c * qk;
         }
-        n[p][q] = 0.0;
-        n[q][p] = 0.0;
+        n[p][q] = 0.0f;
+        n[q][p] = 0.0f;
         for (int k = 0; k < 4; ++k) {  // V J
           const float kp = v[k][p], kq = v[k][q];
           v[k][p] = c * kp - sn * kq;
@@ -164,31 +181,31 @@ FemMat3 fem_rotation_part(FemMat3 f) {
   int best = 0;
   for (int k = 1; k < 4; ++k)
     if (n[k][k] > n[best][best]) best = k;
-  precise float w = v[0][best], x = v[1][best], y = v[2][best], z = v[3][best];
-  precise float len = sqrt(((w * w + x * x) + y * y) + z * z);  // 1 up to rounding
+  PRECISE float w = v[0][best], x = v[1][best], y = v[2][best], z = v[3][best];
+  PRECISE float len = sqrt(w * w + x * x + y * y + z * z);  // 1 up to rounding
   w = w / len;
   x = x / len;
   y = y / len;
   z = z / len;
-  precise FemMat3 r;
-  r.m[0][0] = 1.0 - 2.0 * (y * y + z * z);
-  r.m[0][1] = 2.0 * (x * y - w * z);
-  r.m[0][2] = 2.0 * (x * z + w * y);
-  r.m[1][0] = 2.0 * (x * y + w * z);
-  r.m[1][1] = 1.0 - 2.0 * (x * x + z * z);
-  r.m[1][2] = 2.0 * (y * z - w * x);
-  r.m[2][0] = 2.0 * (x * z - w * y);
-  r.m[2][1] = 2.0 * (y * z + w * x);
-  r.m[2][2] = 1.0 - 2.0 * (x * x + y * y);
+  PRECISE FemMat3 r;
+  r.m[0][0] = 1.0f - 2.0f * (y * y + z * z);
+  r.m[0][1] = 2.0f * (x * y - w * z);
+  r.m[0][2] = 2.0f * (x * z + w * y);
+  r.m[1][0] = 2.0f * (x * y + w * z);
+  r.m[1][1] = 1.0f - 2.0f * (x * x + z * z);
+  r.m[1][2] = 2.0f * (y * z - w * x);
+  r.m[2][0] = 2.0f * (x * z - w * y);
+  r.m[2][1] = 2.0f * (y * z + w * x);
+  r.m[2][2] = 1.0f - 2.0f * (x * x + y * y);
   return r;
 }
 
 /* Stable Neo-Hookean (Macklin, Müller 2021): C_D = |F|_F, dC_D/dF = F / |F|_F
  * (0 at F = 0); C_H = det F - h0, dC_H/dF = cof F. */
 FemConstraints fem_neo_hookean_constraints(FemMat3 f, float h0) {
-  precise FemConstraints c;
+  PRECISE FemConstraints c;
   c.c_d = fem_frobenius_norm(f);
-  precise float inv = c.c_d > 0.0 ? 1.0 / c.c_d : 0.0;
+  PRECISE float inv = c.c_d > 0.0f ? 1.0f / c.c_d : 0.0f;
   for (int r = 0; r < 3; ++r)
     for (int k = 0; k < 3; ++k) c.dc_d.m[r][k] = f.m[r][k] * inv;
   c.c_h = fem_determinant(f) - h0;
@@ -199,17 +216,17 @@ FemConstraints fem_neo_hookean_constraints(FemMat3 f, float h0) {
 /* St. Venant-Kirchhoff: C_D = |E|_F, E = (F^T F - I) / 2, dC_D/dF = F E / |E|_F
  * (0 at E = 0); C_H = det F - h0 (h0 = 1), dC_H/dF = cof F. */
 FemConstraints fem_stvk_constraints(FemMat3 f, float h0) {
-  precise FemConstraints c;
-  precise FemMat3 e;
+  PRECISE FemConstraints c;
+  PRECISE FemMat3 e;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      e.m[i][j] = 0.5 * (((f.m[0][i] * f.m[0][j] + f.m[1][i] * f.m[1][j]) + f.m[2][i] * f.m[2][j]) -
-                         (i == j ? 1.0 : 0.0));
+      e.m[i][j] = 0.5f * (f.m[0][i] * f.m[0][j] + f.m[1][i] * f.m[1][j] + f.m[2][i] * f.m[2][j] -
+                          (i == j ? 1.0f : 0.0f));
   c.c_d = fem_frobenius_norm(e);
-  precise float inv = c.c_d > 0.0 ? 1.0 / c.c_d : 0.0;
+  PRECISE float inv = c.c_d > 0.0f ? 1.0f / c.c_d : 0.0f;
   for (int r = 0; r < 3; ++r)
     for (int k = 0; k < 3; ++k)
-      c.dc_d.m[r][k] = ((f.m[r][0] * e.m[0][k] + f.m[r][1] * e.m[1][k]) + f.m[r][2] * e.m[2][k]) * inv;
+      c.dc_d.m[r][k] = (f.m[r][0] * e.m[0][k] + f.m[r][1] * e.m[1][k] + f.m[r][2] * e.m[2][k]) * inv;
   c.c_h = fem_determinant(f) - h0;
   c.dc_h = fem_cofactor(f);
   return c;
@@ -219,17 +236,17 @@ FemConstraints fem_stvk_constraints(FemMat3 f, float h0) {
  * dC_D/dF = (F - R) / |F - R|_F (0 at F = R); C_H = tr(R^T F) - h0 (h0 = 3),
  * dC_H/dF = R. */
 FemConstraints fem_corotational_constraints(FemMat3 f, float h0) {
-  precise FemConstraints c;
+  PRECISE FemConstraints c;
   const FemMat3 r = fem_rotation_part(f);
-  precise FemMat3 d;
-  precise float trace = 0.0;
+  PRECISE FemMat3 d;
+  PRECISE float trace = 0.0f;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       d.m[i][j] = f.m[i][j] - r.m[i][j];
       trace += r.m[i][j] * f.m[i][j];
     }
   c.c_d = fem_frobenius_norm(d);
-  precise float inv = c.c_d > 0.0 ? 1.0 / c.c_d : 0.0;
+  PRECISE float inv = c.c_d > 0.0f ? 1.0f / c.c_d : 0.0f;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) c.dc_d.m[i][j] = d.m[i][j] * inv;
   c.c_h = trace - h0;
@@ -237,22 +254,27 @@ FemConstraints fem_corotational_constraints(FemMat3 f, float h0) {
   return c;
 }
 
-const int FEM_MODEL_NEO_HOOKEAN = 0;
-const int FEM_MODEL_STVK = 1;
-const int FEM_MODEL_COROTATIONAL = 2;
+#define FEM_MODEL_NEO_HOOKEAN 0
+#define FEM_MODEL_STVK 1
+#define FEM_MODEL_COROTATIONAL 2
 
 /* One tet's two constraints solved together as one 2x2 xPBD system in the
  * W-orthogonal basis (a, b' = b - beta a) of fem_kernels.cpp: see there for
- * the derivation, the scaling and the guards, all reproduced here. */
-void fem_solve_tet(const int model, const uint i) {
-  const uvec4 t = idx[i];
-  const uint d = i * SINEW_FEM_DATA_STRIDE;
+ * the derivation, the scaling and the guards, all reproduced here. xs: the
+ * tet's particles; d: its SINEW_FEM_DATA_STRIDE words of data; ld, lh: its
+ * multipliers at the start of the sweep (0 when reset). */
+FemTetStep fem_solve_tet(int model, const float4 xs[4], const float d[SINEW_FEM_DATA_STRIDE], float ld, float lh,
+                         float inv_h2, bool measure_only) {
+  FemTetStep s;
+  s.residual = 0.0f;
+  s.lambda_d = ld;
+  s.lambda_h = lh;
+  s.moved = false;
   FemMat3 dm_inv;
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) dm_inv.m[r][c] = fem_data[d + SINEW_FEM_DM_INV + 3 * r + c];
-  const vec4 xs[4] = vec4[4](x[t.x], x[t.y], x[t.z], x[t.w]);
+    for (int c = 0; c < 3; ++c) dm_inv.m[r][c] = d[SINEW_FEM_DM_INV + 3 * r + c];
   const FemMat3 f = fem_deformation_gradient(xs[0], xs[1], xs[2], xs[3], dm_inv);
-  const float h0 = fem_data[d + SINEW_FEM_H0];
+  const float h0 = d[SINEW_FEM_H0];
   FemConstraints c;
   if (model == FEM_MODEL_NEO_HOOKEAN)
     c = fem_neo_hookean_constraints(f, h0);
@@ -261,63 +283,53 @@ void fem_solve_tet(const int model, const uint i) {
   else
     c = fem_corotational_constraints(f, h0);
 
-  precise float ad = fem_data[d + SINEW_FEM_ALPHA_D] * p.inv_h2, ah = fem_data[d + SINEW_FEM_ALPHA_H] * p.inv_h2;
-  const uint l = i * SINEW_FEM_LAMBDA_STRIDE;
-  const float ld = p.reset_lambda != 0u ? 0.0 : lambda[l], lh = p.reset_lambda != 0u ? 0.0 : lambda[l + 1];
-  precise float rd = c.c_d + ad * ld, rh = c.c_h + ah * lh;
-  if (p.measure_only != 0u) {
-    precise float r = sqrt(rd * rd + rh * rh);
-    residual[i] = r;
-    return;
+  PRECISE float ad = d[SINEW_FEM_ALPHA_D] * inv_h2, ah = d[SINEW_FEM_ALPHA_H] * inv_h2;
+  PRECISE float rd = c.c_d + ad * ld, rh = c.c_h + ah * lh;
+  if (measure_only) {
+    PRECISE float r = sqrt(rd * rd + rh * rh);
+    s.residual = r;
+    return s;
   }
 
-  vec3 a[4], b[4];
-  fem_position_gradients(c.dc_d, dm_inv, a);
-  fem_position_gradients(c.dc_h, dm_inv, b);
-  precise float aa = 0.0, ab = 0.0;
+  const FemGradients a = fem_position_gradients(c.dc_d, dm_inv);
+  FemGradients b = fem_position_gradients(c.dc_h, dm_inv);
+  PRECISE float aa = 0.0f, ab = 0.0f;
   for (int k = 0; k < 4; ++k) {
-    aa += xs[k].w * dot3(a[k], a[k]);
-    ab += xs[k].w * dot3(a[k], b[k]);
+    aa += xs[k].w * dot3(a.g[k], a.g[k]);
+    ab += xs[k].w * dot3(a.g[k], b.g[k]);
   }
-  precise float beta = aa > 0.0 ? ab / aa : 0.0;
-  precise float bb = 0.0;  // <b', b'>_W
+  PRECISE float beta = aa > 0.0f ? ab / aa : 0.0f;
+  PRECISE float bb = 0.0f;  // <b', b'>_W
   for (int k = 0; k < 4; ++k) {
-    precise vec3 bk = b[k] - beta * a[k];
-    b[k] = bk;
+    PRECISE float3 bk = b.g[k] - beta * a.g[k];
+    b.g[k] = bk;
     bb += xs[k].w * dot3(bk, bk);
   }
   // Scaled by 1 / (sum of the diagonal terms) against float overflow.
-  precise float total = ((aa + bb) + ad) + ah;
+  PRECISE float total = aa + bb + ad + ah;
   // total == 0 or not finite (or det == 0 below): no direction to push
   // along. isnan spelled out, so no compiler may turn !(x > 0) into x <= 0.
-  if (!(total > 0.0) || isnan(total) || isinf(total)) {
-    lambda[l] = ld;
-    lambda[l + 1] = lh;
-    return;
-  }
-  precise float scale = 1.0 / total;
-  precise float saa = scale * aa, sbb = scale * bb, sad = scale * ad, sah = scale * ah;
-  precise float m11 = saa + sad, m12 = -beta * sad, m22 = (sbb + (beta * beta) * sad) + sah;
-  precise float det = ((saa * sbb + saa * ((beta * beta) * sad + sah)) + sad * sbb) + sad * sah;
-  if (!(det > 0.0) || isnan(det)) {
-    lambda[l] = ld;
-    lambda[l + 1] = lh;
-    return;
-  }
-  precise float rhs1 = -scale * rd, rhs2 = -scale * (rh - beta * rd);
-  precise float mu1 = (m22 * rhs1 - m12 * rhs2) / det;
-  precise float mu2 = (m11 * rhs2 - m12 * rhs1) / det;
-  const uint ids[4] = uint[4](t.x, t.y, t.z, t.w);
+  if (!(total > 0.0f) || isnan(total) || isinf(total)) return s;
+  PRECISE float scale = 1.0f / total;
+  PRECISE float saa = scale * aa, sbb = scale * bb, sad = scale * ad, sah = scale * ah;
+  PRECISE float m11 = saa + sad, m12 = -beta * sad, m22 = sbb + beta * beta * sad + sah;
+  PRECISE float det = saa * sbb + saa * (beta * beta * sad + sah) + sad * sbb + sad * sah;
+  if (!(det > 0.0f) || isnan(det)) return s;
+  PRECISE float rhs1 = -scale * rd, rhs2 = -scale * (rh - beta * rd);
+  PRECISE float mu1 = (m22 * rhs1 - m12 * rhs2) / det;
+  PRECISE float mu2 = (m11 * rhs2 - m12 * rhs1) / det;
+  s.moved = true;
   for (int k = 0; k < 4; ++k) {
-    if (xs[k].w > 0.0) {
-      precise vec3 dx = mu1 * a[k] + mu2 * b[k];
-      precise vec3 y = xs[k].xyz + xs[k].w * dx;
-      x[ids[k]] = vec4(y, xs[k].w);
+    if (xs[k].w > 0.0f) {
+      PRECISE float3 dx = mu1 * a.g[k] + mu2 * b.g[k];
+      PRECISE float3 y = xs[k].xyz + xs[k].w * dx;
+      s.x[k] = make_float4_xyz(y, xs[k].w);
     }
   }
-  precise float ld_n = ld + (mu1 - beta * mu2), lh_n = lh + mu2;
-  lambda[l] = ld_n;
-  lambda[l + 1] = lh_n;
+  PRECISE float ld_n = ld + (mu1 - beta * mu2), lh_n = lh + mu2;
+  s.lambda_d = ld_n;
+  s.lambda_h = lh_n;
+  return s;
 }
 
 #endif /* SINEW_FEM_MATH_H */
