@@ -1,5 +1,6 @@
 // simulation_contacts.cpp — moving colliders and targets between frames, and
-// the tools' rigid-body motion.
+// the tissue's side of the tools: their colliders and the reaction the
+// tissue exerts on them.
 //
 // Colliders and targets: each entry of the collider and target buffers
 // (kernels/shared/contact_params.h) holds a pose at the start and at the end
@@ -8,60 +9,23 @@
 // that end pose. The buffers are uploaded before a frame only when something
 // changed, so static colliders cost no transfer.
 //
-// Tools: a tool is a capsule collider whose motion the host integrates. The
-// coupling with the tissue is explicit and one frame long:
-//  1. before frame n (before_frame): semi-implicit Euler over the frame with
-//     the applied force and torque (apply_tool_force), gravity, and the
-//     tissue's reaction measured in frame n-1: v += dt F / M, x += dt v;
-//     the angular velocity likewise from the torque (inertia in the body
-//     frame, the gyroscopic term implicit), q += dt/2 (0, omega) q. The
-//     tool's collider then moves from its old to its new pose across frame
-//     n's substeps.
-//  2. during frame n the tool is an infinitely heavy kinematic collider: the
-//     particles it touches are pushed out and dragged by friction, and each
-//     correction's impulse (with its moment about the tool's centre) is
-//     summed per particle and tool in the contact-impulse buffer.
-//  3. after frame n (after_frame): the sums are read back and reduced in
-//     particle order, in double precision (deterministic), to the frame's
-//     average contact force and torque (reported by tool_state) and to the
-//     force and torque of the frame's last substep, which step 1 uses: that
-//     one belongs to the pose the tool has at the end of the frame, so the
-//     scheme is symplectic Euler on the tool. (Coupling with the frame
-//     average, which belongs to the middle of the frame, lags half a frame
-//     and pumps energy into the tool at any mass: x_{n+1} - 2 x_n + x_{n-1}
-//     = -(omega dt)^2 (x_n + x_{n-1}) / 2 has roots of modulus
-//     sqrt(1 + (omega dt)^2 / 2) > 1.)
-// Limits.
-//  - Stability: explicit Euler on a contact of stiffness k is stable while
-//    sqrt(k / M) dt < 2. That holds for a tool much heavier than the
-//    particles it touches. A slender tool's tiny inertia about its own axis
-//    would break it in rotation, so rotation is stabilised by the touching
-//    particles' inertia; a light tool would break it in translation, so its
-//    mass is floored at what the bound needs (see integrate()). Neither
-//    makes a light tool right: the tissue is pushed by the tool's full
-//    motion as if the tool were immovable and answers a frame later. In the
-//    tests' scene (20 substeps at 60 Hz) a tool 10^4 times as heavy as a
-//    particle rests; one 3 10^3 times or lighter is not held: it drifts
-//    sideways and slides off the block within a few seconds (without the
-//    mass floor, one 10^2 times as heavy was thrown off at 1.8 m/s). Drive a
-//    light or hand-held tool through a virtual coupling (a spring-damper
-//    from the user's pose, via apply_tool_force, stiff no more than the
-//    bound allows) or use a shorter time step.
-//  - Tunnelling: contacts are between particles (mesh vertices) and the
-//    tool's surface, not the tissue's faces. A tool M times as heavy as the
-//    N particles of mass m it rests on pushes them about
-//    (M / (N m)) g h^2 / iterations deep per substep before the tissue's
-//    response reaches them; when that nears the vertex spacing, or a tool
-//    is narrower than it, the tool pushes vertices apart and passes between
-//    them. More substeps (smaller h) or a finer surface mesh cure it.
-//  - A resting tool keeps a small jitter (no damping is added); compare
-//    averages of tool_state over a few frames.
+// Tools: a tool is a capsule collider whose motion the host integrates
+// (rigid_tool.h: the coupling with the tissue, its stabilisation and its
+// limits). Here is the tissue's side: before each frame (before_frame) each
+// tool is integrated over the frame and its collider entry moves from the
+// old pose to the new one across the frame's substeps; during the frame
+// the contact kernel sums each correction's impulse, and its moment about
+// the tool's centre, per particle and tool in the contact-impulse buffer;
+// after the frame (after_frame) the sums are read back and reduced in
+// particle order, in double precision (deterministic), to the tool's
+// reaction: the frame's average contact force and torque (tool_state), the
+// force and torque of its last substep and the mass and inertia of the
+// particles touching the tool at its end (which the next integration uses).
 //
 // State: Impl::colliders and Impl::targets are host copies of the device
 // buffers; the tools' rigid state and the impulse read-back live in
 // Impl::contacts (contact_state.h), all sized in init_contacts: nothing here
 // allocates per frame.
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -141,125 +105,6 @@ bool settle(ColliderEntry& e) {
   return moved;
 }
 
-V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-// v rotated by the unit quaternion q (inverse: conjugate first).
-V3 rotate(const Q4& q, const V3& v, bool inverse = false) {
-  const V3 u{inverse ? -q[1] : q[1], inverse ? -q[2] : q[2], inverse ? -q[3] : q[3]};
-  V3 t = cross(u, v);
-  for (double& c : t) c *= 2.0;
-  const V3 ut = cross(u, t);
-  return {v[0] + q[0] * t[0] + ut[0], v[1] + q[0] * t[1] + ut[1], v[2] + q[0] * t[2] + ut[2]};
-}
-
-using M3 = std::array<V3, 3>;  // row-major
-
-double det3(const M3& a) {
-  return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-         a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-}
-
-// Solves a x = f by Cramer's rule; false (x untouched) when a is singular.
-bool solve3(const M3& a, const V3& f, V3& x) {
-  const double d = det3(a);
-  if (!(std::abs(d) > 0.0) || !std::isfinite(d)) return false;
-  V3 out;
-  for (int k = 0; k < 3; ++k) {
-    M3 m = a;
-    for (int r = 0; r < 3; ++r) m[r][k] = f[r];
-    out[k] = det3(m) / d;
-  }
-  x = out;
-  return true;
-}
-
-// One Newton step of implicit Euler on I (w' - w) + dt w' x (I w') = 0 from
-// w' = w, in the body frame: w' = w - J^-1 dt w x (I w) with
-// J = I + dt (skew(w) I - skew(I w)).
-V3 gyroscopic_step(const V3& inertia, const V3& w, double dt) {
-  const V3 iw{inertia[0] * w[0], inertia[1] * w[1], inertia[2] * w[2]};
-  V3 f = cross(w, iw);
-  for (double& c : f) c *= dt;
-  auto skew = [](const V3& v) { return M3{V3{0.0, -v[2], v[1]}, V3{v[2], 0.0, -v[0]}, V3{-v[1], v[0], 0.0}}; };
-  const M3 sw = skew(w), siw = skew(iw);
-  M3 j;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) j[r][c] = (r == c ? inertia[r] : 0.0) + dt * (sw[r][c] * inertia[c] - siw[r][c]);
-  V3 step{0.0, 0.0, 0.0};
-  if (!solve3(j, f, step)) return w;
-  return {w[0] - step[0], w[1] - step[1], w[2] - step[2]};
-}
-
-// One semi-implicit Euler step of the tool over dt.
-//
-// The explicit coupling is stable while (omega dt)^2 = k dt^2 / M < 4 for
-// the contact's stiffness k. A bound on k: within a substep of length h, a
-// touching particle of mass m_i passes on at most about m_i / h^2 per unit
-// of the tool's displacement per iteration, so k <= K = n_it sum_i m_i / h^2
-// and dt^2 K = n_it n_sub^2 sum_i m_i (and likewise for rotation, with the
-// particles' inertia sum_i m_i (|r_i|^2 I - r_i r_i^T) about the tool's
-// centre). So:
-//  - translation uses the tool's mass M, or dt^2 K / 4 where that is more:
-//    a tool heavy enough for the bound is integrated as it is (the tests'
-//    10^4 mass ratio is); a lighter one is slowed down (over-damped) rather
-//    than thrown off. (Adding dt^2 K to M always, as for rotation, would
-//    also let a heavy tool sink deeper before the tissue stops it.)
-//  - rotation solves (I_tool + dt^2 K) dw = dt tau: (omega dt)^2 < 1 however
-//    small the tool's inertia. That matters for a slender tool, whose
-//    inertia about its own axis (m r^2 / 2) is tiny: without it, friction
-//    spins the tool up until it rolls away. Rotation while touching is
-//    slower than it would be.
-// Equilibria are unchanged (no velocity change where the force and torque
-// vanish). `stiffness` is n_it n_sub^2.
-void integrate(ToolBody& b, double dt, double stiffness) {
-  V3 force, torque;
-  for (int k = 0; k < 3; ++k) {
-    force[k] = b.force[k] + b.coupling_force[k] + b.mass * b.gravity[k];
-    torque[k] = b.torque[k] + b.coupling_torque[k];
-  }
-  // Translation: the tool's own mass, raised where needed to the least
-  // mass that keeps explicit Euler inside its stability bound against K:
-  // dt^2 K / M <= 4 with dt^2 K = n_it n_sub^2 sum m_i (see above).
-  const double mass = std::max(b.mass, 0.25 * stiffness * b.touching_mass);
-  for (int k = 0; k < 3; ++k) b.velocity[k] += dt * force[k] / mass;
-  // The tool's inertia in the world frame, R I R^T, plus the touching
-  // particles' scaled inertia about its centre.
-  M3 a;
-  for (int c = 0; c < 3; ++c) {
-    V3 e{0.0, 0.0, 0.0};
-    e[c] = 1.0;
-    V3 local = rotate(b.rotation, e, true);
-    for (int k = 0; k < 3; ++k) local[k] *= b.inertia[k];
-    const V3 column = rotate(b.rotation, local);
-    for (int r = 0; r < 3; ++r) a[r][c] = column[r] + stiffness * b.touching_inertia[3 * r + c];
-  }
-  V3 dw{0.0, 0.0, 0.0};
-  const V3 impulse{dt * torque[0], dt * torque[1], dt * torque[2]};
-  if (solve3(a, impulse, dw))  // a is symmetric positive definite: inertia > 0
-    for (int k = 0; k < 3; ++k) b.angular_velocity[k] += dw[k];
-  // The gyroscopic term of Euler's equations, I dw/dt = -w x (I w) in the
-  // body frame, implicitly by one Newton step (Catto, "Numerical Methods",
-  // GDC 2015): explicitly, a free tumbling tool would gain energy.
-  b.angular_velocity = rotate(b.rotation, gyroscopic_step(b.inertia, rotate(b.rotation, b.angular_velocity, true), dt));
-
-  for (int k = 0; k < 3; ++k) b.position[k] += dt * b.velocity[k];
-  const V3& o = b.angular_velocity;
-  const Q4& q = b.rotation;
-  const Q4 dq{-(o[0] * q[1] + o[1] * q[2] + o[2] * q[3]), o[0] * q[0] + o[1] * q[3] - o[2] * q[2],
-              o[1] * q[0] + o[2] * q[1] - o[0] * q[3], o[2] * q[0] + o[0] * q[2] - o[1] * q[1]};  // (0, o) q
-  Q4 r;
-  double norm = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    r[k] = q[k] + 0.5 * dt * dq[k];
-    norm += r[k] * r[k];
-  }
-  norm = std::sqrt(norm);
-  for (double& c : r) c /= norm;
-  b.rotation = r;
-  b.force = b.torque = V3{0.0, 0.0, 0.0};
-}
-
 }  // namespace
 
 Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledScene& compiled) {
@@ -296,7 +141,7 @@ Status Simulation::Impl::before_frame() {
     ToolBody& b = c.tools[t];
     const std::size_t at = entry_at(c.colliders + t);
     auto e = load_words<ColliderEntry>(colliders, at);
-    integrate(b, time_step, double(c.iterations) * c.substeps * c.substeps);
+    integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);
     settle(e);  // the frame starts where the last one ended
     set_end_pose(e, b.position, b.rotation);
     store_words(colliders, at, e);

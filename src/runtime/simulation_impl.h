@@ -35,8 +35,8 @@ struct Simulation::Impl {
   std::vector<float> targets;
   ContactState contacts;
   Status init_contacts(const SceneDesc& scene, const CompiledScene& compiled);
-  Status before_frame();  ///< uploads colliders/targets moved since the last frame
-  Status after_frame();   ///< integrates tools from the tissue's reaction
+  Status before_frame();  ///< integrates the tools (rigid_tool.h), uploads what moved
+  Status after_frame();   ///< settles what moved, reduces the tissue's reaction on each tool
 };
 
 
