@@ -220,11 +220,11 @@ class Device {
   virtual Result<BufferHandle> create_buffer(std::size_t bytes, std::string_view label) = 0;
   /// Frees a buffer and its device memory. A program that binds it can no
   /// longer be submitted (an error names the buffer); destroy or rebuild it.
-  virtual Status destroy_buffer(BufferHandle buffer) { return not_yet("destroy_buffer", buffer.id); }
+  virtual Status destroy_buffer(BufferHandle buffer) = 0;
   /// Gives a buffer a new size (> 0), keeping its handle and its first
   /// min(old, new) bytes; the rest is zero. Programs that use it are
   /// prepared again at their next submission (Vulkan records them again).
-  virtual Status resize_buffer(BufferHandle /*buffer*/, std::size_t bytes) { return not_yet("resize_buffer", bytes); }
+  virtual Status resize_buffer(BufferHandle buffer, std::size_t bytes) = 0;
   /// Copies host memory into a buffer. Errors: unknown buffer, range past its end.
   virtual Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) = 0;
   /// Copies a buffer into host memory.
@@ -237,23 +237,23 @@ class Device {
   /// end are errors naming the command.
   virtual Result<ProgramHandle> create_program(const FrameProgram& program) = 0;
   /// Frees a program and everything the device made for it.
-  virtual Status destroy_program(ProgramHandle program) { return not_yet("destroy_program", program.id); }
+  virtual Status destroy_program(ProgramHandle program) = 0;
   /// Starts a program and returns without waiting (on the CPU backend it
   /// has finished when this returns). One submission is in flight at a
   /// time: submitting again first waits for the previous one.
-  virtual Status submit(ProgramHandle program) { return not_yet("submit", program.id); }
+  virtual Status submit(ProgramHandle program) = 0;
   /// Waits for the submission in flight (none: returns at once), then
   /// checks its counters: a counter above its capacity is a
   /// capacity_exceeded error naming it (the frame's other results stand).
-  virtual Status wait() { return not_yet("wait", 0); }
+  virtual Status wait() = 0;
   /// submit() then wait().
-  virtual Status run_program(ProgramHandle program) {
+  Status run_program(ProgramHandle program) {
     if (Status s = submit(program); !s) return s;
     return wait();
   }
   /// The counters of the last program waited for, in declaration order, as
   /// they were at the end of its run. Allocates nothing.
-  [[nodiscard]] virtual std::span<const std::uint32_t> counters() const { return {}; }
+  [[nodiscard]] virtual std::span<const std::uint32_t> counters() const = 0;
   /// [out] times: device time of the last program waited for; timed =
   /// false (and no error) where the device records no timestamps.
   /// Allocates nothing.
@@ -262,13 +262,7 @@ class Device {
     return {};
   }
   /// What the device holds now.
-  [[nodiscard]] virtual DeviceObjects objects() const { return {}; }
-
- private:
-  // TRANSITION (issue 10): until every backend implements the calls above.
-  Status not_yet(const char* call, std::size_t) const {
-    return Error(ErrorCode::internal, std::string(call) + " is not implemented by the " + backend_name() + " backend yet");
-  }
+  [[nodiscard]] virtual DeviceObjects objects() const = 0;
 };
 
 /// Makes a device. Asking for a backend that is not built, or that has no

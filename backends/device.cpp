@@ -153,15 +153,11 @@ Status check_counters(const std::vector<Counter>& counters, std::span<const std:
                "capacity exceeded (work past it was dropped, the rest of the frame stands): " + over);
 }
 
-Status check_program(const FrameProgram& program, std::uint32_t buffer_count) {
-  const std::vector<std::size_t> bytes(buffer_count, SIZE_MAX / 8);
-  return check_program(program, bytes);
-}
 
 Status check_buffer_range(const std::string& label, std::size_t size, std::size_t offset, std::size_t bytes,
                           const char* what) {
   if (offset > size || bytes > size - offset)
-    return Error(std::string(what) + " '" + label + "': bytes [" + std::to_string(offset) + ", " +
+    return Error(ErrorCode::internal, std::string(what) + " '" + label + "': bytes [" + std::to_string(offset) + ", " +
                  std::to_string(offset + bytes) + ") outside the buffer's " + std::to_string(size) + " bytes");
   return {};
 }
@@ -176,7 +172,7 @@ Result<std::size_t> match_device_selector(const std::vector<std::string>& names,
     if (names[i].find(selector) != std::string::npos) return i;
   std::string list;
   for (std::size_t i = 0; i < labels.size(); ++i) list += "\n  " + std::to_string(i) + ": " + labels[i];
-  return Error(std::string("no ") + api + " device matches '" + selector + "'; devices:" + list);
+  return Error(ErrorCode::backend_unavailable, std::string("no ") + api + " device matches '" + selector + "'; devices:" + list);
 }
 
 std::vector<std::string> built_backends() {

@@ -36,9 +36,6 @@ const KernelSignature& kernel_signature(Kernel kernel);
 /// the device's buffers: buffer_bytes[id] is the size of buffer `id`, 0 for
 /// one destroyed. Errors name the command by position and kernel.
 Status check_program(const FrameProgram& program, std::span<const std::size_t> buffer_bytes);
-/// TRANSITION (issue 10): for backends that do not track sizes yet; every
-/// buffer below buffer_count counts as large enough.
-Status check_program(const FrameProgram& program, std::uint32_t buffer_count);
 
 /// The capacity_exceeded error for the counters whose value (values[i],
 /// read after a run) exceeds their capacity, naming each; success when none does.

@@ -105,7 +105,7 @@ void BM_Cube(benchmark::State& state) {
   state.counters["colors"] = info.colors;
   state.counters["particles"] = info.particles;
   state.counters["iterations"] = iterations;
-  state.SetLabel(sim->device().device_name());
+  state.SetLabel(sim->device_name());
 }
 
 void CubeArgs(benchmark::internal::Benchmark* b) {

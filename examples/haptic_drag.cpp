@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
   const std::int64_t t0 = clock.now_ns() + seconds_to_ns(0.01);
   device.set_origin(t0);
   if (auto s = (*loop)->start(); !s) return fail(s.error().message());
-  std::printf("haptic_drag on %s: %u particles; haptic loop at %.0f Hz, %s\n", sim->device().device_name().c_str(),
+  std::printf("haptic_drag on %s: %u particles; haptic loop at %.0f Hz, %s\n", sim->device_name().c_str(),
               sim->info().particles, opt.rate, (*loop)->scheduling().describe().c_str());
 
   // ------------------------------------------------------------ physics, paced to the wall clock

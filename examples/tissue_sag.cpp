@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
   const auto& info = sim->info();
   std::printf("tissue_sag on %s: %u particles, %u constraints (%u distance, %u volume), %u colours, "
               "%d substeps x %d iterations\n",
-              sim->device().device_name().c_str(), info.particles, info.constraints(), info.distance_constraints,
+              sim->device_name().c_str(), info.particles, info.constraints(), info.distance_constraints,
               info.volume_constraints, info.colors, opt.substeps, opt.iterations);
 
   std::filesystem::create_directories(opt.out);

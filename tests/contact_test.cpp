@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/simulation_internals.h"
 #include "test_support.h"
 
 namespace sinew {
@@ -493,7 +494,7 @@ TEST_P(Contact, ParticleAttachedToTwoTargetsSettlesBetweenThem) {
     scene.attachments.push_back({.vertex = {.body_kind = BodyKind::line}, .target = 0, .compliance = 1e-2});
     scene.attachments.push_back({.vertex = {.body_kind = BodyKind::line}, .target = 1, .compliance = ratio * 1e-2});
     CONTACT_SIMULATION(sim, scene);
-    EXPECT_EQ(sim.program().dispatch_count(Kernel::xpbd_solve_attachment), 100u * 2u + 1u)
+    EXPECT_EQ(SimulationInternals::program(sim).dispatch_count(Kernel::xpbd_solve_attachment), 100u * 2u + 1u)
         << "two colours per iteration, plus the measuring pass";
     for (int f = 0; f < 120; ++f) SINEW_ASSERT_OK(sim.step());
     const V3 x = particle(positions(sim), 0);

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "backends/vulkan/vulkan_device.h"
+#include "runtime/simulation_internals.h"
 #include "test_support.h"
 #include "xpbd_params.h"
 
@@ -212,7 +213,7 @@ TEST_F(VulkanBackend, CubeSceneRunsCleanUnderValidationWithKernelTimes) {
   for (float c : x) ASSERT_TRUE(std::isfinite(c));
   EXPECT_EQ(vulkan_validation_messages(), before) << "the validation layer reported problems (printed above)";
   if (validation_requested()) {
-    EXPECT_NE(sim->device().device_name().find("validation on"), std::string::npos);
+    EXPECT_NE(sim->device_name().find("validation on"), std::string::npos);
   }
 
   // The frame's statistics carry the device times of the frame just run.
@@ -223,16 +224,16 @@ TEST_F(VulkanBackend, CubeSceneRunsCleanUnderValidationWithKernelTimes) {
   for (std::size_t k = 0; k < kernel_count; ++k) {
     const auto kernel = static_cast<Kernel>(k);
     EXPECT_GE(times.kernel_ms[k], 0.0) << kernel_name(kernel);
-    EXPECT_EQ(times.dispatches[k], sim->program().dispatch_count(kernel)) << kernel_name(kernel);
+    EXPECT_EQ(times.dispatches[k], SimulationInternals::program(*sim).dispatch_count(kernel)) << kernel_name(kernel);
     dispatches += times.dispatches[k];
     summed += times.kernel_ms[k];
   }
-  EXPECT_EQ(dispatches, sim->program().dispatch_count());
+  EXPECT_EQ(dispatches, SimulationInternals::program(*sim).dispatch_count());
   EXPECT_GT(times.span_ms, 0.0);
   EXPECT_GT(summed, 0.0);
   // The device's own record of the last run is the same.
   DeviceTimes again;
-  SINEW_ASSERT_OK(sim->device().last_run_times(again));
+  SINEW_ASSERT_OK(SimulationInternals::device(*sim).last_run_times(again));
   EXPECT_EQ(again.span_ms, times.span_ms);
 }
 

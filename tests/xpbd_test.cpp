@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "cpu/xpbd_kernels.h"
+#include "runtime/simulation_internals.h"
 #include "test_support.h"
 
 namespace sinew {
@@ -166,13 +167,13 @@ TEST_P(Xpbd, ProgramHoldsOnlyTheStagesTheSceneUses) {
   scene.solver = {.time_step = 0.01, .substeps = 3, .iterations = 2};
   scene.line_bodies.push_back(chain);
   Simulation sim = make(scene, GetParam());
-  const FrameProgram& prog = sim.program();
+  const FrameProgram& prog = SimulationInternals::program(sim);
   EXPECT_EQ(prog.dispatch_count(Kernel::xpbd_solve_volume), 0u) << "a chain has no volume constraints";
   EXPECT_EQ(prog.dispatch_count(Kernel::xpbd_predict), 3u);
   // substeps x iterations x colours, plus one measuring pass per frame.
   EXPECT_EQ(prog.dispatch_count(Kernel::xpbd_solve_distance), 3u * 2u * sim.info().distance_colors + 1u);
   scene.solver.measure_errors = false;
-  EXPECT_EQ(make(scene, GetParam()).program().dispatch_count(Kernel::xpbd_solve_distance),
+  EXPECT_EQ(SimulationInternals::program(make(scene, GetParam())).dispatch_count(Kernel::xpbd_solve_distance),
             3u * 2u * sim.info().distance_colors);
   EXPECT_EQ(sim.info().distance_colors, 2u) << "two links sharing a particle need two colours";
 
@@ -182,7 +183,7 @@ TEST_P(Xpbd, ProgramHoldsOnlyTheStagesTheSceneUses) {
   SceneDesc tets;
   tets.tet_bodies.push_back(body);
   Simulation volume_only = make(tets, GetParam());
-  EXPECT_EQ(volume_only.program().dispatch_count(Kernel::xpbd_solve_distance), 0u);
+  EXPECT_EQ(SimulationInternals::program(volume_only).dispatch_count(Kernel::xpbd_solve_distance), 0u);
   EXPECT_EQ(volume_only.info().distance_constraints, 0u);
   EXPECT_EQ(volume_only.info().volume_constraints, 48u);
 }

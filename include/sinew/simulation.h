@@ -19,8 +19,6 @@
 
 namespace sinew {
 
-class Device;        // internal (backends/backend.h)
-class FrameProgram;  // internal (backends/backend.h)
 
 /// What a compiled scene holds; fixed for the life of a Simulation.
 struct SceneInfo {
@@ -103,11 +101,13 @@ class Simulation {
 
   [[nodiscard]] const SceneInfo& info() const;
   [[nodiscard]] const FrameStats& last_frame() const;
-  [[nodiscard]] const Device& device() const;
-  /// The frame program run by step(), for inspection.
-  [[nodiscard]] const FrameProgram& program() const;
+  /// The backend running the scene: "cpu", "opencl" or "vulkan".
+  [[nodiscard]] std::string backend_name() const;
+  /// Its device, e.g. "CPU reference (2 threads, AVX2)" or "Vulkan: NVIDIA H100 (discrete GPU, ...)".
+  [[nodiscard]] std::string device_name() const;
 
  private:
+  friend struct SimulationInternals;  // the library's own access (src/runtime/simulation_internals.h)
   struct Impl;
   explicit Simulation(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;

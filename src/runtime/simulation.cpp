@@ -1,6 +1,7 @@
 // simulation.cpp — a compiled scene on a device: upload once, run the frame
 // program every step, read back on request.
 #include "sinew/simulation.h"
+#include "runtime/simulation_internals.h"
 
 #include <chrono>
 #include <algorithm>
@@ -142,7 +143,10 @@ Status Simulation::read_velocities(std::vector<float>& xyzw) const {
 
 const SceneInfo& Simulation::info() const { return impl_->info; }
 const FrameStats& Simulation::last_frame() const { return impl_->stats; }
-const Device& Simulation::device() const { return *impl_->device; }
-const FrameProgram& Simulation::program() const { return impl_->program; }
+std::string Simulation::backend_name() const { return impl_->device->backend_name(); }
+std::string Simulation::device_name() const { return impl_->device->device_name(); }
+
+const Device& SimulationInternals::device(const Simulation& sim) { return *sim.impl_->device; }
+const FrameProgram& SimulationInternals::program(const Simulation& sim) { return sim.impl_->program; }
 
 }  // namespace sinew
