@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string>
 
+#include "math/vec3.h"
 #include "sinew/scene.h"
 
 namespace sinew {
@@ -99,7 +100,7 @@ Status finite3(const std::string& name, const std::array<double, 3>& v) {
 }
 
 Status unit_quaternion(const std::string& name, const std::array<double, 4>& q) {
-  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  const double n = math::qnorm(q);
   if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-6)
     return Error(name + " must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
   return {};
@@ -126,8 +127,8 @@ Status check_tri_body(const TriBodyDesc& b, const std::string& name) {
     const Vec3d& p = b.mesh.vertices[tri[0]];
     const Vec3d& q = b.mesh.vertices[tri[1]];
     const Vec3d& r = b.mesh.vertices[tri[2]];
-    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-    const double area = 0.5 * std::hypot(u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]);
+    const Vec3d u = math::sub(q, p), w = math::sub(r, p), normal = math::cross(u, w);
+    const double area = 0.5 * std::hypot(normal[0], normal[1], normal[2]);
     const double scale = std::max({std::hypot(u[0], u[1], u[2]), std::hypot(w[0], w[1], w[2])});
     if (!(area > 1e-12 * scale * scale)) return Error(where + " has zero area (degenerate triangle)");
   }

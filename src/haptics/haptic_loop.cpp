@@ -12,7 +12,7 @@
 #include <limits>
 #include <string>
 
-#include "haptics/vec_math.h"
+#include "math/vec3.h"
 
 namespace sinew::haptics {
 
@@ -159,8 +159,8 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   // 7. Feedback: the impulse integral (zero-order hold of the previous tick's
   // output up to now), then this tick's output.
   if (have_prev_tick_) {
-    fb_.impulse = vm::add(fb_.impulse, vm::mul(prev_force_, dt));
-    fb_.angular_impulse = vm::add(fb_.angular_impulse, vm::mul(prev_torque_, dt));
+    fb_.impulse = math::add(fb_.impulse, math::mul(prev_force_, dt));
+    fb_.angular_impulse = math::add(fb_.angular_impulse, math::mul(prev_torque_, dt));
   }
   const std::uint64_t tick_no = counters_.ticks.load(std::memory_order_relaxed) + 1;
   fb_.ticks = tick_no;

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "haptics/vec_math.h"
+#include "math/vec3.h"
 #include "sinew/haptics/clock.h"
 
 namespace sinew::haptics {
@@ -45,9 +45,9 @@ Status check_samples(const std::vector<TrajectorySample>& samples, const std::st
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const TrajectorySample& s = samples[i];
     const std::string where = origin + ": sample " + std::to_string(i);
-    if (!std::isfinite(s.time) || !vm::finite(s.position) || !vm::finite(s.rotation))
+    if (!std::isfinite(s.time) || !math::finite(s.position) || !math::finite(s.rotation))
       return Error(where + " has a non-finite value");
-    if (vm::qdot(s.rotation, s.rotation) < 1e-12) return Error(where + " has a zero quaternion");
+    if (math::qdot(s.rotation, s.rotation) < 1e-12) return Error(where + " has a zero quaternion");
     if (i > 0 && !(s.time > samples[i - 1].time))
       return Error(where + ": time " + std::to_string(s.time) + " s is not after the previous sample's " +
                    std::to_string(samples[i - 1].time) + " s");
@@ -93,8 +93,8 @@ Result<std::vector<TrajectorySample>> read_trajectory_csv(const std::filesystem:
     s.time = v[0];
     s.position = {v[1], v[2], v[3]};
     const Quat q{v[4], v[5], v[6], v[7]};
-    if (vm::qdot(q, q) < 1e-12) return Error(where + "quaternion is zero");
-    s.rotation = vm::normalize(q);
+    if (math::qdot(q, q) < 1e-12) return Error(where + "quaternion is zero");
+    s.rotation = math::normalize(q);
     if (columns == 9) {
       if (v[8] < 0 || v[8] != std::floor(v[8]) || v[8] > 4294967295.0)
         return Error(where + "buttons must be a non-negative integer ('" + cells[8] + "')");
@@ -125,7 +125,7 @@ Result<ReplayDevice> ReplayDevice::create(std::vector<TrajectorySample> samples,
                                           std::string name) {
   if (auto s = check_samples(samples, name); !s) return s.error();
   ReplayDevice d;
-  for (TrajectorySample& s : samples) s.rotation = vm::normalize(s.rotation);
+  for (TrajectorySample& s : samples) s.rotation = math::normalize(s.rotation);
   d.samples_ = std::move(samples);
   d.origin_ns_ = origin_ns;
   d.loop_ = loop;
@@ -165,10 +165,10 @@ bool ReplayDevice::sample(std::int64_t now_ns, DeviceSample& out) noexcept {
   const TrajectorySample& b = samples_[cursor_ + 1];
   const double dt = b.time - a.time;
   const double u = (t - a.time) / dt;
-  out.position = vm::lerp(a.position, b.position, u);
-  out.rotation = vm::nlerp(a.rotation, b.rotation, u);
-  out.velocity = vm::mul(vm::sub(b.position, a.position), 1.0 / dt);
-  out.angular_velocity = vm::angular_velocity(a.rotation, b.rotation, dt);
+  out.position = math::lerp(a.position, b.position, u);
+  out.rotation = math::nlerp(a.rotation, b.rotation, u);
+  out.velocity = math::mul(math::sub(b.position, a.position), 1.0 / dt);
+  out.angular_velocity = math::angular_velocity(a.rotation, b.rotation, dt);
   out.buttons = a.buttons;
   return true;
 }

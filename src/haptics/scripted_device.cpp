@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "haptics/vec_math.h"
+#include "math/vec3.h"
 #include "sinew/haptics/clock.h"
 
 namespace sinew::haptics {
@@ -38,9 +38,9 @@ bool ScriptedDevice::sample(std::int64_t now_ns, DeviceSample& out) noexcept {
   out.sequence = ++sequence_;
   out.time_ns = now_ns;
   out.position = p.position;
-  out.rotation = vm::normalize(p.rotation);  // NaN stays NaN: the coupling zeroes force and torque
-  out.velocity = vm::mul(vm::sub(after.position, before.position), 0.5 / h_);
-  out.angular_velocity = vm::angular_velocity(vm::normalize(before.rotation), vm::normalize(after.rotation), 2.0 * h_);
+  out.rotation = math::normalize(p.rotation);  // NaN stays NaN: the coupling zeroes force and torque
+  out.velocity = math::mul(math::sub(after.position, before.position), 0.5 / h_);
+  out.angular_velocity = math::angular_velocity(math::normalize(before.rotation), math::normalize(after.rotation), 2.0 * h_);
   out.buttons = p.buttons;
   return true;
 }
@@ -55,7 +55,7 @@ bool NullDevice::sample(std::int64_t now_ns, DeviceSample& out) noexcept {
   out.sequence = ++sequence_;
   out.time_ns = now_ns;
   out.position = pose_.position;
-  out.rotation = vm::normalize(pose_.rotation);
+  out.rotation = math::normalize(pose_.rotation);
   out.velocity = {0.0, 0.0, 0.0};
   out.angular_velocity = {0.0, 0.0, 0.0};
   out.buttons = pose_.buttons;

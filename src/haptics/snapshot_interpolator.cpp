@@ -9,7 +9,7 @@
 #include <limits>
 #include <string>
 
-#include "haptics/vec_math.h"
+#include "math/vec3.h"
 #include "sinew/haptics/clock.h"
 
 namespace sinew::haptics {
@@ -77,11 +77,11 @@ RenderedTool SnapshotHistory::render(std::int64_t now_ns, const InterpolationPar
     u = u_max;
   }
   r.u = u;
-  r.position = vm::lerp(a.position, b.position, u);
-  r.velocity = vm::lerp(a.velocity, b.velocity, u);
-  r.angular_velocity = vm::lerp(a.angular_velocity, b.angular_velocity, u);
-  r.contact_force = vm::lerp(a.contact_force, b.contact_force, u);
-  r.rotation = vm::nlerp(a.rotation, b.rotation, u);
+  r.position = math::lerp(a.position, b.position, u);
+  r.velocity = math::lerp(a.velocity, b.velocity, u);
+  r.angular_velocity = math::lerp(a.angular_velocity, b.angular_velocity, u);
+  r.contact_force = math::lerp(a.contact_force, b.contact_force, u);
+  r.rotation = math::nlerp(a.rotation, b.rotation, u);
   // The rendered state stands for the time a + u D on the loop clock.
   r.render_age = ns_to_seconds(now_ns - a.stamp_ns) - u * interval;
   return r;

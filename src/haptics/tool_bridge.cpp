@@ -7,7 +7,7 @@
 #include <cmath>
 #include <string>
 
-#include "haptics/vec_math.h"
+#include "math/vec3.h"
 
 namespace sinew::haptics {
 
@@ -34,12 +34,12 @@ Status HapticToolBridge::apply_feedback(Simulation& sim) {
     // Mean device force over the interval between the two readings (exact:
     // the impulse integral is a zero-order hold of every tick's output).
     const double dt = ns_to_seconds(fb.time_ns - prev_.time_ns);
-    force_ = vm::mul(vm::sub(fb.impulse, prev_.impulse), -1.0 / dt);
-    torque_ = vm::mul(vm::sub(fb.angular_impulse, prev_.angular_impulse), -1.0 / dt);
+    force_ = math::mul(math::sub(fb.impulse, prev_.impulse), -1.0 / dt);
+    torque_ = math::mul(math::sub(fb.angular_impulse, prev_.angular_impulse), -1.0 / dt);
   } else if (got && !same_loop) {
     // First reading (of this loop): the newest tick's output (no interval to average over yet).
-    force_ = vm::mul(fb.force, -1.0);
-    torque_ = vm::mul(fb.torque, -1.0);
+    force_ = math::mul(fb.force, -1.0);
+    torque_ = math::mul(fb.torque, -1.0);
   } else {
     ++missing_;  // no tick since the previous frame: the tool gets nothing
   }
@@ -47,15 +47,15 @@ Status HapticToolBridge::apply_feedback(Simulation& sim) {
     prev_ = fb;
     have_prev_ = true;
   }
-  if (!vm::finite(force_) || !vm::finite(torque_)) {  // cannot happen with the safety chain; never pass it on
+  if (!math::finite(force_) || !math::finite(torque_)) {  // cannot happen with the safety chain; never pass it on
     force_ = torque_ = {0.0, 0.0, 0.0};
   }
   Vec3 f = force_, t = torque_;
   if (damping_ > 0.0 || angular_damping_ > 0.0) {
     auto state = sim.tool_state(tool_);
     if (!state) return state.error();
-    f = vm::sub(f, vm::mul(state->velocity, damping_));
-    t = vm::sub(t, vm::mul(state->angular_velocity, angular_damping_));
+    f = math::sub(f, math::mul(state->velocity, damping_));
+    t = math::sub(t, math::mul(state->angular_velocity, angular_damping_));
   }
   return sim.apply_tool_force(tool_, f, t);
 }
@@ -74,9 +74,9 @@ Status HapticToolBridge::publish(const Simulation& sim) {
   s.angular_velocity = state->angular_velocity;
   s.contact_force = state->contact_force;
   s.contact_torque = state->contact_torque;
-  const double f = vm::norm(s.contact_force);
+  const double f = math::norm(s.contact_force);
   s.in_contact = f > 0.0 ? 1u : 0u;
-  s.contact_normal = f > 0.0 ? vm::mul(s.contact_force, 1.0 / f) : Vec3{0.0, 0.0, 0.0};
+  s.contact_normal = f > 0.0 ? math::mul(s.contact_force, 1.0 / f) : Vec3{0.0, 0.0, 0.0};
   snapshots_.publish(s);
   return {};
 }

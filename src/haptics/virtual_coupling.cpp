@@ -7,7 +7,7 @@
 #include <cmath>
 #include <string>
 
-#include "haptics/vec_math.h"
+#include "math/vec3.h"
 
 namespace sinew::haptics {
 
@@ -38,20 +38,20 @@ CouplingOutput VirtualCoupling::raw(const DeviceSample& device, const RenderedTo
   if (!tool.valid()) return out;
   // Force on the device: the spring pulls the hand towards the tool, the
   // damper resists their relative velocity. The tool gets the opposite.
-  out.raw_force = vm::add(vm::mul(vm::sub(tool.position, device.position), p_.stiffness),
-                          vm::mul(vm::sub(tool.velocity, device.velocity), p_.damping));
-  const Vec3 twist = vm::rotation_vector(vm::qmul(tool.rotation, vm::conj(device.rotation)));
-  out.raw_torque = vm::add(vm::mul(twist, p_.rotational_stiffness),
-                           vm::mul(vm::sub(tool.angular_velocity, device.angular_velocity), p_.rotational_damping));
+  out.raw_force = math::add(math::mul(math::sub(tool.position, device.position), p_.stiffness),
+                          math::mul(math::sub(tool.velocity, device.velocity), p_.damping));
+  const Vec3 twist = math::rotation_vector(math::qmul(tool.rotation, math::conj(device.rotation)));
+  out.raw_torque = math::add(math::mul(twist, p_.rotational_stiffness),
+                           math::mul(math::sub(tool.angular_velocity, device.angular_velocity), p_.rotational_damping));
   // A NaN quaternion gives a NaN twist; make sure the chain sees it.
-  if (!vm::finite(device.rotation) || !vm::finite(tool.rotation)) out.raw_torque[0] = std::nan("");
+  if (!math::finite(device.rotation) || !math::finite(tool.rotation)) out.raw_torque[0] = std::nan("");
   return out;
 }
 
 CouplingOutput VirtualCoupling::evaluate(const DeviceSample& device, const RenderedTool& tool, double gain) noexcept {
   CouplingOutput out = raw(device, tool);
   // A NaN/Inf anywhere (device, snapshot, parameters) zeroes force and torque alike.
-  if (!vm::finite(out.raw_force) || !vm::finite(out.raw_torque)) {
+  if (!math::finite(out.raw_force) || !math::finite(out.raw_torque)) {
     const double nan = std::nan("");
     const Vec3 bad{nan, nan, nan};
     out.force = force_.apply(bad, gain, out.flags);

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <string>
 
+#include "math/vec3.h"
 #include "sinew/mesh.h"
 
 namespace sinew {
@@ -30,10 +31,7 @@ std::string tet_text(std::size_t t, const std::array<std::uint32_t, 4>& tet) {
 
 // Six times the signed volume: dot(b - a, cross(c - a, d - a)).
 double orientation(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
-  const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
-  const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
-  const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
-  return ux * (vy * wz - vz * wy) + uy * (vz * wx - vx * wz) + uz * (vx * wy - vy * wx);
+  return math::dot(math::sub(b, a), math::cross(math::sub(c, a), math::sub(d, a)));
 }
 
 Status check_vertices(const TetMesh& mesh, const std::string& origin) {
@@ -70,8 +68,8 @@ Status check_indices(const TetMesh& mesh, const std::string& origin) {
 }
 
 double squared_distance(const Vec3d& a, const Vec3d& b) {
-  const double x = b[0] - a[0], y = b[1] - a[1], z = b[2] - a[2];
-  return x * x + y * y + z * z;
+  const Vec3d d = math::sub(b, a);
+  return math::dot(d, d);
 }
 
 double longest_edge(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {

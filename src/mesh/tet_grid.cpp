@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "math/vec3.h"
 #include "sinew/mesh.h"
 
 namespace sinew {
@@ -29,11 +30,7 @@ Vec3d unit_corner(int c) {
 
 double unit_orientation(const LocalTet& t) {
   const Vec3d a = unit_corner(t[0]), b = unit_corner(t[1]), c = unit_corner(t[2]), d = unit_corner(t[3]);
-  const Vec3d u{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const Vec3d v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  const Vec3d w{d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-         u[2] * (v[0] * w[1] - v[1] * w[0]);
+  return math::dot(math::sub(b, a), math::cross(math::sub(c, a), math::sub(d, a)));
 }
 
 // Swaps two vertices of every negatively oriented template tet.

@@ -6,23 +6,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "math/vec3.h"
+
 namespace sinew {
 namespace {
 
-using V3 = std::array<double, 3>;
-using Q4 = std::array<double, 4>;  // (w, x, y, z)
-
-V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-// v rotated by the unit quaternion q (inverse: conjugate first).
-V3 rotate(const Q4& q, const V3& v, bool inverse = false) {
-  const V3 u{inverse ? -q[1] : q[1], inverse ? -q[2] : q[2], inverse ? -q[3] : q[3]};
-  V3 t = cross(u, v);
-  for (double& c : t) c *= 2.0;
-  const V3 ut = cross(u, t);
-  return {v[0] + q[0] * t[0] + ut[0], v[1] + q[0] * t[1] + ut[1], v[2] + q[0] * t[2] + ut[2]};
-}
+using math::Quat;
+using V3 = math::Vec3;
 
 using M3 = std::array<V3, 3>;  // row-major
 
@@ -50,8 +40,7 @@ bool solve3(const M3& a, const V3& f, V3& x) {
 // J = I + dt (skew(w) I - skew(I w)).
 V3 gyroscopic_step(const V3& inertia, const V3& w, double dt) {
   const V3 iw{inertia[0] * w[0], inertia[1] * w[1], inertia[2] * w[2]};
-  V3 f = cross(w, iw);
-  for (double& c : f) c *= dt;
+  const V3 f = math::mul(math::cross(w, iw), dt);
   auto skew = [](const V3& v) { return M3{V3{0.0, -v[2], v[1]}, V3{v[2], 0.0, -v[0]}, V3{-v[1], v[0], 0.0}}; };
   const M3 sw = skew(w), siw = skew(iw);
   M3 j;
@@ -59,7 +48,7 @@ V3 gyroscopic_step(const V3& inertia, const V3& w, double dt) {
     for (int c = 0; c < 3; ++c) j[r][c] = (r == c ? inertia[r] : 0.0) + dt * (sw[r][c] * inertia[c] - siw[r][c]);
   V3 step{0.0, 0.0, 0.0};
   if (!solve3(j, f, step)) return w;
-  return {w[0] - step[0], w[1] - step[1], w[2] - step[2]};
+  return math::sub(w, step);
 }
 
 }  // namespace
@@ -86,11 +75,8 @@ V3 gyroscopic_step(const V3& inertia, const V3& w, double dt) {
 // Equilibria are unchanged (no velocity change where the force and torque
 // vanish). `stiffness` is n_it n_sub^2.
 void integrate_tool(ToolBody& b, double dt, double stiffness) {
-  V3 force, torque;
-  for (int k = 0; k < 3; ++k) {
-    force[k] = b.force[k] + b.coupling_force[k] + b.mass * b.gravity[k];
-    torque[k] = b.torque[k] + b.coupling_torque[k];
-  }
+  const V3 force = math::add(math::add(b.force, b.coupling_force), math::mul(b.gravity, b.mass));
+  const V3 torque = math::add(b.torque, b.coupling_torque);
   // Translation: the tool's own mass, raised where needed to the least
   // mass that keeps explicit Euler inside its stability bound against K:
   // dt^2 K / M <= 4 with dt^2 K = n_it n_sub^2 sum m_i (see above).
@@ -102,32 +88,27 @@ void integrate_tool(ToolBody& b, double dt, double stiffness) {
   for (int c = 0; c < 3; ++c) {
     V3 e{0.0, 0.0, 0.0};
     e[c] = 1.0;
-    V3 local = rotate(b.rotation, e, true);
+    V3 local = math::rotate(math::conj(b.rotation), e);
     for (int k = 0; k < 3; ++k) local[k] *= b.inertia[k];
-    const V3 column = rotate(b.rotation, local);
+    const V3 column = math::rotate(b.rotation, local);
     for (int r = 0; r < 3; ++r) a[r][c] = column[r] + stiffness * b.touching_inertia[3 * r + c];
   }
   V3 dw{0.0, 0.0, 0.0};
-  const V3 impulse{dt * torque[0], dt * torque[1], dt * torque[2]};
-  if (solve3(a, impulse, dw))  // a is symmetric positive definite: inertia > 0
-    for (int k = 0; k < 3; ++k) b.angular_velocity[k] += dw[k];
+  if (solve3(a, math::mul(torque, dt), dw))  // a is symmetric positive definite: inertia > 0
+    b.angular_velocity = math::add(b.angular_velocity, dw);
   // The gyroscopic term of Euler's equations, I dw/dt = -w x (I w) in the
   // body frame, implicitly by one Newton step (Catto, "Numerical Methods",
   // GDC 2015): explicitly, a free tumbling tool would gain energy.
-  b.angular_velocity = rotate(b.rotation, gyroscopic_step(b.inertia, rotate(b.rotation, b.angular_velocity, true), dt));
+  b.angular_velocity = math::rotate(
+      b.rotation, gyroscopic_step(b.inertia, math::rotate(math::conj(b.rotation), b.angular_velocity), dt));
 
-  for (int k = 0; k < 3; ++k) b.position[k] += dt * b.velocity[k];
-  const V3& o = b.angular_velocity;
-  const Q4& q = b.rotation;
-  const Q4 dq{-(o[0] * q[1] + o[1] * q[2] + o[2] * q[3]), o[0] * q[0] + o[1] * q[3] - o[2] * q[2],
-              o[1] * q[0] + o[2] * q[1] - o[0] * q[3], o[2] * q[0] + o[0] * q[2] - o[1] * q[1]};  // (0, o) q
-  Q4 r;
-  double norm = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    r[k] = q[k] + 0.5 * dt * dq[k];
-    norm += r[k] * r[k];
-  }
-  norm = std::sqrt(norm);
+  b.position = math::add(b.position, math::mul(b.velocity, dt));
+  // q += dt/2 (0, omega) q, then |q| = 1 again.
+  const Quat& q = b.rotation;
+  const Quat dq = math::pure_mul(b.angular_velocity, q);
+  Quat r;
+  for (int k = 0; k < 4; ++k) r[k] = q[k] + 0.5 * dt * dq[k];
+  const double norm = math::qnorm(r);
   for (double& c : r) c /= norm;
   b.rotation = r;
   b.force = b.torque = V3{0.0, 0.0, 0.0};

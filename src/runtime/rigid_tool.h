@@ -55,13 +55,15 @@
 
 #include <array>
 
+#include "math/vec3.h"
+
 namespace sinew {
 
 /// A tool's rigid state.
 struct ToolBody {
-  using V3 = std::array<double, 3>;
+  using V3 = math::Vec3;
   V3 position{}, velocity{}, angular_velocity{};  ///< [m], [m/s], world [rad/s]
-  std::array<double, 4> rotation{1, 0, 0, 0};     ///< unit (w, x, y, z)
+  math::Quat rotation{1, 0, 0, 0};                ///< unit (w, x, y, z)
   V3 force{}, torque{};                           ///< applied during the next frame [N], [N m]
   V3 contact_force{}, contact_torque{};           ///< the tissue's reaction, last frame's average
   V3 coupling_force{}, coupling_torque{};         ///< the reaction in the last frame's last substep

@@ -32,6 +32,7 @@
 
 #include "compiler/float_words.h"
 #include "contact_params.h"
+#include "math/vec3.h"
 #include "runtime/simulation_impl.h"
 
 namespace sinew {
@@ -40,8 +41,8 @@ namespace {
 using kernels::ColliderEntry;
 using kernels::ColliderHeader;
 using kernels::TargetEntry;
-using V3 = std::array<double, 3>;
-using Q4 = std::array<double, 4>;  // (w, x, y, z)
+using V3 = math::Vec3;
+using Q4 = math::Quat;
 
 constexpr std::size_t kHeaderFloats = sizeof(ColliderHeader) / sizeof(float);
 constexpr std::size_t kEntryFloats = sizeof(ColliderEntry) / sizeof(float);
@@ -74,7 +75,7 @@ Status check_finite(const char* call, const char* name, const V3& v) {
 }
 
 Status check_rotation(const char* call, const Q4& q) {
-  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  const double n = math::qnorm(q);
   if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-6)
     return Error(std::string(call) + ": rotation must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
   return {};
@@ -202,7 +203,7 @@ Status Simulation::Impl::after_frame() {
       const double m = slot[19];
       if (m > 0.0) {  // touching at the end of the frame: lever r = slot[16..18]
         const V3 r{slot[16], slot[17], slot[18]};
-        const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        const double r2 = math::dot(r, r);
         mass += m;
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j) inertia[3 * i + j] += m * ((i == j ? r2 : 0.0) - r[i] * r[j]);

@@ -1,18 +1,30 @@
-// src/haptics/vec_math.h — the few 3-vector and quaternion operations the
-// haptics code needs, inline and allocation-free (tick-safe).
+// src/math/vec3.h — the host's 3-vectors and unit quaternions, in double
+// precision on std::array: one set of inline, allocation-free operations
+// (tick-safe) for the haptics code, the rigid tools (src/runtime), the scene
+// checks and the mesh code. Quaternions are (w, x, y, z). The kernels' float
+// vectors are kernels/math/vec4.h, not these.
+//
+// Keep each operation's arithmetic as it is: the haptics tests and the
+// tools' trajectories depend on its rounding bit for bit (e.g. norm is
+// sqrt(dot), evaluated left to right; normalize scales first, qnorm does not).
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
-#include "sinew/haptics/snapshot_channel.h"
+namespace sinew::math {
 
-namespace sinew::haptics::vm {
+using Vec3 = std::array<double, 3>;
+using Quat = std::array<double, 4>;  ///< (w, x, y, z)
 
 inline Vec3 add(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 inline Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 inline Vec3 mul(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
 inline double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
 inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
 inline bool finite(const Vec3& a) { return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]); }
 inline bool finite(const Quat& q) {
@@ -29,6 +41,22 @@ inline Quat qmul(const Quat& a, const Quat& b) {
 }
 inline Quat conj(const Quat& q) { return {q[0], -q[1], -q[2], -q[3]}; }
 inline double qdot(const Quat& a, const Quat& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+/// |q| = sqrt(qdot(q, q)), unscaled (see normalize for a robust unit quaternion).
+inline double qnorm(const Quat& q) { return std::sqrt(qdot(q, q)); }
+/// The product (0, o) q of the pure quaternion (0, o) and q: with o an
+/// angular velocity, dq/dt = (0, o) q / 2.
+inline Quat pure_mul(const Vec3& o, const Quat& q) {
+  return {-(o[0] * q[1] + o[1] * q[2] + o[2] * q[3]), o[0] * q[0] + o[1] * q[3] - o[2] * q[2],
+          o[1] * q[0] + o[2] * q[1] - o[0] * q[3], o[2] * q[0] + o[0] * q[2] - o[1] * q[1]};
+}
+/// v rotated by the unit quaternion q: v + 2 w (u x v) + 2 u x (u x v),
+/// u = (x, y, z); rotate(conj(q), v) is the inverse rotation.
+inline Vec3 rotate(const Quat& q, const Vec3& v) {
+  const Vec3 u{q[1], q[2], q[3]};
+  const Vec3 t = mul(cross(u, v), 2.0);
+  const Vec3 ut = cross(u, t);
+  return {v[0] + q[0] * t[0] + ut[0], v[1] + q[0] * t[1] + ut[1], v[2] + q[0] * t[2] + ut[2]};
+}
 /// q / |q|; the identity only for an exactly zero q. A NaN or Inf
 /// component gives all NaN: a bad rotation must stay non-finite so the
 /// coupling's finite check zeroes force and torque (mapped to the identity
@@ -65,4 +93,4 @@ inline Vec3 angular_velocity(const Quat& a, const Quat& b, double dt) {
   return mul(rotation_vector(qmul(b, conj(a))), 1.0 / dt);
 }
 
-}  // namespace sinew::haptics::vm
+}  // namespace sinew::math
