@@ -1,9 +1,9 @@
 # Checks, at configure time, that every kernel of the registry
 # (kernels/kernel_list.h) has its CPU reference (a definition `void NAME(` in
-# some kernels/cpu/*.cpp) and its GPU source: kernels/gpu/NAME.gpu, or, for
-# kernels not yet moved to the single source, both kernels/opencl/NAME.cl and
-# kernels/glsl/NAME.comp. Also that no GPU source is left without a registry
-# entry. A missing one stops the configuration with the kernel's name.
+# some kernels/cpu/*.cpp) and its GPU source kernels/gpu/NAME.gpu (one source
+# for OpenCL and Vulkan, through kernels/gpu/gpu_lang.h). Also that no GPU
+# source is left without a registry entry. A missing one stops the
+# configuration with the kernel's name.
 function(sinew_check_kernel_registry)
   set(root ${PROJECT_SOURCE_DIR}/kernels)
   file(READ ${root}/kernel_list.h list_text)
@@ -31,12 +31,11 @@ function(sinew_check_kernel_registry)
     if(NOT defined)
       list(APPEND problems "${name}: no CPU reference (void ${name}( in kernels/cpu/*.cpp)")
     endif()
-    if(NOT EXISTS ${root}/gpu/${name}.gpu AND
-       NOT (EXISTS ${root}/opencl/${name}.cl AND EXISTS ${root}/glsl/${name}.comp))
+    if(NOT EXISTS ${root}/gpu/${name}.gpu)
       list(APPEND problems "${name}: no GPU source (kernels/gpu/${name}.gpu)")
     endif()
   endforeach()
-  file(GLOB gpu_sources ${root}/gpu/*.gpu ${root}/opencl/*.cl ${root}/glsl/*.comp)
+  file(GLOB gpu_sources ${root}/gpu/*.gpu)
   foreach(src IN LISTS gpu_sources)
     get_filename_component(name ${src} NAME_WE)
     if(NOT name IN_LIST names)
