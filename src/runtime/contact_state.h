@@ -1,7 +1,6 @@
 // contact_state.h — the host side of contacts that Simulation::Impl keeps
 // between frames (simulation_contacts.cpp): which device buffers need an
-// upload, the rigid tools' state (rigid_tool.h) and the read-back of the
-// contact impulses. Everything is sized in init_contacts; nothing here
+// upload and the rigid tools' state (rigid_tool.h). Everything is sized in init_contacts; nothing here
 // grows per frame.
 #pragma once
 
@@ -18,7 +17,6 @@ struct ContactState {
   bool colliders_dirty = false;  ///< the collider buffer changed since its last upload
   bool targets_dirty = false;    ///< the target buffer changed since its last upload
   std::vector<ToolBody> tools;
-  std::vector<float> impulses;  ///< the contact impulse buffer as read back after each frame
 };
 
 }  // namespace sinew

@@ -14,45 +14,14 @@
 
 namespace sinew {
 
-// Reads back the residuals, velocities and positions and reduces them in
-// double precision, in a fixed order (the same numbers on every backend).
-Status Simulation::Impl::measure(FrameStats& out) const {
-  double sum = 0.0, largest = 0.0;
-  std::size_t count = 0;
-  std::vector<float> r;
-  for (std::size_t k = 0; k < block_sizes.size(); ++k) {
-    r.resize(block_sizes[k]);
-    if (r.empty()) continue;
-    if (Status s = device->read_buffer(buffers.blocks[k].residual, 0, r.data(), r.size() * sizeof(float)); !s) return s;
-    for (float v : r) {
-      sum += double(v) * v;
-      largest = std::max(largest, double(v));
-    }
-    count += r.size();
-  }
-  out.residual_rms = count ? std::sqrt(sum / double(count)) : 0.0;
-  out.max_residual = largest;
-
-  std::vector<float> x(std::size_t{info.particles} * 4), v(x.size());
-  if (Status s = device->read_buffer(buffers.position, 0, x.data(), x.size() * sizeof(float)); !s) return s;
-  if (Status s = device->read_buffer(buffers.velocity, 0, v.data(), v.size() * sizeof(float)); !s) return s;
-  double ke = 0.0;
-  for (std::size_t p = 0; p < info.particles; ++p) {
-    const float w = x[4 * p + 3];
-    if (w > 0.0f) ke += 0.5 / w * (double(v[4 * p]) * v[4 * p] + double(v[4 * p + 1]) * v[4 * p + 1] +
-                                    double(v[4 * p + 2]) * v[4 * p + 2]);
-  }
-  out.kinetic_energy = ke;
-
-  double volume = 0.0;
-  for (const auto& t : tets) {
-    auto at = [&](int k) {
-      return kernels::double4{x[4 * t[k]], x[4 * t[k] + 1], x[4 * t[k] + 2], 0.0};
-    };
-    volume += kernels::tet_volume(at(0), at(1), at(2), at(3));
-  }
-  out.volume_change = rest_volume > 0.0 ? volume / rest_volume - 1.0 : 0.0;
-  return {};
+// The errors of the frame from the device's reductions (stats_program.h):
+// the same numbers on every backend.
+void Simulation::Impl::measure(FrameStats& out) const {
+  const DeviceStats& d = device_stats;
+  out.residual_rms = d.constraints ? std::sqrt(d.residual_sum_squares / double(d.constraints)) : 0.0;
+  out.max_residual = d.residual_max;
+  out.kinetic_energy = d.kinetic_energy;
+  out.volume_change = rest_volume > 0.0 ? d.volume / rest_volume - 1.0 : 0.0;
 }
 
 Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -72,17 +41,13 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
   if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
-  impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
-  auto prepared = impl->device->create_program(impl->program);
-  if (!prepared) return prepared.error();
-  impl->prepared = *prepared;
   impl->time_step = scene.solver.time_step;
   impl->measure_errors = scene.solver.measure_errors;
-  for (const ConstraintBlock& block : compiled->blocks) impl->block_sizes.push_back(block.size());
+  std::vector<std::array<std::uint32_t, 4>> tets;  // every tet body's tets, as particle indices
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
     const std::uint32_t first = compiled->tet_body_first_particle[b];
     for (const auto& t : scene.tet_bodies[b].mesh.tets) {
-      impl->tets.push_back({first + t[0], first + t[1], first + t[2], first + t[3]});
+      tets.push_back({first + t[0], first + t[1], first + t[2], first + t[3]});
       const auto at = [&](int k) {
         const Vec3d& p = scene.tet_bodies[b].mesh.vertices[t[k]];
         return kernels::double4{p[0], p[1], p[2], 0.0};
@@ -90,6 +55,15 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
       impl->rest_volume += kernels::tet_volume(at(0), at(1), at(2), at(3));
     }
   }
+  auto plan = make_stats_plan(*impl->device, *compiled, impl->buffers, tets, impl->measure_errors,
+                              static_cast<std::uint32_t>(impl->contacts.tools.size()));
+  if (!plan) return plan.error();
+  impl->stats_plan = std::move(*plan);
+  impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
+  append_stats(impl->program, impl->stats_plan, *compiled, impl->buffers);
+  auto prepared = impl->device->create_program(impl->program);
+  if (!prepared) return prepared.error();
+  impl->prepared = *prepared;
 
   SceneInfo& info = impl->info;
   info.particles = static_cast<std::uint32_t>(compiled->positions.size());
@@ -118,16 +92,16 @@ Status Simulation::step() {
   if (Status s = impl_->before_frame(); !s) return s;
   if (Status s = impl_->device->run_program(impl_->prepared); !s) return s;
   if (Status s = impl_->device->last_run_times(impl_->stats.device); !s) return s;
+  const auto ran = std::chrono::steady_clock::now();
+  if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
+  impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4;
   if (Status s = impl_->after_frame(); !s) return s;
+  if (impl_->measure_errors) impl_->measure(impl_->stats);
   const auto end = std::chrono::steady_clock::now();
   impl_->stats.frame += 1;
   impl_->stats.time = static_cast<double>(impl_->stats.frame) * impl_->time_step;
   impl_->stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
-  if (impl_->measure_errors) {
-    if (Status s = impl_->measure(impl_->stats); !s) return s;
-    impl_->stats.measure_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - end).count();
-  }
+  impl_->stats.measure_ms = std::chrono::duration<double, std::milli>(end - ran).count();
   return {};
 }
 

@@ -16,15 +16,14 @@
 // old pose to the new one across the frame's substeps; during the frame
 // the contact kernel sums each correction's impulse, and its moment about
 // the tool's centre, per particle and tool in the contact-impulse buffer;
-// after the frame (after_frame) the sums are read back and reduced in
-// particle order, in double precision (deterministic), to the tool's
-// reaction: the frame's average contact force and torque (tool_state), the
+// at the end of the frame they are reduced on the device, in a fixed order
+// and double-float precision (program/stats_program.h), and after it
+// (after_frame) a few words come back as the tool's reaction: the frame's average contact force and torque (tool_state), the
 // force and torque of its last substep and the mass and inertia of the
 // particles touching the tool at its end (which the next integration uses).
 //
 // State: Impl::colliders and Impl::targets are host copies of the device
-// buffers; the tools' rigid state and the impulse read-back live in
-// Impl::contacts (contact_state.h), all sized in init_contacts: nothing here
+// buffers; the tools' rigid state lives in Impl::contacts (contact_state.h), all sized in init_contacts: nothing here
 // allocates per frame.
 #include <cmath>
 #include <sstream>
@@ -124,7 +123,6 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
   contacts.colliders = header.colliders;
   contacts.substeps = static_cast<std::uint32_t>(scene.solver.substeps);
   contacts.iterations = static_cast<std::uint32_t>(scene.solver.iterations);
-  contacts.impulses.assign(std::size_t{compiled.contact_impulse_slots} * 4, 0.0f);
   for (const ToolDesc& d : scene.tools) {
     ToolBody& b = contacts.tools.emplace_back();
     b.position = d.position;
@@ -183,41 +181,20 @@ Status Simulation::Impl::after_frame() {
   }
   if (c.tools.empty()) return {};
 
-  // The tissue's reaction on each tool: the frame's impulse sums, reduced
-  // in particle order in double precision.
-  if (!c.impulses.empty())
-    if (Status s = device->read_buffer(buffers.contact_impulses, 0, c.impulses.data(), c.impulses.size() * sizeof(float));
-        !s)
-      return s;
-  const std::size_t tools = c.tools.size();
-  const std::size_t particles = c.impulses.size() / (4 * SINEW_CONTACT_IMPULSE_FLOAT4S * tools);
+  // The tissue's reaction on each tool: the frame's impulse sums and the
+  // touching particles' mass and inertia, reduced on the device (stats_program.h).
   const double h = time_step / c.substeps;
-  for (std::size_t t = 0; t < tools; ++t) {
-    double sums[4][3] = {};  // frame impulse, its moment, last substep's impulse, its moment
-    double mass = 0.0;
-    std::array<double, 9> inertia{};
-    for (std::size_t p = 0; p < particles; ++p) {
-      const float* slot = c.impulses.data() + (p * tools + t) * SINEW_CONTACT_IMPULSE_FLOAT4S * 4;
-      for (int s = 0; s < 4; ++s)
-        for (int k = 0; k < 3; ++k) sums[s][k] += slot[4 * s + k];
-      const double m = slot[19];
-      if (m > 0.0) {  // touching at the end of the frame: lever r = slot[16..18]
-        const V3 r{slot[16], slot[17], slot[18]};
-        const double r2 = math::dot(r, r);
-        mass += m;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) inertia[3 * i + j] += m * ((i == j ? r2 : 0.0) - r[i] * r[j]);
-      }
-    }
+  for (std::size_t t = 0; t < c.tools.size(); ++t) {
+    const DeviceStats::Tool& sums = device_stats.tools[t];
     ToolBody& b = c.tools[t];
     for (int k = 0; k < 3; ++k) {
-      b.contact_force[k] = sums[0][k] / time_step;
-      b.contact_torque[k] = sums[1][k] / time_step;
-      b.coupling_force[k] = sums[2][k] / h;
-      b.coupling_torque[k] = sums[3][k] / h;
+      b.contact_force[k] = sums.sums[0][k] / time_step;
+      b.contact_torque[k] = sums.sums[1][k] / time_step;
+      b.coupling_force[k] = sums.sums[2][k] / h;
+      b.coupling_torque[k] = sums.sums[3][k] / h;
     }
-    b.touching_mass = mass;
-    b.touching_inertia = inertia;
+    b.touching_mass = sums.mass;
+    b.touching_inertia = sums.inertia;
   }
   return {};
 }

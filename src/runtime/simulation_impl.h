@@ -1,6 +1,6 @@
 // simulation_impl.h — the state behind sinew::Simulation, shared by the
 // files that implement it: simulation.cpp (create, step, read-back, error
-// measurement) and simulation_contacts.cpp (colliders, targets, tools).
+// statistics) and simulation_contacts.cpp (colliders, targets, tools).
 #pragma once
 
 #include <array>
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "compiler/scene_compiler.h"
+#include "program/stats_program.h"
 #include "program/xpbd_program.h"
 #include "runtime/contact_state.h"
 #include "sinew/simulation.h"
@@ -23,11 +24,13 @@ struct Simulation::Impl {
   FrameStats stats;
   double time_step = 0.0;
   bool measure_errors = true;
-  std::vector<std::uint32_t> block_sizes;             // constraints per block, for the residual read-back
-  std::vector<std::array<std::uint32_t, 4>> tets;    // every tet body's tets, as particle indices
-  double rest_volume = 0.0;                           // their total rest volume [m^3]
+  double rest_volume = 0.0;  // every tet body's total rest volume [m^3]
+  // The errors and the tools' reaction, reduced on the device at the end of
+  // each frame (stats_program.h) and read back as a few words.
+  StatsPlan stats_plan;
+  DeviceStats device_stats;
 
-  Status measure(FrameStats& stats) const;
+  void measure(FrameStats& stats) const;
 
   // simulation_contacts.cpp: host copies of the collider and target
   // buffers (rewritten before each frame) and the tools' rigid state.
@@ -36,7 +39,7 @@ struct Simulation::Impl {
   ContactState contacts;
   Status init_contacts(const SceneDesc& scene, const CompiledScene& compiled);
   Status before_frame();  ///< integrates the tools (rigid_tool.h), uploads what moved
-  Status after_frame();   ///< settles what moved, reduces the tissue's reaction on each tool
+  Status after_frame();   ///< settles what moved, takes each tool's reaction from device_stats
 };
 
 
