@@ -16,14 +16,15 @@
 //     particles it touches are pushed out and dragged by friction, and each
 //     correction's impulse (with its moment about the tool's centre) is
 //     summed per particle and tool in the contact-impulse buffer.
-//  3. after frame n (Simulation::Impl::after_frame): the sums are read back
-//     and reduced in particle order, in double precision (deterministic), to
-//     the frame's average contact force and torque (reported by tool_state)
-//     and to the force and torque of the frame's last substep, which step 1
-//     uses: that one belongs to the pose the tool has at the end of the
-//     frame, so the scheme is symplectic Euler on the tool. (Coupling with
-//     the frame average, which belongs to the middle of the frame, lags half
-//     a frame and pumps energy into the tool at any mass:
+//  3. at the end of frame n the sums are reduced on the device in a fixed
+//     order, in double-float precision (program/stats_program.h), and read
+//     back after it (Simulation::Impl::after_frame) as the frame's average
+//     contact force and torque (reported by tool_state) and the force and
+//     torque of the frame's last substep, which step 1 uses: that one
+//     belongs to the pose the tool has at the end of the frame, so the
+//     scheme is symplectic Euler on the tool. (Coupling with the frame
+//     average, which belongs to the middle of the frame, lags half a frame
+//     and pumps energy into the tool at any mass:
 //     x_{n+1} - 2 x_n + x_{n-1} = -(omega dt)^2 (x_n + x_{n-1}) / 2 has
 //     roots of modulus sqrt(1 + (omega dt)^2 / 2) > 1.)
 // Limits.

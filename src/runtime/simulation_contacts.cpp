@@ -18,13 +18,14 @@
 // the tool's centre, per particle and tool in the contact-impulse buffer;
 // at the end of the frame they are reduced on the device, in a fixed order
 // and double-float precision (program/stats_program.h), and after it
-// (after_frame) a few words come back as the tool's reaction: the frame's average contact force and torque (tool_state), the
-// force and torque of its last substep and the mass and inertia of the
-// particles touching the tool at its end (which the next integration uses).
+// (after_frame) a few words come back as the tool's reaction: the frame's
+// average contact force and torque (tool_state), the force and torque of
+// its last substep and the mass and inertia of the particles touching the
+// tool at its end (which the next integration uses).
 //
 // State: Impl::colliders and Impl::targets are host copies of the device
-// buffers; the tools' rigid state lives in Impl::contacts (contact_state.h), all sized in init_contacts: nothing here
-// allocates per frame.
+// buffers; the tools' rigid state lives in Impl::contacts (contact_state.h),
+// all sized in init_contacts: nothing here allocates per frame.
 #include <cmath>
 #include <sstream>
 #include <string>
