@@ -1,10 +1,11 @@
 // Every GPU backend against the CPU reference backend:
 //  - kernel by kernel: random inputs (fresh each run), outputs poisoned
 //    with NaN before the run, one dispatch on each device, results within
-//    1e-5 relative (float32 rounding of a few operations; the OpenCL and
-//    GLSL kernels use the CPU kernels' operation order, so most results are
-//    bitwise equal and the tolerance only covers sqrt/division rounding
-//    differences a device may have);
+//    1e-5 relative (float32 rounding of a few operations; the GPU kernels,
+//    kernels/gpu/NAME.gpu compiled to OpenCL C and SPIR-V, use the CPU
+//    kernels' operation order, so most results are bitwise equal and the
+//    tolerance only covers sqrt/division rounding differences a device may
+//    have);
 //  - scene by scene: after 100 frames positions agree within 1e-4 of the
 //    bounding-box diagonal.
 // A backend that is built but has no device here is skipped.

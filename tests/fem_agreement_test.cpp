@@ -2,9 +2,10 @@
 // CPU reference, kernel by kernel (see agreement_support.h).
 //
 // xpbd_solve_neo_hookean, xpbd_solve_stvk and xpbd_solve_corotational
-// (kernels/cpu/fem_kernels.cpp; twins in kernels/opencl and kernels/glsl),
+// (kernels/cpu/fem_kernels.cpp; GPU twins kernels/gpu/NAME.gpu, compiled to
+// OpenCL C and SPIR-V),
 // one dispatch each of one colour of random tets, fresh inputs each run:
-// per-tet data built as src/scene/compile_fem.cpp builds it (Dm^-1 from the
+// per-tet data built as src/compiler/compile_fem.cpp builds it (Dm^-1 from the
 // float rest positions in double, rest volume, compliances from random E and
 // nu, h0 per model), deformed near rest, rotated, stretched, strongly
 // compressed, inverted, nearly flat, and the guard cases of the kernel

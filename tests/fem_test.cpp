@@ -53,8 +53,9 @@ using M3 = mat3<double>;
 class Fem : public test::BackendTest {};
 
 // A simulation of `scene` on the test's backend, or a failure (every
-// backend has the FEM kernels: kernels/opencl and kernels/glsl twin
-// kernels/cpu/fem_kernels.cpp, tests/fem_agreement_test.cpp compares them).
+// backend has the FEM kernels: kernels/gpu/NAME.gpu, compiled to OpenCL C
+// and SPIR-V, twin kernels/cpu/fem_kernels.cpp, tests/fem_agreement_test.cpp
+// compares them).
 #define FEM_SIMULATION(sim, scene)                                \
   auto sim##_made = test::create_or_skip(scene, GetParam());      \
   ASSERT_TRUE(sim##_made.ok()) << sim##_made.error().message();   \
@@ -216,7 +217,7 @@ std::array<double, 3> energy_gradient_sum(TetMaterial model, const Lame& l, cons
 std::vector<float> relax(Simulation& first_sim, SceneDesc scene, const std::string& backend, int max_frames,
                          double ke_tol, int& frames) {
   Simulation* sim = &first_sim;
-  Result<Simulation> restarted = Error("");
+  Result<Simulation> restarted = Error(ErrorCode::internal, "");
   frames = 0;
   double peak = 0.0;
   while (frames < max_frames) {

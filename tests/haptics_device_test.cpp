@@ -188,6 +188,11 @@ TEST(HapticsDevice, MalformedTrajectoriesNameFileAndLine) {
   EXPECT_TRUE(says(ReplayDevice::create({}).status(), "no samples"));
   EXPECT_TRUE(says(ReplayDevice::create({{0.1, {}, {1, 0, 0, 0}, 0}, {0.1, {}, {1, 0, 0, 0}, 0}}).status(),
                    "sample 1: time"));
+  // A bad file is a bad input file; bad samples given in code are a bad parameter.
+  EXPECT_EQ(ReplayDevice::load(tmp("missing.csv")).error().code(), sinew::ErrorCode::bad_input_file);
+  EXPECT_EQ(read_trajectory_csv(not_number).error().code(), sinew::ErrorCode::bad_input_file);
+  EXPECT_EQ(read_trajectory_csv(no_rows).error().code(), sinew::ErrorCode::bad_input_file);
+  EXPECT_EQ(ReplayDevice::create({}).error().code(), sinew::ErrorCode::bad_parameter);
 }
 
 }  // namespace

@@ -47,10 +47,15 @@ sinew::Result<sinew::TetMesh> read_pair(const std::string& stem, const std::stri
   return sinew::read_tetgen(tmp_dir() / stem);
 }
 
-// The message holds every expected fragment (e.g. "file.node:4:").
+// The message holds every expected fragment (e.g. "file.node:4:"), and the
+// error is a bad file (ErrorCode::bad_input_file), whatever is wrong in it.
 ::testing::AssertionResult fails_with(const sinew::Result<sinew::TetMesh>& r,
                                       std::vector<std::string> fragments) {
   if (r.ok()) return ::testing::AssertionFailure() << "read succeeded";
+  if (r.error().code() != sinew::ErrorCode::bad_input_file) {
+    return ::testing::AssertionFailure() << "code " << sinew::error_code_name(r.error().code())
+                                         << ", not bad_input_file: " << r.error().message();
+  }
   for (const std::string& f : fragments) {
     if (r.error().message().find(f) == std::string::npos) {
       return ::testing::AssertionFailure() << "'" << f << "' not in: " << r.error().message();
@@ -298,6 +303,7 @@ TEST(MeshBadInput, TruncationsAndCorruptionsNeverCrash) {
   auto check = [](const sinew::Result<sinew::TetMesh>& r, const std::string& name) {
     if (!r.ok()) {
       EXPECT_NE(r.error().message().find(name), std::string::npos) << r.error().message();
+      EXPECT_EQ(r.error().code(), sinew::ErrorCode::bad_input_file) << r.error().message();
     }
   };
   for (std::size_t n = 0; n <= kMsh41.size(); ++n)
@@ -330,6 +336,8 @@ TEST(MeshBadInput, CheckTetMeshNamesOriginAndTet) {
   const auto range = sinew::check_tet_mesh(m, "unit");
   ASSERT_FALSE(range.ok());
   EXPECT_NE(range.error().message().find("unit: tet 1"), std::string::npos) << range.error().message();
+  // A mesh given in code is a bad parameter; the same fault read from a file is a bad file (fails_with).
+  EXPECT_EQ(range.error().code(), sinew::ErrorCode::bad_parameter);
   m.tets = {{0, 1, 2, 3}};
   m.vertices[2][1] = std::numeric_limits<double>::quiet_NaN();
   const auto nan = sinew::check_tet_mesh(m, "unit");

@@ -116,7 +116,7 @@ TEST(MeshReaders, Armadillo4kTetGen) {
 }
 
 TEST(MeshReaders, Armadillo13kGmsh41) {
-  sinew::Result<TetMesh> mesh = sinew::Error("not read");
+  sinew::Result<TetMesh> mesh = sinew::Error(sinew::ErrorCode::internal, "not read");
   const double t = seconds([&] { mesh = sinew::read_tet_mesh(kTetDir / "Armadillo13K.msh"); });
   ASSERT_TRUE(mesh.ok()) << mesh.error().message();
   std::cout << "[ timing   ] Armadillo13K.msh read in " << t * 1e3 << " ms\n";
@@ -148,7 +148,7 @@ TEST(MeshReaders, Kidney57kIsAKidneySizedOrganInMillimetres) {
 // but well shaped (volume / longest edge^3 >= 5e-4), so they pass the
 // per-tet flatness test of check_tet_mesh.
 TEST(MeshReaders, Liver382kIsALiverSizedOrganInMillimetres) {
-  sinew::Result<TetMesh> mesh = sinew::Error("not read");
+  sinew::Result<TetMesh> mesh = sinew::Error(sinew::ErrorCode::internal, "not read");
   const double t = seconds([&] { mesh = sinew::read_tetgen(kTetDir / "liver_382k.node"); });
   ASSERT_TRUE(mesh.ok()) << mesh.error().message();
   std::cout << "[ timing   ] liver_382k read in " << t * 1e3 << " ms\n";

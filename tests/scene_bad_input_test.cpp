@@ -32,6 +32,7 @@ void expect_error(const std::function<void(SceneDesc&)>& spoil, const std::strin
   auto sim = Simulation::create(scene, {.backend = "cpu"});
   ASSERT_FALSE(sim.ok()) << "expected an error mentioning '" << needle << "'";
   EXPECT_NE(sim.error().message().find(needle), std::string::npos) << sim.error().message();
+  EXPECT_EQ(sim.error().code(), ErrorCode::bad_parameter) << sim.error().message();
 }
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -92,6 +93,7 @@ TEST(SceneBadInput, ElasticMaterial) {
     Status s = body.set_elastic(e, 0.3);
     ASSERT_FALSE(s.ok());
     EXPECT_NE(s.error().message().find("youngs_modulus"), std::string::npos);
+    EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
   }
   for (double nu : {0.5, 0.7, -1.0, kNaN}) {
     Status s = body.set_elastic(1e4, nu);
@@ -107,18 +109,39 @@ TEST(SceneBadInput, Backends) {
   auto unknown = Simulation::create(valid_scene(), {.backend = "cuda"});
   ASSERT_FALSE(unknown.ok());
   EXPECT_NE(unknown.error().message().find("unknown backend 'cuda'"), std::string::npos);
+  EXPECT_EQ(unknown.error().code(), ErrorCode::bad_parameter);
   for (const char* name : {"opencl", "vulkan"}) {
     const auto built = built_backends();
     if (std::find(built.begin(), built.end(), name) != built.end()) continue;
     auto missing = Simulation::create(valid_scene(), {.backend = name});
     ASSERT_FALSE(missing.ok());
     EXPECT_NE(missing.error().message().find(name), std::string::npos) << missing.error().message();
+    EXPECT_EQ(missing.error().code(), ErrorCode::backend_unavailable) << missing.error().message();
   }
   auto threads = Simulation::create(valid_scene(), {.backend = "cpu", .threads = -2});
   ASSERT_FALSE(threads.ok());
   EXPECT_NE(threads.error().message().find("threads"), std::string::npos);
+  EXPECT_EQ(threads.error().code(), ErrorCode::bad_parameter);
   auto fallback = Simulation::create(valid_scene(), {.backend = "auto", .quiet = true});
   ASSERT_TRUE(fallback.ok()) << fallback.error().message();
+}
+
+// The code tells a caller what to do next: fix the name (bad_parameter) or
+// try another backend (backend_unavailable).
+TEST(DeviceBadInput, BackendErrorCodes) {
+  auto nonsense = create_device({.backend = "nonsense"});
+  ASSERT_FALSE(nonsense.ok());
+  EXPECT_EQ(nonsense.error().code(), ErrorCode::bad_parameter) << nonsense.error().message();
+  const auto built = built_backends();
+  for (const char* name : {"opencl", "vulkan"}) {
+    const bool is_built = std::find(built.begin(), built.end(), name) != built.end();
+    // Not built: says so. Built: no device is named like this, or there is no
+    // device (or driver) at all.
+    auto missing = create_device({.backend = name, .device = "no device is named like this"});
+    ASSERT_FALSE(missing.ok()) << name;
+    EXPECT_EQ(missing.error().code(), ErrorCode::backend_unavailable)
+        << name << (is_built ? " (built): " : " (not built): ") << missing.error().message();
+  }
 }
 
 TEST(DeviceBadInput, BuffersAndPrograms) {

@@ -1,10 +1,11 @@
 // thin_agreement_test.cpp — the thin kernels on every GPU backend against the
 // CPU reference, kernel by kernel (see agreement_support.h):
 // xpbd_solve_area, xpbd_solve_dihedral and xpbd_solve_line_bending
-// (kernels/cpu/thin_kernels.cpp; twins kernels/opencl/*.cl, kernels/glsl/*.comp).
+// (kernels/cpu/thin_kernels.cpp; GPU twins kernels/gpu/NAME.gpu, compiled to
+// OpenCL C and SPIR-V).
 //
 // Inputs are built the way the scene compiler builds them
-// (src/scene/compile_thin.cpp): a rest shape in float, its rest value (area,
+// (src/compiler/compile_thin.cpp): a rest shape in float, its rest value (area,
 // dihedral angle, Kelager offset) computed from the float positions with the
 // very functions of thin_kernels.h, compliances in the units of
 // thin_params.h; then the movable vertices are displaced from the rest shape
@@ -22,7 +23,7 @@
 //
 // Tolerance: expect_agree's 1e-5 relative. The twins use the CPU kernels'
 // operation order without contraction, and the dihedral angle's atan2 is
-// our own thin::atan2_portable (kernels/cpu/thin_kernels.h: + - * / and
+// our own thin::atan2_portable (kernels/math/thin_math.h: + - * / and
 // sqrt only), which the twins repeat operation for operation, so on PoCL and
 // lavapipe every word is bitwise equal whatever the C library; the
 // tolerance is left for devices whose division and sqrt are not correctly

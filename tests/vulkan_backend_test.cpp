@@ -1,7 +1,8 @@
-// The Vulkan backend's own duties: the embedded SPIR-V makes pipelines on
-// every device found, kernels without a GLSL twin are clear errors, device
-// selection errors are clear, staged copies (discrete GPUs) and mapped
-// memory (lavapipe, integrated GPUs) agree, a recorded frame with barriers
+// The Vulkan backend's own duties: the embedded SPIR-V (of every
+// kernels/gpu/NAME.gpu, compiled to OpenCL C and SPIR-V) makes a pipeline
+// for every kernel on every device found, device selection errors are
+// clear, staged copies (discrete GPUs) and mapped memory (lavapipe,
+// integrated GPUs) agree, a recorded frame with barriers
 // reproduces the CPU reference bitwise, a cube scene runs clean under the
 // validation layer with GPU timestamps per kernel, the validation counter
 // counts a deliberate mistake, and "auto" never picks a CPU device such as

@@ -1,7 +1,7 @@
 // opencl_device.h — the OpenCL backend: any OpenCL 1.2+ device (PoCL on a
-// CPU, NVIDIA, AMD, Intel GPUs). Kernels (kernels/gpu/*.gpu and
-// kernels/opencl/*.cl) are embedded at build time, built at run time for the
-// chosen device and cached on disk.
+// CPU, NVIDIA, AMD, Intel GPUs). Kernels (kernels/gpu/NAME.gpu, compiled to
+// OpenCL C and SPIR-V; here the OpenCL C) are embedded at build time, built
+// at run time for the chosen device and cached on disk.
 #pragma once
 
 #include <memory>

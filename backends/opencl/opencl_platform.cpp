@@ -1,10 +1,11 @@
 // opencl_platform.cpp — OpenCL platforms and devices, contexts and queues,
 // and the kernel build.
 //
-// The embedded kernel program (every kernels/opencl/*.cl and
-// kernels/gpu/*.gpu, headers inlined) is built once per device; the binary
-// is cached under $XDG_CACHE_HOME/sinew (else ~/.cache/sinew) keyed by a
-// hash of platform, device, driver version, build options and source.
+// The embedded kernel program (every kernels/gpu/NAME.gpu, compiled to
+// OpenCL C and SPIR-V; here the OpenCL C, headers inlined) is built once
+// per device; the binary is cached under $XDG_CACHE_HOME/sinew (else
+// ~/.cache/sinew) keyed by a hash of platform, device, driver version,
+// build options and source.
 #include "backends/opencl/opencl_platform.h"
 
 #include <cstdio>

@@ -14,7 +14,9 @@
 
 namespace sinew::opencl {
 
-extern const char* const kProgramSource;  // generated from kernels/opencl and kernels/gpu (EmbedKernelSources.cmake)
+// Generated from kernels/gpu/NAME.gpu (compiled to OpenCL C and SPIR-V; this is
+// the OpenCL C) by cmake/EmbedKernelSources.cmake.
+extern const char* const kProgramSource;
 
 /// "OpenCL error -5 (CL_OUT_OF_RESOURCES)".
 std::string cl_status(cl_int code);

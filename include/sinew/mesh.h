@@ -76,7 +76,9 @@ Result<TetMesh> read_tet_mesh(const std::filesystem::path& path);
 /// 1e-12 of the cube of its own longest edge, a flatness test independent of
 /// units, mesh size and grading (zero-volume and inverted tets are errors,
 /// naming the tet, its vertices, its signed volume and that minimum).
-/// `origin` prefixes the messages (e.g. a file name).
+/// `origin` prefixes the messages (e.g. a file name). Errors are
+/// ErrorCode::bad_parameter (a mesh given in code); the readers report the
+/// same faults in a file as ErrorCode::bad_input_file.
 Status check_tet_mesh(const TetMesh& mesh, const std::string& origin = "mesh");
 
 /// Multiplies every position by `factor` (e.g. 1e-3 for millimetres to metres).

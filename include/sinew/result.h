@@ -16,7 +16,7 @@ namespace sinew {
 /// (retry on another backend, grow a capacity, report a bad file) and not others.
 enum class ErrorCode {
   bad_parameter,        ///< a value given to sinew is out of its range, non-finite or inconsistent
-  bad_input_file,       ///< a file could not be read or is malformed
+  bad_input_file,       ///< a file could not be read (or written) or is malformed
   backend_unavailable,  ///< the backend is not built, or has no device or driver here
   device_lost,          ///< the device stopped working (driver reset, hang, crash)
   out_of_memory,        ///< host or device memory ran out
@@ -44,7 +44,8 @@ class Error {
  public:
   Error(ErrorCode code, std::string message) : code_(code), message_(std::move(message)) {}
   /// TRANSITION (issue 10): a message without a code is a bad parameter
-  /// until every call site names its code.
+  /// until every call site names its code. Its last user is
+  /// benchmarks/cube_benchmark.cpp; delete this once that names its code.
   explicit Error(std::string message) : Error(ErrorCode::bad_parameter, std::move(message)) {}
   [[nodiscard]] ErrorCode code() const { return code_; }
   [[nodiscard]] const std::string& message() const { return message_; }

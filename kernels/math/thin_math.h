@@ -66,9 +66,9 @@ inline bool triangle_area_gradients(vec4<T> x0, vec4<T> x1, vec4<T> x2, vec4<T> 
 }
 
 /// atan2(y, x) in [-pi, pi]: the angle of the point (x, y), our own, used
-/// by dihedral_angle here and by its OpenCL and GLSL twins
-/// (thin_atan2_portable in kernels/opencl/thin_math.h and
-/// kernels/glsl/thin_math.h), which repeat it operation for operation.
+/// by dihedral_angle here and by its GPU twin (thin_atan2_portable in
+/// kernels/gpu/thin_math.h, used by kernels/gpu/NAME.gpu, compiled to
+/// OpenCL C and SPIR-V), which repeats it operation for operation.
 /// Why not std::atan2: the rest angles the scene compiler stores are
 /// computed on the host with this function, and a hinge at rest has
 /// C == 0 exactly only if every backend computes the very same bits. The C

@@ -101,7 +101,8 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
   if (surfaces > 0 && particles > 0) {
     const std::uint64_t slots = std::uint64_t{SINEW_CONTACT_IMPULSE_FLOAT4S} * particles * tools;
     if (slots > std::numeric_limits<std::uint32_t>::max() / 4)
-      return Error("tools: " + std::to_string(tools) + " tools and " + std::to_string(particles) +
+      return Error(ErrorCode::bad_parameter,
+                   "tools: " + std::to_string(tools) + " tools and " + std::to_string(particles) +
                    " particles need more contact-impulse slots than 32-bit sizes address");
     RawConstraints& contacts =
         b.constraints(Kernel::xpbd_solve_contacts, 1, SINEW_CONTACT_DATA_STRIDE,
@@ -118,7 +119,8 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
   // Attachments: a zero-length constraint from a vertex to its target. The
   // colouring puts several attachments of one particle in different colours.
   if (scene.targets.size() >= (std::size_t{1} << 24))
-    return Error("targets: " + std::to_string(scene.targets.size()) +
+    return Error(ErrorCode::bad_parameter,
+                 "targets: " + std::to_string(scene.targets.size()) +
                  " targets are more than the 2^24 an attachment can index");
   for (const AttachmentDesc& a : scene.attachments) {
     const std::uint32_t particle = first_particle(out, a.vertex) + a.vertex.vertex;

@@ -54,7 +54,8 @@ Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32
     case TetMaterial::stvk:
     case TetMaterial::corotational:
       if (!(lame > 0.0))
-        return Error(name + ".poisson_ratio must be > 0 for the " +
+        return Error(ErrorCode::bad_parameter,
+                     name + ".poisson_ratio must be > 0 for the " +
                      (body.material == TetMaterial::stvk ? "stvk" : "corotational") +
                      " material (got " + str(nu) +
                      "): its hydrostatic constraint has compliance 1 / (lambda V) with "
@@ -67,7 +68,8 @@ Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32
     case TetMaterial::none: return {};
   }
   if (!(std::isfinite(stiff_d) && std::isfinite(stiff_h) && stiff_d > 0.0 && stiff_h > 0.0))
-    return Error(name + ": youngs_modulus " + str(young) + " and poisson_ratio " + str(nu) +
+    return Error(ErrorCode::bad_parameter,
+                 name + ": youngs_modulus " + str(young) + " and poisson_ratio " + str(nu) +
                  " give Lame parameters that are not finite and positive");
 
   RawConstraints& fem = b.constraints(kernel, 4, SINEW_FEM_DATA_STRIDE, SINEW_FEM_LAMBDA_STRIDE);
@@ -90,7 +92,9 @@ Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32
                        dm[0][1] * (dm[1][0] * dm[2][2] - dm[1][2] * dm[2][0]) +
                        dm[0][2] * (dm[1][0] * dm[2][1] - dm[1][1] * dm[2][0]);
     if (!(det > 0.0))
-      return Error(where() + " has no positive volume in single precision (its edge matrix Dm is singular or inverted)");
+      return Error(ErrorCode::bad_parameter,
+                   where() +
+                       " has no positive volume in single precision (its edge matrix Dm is singular or inverted)");
     // Dm^-1 = adj(Dm) / det: row i of the inverse is (column j x column k) / det.
     double inv[3][3];
     for (int i = 0; i < 3; ++i) {
@@ -110,7 +114,8 @@ Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32
       }
     const double condition = std::sqrt(norm_dm * norm_inv);
     if (!(condition < 1e5))
-      return Error(where() + " is too flat for single precision FEM (condition number of its edge matrix " +
+      return Error(ErrorCode::bad_parameter,
+                   where() + " is too flat for single precision FEM (condition number of its edge matrix " +
                    str(condition) + ", must be < 1e5)");
     const double volume = det / 6.0;
     const double alpha_d = 1.0 / (stiff_d * volume), alpha_h = 1.0 / (stiff_h * volume);
@@ -123,10 +128,12 @@ Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32
     row[SINEW_FEM_H0] = static_cast<float>(h0);
     for (float v : row)
       if (!std::isfinite(v))
-        return Error(where() + ": its FEM data do not fit in single precision (rest volume " + str(volume) +
+        return Error(ErrorCode::bad_parameter,
+                     where() + ": its FEM data do not fit in single precision (rest volume " + str(volume) +
                      " m^3, compliances " + str(alpha_d) + " and " + str(alpha_h) + " 1/(Pa m^3))");
     if (!(row[SINEW_FEM_ALPHA_D] > 0.0f && row[SINEW_FEM_ALPHA_H] > 0.0f))
-      return Error(where() + ": its compliances " + str(alpha_d) + " and " + str(alpha_h) +
+      return Error(ErrorCode::bad_parameter,
+                   where() + ": its compliances " + str(alpha_d) + " and " + str(alpha_h) +
                    " 1/(Pa m^3) round to 0 in single precision (youngs_modulus too large for this tet size)");
     for (std::uint32_t k : q) fem.particles.push_back(first + k);
     fem.data.insert(fem.data.end(), row, row + SINEW_FEM_DATA_STRIDE);

@@ -61,7 +61,8 @@ Status add_tri_body(SceneBuilder& b, const TriBodyDesc& body, const std::string&
     const auto& q = tris[t];
     const float a = kernels::thin::triangle_area(at(q[0]), at(q[1]), at(q[2]));
     if (!(a > 0.0f))
-      return Error(name + ".mesh: triangle " + std::to_string(t) +
+      return Error(ErrorCode::bad_parameter,
+                   name + ".mesh: triangle " + std::to_string(t) +
                    " has no positive area in single precision (too small for float32 positions)");
     rest_area[t] = a;
     for (std::uint32_t k : q) b.mass[first + k] += body.density * body.thickness * a / 3.0;

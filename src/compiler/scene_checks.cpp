@@ -18,38 +18,42 @@ std::string str(double v) {
 }
 
 Status positive(const std::string& name, double v) {
-  if (!std::isfinite(v) || v <= 0.0) return Error(name + " must be finite and > 0 (got " + str(v) + ")");
+  if (!std::isfinite(v) || v <= 0.0)
+    return Error(ErrorCode::bad_parameter, name + " must be finite and > 0 (got " + str(v) + ")");
   return {};
 }
 
 Status non_negative(const std::string& name, double v) {
-  if (!std::isfinite(v) || v < 0.0) return Error(name + " must be finite and >= 0 (got " + str(v) + ")");
+  if (!std::isfinite(v) || v < 0.0)
+    return Error(ErrorCode::bad_parameter, name + " must be finite and >= 0 (got " + str(v) + ")");
   return {};
 }
 
 Status check_elastic(const std::string& prefix, double young, double poisson) {
   if (Status s = positive(prefix + "youngs_modulus", young); !s) return s;
   if (!std::isfinite(poisson) || poisson <= -1.0 || poisson >= 0.5)
-    return Error(prefix + "poisson_ratio must be in (-1, 0.5) (got " + str(poisson) + ")");
+    return Error(ErrorCode::bad_parameter, prefix + "poisson_ratio must be in (-1, 0.5) (got " + str(poisson) + ")");
   return {};
 }
 
 Status check_initial(const std::string& name, const std::vector<Vec3d>& initial, std::size_t vertex_count) {
   if (initial.empty()) return {};
   if (initial.size() != vertex_count)
-    return Error(name + ".initial_vertices has " + std::to_string(initial.size()) + " entries for " +
+    return Error(ErrorCode::bad_parameter,
+                 name + ".initial_vertices has " + std::to_string(initial.size()) + " entries for " +
                  std::to_string(vertex_count) + " vertices");
   for (std::size_t i = 0; i < initial.size(); ++i)
     for (int k = 0; k < 3; ++k)
       if (!std::isfinite(initial[i][k]))
-        return Error(name + ".initial_vertices[" + std::to_string(i) + "] is not finite");
+        return Error(ErrorCode::bad_parameter, name + ".initial_vertices[" + std::to_string(i) + "] is not finite");
   return {};
 }
 
 Status check_pinned(const std::string& body, const std::vector<std::uint32_t>& pinned, std::size_t vertex_count) {
   for (std::size_t i = 0; i < pinned.size(); ++i)
     if (pinned[i] >= vertex_count)
-      return Error(body + ".pinned[" + std::to_string(i) + "] = " + std::to_string(pinned[i]) +
+      return Error(ErrorCode::bad_parameter,
+                   body + ".pinned[" + std::to_string(i) + "] = " + std::to_string(pinned[i]) +
                    " is not a vertex (the body has " + std::to_string(vertex_count) + ")");
   return {};
 }
@@ -67,42 +71,48 @@ Status check_tet_body(const TetBodyDesc& b, const std::string& name) {
 
 Status check_line_body(const LineBodyDesc& b, const std::string& name) {
   const std::size_t n = b.vertices.size();
-  if (n == 0) return Error(name + ".vertices is empty");
+  if (n == 0) return Error(ErrorCode::bad_parameter, name + ".vertices is empty");
   if (b.masses.size() != n)
-    return Error(name + ".masses has " + std::to_string(b.masses.size()) + " entries for " + std::to_string(n) +
+    return Error(ErrorCode::bad_parameter,
+                 name + ".masses has " + std::to_string(b.masses.size()) + " entries for " + std::to_string(n) +
                  " vertices");
   for (std::size_t i = 0; i < n; ++i) {
     for (double c : b.vertices[i])
-      if (!std::isfinite(c)) return Error(name + ".vertices[" + std::to_string(i) + "] is not finite");
+      if (!std::isfinite(c))
+        return Error(ErrorCode::bad_parameter, name + ".vertices[" + std::to_string(i) + "] is not finite");
     if (Status s = positive(name + ".masses[" + std::to_string(i) + "]", b.masses[i]); !s) return s;
   }
   for (std::size_t i = 0; i < b.segments.size(); ++i) {
     const auto [a, c] = b.segments[i];
     const std::string seg = name + ".segments[" + std::to_string(i) + "]";
     if (a >= n || c >= n)
-      return Error(seg + " = (" + std::to_string(a) + ", " + std::to_string(c) + ") refers past the " +
+      return Error(ErrorCode::bad_parameter,
+                   seg + " = (" + std::to_string(a) + ", " + std::to_string(c) + ") refers past the " +
                    std::to_string(n) + " vertices");
     const Vec3d& p = b.vertices[a];
     const Vec3d& q = b.vertices[c];
     const double len = std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
-    if (!(len > 0.0)) return Error(seg + " has zero rest length");
+    if (!(len > 0.0)) return Error(ErrorCode::bad_parameter, seg + " has zero rest length");
   }
   if (Status s = non_negative(name + ".compliance", b.compliance); !s) return s;
-  if (std::isnan(b.bending_compliance)) return Error(name + ".bending_compliance is NaN");
+  if (std::isnan(b.bending_compliance)) return Error(ErrorCode::bad_parameter, name + ".bending_compliance is NaN");
   if (Status s = check_initial(name, b.initial_vertices, n); !s) return s;
   return check_pinned(name, b.pinned, n);
 }
 
 Status finite3(const std::string& name, const std::array<double, 3>& v) {
   for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(v[k])) return Error(name + "[" + std::to_string(k) + "] must be finite (got " + str(v[k]) + ")");
+    if (!std::isfinite(v[k]))
+      return Error(ErrorCode::bad_parameter,
+                   name + "[" + std::to_string(k) + "] must be finite (got " + str(v[k]) + ")");
   return {};
 }
 
 Status unit_quaternion(const std::string& name, const std::array<double, 4>& q) {
   const double n = math::qnorm(q);
   if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-6)
-    return Error(name + " must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 name + " must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
   return {};
 }
 
@@ -110,33 +120,37 @@ Status check_friction(const std::string& name, double mu_s, double mu_k) {
   if (Status s = non_negative(name + ".static_friction", mu_s); !s) return s;
   if (Status s = non_negative(name + ".dynamic_friction", mu_k); !s) return s;
   if (mu_k > mu_s)
-    return Error(name + ".dynamic_friction (" + str(mu_k) + ") must not exceed static_friction (" + str(mu_s) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 name + ".dynamic_friction (" + str(mu_k) + ") must not exceed static_friction (" + str(mu_s) + ")");
   return {};
 }
 
 Status check_tri_body(const TriBodyDesc& b, const std::string& name) {
   const std::size_t n = b.mesh.vertices.size();
-  if (b.mesh.triangles.empty()) return Error(name + ".mesh has no triangles");
+  if (b.mesh.triangles.empty()) return Error(ErrorCode::bad_parameter, name + ".mesh has no triangles");
   for (std::size_t i = 0; i < n; ++i)
     if (Status s = finite3(name + ".mesh.vertices[" + std::to_string(i) + "]", b.mesh.vertices[i]); !s) return s;
   for (std::size_t t = 0; t < b.mesh.triangles.size(); ++t) {
     const auto& tri = b.mesh.triangles[t];
     const std::string where = name + ".mesh.triangles[" + std::to_string(t) + "]";
     for (std::uint32_t v : tri)
-      if (v >= n) return Error(where + " refers to vertex " + std::to_string(v) + " of " + std::to_string(n));
+      if (v >= n)
+        return Error(ErrorCode::bad_parameter,
+                     where + " refers to vertex " + std::to_string(v) + " of " + std::to_string(n));
     const Vec3d& p = b.mesh.vertices[tri[0]];
     const Vec3d& q = b.mesh.vertices[tri[1]];
     const Vec3d& r = b.mesh.vertices[tri[2]];
     const Vec3d u = math::sub(q, p), w = math::sub(r, p), normal = math::cross(u, w);
     const double area = 0.5 * std::hypot(normal[0], normal[1], normal[2]);
     const double scale = std::max({std::hypot(u[0], u[1], u[2]), std::hypot(w[0], w[1], w[2])});
-    if (!(area > 1e-12 * scale * scale)) return Error(where + " has zero area (degenerate triangle)");
+    if (!(area > 1e-12 * scale * scale))
+      return Error(ErrorCode::bad_parameter, where + " has zero area (degenerate triangle)");
   }
   if (Status s = positive(name + ".thickness", b.thickness); !s) return s;
   if (Status s = positive(name + ".density", b.density); !s) return s;
   if (Status s = non_negative(name + ".distance_compliance", b.distance_compliance); !s) return s;
   if (Status s = non_negative(name + ".area_compliance", b.area_compliance); !s) return s;
-  if (std::isnan(b.bending_compliance)) return Error(name + ".bending_compliance is NaN");
+  if (std::isnan(b.bending_compliance)) return Error(ErrorCode::bad_parameter, name + ".bending_compliance is NaN");
   if (Status s = check_initial(name, b.initial_vertices, n); !s) return s;
   return check_pinned(name, b.pinned, n);
 }
@@ -185,12 +199,16 @@ std::size_t vertex_count(const SceneDesc& scene, const VertexRef& ref) {
 
 Status check_attachment(const SceneDesc& scene, const AttachmentDesc& a, const std::string& name) {
   const std::size_t n = vertex_count(scene, a.vertex);
-  if (n == 0) return Error(name + ".vertex refers to body " + std::to_string(a.vertex.body) + ", which does not exist");
+  if (n == 0)
+    return Error(ErrorCode::bad_parameter,
+                 name + ".vertex refers to body " + std::to_string(a.vertex.body) + ", which does not exist");
   if (a.vertex.vertex >= n)
-    return Error(name + ".vertex.vertex = " + std::to_string(a.vertex.vertex) + " is not a vertex (the body has " +
+    return Error(ErrorCode::bad_parameter,
+                 name + ".vertex.vertex = " + std::to_string(a.vertex.vertex) + " is not a vertex (the body has " +
                  std::to_string(n) + ")");
   if (a.target >= scene.targets.size())
-    return Error(name + ".target = " + std::to_string(a.target) + " is not a target (the scene has " +
+    return Error(ErrorCode::bad_parameter,
+                 name + ".target = " + std::to_string(a.target) + " is not a target (the scene has " +
                  std::to_string(scene.targets.size()) + ")");
   return non_negative(name + ".compliance", a.compliance);
 }
@@ -225,11 +243,13 @@ Status check_scene(const SceneDesc& scene) {
   if (Status s = finite3("gravity", scene.gravity); !s) return s;
   if (Status s = positive("solver.time_step", scene.solver.time_step); !s) return s;
   if (scene.solver.substeps < 1)
-    return Error("solver.substeps must be >= 1 (got " + std::to_string(scene.solver.substeps) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "solver.substeps must be >= 1 (got " + std::to_string(scene.solver.substeps) + ")");
   if (scene.solver.iterations < 1)
-    return Error("solver.iterations must be >= 1 (got " + std::to_string(scene.solver.iterations) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "solver.iterations must be >= 1 (got " + std::to_string(scene.solver.iterations) + ")");
   if (scene.tet_bodies.empty() && scene.tri_bodies.empty() && scene.line_bodies.empty() && scene.tools.empty())
-    return Error("the scene has no bodies");
+    return Error(ErrorCode::bad_parameter, "the scene has no bodies");
   if (Status s = check_all(scene.tet_bodies, "tet_bodies", check_tet_body); !s) return s;
   if (Status s = check_all(scene.tri_bodies, "tri_bodies", check_tri_body); !s) return s;
   if (Status s = check_all(scene.line_bodies, "line_bodies", check_line_body); !s) return s;

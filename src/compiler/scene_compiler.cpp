@@ -31,7 +31,8 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
     const float v = kernels::tet_volume(b.positions[first + q[0]], b.positions[first + q[1]],
                                         b.positions[first + q[2]], b.positions[first + q[3]]);
     if (!(v > 0.0f))
-      return Error(name + ".mesh: tet " + std::to_string(t) +
+      return Error(ErrorCode::bad_parameter,
+                   name + ".mesh: tet " + std::to_string(t) +
                    " has no positive volume in single precision (too small for float32 positions)");
     rest_volume[t] = v;
     for (std::uint32_t k : q) b.mass[first + k] += body.density * v / 4.0;
@@ -89,7 +90,9 @@ Status add_line_body(SceneBuilder& b, const LineBodyDesc& body, const std::strin
   for (std::size_t s = 0; s < body.segments.size(); ++s) {
     const auto [p, q] = body.segments[s];
     const float len = kernels::edge_length(b.positions[first + p], b.positions[first + q]);
-    if (!(len > 0.0f)) return Error(name + ".segments[" + std::to_string(s) + "] has zero length in single precision");
+    if (!(len > 0.0f))
+      return Error(ErrorCode::bad_parameter,
+                   name + ".segments[" + std::to_string(s) + "] has zero length in single precision");
     distance.particles.push_back(first + p);
     distance.particles.push_back(first + q);
     distance.data.push_back(len);
@@ -156,7 +159,8 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   for (const auto& body : scene.tri_bodies) total += body.mesh.vertices.size();
   for (const auto& body : scene.line_bodies) total += body.vertices.size();
   if (total >= std::numeric_limits<std::uint32_t>::max())
-    return Error("the scene has " + std::to_string(total) + " particles, more than 32-bit indices can address");
+    return Error(ErrorCode::bad_parameter,
+                 "the scene has " + std::to_string(total) + " particles, more than 32-bit indices can address");
 
   SceneBuilder b;
   CompiledScene out;
@@ -185,7 +189,8 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   for (std::size_t p = 0; p < b.positions.size(); ++p) {
     const double w = b.mass[p] > 0.0 ? 1.0 / b.mass[p] : 0.0;
     if (!std::isfinite(static_cast<float>(w)))
-      return Error("particle " + std::to_string(p) + " has a mass of " + std::to_string(b.mass[p]) +
+      return Error(ErrorCode::bad_parameter,
+                   "particle " + std::to_string(p) + " has a mass of " + std::to_string(b.mass[p]) +
                    " kg, too small for a float32 inverse mass");
     b.positions[p].w = static_cast<float>(w);
     movable[p] = b.positions[p].w > 0.0f;
@@ -193,7 +198,8 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   // Gauss-Seidel order: kSolveOrder (solve_order.h; contacts last, so they win).
   for (const RawConstraints& raw : b.raw)
     if (solve_rank(raw.kernel) == kNotSolved)
-      return Error("internal: kernel " + std::string(kernel_name(raw.kernel)) +
+      return Error(ErrorCode::internal,
+                   "internal: kernel " + std::string(kernel_name(raw.kernel)) +
                    " has no place in the solve order (src/compiler/solve_order.h)");
   std::stable_sort(b.raw.begin(), b.raw.end(), [](const RawConstraints& x, const RawConstraints& y) {
     return solve_rank(x.kernel) < solve_rank(y.kernel);

@@ -19,14 +19,19 @@ namespace sinew::haptics {
 Status check(const HapticLoopSettings& s) {
   // >= 1 Hz: the period is an int64 count of nanoseconds.
   if (!(s.rate_hz >= 1.0) || !std::isfinite(s.rate_hz) || s.rate_hz > 1e6)
-    return Error("rate_hz must be >= 1 and at most 1e6 [Hz] (got " + std::to_string(s.rate_hz) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "rate_hz must be >= 1 and at most 1e6 [Hz] (got " + std::to_string(s.rate_hz) + ")");
   if (s.realtime && (s.realtime_priority < 1 || s.realtime_priority > 99))
-    return Error("realtime_priority must be in 1..99 (got " + std::to_string(s.realtime_priority) + ")");
-  if (s.cpu < -1) return Error("cpu must be -1 (no pinning) or a CPU index (got " + std::to_string(s.cpu) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "realtime_priority must be in 1..99 (got " + std::to_string(s.realtime_priority) + ")");
+  if (s.cpu < -1)
+    return Error(ErrorCode::bad_parameter,
+                 "cpu must be -1 (no pinning) or a CPU index (got " + std::to_string(s.cpu) + ")");
   if (s.telemetry_capacity < 1 || s.telemetry_capacity > kMaxTelemetryCapacity)
-    return Error("telemetry_capacity must be in 1.." + std::to_string(kMaxTelemetryCapacity) + " ticks (got " +
+    return Error(ErrorCode::bad_parameter,
+                 "telemetry_capacity must be in 1.." + std::to_string(kMaxTelemetryCapacity) + " ticks (got " +
                  std::to_string(s.telemetry_capacity) + ")");
-  if (s.snapshot_read_attempts < 1) return Error("snapshot_read_attempts must be >= 1");
+  if (s.snapshot_read_attempts < 1) return Error(ErrorCode::bad_parameter, "snapshot_read_attempts must be >= 1");
   if (auto st = check(s.coupling); !st) return st;
   if (auto st = check(s.watchdog); !st) return st;
   return check(s.interpolation);
@@ -39,7 +44,8 @@ Result<std::unique_ptr<HapticLoop>> HapticLoop::create(const HapticLoopSettings&
   try {
     return std::unique_ptr<HapticLoop>(new HapticLoop(settings, device, snapshots, feedback, clock));
   } catch (const std::exception& e) {  // the telemetry ring (or the settings' copy) could not be allocated
-    return Error("cannot create the haptic loop (telemetry_capacity " + std::to_string(settings.telemetry_capacity) +
+    return Error(ErrorCode::out_of_memory,
+                 "cannot create the haptic loop (telemetry_capacity " + std::to_string(settings.telemetry_capacity) +
                  "): " + e.what());
   }
 }
@@ -66,10 +72,13 @@ HapticCounters HapticLoop::counters() const {
 }
 
 Status HapticLoop::copy_telemetry(std::vector<TickRecord>& out) const {
-  if (running()) return Error("copy_telemetry: stop the haptic loop first (the ring is written without locks)");
+  if (running())
+    return Error(ErrorCode::bad_parameter,
+                 "copy_telemetry: stop the haptic loop first (the ring is written without locks)");
   int idle = kIdle;
   if (!access_.compare_exchange_strong(idle, kCopying, std::memory_order_acquire, std::memory_order_relaxed))
-    return Error("copy_telemetry: a tick() is in progress on another thread (stop calling tick() first)");
+    return Error(ErrorCode::bad_parameter,
+                 "copy_telemetry: a tick() is in progress on another thread (stop calling tick() first)");
   struct Release {
     std::atomic<int>& a;
     ~Release() { a.store(kIdle, std::memory_order_release); }
@@ -198,8 +207,9 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
 }
 
 Status HapticLoop::start() {
-  if (running()) return Error("the haptic loop is already running");
-  if (auto s = device_.start(clock_.now_ns()); !s) return Error("device " + device_.name() + ": " + s.error().message());
+  if (running()) return Error(ErrorCode::bad_parameter, "the haptic loop is already running");
+  if (auto s = device_.start(clock_.now_ns()); !s)
+    return Error(s.error().code(), "device " + device_.name() + ": " + s.error().message());
   std::string latency = "not requested";
   if (settings_.zero_cpu_latency) qos_fd_ = hold_cpu_latency(0, latency);
   stop_.store(false, std::memory_order_relaxed);
@@ -212,7 +222,7 @@ Status HapticLoop::start() {
     release_cpu_latency(qos_fd_);
     qos_fd_ = -1;
     device_.stop();
-    return Error(std::string("cannot create the haptic thread: ") + e.what());
+    return Error(ErrorCode::internal, std::string("cannot create the haptic thread: ") + e.what());
   }
   ready_.wait(false, std::memory_order_acquire);  // scheduling_ is set
   scheduling_.cpu_latency = latency;

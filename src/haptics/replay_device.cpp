@@ -41,15 +41,17 @@ bool parse_double(const std::string& s, double& v) {
 }
 
 Status check_samples(const std::vector<TrajectorySample>& samples, const std::string& origin) {
-  if (samples.empty()) return Error(origin + ": no samples");
+  if (samples.empty()) return Error(ErrorCode::bad_parameter, origin + ": no samples");
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const TrajectorySample& s = samples[i];
     const std::string where = origin + ": sample " + std::to_string(i);
     if (!std::isfinite(s.time) || !math::finite(s.position) || !math::finite(s.rotation))
-      return Error(where + " has a non-finite value");
-    if (math::qdot(s.rotation, s.rotation) < 1e-12) return Error(where + " has a zero quaternion");
+      return Error(ErrorCode::bad_parameter, where + " has a non-finite value");
+    if (math::qdot(s.rotation, s.rotation) < 1e-12)
+      return Error(ErrorCode::bad_parameter, where + " has a zero quaternion");
     if (i > 0 && !(s.time > samples[i - 1].time))
-      return Error(where + ": time " + std::to_string(s.time) + " s is not after the previous sample's " +
+      return Error(ErrorCode::bad_parameter,
+                   where + ": time " + std::to_string(s.time) + " s is not after the previous sample's " +
                    std::to_string(samples[i - 1].time) + " s");
   }
   return {};
@@ -59,7 +61,7 @@ Status check_samples(const std::vector<TrajectorySample>& samples, const std::st
 
 Result<std::vector<TrajectorySample>> read_trajectory_csv(const std::filesystem::path& path) {
   std::ifstream in(path);
-  if (!in) return Error("cannot open trajectory " + path.string());
+  if (!in) return Error(ErrorCode::bad_input_file, "cannot open trajectory " + path.string());
   const std::string file = path.string();
   std::vector<TrajectorySample> samples;
   std::string line;
@@ -74,50 +76,56 @@ Result<std::vector<TrajectorySample>> read_trajectory_csv(const std::filesystem:
     if (columns == 0) {  // the header
       static const char* kNames[] = {"time", "x", "y", "z", "qw", "qx", "qy", "qz", "buttons"};
       if (cells.size() != 4 && cells.size() != 8 && cells.size() != 9)
-        return Error(where + "header must be time,x,y,z[,qw,qx,qy,qz[,buttons]] (got " + std::to_string(cells.size()) +
+        return Error(ErrorCode::bad_input_file,
+                     where + "header must be time,x,y,z[,qw,qx,qy,qz[,buttons]] (got " + std::to_string(cells.size()) +
                      " columns)");
       for (std::size_t c = 0; c < cells.size(); ++c)
         if (cells[c] != kNames[c])
-          return Error(where + "header column " + std::to_string(c + 1) + " must be '" + kNames[c] + "' (got '" +
+          return Error(ErrorCode::bad_input_file,
+                       where + "header column " + std::to_string(c + 1) + " must be '" + kNames[c] + "' (got '" +
                        cells[c] + "')");
       columns = cells.size();
       continue;
     }
     if (cells.size() != columns)
-      return Error(where + "expected " + std::to_string(columns) + " values, got " + std::to_string(cells.size()));
+      return Error(ErrorCode::bad_input_file,
+                   where + "expected " + std::to_string(columns) + " values, got " + std::to_string(cells.size()));
     double v[9] = {0, 0, 0, 0, 1, 0, 0, 0, 0};
     for (std::size_t c = 0; c < columns; ++c)
       if (!parse_double(cells[c], v[c]) || !std::isfinite(v[c]))
-        return Error(where + "column " + std::to_string(c + 1) + " is not a finite number ('" + cells[c] + "')");
+        return Error(ErrorCode::bad_input_file,
+                     where + "column " + std::to_string(c + 1) + " is not a finite number ('" + cells[c] + "')");
     TrajectorySample s;
     s.time = v[0];
     s.position = {v[1], v[2], v[3]};
     const Quat q{v[4], v[5], v[6], v[7]};
-    if (math::qdot(q, q) < 1e-12) return Error(where + "quaternion is zero");
+    if (math::qdot(q, q) < 1e-12) return Error(ErrorCode::bad_input_file, where + "quaternion is zero");
     s.rotation = math::normalize(q);
     if (columns == 9) {
       if (v[8] < 0 || v[8] != std::floor(v[8]) || v[8] > 4294967295.0)
-        return Error(where + "buttons must be a non-negative integer ('" + cells[8] + "')");
+        return Error(ErrorCode::bad_input_file, where + "buttons must be a non-negative integer ('" + cells[8] + "')");
       s.buttons = static_cast<std::uint32_t>(v[8]);
     }
     if (!samples.empty() && !(s.time > samples.back().time))
-      return Error(where + "time " + cells[0] + " s is not after the previous row's " +
+      return Error(ErrorCode::bad_input_file,
+                   where + "time " + cells[0] + " s is not after the previous row's " +
                    std::to_string(samples.back().time) + " s");
     samples.push_back(s);
   }
-  if (columns == 0) return Error(file + ": no header line (time,x,y,z[,qw,qx,qy,qz[,buttons]])");
-  if (samples.empty()) return Error(file + ": no samples after the header");
+  if (columns == 0)
+    return Error(ErrorCode::bad_input_file, file + ": no header line (time,x,y,z[,qw,qx,qy,qz[,buttons]])");
+  if (samples.empty()) return Error(ErrorCode::bad_input_file, file + ": no samples after the header");
   return samples;
 }
 
 Status write_trajectory_csv(const std::filesystem::path& path, std::span<const TrajectorySample> samples) {
   std::FILE* f = std::fopen(path.string().c_str(), "w");
-  if (!f) return Error("cannot write trajectory " + path.string());
+  if (!f) return Error(ErrorCode::bad_input_file, "cannot write trajectory " + path.string());
   std::fprintf(f, "time,x,y,z,qw,qx,qy,qz,buttons\n");
   for (const TrajectorySample& s : samples)
     std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%u\n", s.time, s.position[0], s.position[1],
                  s.position[2], s.rotation[0], s.rotation[1], s.rotation[2], s.rotation[3], s.buttons);
-  if (std::fclose(f) != 0) return Error("cannot write trajectory " + path.string());
+  if (std::fclose(f) != 0) return Error(ErrorCode::bad_input_file, "cannot write trajectory " + path.string());
   return {};
 }
 
@@ -138,7 +146,9 @@ Result<ReplayDevice> ReplayDevice::create(std::vector<TrajectorySample> samples,
 Result<ReplayDevice> ReplayDevice::load(const std::filesystem::path& path, std::int64_t origin_ns, bool loop) {
   auto samples = read_trajectory_csv(path);
   if (!samples) return samples.error();
-  return create(std::move(*samples), origin_ns, loop, "replay " + path.string());
+  auto device = create(std::move(*samples), origin_ns, loop, "replay " + path.string());
+  if (!device) return Error(ErrorCode::bad_input_file, device.error().message());  // the samples came from the file
+  return device;
 }
 
 bool ReplayDevice::sample(std::int64_t now_ns, DeviceSample& out) noexcept {

@@ -12,11 +12,13 @@ namespace sinew::haptics {
 
 namespace {
 Status check_scripted(const ScriptedDevice::Script& script, double rate_hz, double difference_step) {
-  if (!script) return Error("scripted device: the script is empty");
+  if (!script) return Error(ErrorCode::bad_parameter, "scripted device: the script is empty");
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
-    return Error("scripted device: rate_hz must be finite and > 0 [Hz] (got " + std::to_string(rate_hz) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "scripted device: rate_hz must be finite and > 0 [Hz] (got " + std::to_string(rate_hz) + ")");
   if (!(difference_step > 0.0) || !std::isfinite(difference_step))
-    return Error("scripted device: difference_step must be finite and > 0 [s] (got " +
+    return Error(ErrorCode::bad_parameter,
+                 "scripted device: difference_step must be finite and > 0 [s] (got " +
                  std::to_string(difference_step) + ")");
   return {};
 }

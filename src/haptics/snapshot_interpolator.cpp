@@ -16,12 +16,15 @@ namespace sinew::haptics {
 
 Status check(const InterpolationParams& p) {
   if (!(p.extrapolation_horizon >= 0.0) || !std::isfinite(p.extrapolation_horizon))
-    return Error("interpolation.extrapolation_horizon must be finite and >= 0 [s] (got " +
+    return Error(ErrorCode::bad_parameter,
+                 "interpolation.extrapolation_horizon must be finite and >= 0 [s] (got " +
                  std::to_string(p.extrapolation_horizon) + ")");
   if (!(p.max_interval > 0.0) || !std::isfinite(p.max_interval))
-    return Error("interpolation.max_interval must be finite and > 0 [s] (got " + std::to_string(p.max_interval) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "interpolation.max_interval must be finite and > 0 [s] (got " + std::to_string(p.max_interval) + ")");
   if (!(p.min_interval >= 0.0) || !(p.min_interval <= p.max_interval))
-    return Error("interpolation.min_interval must be >= 0 and <= max_interval [s] (got " +
+    return Error(ErrorCode::bad_parameter,
+                 "interpolation.min_interval must be >= 0 and <= max_interval [s] (got " +
                  std::to_string(p.min_interval) + ")");
   return {};
 }

@@ -13,9 +13,11 @@ namespace sinew::haptics {
 
 Status HapticToolBridge::set_damping(double linear, double angular) {
   if (!(linear >= 0.0) || !std::isfinite(linear))
-    return Error("tool damping must be finite and >= 0 [N s/m] (got " + std::to_string(linear) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "tool damping must be finite and >= 0 [N s/m] (got " + std::to_string(linear) + ")");
   if (!(angular >= 0.0) || !std::isfinite(angular))
-    return Error("tool angular damping must be finite and >= 0 [N m s/rad] (got " + std::to_string(angular) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 "tool angular damping must be finite and >= 0 [N m s/rad] (got " + std::to_string(angular) + ")");
   damping_ = linear;
   angular_damping_ = angular;
   return {};

@@ -16,7 +16,8 @@ namespace {
 Status at_least(const char* name, double v, double lo, bool strict, const char* unit) {
   const bool ok = std::isfinite(v) && (strict ? v > lo : v >= lo);
   if (!ok)
-    return Error(std::string("coupling.") + name + " must be finite and " + (strict ? "> 0" : ">= 0") + " [" + unit +
+    return Error(ErrorCode::bad_parameter,
+                 std::string("coupling.") + name + " must be finite and " + (strict ? "> 0" : ">= 0") + " [" + unit +
                  "] (got " + std::to_string(v) + ")");
   return {};
 }

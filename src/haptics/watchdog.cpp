@@ -11,7 +11,8 @@ namespace sinew::haptics {
 namespace {
 Status positive(const char* name, double v) {
   if (!(v > 0.0) || !std::isfinite(v))
-    return Error(std::string("watchdog.") + name + " must be finite and > 0 [s] (got " + std::to_string(v) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 std::string("watchdog.") + name + " must be finite and > 0 [s] (got " + std::to_string(v) + ")");
   return {};
 }
 }  // namespace

@@ -530,7 +530,8 @@ class GmshParser {
     mesh.tets.reserve(tets_.size());
     for (const auto& tet : tets_)
       mesh.tets.push_back({dense[tet[0]], dense[tet[1]], dense[tet[2]], dense[tet[3]]});
-    if (Status s = check_tet_mesh(mesh, where_.file); !s) return s.error();
+    // check_tet_mesh says bad_parameter (a mesh given in code); here the file is at fault.
+    if (Status s = check_tet_mesh(mesh, where_.file); !s) return Error(ErrorCode::bad_input_file, s.error().message());
     return mesh;
   }
 
@@ -556,7 +557,7 @@ Result<TetMesh> read_gmsh(const std::filesystem::path& path) {
     if (!text) return text.error();
     return GmshParser(*text, path.string()).parse();
   } catch (const std::bad_alloc&) {
-    return Error(path.string() + ": out of memory while reading the mesh");
+    return Error(ErrorCode::out_of_memory, path.string() + ": out of memory while reading the mesh");
   }
 }
 

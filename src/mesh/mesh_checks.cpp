@@ -38,7 +38,8 @@ Status check_vertices(const TetMesh& mesh, const std::string& origin) {
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Vec3d& p = mesh.vertices[v];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      return Error(origin + ": vertex " + std::to_string(v) + " has a non-finite coordinate (" +
+      return Error(ErrorCode::bad_parameter,
+                   origin + ": vertex " + std::to_string(v) + " has a non-finite coordinate (" +
                    short_number(p[0]) + ", " + short_number(p[1]) + ", " + short_number(p[2]) + ")");
     }
   }
@@ -51,14 +52,16 @@ Status check_indices(const TetMesh& mesh, const std::string& origin) {
     const auto& tet = mesh.tets[t];
     for (std::uint32_t v : tet) {
       if (v >= n) {
-        return Error(origin + ": " + tet_text(t, tet) + " refers to vertex " + std::to_string(v) +
+        return Error(ErrorCode::bad_parameter,
+                     origin + ": " + tet_text(t, tet) + " refers to vertex " + std::to_string(v) +
                      ", but the mesh has only " + std::to_string(n) + " vertices");
       }
     }
     for (int i = 0; i < 4; ++i) {
       for (int j = i + 1; j < 4; ++j) {
         if (tet[static_cast<std::size_t>(i)] == tet[static_cast<std::size_t>(j)]) {
-          return Error(origin + ": " + tet_text(t, tet) + " repeats vertex " +
+          return Error(ErrorCode::bad_parameter,
+                       origin + ": " + tet_text(t, tet) + " repeats vertex " +
                        std::to_string(tet[static_cast<std::size_t>(i)]));
         }
       }
@@ -93,7 +96,8 @@ Status check_volumes(const TetMesh& mesh, const std::string& origin) {
     // A sliver that is inverted by less than the tolerance is reported as
     // zero-volume: its sign is not meaningful at that size.
     const char* what = volume < -min_volume ? " is inverted" : " has zero volume";
-    return Error(origin + ": " + tet_text(t, tet) + what + " (signed volume " + short_number(volume) +
+    return Error(ErrorCode::bad_parameter,
+                 origin + ": " + tet_text(t, tet) + what + " (signed volume " + short_number(volume) +
                  ", minimum " + short_number(min_volume) + ")");
   }
   return {};
@@ -102,7 +106,7 @@ Status check_volumes(const TetMesh& mesh, const std::string& origin) {
 }  // namespace
 
 Status check_tet_mesh(const TetMesh& mesh, const std::string& origin) {
-  if (mesh.tets.empty()) return Error(origin + ": mesh has no tets");
+  if (mesh.tets.empty()) return Error(ErrorCode::bad_parameter, origin + ": mesh has no tets");
   if (Status s = check_vertices(mesh, origin); !s) return s;
   if (Status s = check_indices(mesh, origin); !s) return s;
   return check_volumes(mesh, origin);

@@ -90,28 +90,32 @@ Status validate(const TetGridDesc& d) {
   const std::array<std::pair<const char*, int>, 3> counts{{{"nx", d.nx}, {"ny", d.ny}, {"nz", d.nz}}};
   for (const auto& [name, n] : counts) {
     if (n < 1) {
-      return Error("make_tet_grid: " + std::string(name) + " must be >= 1 (got " + std::to_string(n) + ")");
+      return Error(ErrorCode::bad_parameter,
+                   "make_tet_grid: " + std::string(name) + " must be >= 1 (got " + std::to_string(n) + ")");
     }
   }
   for (int a = 0; a < 3; ++a) {
     const double h = d.cell_size[static_cast<std::size_t>(a)];
     if (!std::isfinite(h) || !(h > 0.0)) {
-      return Error("make_tet_grid: cell_size[" + std::to_string(a) + "] must be finite and > 0 (got " +
+      return Error(ErrorCode::bad_parameter,
+                   "make_tet_grid: cell_size[" + std::to_string(a) + "] must be finite and > 0 (got " +
                    number_text(h) + ")");
     }
     const double o = d.origin[static_cast<std::size_t>(a)];
     if (!std::isfinite(o)) {
-      return Error("make_tet_grid: origin[" + std::to_string(a) + "] must be finite (got " + number_text(o) +
+      return Error(ErrorCode::bad_parameter,
+                   "make_tet_grid: origin[" + std::to_string(a) + "] must be finite (got " + number_text(o) +
                    ")");
     }
     const double far = o + static_cast<double>(counts[static_cast<std::size_t>(a)].second) * h;
     if (!std::isfinite(far)) {
-      return Error("make_tet_grid: origin[" + std::to_string(a) + "] + n * cell_size[" + std::to_string(a) +
+      return Error(ErrorCode::bad_parameter,
+                   "make_tet_grid: origin[" + std::to_string(a) + "] + n * cell_size[" + std::to_string(a) +
                    "] overflows a double");
     }
   }
   if (d.split != TetsPerCell::five && d.split != TetsPerCell::six) {
-    return Error("make_tet_grid: split must be TetsPerCell::five or TetsPerCell::six");
+    return Error(ErrorCode::bad_parameter, "make_tet_grid: split must be TetsPerCell::five or TetsPerCell::six");
   }
   // Vertex indices are uint32; the product of three ints needs checking in
   // steps because it can overflow even 64 bits.
@@ -120,7 +124,8 @@ Status validate(const TetGridDesc& d) {
   for (const auto& [name, n] : counts) {
     vertices *= static_cast<std::uint64_t>(n) + 1;  // <= 2^32 * 2^31 before the check below
     if (vertices > limit) {
-      return Error("make_tet_grid: (nx+1)*(ny+1)*(nz+1) vertices exceed the 32-bit index limit " +
+      return Error(ErrorCode::bad_parameter,
+                   "make_tet_grid: (nx+1)*(ny+1)*(nz+1) vertices exceed the 32-bit index limit " +
                    std::to_string(limit) + " (nx=" + std::to_string(d.nx) + ", ny=" + std::to_string(d.ny) +
                    ", nz=" + std::to_string(d.nz) + ")");
     }
@@ -198,10 +203,12 @@ Result<TetMesh> make_tet_grid(const TetGridDesc& desc) {
   } catch (const std::bad_alloc&) {
     // A grid within the uint32 vertex limit can still need more memory than
     // the machine has (up to ~25e9 tets); report it instead of throwing.
-    return Error("make_tet_grid: out of memory for a " + std::to_string(desc.nx) + " x " +
+    return Error(ErrorCode::out_of_memory,
+                 "make_tet_grid: out of memory for a " + std::to_string(desc.nx) + " x " +
                  std::to_string(desc.ny) + " x " + std::to_string(desc.nz) + " grid");
   } catch (const std::length_error&) {
-    return Error("make_tet_grid: grid of " + std::to_string(desc.nx) + " x " + std::to_string(desc.ny) +
+    return Error(ErrorCode::out_of_memory,
+                 "make_tet_grid: grid of " + std::to_string(desc.nx) + " x " + std::to_string(desc.ny) +
                  " x " + std::to_string(desc.nz) + " cells is too large");
   }
 }

@@ -329,10 +329,12 @@ Result<TetMesh> read_tetgen(const std::filesystem::path& path) {
     TetMesh mesh;
     if (Status s = read_ele_file(ele_path, nodes, mesh.tets); !s) return s.error();
     mesh.vertices = std::move(nodes.points);
-    if (Status s = check_tet_mesh(mesh, ele_path.string()); !s) return s.error();
+    // check_tet_mesh says bad_parameter (a mesh given in code); here the file is at fault.
+    if (Status s = check_tet_mesh(mesh, ele_path.string()); !s)
+      return Error(ErrorCode::bad_input_file, s.error().message());
     return mesh;
   } catch (const std::bad_alloc&) {
-    return Error(path.string() + ": out of memory while reading the mesh");
+    return Error(ErrorCode::out_of_memory, path.string() + ": out of memory while reading the mesh");
   }
 }
 
@@ -340,7 +342,8 @@ Result<TetMesh> read_tet_mesh(const std::filesystem::path& path) {
   const std::string ext = lower(path.extension().string());
   if (ext == ".msh") return read_gmsh(path);
   if (ext == ".node" || ext == ".ele") return read_tetgen(path);
-  return Error(path.string() + ": unknown tet mesh extension '" + path.extension().string() +
+  return Error(ErrorCode::bad_input_file,
+               path.string() + ": unknown tet mesh extension '" + path.extension().string() +
                "' (expected .msh, .node or .ele)");
 }
 

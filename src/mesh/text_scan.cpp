@@ -14,16 +14,18 @@ namespace fs = std::filesystem;
 
 Result<std::string> read_whole_file(const fs::path& path) {
   std::error_code ec;
-  if (!fs::exists(path, ec)) return Error(path.string() + ": cannot open file (it does not exist)");
-  if (!fs::is_regular_file(path, ec)) return Error(path.string() + ": not a regular file");
+  if (!fs::exists(path, ec))
+    return Error(ErrorCode::bad_input_file, path.string() + ": cannot open file (it does not exist)");
+  if (!fs::is_regular_file(path, ec)) return Error(ErrorCode::bad_input_file, path.string() + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Error(path.string() + ": cannot open file (" + std::strerror(errno) + ")");
+  if (!in) return Error(ErrorCode::bad_input_file, path.string() + ": cannot open file (" + std::strerror(errno) + ")");
   const auto size = fs::file_size(path, ec);
-  if (ec) return Error(path.string() + ": cannot read file size (" + ec.message() + ")");
+  if (ec) return Error(ErrorCode::bad_input_file, path.string() + ": cannot read file size (" + ec.message() + ")");
   std::string text(static_cast<std::size_t>(size), '\0');
   in.read(text.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::uintmax_t>(in.gcount()) != size) {
-    return Error(path.string() + ": read error (file shorter than its size " + std::to_string(size) + ")");
+    return Error(ErrorCode::bad_input_file,
+                 path.string() + ": read error (file shorter than its size " + std::to_string(size) + ")");
   }
   return text;
 }
@@ -34,7 +36,7 @@ std::string quoted(std::string_view tok) {
 }
 
 Error Where::at(std::size_t line, const std::string& what) const {
-  return Error(file + ":" + std::to_string(line) + ": " + what);
+  return Error(ErrorCode::bad_input_file, file + ":" + std::to_string(line) + ": " + what);
 }
 
 bool Scanner::next(Token& t) {

@@ -77,13 +77,16 @@ Status write_text_file(const fs::path& path, const std::string& text) {
   if (!parent.empty()) {
     fs::create_directories(parent, ec);
     if (ec)
-      return Error(path.string() + ": cannot create folder " + parent.string() + " (" + ec.message() + ")");
+      return Error(ErrorCode::bad_input_file,
+                   path.string() + ": cannot create folder " + parent.string() + " (" + ec.message() + ")");
   }
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) return Error(path.string() + ": cannot open file for writing (" + std::strerror(errno) + ")");
+  if (!out)
+    return Error(ErrorCode::bad_input_file,
+                 path.string() + ": cannot open file for writing (" + std::strerror(errno) + ")");
   out.write(text.data(), static_cast<std::streamsize>(text.size()));
   out.close();
-  if (!out) return Error(path.string() + ": write failed (disk full?)");
+  if (!out) return Error(ErrorCode::bad_input_file, path.string() + ": write failed (disk full?)");
   return {};
 }
 
@@ -92,31 +95,35 @@ Status check_vtu_input(const fs::path& path, std::span<const float> positions, i
                        std::span<const VertexField> fields) {
   const std::string where = path.string() + ": ";
   if (stride != 3 && stride != 4) {
-    return Error(where + "stride must be 3 or 4 (got " + std::to_string(stride) + ")");
+    return Error(ErrorCode::bad_parameter, where + "stride must be 3 or 4 (got " + std::to_string(stride) + ")");
   }
   const auto s = static_cast<std::size_t>(stride);
   if (positions.size() % s != 0) {
-    return Error(where + "positions holds " + std::to_string(positions.size()) +
+    return Error(ErrorCode::bad_parameter,
+                 where + "positions holds " + std::to_string(positions.size()) +
                  " floats, not a multiple of stride " + std::to_string(stride));
   }
   const std::size_t n = positions.size() / s;
   for (std::size_t t = 0; t < tets.size(); ++t) {
     for (std::uint32_t v : tets[t]) {
       if (v >= n) {
-        return Error(where + "tet " + std::to_string(t) + " refers to vertex " + std::to_string(v) +
+        return Error(ErrorCode::bad_parameter,
+                     where + "tet " + std::to_string(t) + " refers to vertex " + std::to_string(v) +
                      ", but there are only " + std::to_string(n) + " vertices");
       }
     }
   }
   for (const VertexField& f : fields) {
     const std::string name = "field '" + f.name + "'";
-    if (f.name.empty()) return Error(where + "a field has an empty name");
+    if (f.name.empty()) return Error(ErrorCode::bad_parameter, where + "a field has an empty name");
     if (f.components != 1 && f.components != 3) {
-      return Error(where + name + ": components must be 1 or 3 (got " + std::to_string(f.components) + ")");
+      return Error(ErrorCode::bad_parameter,
+                   where + name + ": components must be 1 or 3 (got " + std::to_string(f.components) + ")");
     }
     const std::size_t expected = n * static_cast<std::size_t>(f.components);
     if (f.values.size() != expected) {
-      return Error(where + name + " has " + std::to_string(f.values.size()) + " values, expected " +
+      return Error(ErrorCode::bad_parameter,
+                   where + name + " has " + std::to_string(f.values.size()) + " values, expected " +
                    std::to_string(expected) + " (" + std::to_string(n) + " vertices x " +
                    std::to_string(f.components) + " components)");
     }
@@ -218,12 +225,13 @@ Status write_vtu(const std::filesystem::path& path, std::span<const float> posit
 Status write_pvd(const std::filesystem::path& path, std::span<const std::filesystem::path> vtu_files,
                  std::span<const double> times) {
   if (vtu_files.size() != times.size()) {
-    return Error(path.string() + ": " + std::to_string(vtu_files.size()) + " files but " +
+    return Error(ErrorCode::bad_parameter,
+                 path.string() + ": " + std::to_string(vtu_files.size()) + " files but " +
                  std::to_string(times.size()) + " times");
   }
   for (std::size_t i = 0; i < times.size(); ++i) {
     if (!std::isfinite(times[i]))
-      return Error(path.string() + ": time " + std::to_string(i) + " is not finite");
+      return Error(ErrorCode::bad_parameter, path.string() + ": time " + std::to_string(i) + " is not finite");
   }
   std::string out = "<?xml version=\"1.0\"?>\n";
   out += "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";

@@ -62,14 +62,16 @@ std::string str(double v) {
 
 Status check_index(const char* call, const char* what, std::size_t index, std::size_t count) {
   if (index < count) return {};
-  return Error(std::string(call) + ": index " + std::to_string(index) + " is not a " + what + " (the scene has " +
+  return Error(ErrorCode::bad_parameter,
+               std::string(call) + ": index " + std::to_string(index) + " is not a " + what + " (the scene has " +
                std::to_string(count) + ")");
 }
 
 Status check_finite(const char* call, const char* name, const V3& v) {
   for (int k = 0; k < 3; ++k)
     if (!std::isfinite(v[k]))
-      return Error(std::string(call) + ": " + name + "[" + std::to_string(k) + "] must be finite (got " + str(v[k]) +
+      return Error(ErrorCode::bad_parameter,
+                   std::string(call) + ": " + name + "[" + std::to_string(k) + "] must be finite (got " + str(v[k]) +
                    ")");
   return {};
 }
@@ -77,7 +79,8 @@ Status check_finite(const char* call, const char* name, const V3& v) {
 Status check_rotation(const char* call, const Q4& q) {
   const double n = math::qnorm(q);
   if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-6)
-    return Error(std::string(call) + ": rotation must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
+    return Error(ErrorCode::bad_parameter,
+                 std::string(call) + ": rotation must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
   return {};
 }
 
@@ -118,7 +121,8 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
   const auto header = load_words<ColliderHeader>(colliders, 0);
   if (header.colliders != scene.colliders.size() || header.tools != scene.tools.size() ||
       colliders.size() != device_floats(colliders))
-    return Error("internal: the compiled collider buffer does not match the scene's colliders and tools");
+    return Error(ErrorCode::internal,
+                 "internal: the compiled collider buffer does not match the scene's colliders and tools");
 
   contacts = ContactState{};
   contacts.colliders = header.colliders;
