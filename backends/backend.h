@@ -32,25 +32,11 @@
 #include <variant>
 #include <vector>
 
-#include "kernel_list.h"
+#include "backends/kernel.h"
 #include "sinew/device.h"
 #include "sinew/result.h"
 
 namespace sinew {
-
-/// Every kernel of the registry (kernels/kernel_list.h), by name.
-enum class Kernel : std::uint32_t {
-#define SINEW_KERNEL_ENUM(name, bindings, params, group) name,
-  SINEW_KERNELS(SINEW_KERNEL_ENUM)
-#undef SINEW_KERNEL_ENUM
-  count_  ///< number of kernels, not a kernel
-};
-
-inline constexpr std::size_t kernel_count = static_cast<std::size_t>(Kernel::count_);
-static_assert(kernel_count <= DeviceTimes::max_kernels, "DeviceTimes cannot time every kernel");
-
-/// The kernel's name, the same in every kernel language ("xpbd_predict").
-std::string_view kernel_name(Kernel kernel);
 
 /// A device buffer; valid only with the device that made it. Ids are never
 /// reused, so a handle to a destroyed buffer stays invalid.

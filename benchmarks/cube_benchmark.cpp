@@ -44,7 +44,7 @@ sinew::Result<sinew::TetMaterial> material_from_env() {
   if (name == "neo_hookean") return sinew::TetMaterial::neo_hookean;
   if (name == "stvk") return sinew::TetMaterial::stvk;
   if (name == "corotational") return sinew::TetMaterial::corotational;
-  return sinew::Error("SINEW_MATERIAL must be xpbd, neo_hookean, stvk or corotational (got " + name + ")");
+  return sinew::Error(sinew::ErrorCode::bad_parameter, "SINEW_MATERIAL must be xpbd, neo_hookean, stvk or corotational (got " + name + ")");
 }
 
 bool simd_from_env() {

@@ -31,14 +31,14 @@ inline std::vector<std::string> gpu_backends() {
   std::vector<std::string> out;
   for (const std::string& b : test::backends())
     if (b != "cpu") out.push_back(b);
-  if (out.empty()) out.push_back("none-built");  // keeps the suites instantiated; skipped below
+  if (out.empty()) out.push_back("none_built");  // keeps the suites instantiated; skipped below
   return out;
 }
 
 class Agreement : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    if (GetParam() == "none-built") GTEST_SKIP() << "no GPU backend is built";
+    if (GetParam() == "none_built") GTEST_SKIP() << "no GPU backend is built";
     if (const std::string why = missing_device(GetParam()); !why.empty())
       GTEST_SKIP() << "backend " << GetParam() << " has no device here: " << why;
   }

@@ -43,10 +43,6 @@ constexpr const char* error_code_name(ErrorCode code) {
 class Error {
  public:
   Error(ErrorCode code, std::string message) : code_(code), message_(std::move(message)) {}
-  /// TRANSITION (issue 10): a message without a code is a bad parameter
-  /// until every call site names its code. Its last user is
-  /// benchmarks/cube_benchmark.cpp; delete this once that names its code.
-  explicit Error(std::string message) : Error(ErrorCode::bad_parameter, std::move(message)) {}
   [[nodiscard]] ErrorCode code() const { return code_; }
   [[nodiscard]] const std::string& message() const { return message_; }
 

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cpu/cpu_kernels.h"  // the kernel entry points, declared from the registry
 #include "contact_params.h"
 #include "math/vec4.h"
 
@@ -44,8 +45,5 @@ struct SignedDistance {
   float4 normal;
 };
 SignedDistance collider_distance(const ColliderEntry& e, float4 local);
-
-void xpbd_solve_attachment(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_solve_contacts(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 
 }  // namespace sinew::kernels

@@ -7,12 +7,6 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cpu/cpu_kernels.h"  // the kernel entry points, declared from the registry
 #include "math/fem_math.h"
 
-namespace sinew::kernels {
-
-void xpbd_solve_neo_hookean(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_solve_stvk(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_solve_corotational(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-
-}  // namespace sinew::kernels

@@ -7,12 +7,6 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cpu/cpu_kernels.h"  // the kernel entry points, declared from the registry
 #include "math/thin_math.h"
 
-namespace sinew::kernels {
-
-void xpbd_solve_area(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_solve_dihedral(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_solve_line_bending(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-
-}  // namespace sinew::kernels

@@ -10,20 +10,10 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cpu/cpu_kernels.h"  // the kernel entry points, declared from the registry
 #include "math/xpbd_math.h"
 
 namespace sinew::kernels {
-
-/// Signature of every CPU kernel: parameters (the struct from
-/// kernels/shared), the bound buffers in binding order, and the work items
-/// [begin, end) to process.
-using CpuKernelFn = void (*)(const void* params, std::byte* const* bindings, std::uint32_t begin,
-                             std::uint32_t end);
-
-void xpbd_predict(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_update_velocity(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_solve_distance(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
-void xpbd_solve_volume(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 
 /// True when this CPU runs AVX2 (checked once by the CPU backend).
 bool cpu_has_avx2();

@@ -1,4 +1,4 @@
-/* fem_math.h — GPU twin of kernels/cpu/fem_kernels.h: the 3x3 matrix
+/* fem_math.h — GPU twin of kernels/math/fem_math.h: the 3x3 matrix
  * helpers and the constraint functions of the FEM tet materials, and the
  * coupled 2x2 xPBD tet solve of kernels/cpu/fem_kernels.cpp (solve_tets),
  * shared by xpbd_solve_neo_hookean.gpu, xpbd_solve_stvk.gpu and

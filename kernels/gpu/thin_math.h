@@ -1,5 +1,5 @@
 /* thin_math.h — GPU twin of the constraint functions of
- * kernels/cpu/thin_kernels.h (namespace thin) and of the xPBD step of
+ * kernels/math/thin_math.h (namespace thin) and of the xPBD step of
  * kernels/cpu/thin_kernels.cpp (apply<N>), shared by xpbd_solve_area.gpu,
  * xpbd_solve_dihedral.gpu and xpbd_solve_line_bending.gpu.
  *  - area: C = |(x1 - x0) x (x2 - x0)| / 2 - A0;
@@ -78,7 +78,7 @@ ThinGradients thin_triangle_area_gradients(float3 x0, float3 x1, float3 x2) {
   return r;
 }
 
-/* ---- atan2: thin::atan2_portable<float> of kernels/cpu/thin_kernels.h,
+/* ---- atan2: thin::atan2_portable<float> of kernels/math/thin_math.h,
  * operation for operation (the algorithm, its identities and the number of
  * series terms are explained there): only + - * / and sqrt, correctly
  * rounded here as on the CPU, in the CPU's order, every result PRECISE.

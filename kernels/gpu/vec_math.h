@@ -1,5 +1,5 @@
 /* vec_math.h — the vector helpers of the GPU kernels, rounding exactly like
- * kernels/cpu/cpu_math.h: dot and cross products written out in the CPU
+ * kernels/math/vec4.h: dot and cross products written out in the CPU
  * code's order (the builtins dot/cross may fuse or reorder) and every result
  * PRECISE (gpu_lang.h: no fused multiply-add in either language). Then a
  * rest value computed on the host is reproduced exactly, and a body at rest

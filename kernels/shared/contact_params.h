@@ -44,7 +44,7 @@
  *     with the last substep's force, the one at the tool's end-of-frame
  *     pose, its rotation stabilised by the inertia of the particles it
  *     touches, and reports the frame average; see
- *     src/scene/simulation_contacts.cpp.)
+ *     src/runtime/simulation_contacts.cpp.)
  * data: SINEW_CONTACT_DATA_STRIDE floats per constraint: [0] margin [m], a
  *   distance the particle keeps from every surface (0 for mesh vertices).
  * lambda: SINEW_CONTACT_LAMBDA_PER_COLLIDER floats per (constraint,

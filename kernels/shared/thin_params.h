@@ -4,8 +4,8 @@
  * SolveParams and the standard solve bindings (xpbd_params.h): particle
  * indices `arity` uint per constraint (no padding), data
  * SINEW_*_DATA_STRIDE floats per constraint as laid out below, one lambda
- * per constraint. Constraint functions and gradients: kernels/cpu/
- * thin_kernels.h; compliances: include/sinew/scene.h.
+ * per constraint. Constraint functions and gradients: kernels/math/
+ * thin_math.h; compliances: include/sinew/scene.h.
  *
  * xpbd_solve_area: arity 3, the triangle (x0, x1, x2) in mesh order.
  *   [0] A0, rest area [m^2];  [1] alpha [m^3/N] = c_a A0 / t.

@@ -22,7 +22,7 @@
 #include <iterator>
 #include <string_view>
 
-#include "backends/backend.h"
+#include "backends/kernel.h"
 #include "kernel_list.h"
 
 namespace sinew {
