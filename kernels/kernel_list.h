@@ -55,7 +55,7 @@
   SINEW_KERNEL(reduce_blocks, 3, ReduceParams, 256)                              \
   /* per-frame statistics (kernels/shared/stats_params.h) */                     \
   SINEW_KERNEL(stats_kinetic_energy, 3, StatsParams, 0)                          \
-  SINEW_KERNEL(stats_tet_volume, 3, StatsParams, 0)                              \
+  SINEW_KERNEL(stats_surface_volume, 3, StatsParams, 0)                          \
   SINEW_KERNEL(stats_tool_terms, 2, StatsParams, 0)                              \
   SINEW_KERNEL(reduce_dd_blocks, 3, ReduceDdParams, 256)
 

@@ -188,6 +188,57 @@ TEST_P(Xpbd, ProgramHoldsOnlyTheStagesTheSceneUses) {
   EXPECT_EQ(volume_only.info().volume_constraints, 48u);
 }
 
+// The statistics are reduced on the device (double-float terms, fixed
+// order): they equal double-precision sums over the read-back state to
+// ~1e-13 (the volume from the boundary surface, the definition from the
+// tets), and are the same bits on every backend.
+TEST_P(Xpbd, DeviceStatisticsEqualDoubleSumsOfTheStateAndAgreeAcrossBackends) {
+  TetBodyDesc body;
+  body.mesh = test::box_mesh(6, 3, 3, 0.01);
+  body.density = 1000.0;
+  SINEW_ASSERT_OK(body.set_elastic(2e4, 0.4));
+  for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
+    if (body.mesh.vertices[v][0] == 0.0) body.pinned.push_back(v);
+  SceneDesc scene;
+  scene.solver = {.time_step = 1.0 / 60.0, .substeps = 4, .iterations = 2};
+  scene.tet_bodies.push_back(body);
+  Simulation sim = make(scene, GetParam());
+  Simulation reference = make(scene, "cpu");
+  for (int f = 0; f < 20; ++f) {
+    SINEW_ASSERT_OK(sim.step());
+    SINEW_ASSERT_OK(reference.step());
+  }
+  std::vector<float> x = positions(sim), v;
+  SINEW_ASSERT_OK(sim.read_velocities(v));
+  double ke = 0.0, volume = 0.0, rest = 0.0;
+  for (std::size_t p = 0; p < x.size() / 4; ++p)
+    if (x[4 * p + 3] > 0.0f)
+      ke += 0.5 / x[4 * p + 3] * (double(v[4 * p]) * v[4 * p] + double(v[4 * p + 1]) * v[4 * p + 1] +
+                                  double(v[4 * p + 2]) * v[4 * p + 2]);
+  for (const auto& t : body.mesh.tets) {
+    const auto at = [&](int k) { return kernels::double4{x[4 * t[k]], x[4 * t[k] + 1], x[4 * t[k] + 2], 0.0}; };
+    const auto rest_at = [&](int k) {
+      const Vec3d& r = body.mesh.vertices[t[k]];
+      return kernels::double4{r[0], r[1], r[2], 0.0};
+    };
+    volume += kernels::tet_volume(at(0), at(1), at(2), at(3));
+    rest += kernels::tet_volume(rest_at(0), rest_at(1), rest_at(2), rest_at(3));
+  }
+  const FrameStats& s = sim.last_frame();
+  EXPECT_GT(s.kinetic_energy, 1e-6) << "the block is moving";
+  EXPECT_NEAR(s.kinetic_energy, ke, 1e-12 * ke);
+  EXPECT_NE(s.volume_change, 0.0);
+  EXPECT_NEAR(s.volume_change, volume / rest - 1.0, 1e-12);
+  EXPECT_GT(s.residual_rms, 0.0);
+  EXPECT_GE(s.max_residual, s.residual_rms);
+  const FrameStats& r = reference.last_frame();
+  EXPECT_EQ(s.kinetic_energy, r.kinetic_energy);
+  EXPECT_EQ(s.volume_change, r.volume_change);
+  EXPECT_EQ(s.residual_rms, r.residual_rms);
+  EXPECT_EQ(s.max_residual, r.max_residual);
+  EXPECT_LT(s.read_back_bytes, 100u) << "a few words per frame, not the state";
+}
+
 TEST_P(Xpbd, FrameStatsReportTheErrors) {
   // Kinetic energy of a falling particle is m v^2 / 2 of its velocity.
   LineBodyDesc p;

@@ -48,21 +48,20 @@ void stats_kinetic_energy(const void* params, std::byte* const* bindings, std::u
   }
 }
 
-void stats_tet_volume(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+void stats_surface_volume(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const StatsParams*>(params);
   const auto* x = reinterpret_cast<const float4*>(bindings[0]);
-  const auto* tets = reinterpret_cast<const uint4*>(bindings[1]);
+  const auto* faces = reinterpret_cast<const uint4*>(bindings[1]);
   auto* terms = reinterpret_cast<float*>(bindings[2]);
   for (std::uint32_t i = begin; i < end && i < p.count; ++i) {
-    const float4 a = x[tets[i].x], b = x[tets[i].y], c = x[tets[i].z], d = x[tets[i].w];
-    const dd e1[3] = {difference(b.x, a.x), difference(b.y, a.y), difference(b.z, a.z)};
-    const dd e2[3] = {difference(c.x, a.x), difference(c.y, a.y), difference(c.z, a.z)};
-    const dd e3[3] = {difference(d.x, a.x), difference(d.y, a.y), difference(d.z, a.z)};
+    const float4 a = x[faces[i].x], b = x[faces[i].y], c = x[faces[i].z], r = x[faces[i].w];
+    const dd e1[3] = {difference(a.x, r.x), difference(a.y, r.y), difference(a.z, r.z)};
+    const dd e2[3] = {difference(b.x, r.x), difference(b.y, r.y), difference(b.z, r.z)};
+    const dd e3[3] = {difference(c.x, r.x), difference(c.y, r.y), difference(c.z, r.z)};
     const dd n[3] = {dd_sub(dd_mul(e2[1], e3[2]), dd_mul(e2[2], e3[1])),
                      dd_sub(dd_mul(e2[2], e3[0]), dd_mul(e2[0], e3[2])),
                      dd_sub(dd_mul(e2[0], e3[1]), dd_mul(e2[1], e3[0]))};
-    const dd six_v = dd_add(dd_add(dd_mul(e1[0], n[0]), dd_mul(e1[1], n[1])), dd_mul(e1[2], n[2]));
-    store(terms, i, dd_div(six_v, dd{6.0f, 0.0f}));
+    store(terms, i, dd_add(dd_add(dd_mul(e1[0], n[0]), dd_mul(e1[1], n[1])), dd_mul(e1[2], n[2])));
   }
 }
 

@@ -17,7 +17,7 @@ constexpr std::uint32_t kImpulseFloats = 4 * SINEW_CONTACT_IMPULSE_FLOAT4S;  // 
 constexpr std::uint32_t kToolPairs = 12 + SINEW_TOOL_TERMS;  // impulse sums, then mass and inertia
 
 // Word offsets of the item counts in the constants buffer; block k's count at kFirstBlock + k.
-enum CountWord : std::uint32_t { kParticles = 0, kTets = 1, kSlots = 2, kFirstBlock = 3 };
+enum CountWord : std::uint32_t { kParticles = 0, kFaces = 1, kSlots = 2, kFirstBlock = 3 };
 
 Result<BufferHandle> make_words(Device& device, std::size_t words, std::string_view label) {
   return device.create_buffer(std::max<std::size_t>(words, 4) * 4, label);
@@ -46,7 +46,7 @@ void for_each_reduction(const StatsPlan& plan, Visit visit) {
       visit("residual max", k, scratch.take(reduce_scratch_words(n)), results.take(1));
     }
     visit("kinetic energy", 0, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
-    visit("volume", 0, scratch.take(reduce_dd_scratch_words(plan.tet_count)), results.take(2));
+    visit("volume", 0, scratch.take(reduce_dd_scratch_words(plan.face_count)), results.take(2));
   }
   for (std::uint32_t k = 0; k < plan.tools * kToolPairs; ++k)
     visit("tool", k, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
@@ -58,29 +58,30 @@ double pair(const std::vector<float>& r, std::uint32_t at) { return double(r[at]
 }  // namespace
 
 Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene, const XpbdBuffers& /*buffers*/,
-                                  const std::vector<std::array<std::uint32_t, 4>>& tets, bool errors,
+                                  const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
                                   std::uint32_t tools) {
   StatsPlan plan;
   plan.errors = errors;
   plan.tools = tools;
   plan.particles = static_cast<std::uint32_t>(scene.positions.size());
-  plan.tet_count = errors ? static_cast<std::uint32_t>(tets.size()) : 0u;
+  plan.face_count = errors ? static_cast<std::uint32_t>(faces.size()) : 0u;
   for (const ConstraintBlock& block : scene.blocks) plan.block_sizes.push_back(block.size());
   if (!errors && tools == 0) return plan;
 
-  std::vector<std::uint32_t> constants{plan.particles, plan.tet_count, plan.particles * tools};
+  std::vector<std::uint32_t> constants{plan.particles, plan.face_count, plan.particles * tools};
   constants.insert(constants.end(), plan.block_sizes.begin(), plan.block_sizes.end());
   auto made = make_words(device, constants.size(), "statistics counts");
   if (!made) return made.error();
   plan.constants = *made;
   if (Status s = device.write_buffer(plan.constants, 0, constants.data(), constants.size() * 4); !s) return s.error();
-  made = make_words(device, 4 * std::size_t{plan.tet_count}, "statistics tets");
+  made = make_words(device, 4 * std::size_t{plan.face_count}, "statistics faces");
   if (!made) return made.error();
-  plan.tets = *made;
-  if (plan.tet_count)
-    if (Status s = device.write_buffer(plan.tets, 0, tets.data(), tets.size() * sizeof(tets[0])); !s) return s.error();
+  plan.faces = *made;
+  if (plan.face_count)
+    if (Status s = device.write_buffer(plan.faces, 0, faces.data(), faces.size() * sizeof(faces[0])); !s)
+      return s.error();
   // One terms buffer, reused in turn by each map kernel and its reduction.
-  const std::uint32_t terms = std::max({2 * plan.particles, 2 * plan.tet_count, 2 * SINEW_TOOL_TERMS * plan.particles * tools});
+  const std::uint32_t terms = std::max({2 * plan.particles, 2 * plan.face_count, 2 * SINEW_TOOL_TERMS * plan.particles * tools});
   made = make_words(device, terms, "statistics terms");
   if (!made) return made.error();
   plan.terms = *made;
@@ -138,10 +139,10 @@ void append_stats(FrameProgram& program, const StatsPlan& plan, const CompiledSc
       program.barrier();
       from = append_reduce_dd(program, {plan.constants, kParticles, particles}, DdItems::pairs, {plan.terms, 0}, 2, at);
     } else if (w == "volume") {
-      p.count = plan.tet_count;
-      program.dispatch(Kernel::stats_tet_volume, plan.tet_count, {buffers.position, plan.tets, plan.terms}, p);
+      p.count = plan.face_count;
+      program.dispatch(Kernel::stats_surface_volume, plan.face_count, {buffers.position, plan.faces, plan.terms}, p);
       program.barrier();
-      from = append_reduce_dd(program, {plan.constants, kTets, plan.tet_count}, DdItems::pairs, {plan.terms, 0}, 2, at);
+      from = append_reduce_dd(program, {plan.constants, kFaces, plan.face_count}, DdItems::pairs, {plan.terms, 0}, 2, at);
     } else {  // tool sums: pair k of tool t
       const auto t = static_cast<std::uint32_t>(k / kToolPairs), j = static_cast<std::uint32_t>(k % kToolPairs);
       if (k == 0) {  // the mass and inertia terms of every (particle, tool) slot, once
@@ -179,7 +180,7 @@ Status read_stats(Device& device, StatsPlan& plan, DeviceStats& out) {
       out.constraints += plan.block_sizes[k];
     }
     out.kinetic_energy = pair(r, plan.kinetic_energy);
-    out.volume = pair(r, plan.volume);
+    out.volume = pair(r, plan.volume) / 6.0;  // the terms are 6 x volume
   }
   out.tools.resize(plan.tools);
   for (std::uint32_t t = 0; t < plan.tools; ++t) {

@@ -23,7 +23,7 @@ struct DeviceStats {
   double residual_max = 0.0;
   std::uint64_t constraints = 0;
   double kinetic_energy = 0.0;  ///< [J]
-  double volume = 0.0;          ///< total signed tet volume [m^3]
+  double volume = 0.0;          ///< total signed volume of the tet bodies [m^3]
   struct Tool {
     double sums[4][3] = {};  ///< frame impulse, its moment, last substep's impulse, its moment (contact_params.h)
     double mass = 0.0;       ///< mass of the particles touching it at the frame's end [kg]
@@ -37,8 +37,8 @@ struct StatsPlan {
   bool errors = false;             ///< residuals, kinetic energy and volume are reduced
   std::uint32_t tools = 0;
   std::vector<std::uint32_t> block_sizes;
-  std::uint32_t particles = 0, tet_count = 0;
-  BufferHandle constants, tets, terms, scratch, results;
+  std::uint32_t particles = 0, face_count = 0;
+  BufferHandle constants, faces, terms, scratch, results;
   std::uint32_t result_words = 0;
   // Word offsets in `results`:
   std::vector<std::uint32_t> residual_squares, residual_max;  ///< per block: a (hi, lo) pair, a float
@@ -47,10 +47,12 @@ struct StatsPlan {
   std::vector<float> read_back;                               ///< the host copy, sized once
 };
 
-/// Creates the statistics' buffers. [in] tets: every tet body's tets as
-/// particle indices; errors: SolverSettings::measure_errors; tools: rigid tools.
+/// Creates the statistics' buffers. [in] faces: every tet body's boundary
+/// triangles, wound outward, with a particle of the same body (the
+/// reference point r of stats_surface_volume), as particle indices;
+/// errors: SolverSettings::measure_errors; tools: rigid tools.
 Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
-                                  const std::vector<std::array<std::uint32_t, 4>>& tets, bool errors,
+                                  const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
                                   std::uint32_t tools);
 
 /// Appends the statistics to the end of a frame program (after its last

@@ -43,19 +43,25 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
   impl->time_step = scene.solver.time_step;
   impl->measure_errors = scene.solver.measure_errors;
-  std::vector<std::array<std::uint32_t, 4>> tets;  // every tet body's tets, as particle indices
+  // Every tet body's boundary (wound outward) with one particle of the body
+  // as the reference point: its volume on the device (stats_surface_volume).
+  std::vector<std::array<std::uint32_t, 4>> faces;
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
+    const TetMesh& mesh = scene.tet_bodies[b].mesh;
     const std::uint32_t first = compiled->tet_body_first_particle[b];
-    for (const auto& t : scene.tet_bodies[b].mesh.tets) {
-      tets.push_back({first + t[0], first + t[1], first + t[2], first + t[3]});
+    for (const auto& t : mesh.tets) {
       const auto at = [&](int k) {
-        const Vec3d& p = scene.tet_bodies[b].mesh.vertices[t[k]];
+        const Vec3d& p = mesh.vertices[t[k]];
         return kernels::double4{p[0], p[1], p[2], 0.0};
       };
       impl->rest_volume += kernels::tet_volume(at(0), at(1), at(2), at(3));
     }
+    if (!impl->measure_errors) continue;
+    const TriMesh boundary = extract_boundary_surface(mesh);
+    for (const auto& f : boundary.triangles)
+      faces.push_back({first + f[0], first + f[1], first + f[2], first + boundary.triangles.front()[0]});
   }
-  auto plan = make_stats_plan(*impl->device, *compiled, impl->buffers, tets, impl->measure_errors,
+  auto plan = make_stats_plan(*impl->device, *compiled, impl->buffers, faces, impl->measure_errors,
                               static_cast<std::uint32_t>(impl->contacts.tools.size()));
   if (!plan) return plan.error();
   impl->stats_plan = std::move(*plan);
