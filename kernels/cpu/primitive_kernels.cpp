@@ -62,16 +62,35 @@ std::uint32_t identity(std::uint32_t op) {
     default: return 0u;  // +0.0f and 0u
   }
 }
-std::uint32_t combine(std::uint32_t op, std::uint32_t a, std::uint32_t b) {
+template <std::uint32_t Op>
+std::uint32_t combine(std::uint32_t a, std::uint32_t b) {
+  if constexpr (Op == SINEW_REDUCE_SUM_F32 || Op == SINEW_REDUCE_SUM_SQUARES_F32) return as_bits(as_float(a) + as_float(b));
+  if constexpr (Op == SINEW_REDUCE_MIN_F32) return as_float(b) < as_float(a) ? b : a;
+  if constexpr (Op == SINEW_REDUCE_MAX_F32) return as_float(b) > as_float(a) ? b : a;
+  if constexpr (Op == SINEW_REDUCE_SUM_U32) return a + b;
+  if constexpr (Op == SINEW_REDUCE_MIN_U32) return std::min(a, b);
+  if constexpr (Op == SINEW_REDUCE_MAX_U32) return std::max(a, b);
+  return a;
+}
+
+// The pairwise tree of a block: v[t] = op(v[t], v[t + s]) for s = 128, ..., 1.
+template <std::uint32_t Op>
+void halve(std::uint32_t* v) {
+  for (std::uint32_t s = kBlock / 2; s > 0; s /= 2)
+    for (std::uint32_t t = 0; t < s; ++t) v[t] = combine<Op>(v[t], v[t + s]);
+}
+
+// The operator chosen once per block, not per pair.
+void halve(std::uint32_t op, std::uint32_t* v) {
   switch (op) {
     case SINEW_REDUCE_SUM_F32:
-    case SINEW_REDUCE_SUM_SQUARES_F32: return as_bits(as_float(a) + as_float(b));
-    case SINEW_REDUCE_MIN_F32: return as_float(b) < as_float(a) ? b : a;
-    case SINEW_REDUCE_MAX_F32: return as_float(b) > as_float(a) ? b : a;
-    case SINEW_REDUCE_SUM_U32: return a + b;
-    case SINEW_REDUCE_MIN_U32: return std::min(a, b);
-    case SINEW_REDUCE_MAX_U32: return std::max(a, b);
-    default: return a;
+    case SINEW_REDUCE_SUM_SQUARES_F32: return halve<SINEW_REDUCE_SUM_F32>(v);
+    case SINEW_REDUCE_MIN_F32: return halve<SINEW_REDUCE_MIN_F32>(v);
+    case SINEW_REDUCE_MAX_F32: return halve<SINEW_REDUCE_MAX_F32>(v);
+    case SINEW_REDUCE_SUM_U32: return halve<SINEW_REDUCE_SUM_U32>(v);
+    case SINEW_REDUCE_MIN_U32: return halve<SINEW_REDUCE_MIN_U32>(v);
+    case SINEW_REDUCE_MAX_U32: return halve<SINEW_REDUCE_MAX_U32>(v);
+    default: return;  // an unknown operator keeps v[0] (the GPU twins do the same)
   }
 }
 
@@ -175,8 +194,7 @@ void reduce_blocks(const void* params, std::byte* const* bindings, std::uint32_t
         if (p.op == SINEW_REDUCE_SUM_SQUARES_F32) v[t] = as_bits(as_float(v[t]) * as_float(v[t]));
       }
     }
-    for (std::uint32_t s = kBlock / 2; s > 0; s /= 2)
-      for (std::uint32_t t = 0; t < s; ++t) v[t] = combine(p.op, v[t], v[t + s]);
+    halve(p.op, v);
     partials[p.out_offset + b] = v[0];
   }
 }

@@ -33,6 +33,9 @@ struct Layout {
   }
 };
 
+// The reductions of a plan, in the order they run.
+enum class Reduction { residual_squares, residual_max, kinetic_energy, volume, tool, end };
+
 // Visits the reductions of a plan in one fixed order, with the scratch and
 // result words each one owns; make_stats_plan sizes with it and
 // append_stats emits with it, so the two cannot disagree.
@@ -42,22 +45,22 @@ void for_each_reduction(const StatsPlan& plan, Visit visit) {
   if (plan.errors) {
     for (std::size_t k = 0; k < plan.block_sizes.size(); ++k) {
       const std::uint32_t n = plan.block_sizes[k];
-      visit("residual squares", k, scratch.take(reduce_dd_scratch_words(n)), results.take(2));
-      visit("residual max", k, scratch.take(reduce_scratch_words(n)), results.take(1));
+      visit(Reduction::residual_squares, k, scratch.take(reduce_dd_scratch_words(n)), results.take(2));
+      visit(Reduction::residual_max, k, scratch.take(reduce_scratch_words(n)), results.take(1));
     }
-    visit("kinetic energy", 0, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
-    visit("volume", 0, scratch.take(reduce_dd_scratch_words(plan.face_count)), results.take(2));
+    visit(Reduction::kinetic_energy, 0, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
+    visit(Reduction::volume, 0, scratch.take(reduce_dd_scratch_words(plan.face_count)), results.take(2));
   }
   for (std::uint32_t k = 0; k < plan.tools * kToolPairs; ++k)
-    visit("tool", k, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
-  visit("end", 0, scratch.next, results.next);
+    visit(Reduction::tool, k, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
+  visit(Reduction::end, 0, scratch.next, results.next);
 }
 
 double pair(const std::vector<float>& r, std::uint32_t at) { return double(r[at]) + double(r[at + 1]); }
 
 }  // namespace
 
-Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene, const XpbdBuffers& /*buffers*/,
+Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
                                   const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
                                   std::uint32_t tools) {
   StatsPlan plan;
@@ -87,20 +90,19 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene, co
   plan.terms = *made;
 
   std::uint32_t scratch_words = 0;
-  for_each_reduction(plan, [&](const char* what, std::size_t k, std::uint32_t scratch, std::uint32_t result) {
-    const std::string_view w(what);
-    if (w == "end") {
+  for_each_reduction(plan, [&](Reduction w, std::size_t k, std::uint32_t scratch, std::uint32_t result) {
+    if (w == Reduction::end) {
       scratch_words = scratch;
       plan.result_words = result;
-    } else if (w == "residual squares") {
+    } else if (w == Reduction::residual_squares) {
       plan.residual_squares.push_back(result);
-    } else if (w == "residual max") {
+    } else if (w == Reduction::residual_max) {
       plan.residual_max.push_back(result);
-    } else if (w == "kinetic energy") {
+    } else if (w == Reduction::kinetic_energy) {
       plan.kinetic_energy = result;
-    } else if (w == "volume") {
+    } else if (w == Reduction::volume) {
       plan.volume = result;
-    } else if (w == "tool" && k == 0) {
+    } else if (w == Reduction::tool && k == 0) {
       plan.tool_first = result;
     }
   });
@@ -114,31 +116,29 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene, co
   return plan;
 }
 
-void append_stats(FrameProgram& program, const StatsPlan& plan, const CompiledScene& /*scene*/,
-                  const XpbdBuffers& buffers) {
+void append_stats(FrameProgram& program, const StatsPlan& plan, const XpbdBuffers& buffers) {
   if (!plan.errors && plan.tools == 0) return;
   const std::uint32_t particles = plan.particles;
   kernels::StatsParams p{};
-  for_each_reduction(plan, [&](const char* what, std::size_t k, std::uint32_t scratch, std::uint32_t result) {
-    const std::string_view w(what);
+  for_each_reduction(plan, [&](Reduction w, std::size_t k, std::uint32_t scratch, std::uint32_t result) {
     const DeviceWords at{plan.scratch, scratch};
     std::uint32_t from = 0, words = 2;
-    if (w == "end") return;
-    if (w == "residual squares" || w == "residual max") {
+    if (w == Reduction::end) return;
+    if (w == Reduction::residual_squares || w == Reduction::residual_max) {
       const DeviceCount n{plan.constants, kFirstBlock + static_cast<std::uint32_t>(k), plan.block_sizes[k]};
       const DeviceWords residual{buffers.blocks[k].residual, 0};
-      if (w == "residual squares") {
+      if (w == Reduction::residual_squares) {
         from = append_reduce_dd(program, n, DdItems::squares, residual, 1, at);
       } else {
         from = append_reduce(program, n, ReduceOp::max_f32, residual, 1, at);
         words = 1;
       }
-    } else if (w == "kinetic energy") {
+    } else if (w == Reduction::kinetic_energy) {
       p.count = particles;
       program.dispatch(Kernel::stats_kinetic_energy, particles, {buffers.position, buffers.velocity, plan.terms}, p);
       program.barrier();
       from = append_reduce_dd(program, {plan.constants, kParticles, particles}, DdItems::pairs, {plan.terms, 0}, 2, at);
-    } else if (w == "volume") {
+    } else if (w == Reduction::volume) {
       p.count = plan.face_count;
       program.dispatch(Kernel::stats_surface_volume, plan.face_count, {buffers.position, plan.faces, plan.terms}, p);
       program.barrier();

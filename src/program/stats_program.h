@@ -51,14 +51,13 @@ struct StatsPlan {
 /// triangles, wound outward, with a particle of the same body (the
 /// reference point r of stats_surface_volume), as particle indices;
 /// errors: SolverSettings::measure_errors; tools: rigid tools.
-Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
+Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
                                   const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
                                   std::uint32_t tools);
 
 /// Appends the statistics to the end of a frame program (after its last
 /// update of velocities). Nothing when the plan has neither errors nor tools.
-void append_stats(FrameProgram& program, const StatsPlan& plan, const CompiledScene& scene,
-                  const XpbdBuffers& buffers);
+void append_stats(FrameProgram& program, const StatsPlan& plan, const XpbdBuffers& buffers);
 
 /// Reads the results of the last frame (one read of result_words words) into `out`.
 Status read_stats(Device& device, StatsPlan& plan, DeviceStats& out);

@@ -61,12 +61,12 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     for (const auto& f : boundary.triangles)
       faces.push_back({first + f[0], first + f[1], first + f[2], first + boundary.triangles.front()[0]});
   }
-  auto plan = make_stats_plan(*impl->device, *compiled, impl->buffers, faces, impl->measure_errors,
+  auto plan = make_stats_plan(*impl->device, *compiled, faces, impl->measure_errors,
                               static_cast<std::uint32_t>(impl->contacts.tools.size()));
   if (!plan) return plan.error();
   impl->stats_plan = std::move(*plan);
   impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
-  append_stats(impl->program, impl->stats_plan, *compiled, impl->buffers);
+  append_stats(impl->program, impl->stats_plan, impl->buffers);
   auto prepared = impl->device->create_program(impl->program);
   if (!prepared) return prepared.error();
   impl->prepared = *prepared;
