@@ -1,52 +1,130 @@
 // organ_step — median wall time of Simulation::step() on a real organ mesh, in the mesher's vertex
-// order, timed outside step() (errors measured or not): how the frame costs on livers and kidneys,
-// not only on the benchmark cube. Prints "median_ms,residual_rms,kinetic_energy,volume_change".
-//   organ_step BACKEND MESH.node FRAMES MEASURE_ERRORS(0|1)
-//   e.g. organ_step cpu build/data/meshes/tet/liver_382k.node 10 1
-// The mesh is in millimetres (scaled to metres), E = 30 kPa, nu = 0.45, pinned within 5 mm of its
-// lowest x, 10 substeps x 1 iteration at 60 Hz.
+// order, timed outside step(): how a frame costs on livers and kidneys, not only on the benchmark
+// cube, and the projections per second that compare the two per constraint.
+//
+//   organ_step BACKEND MESH.node FRAMES [--errors] [--material none|neo_hookean|stvk|corotational]
+//              [--no-reorder] [--substeps N] [--iterations N] [--threads N]
+//   e.g. organ_step cpu build/data/meshes/tet/liver_382k.node 10 --errors
+//   MESH.node may be cube:N, the benchmark cube of N^3 cells (100 mm wide) at the same settings.
+//
+// The mesh is in millimetres (scaled to metres), density 1060 kg/m^3, E = 30 kPa, nu = 0.45
+// (distance + volume constraints, or the FEM material), pinned within 5 mm of its lowest x,
+// 10 substeps x 1 iteration at 60 Hz unless told otherwise. --no-reorder keeps the particles in the
+// mesher's order on the device (SolverSettings::reorder_particles = false), for before/after.
+// Prints one CSV line after a header:
+//   backend,mesh,material,reorder,particles,constraints,colors,median_ms,mprojections_per_s,min_ms,
+//   cpu_ms (median process CPU time per frame), residual_rms,kinetic_energy,volume_change
 #include <sinew/simulation.h>
+
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
+
+namespace {
+
+int usage() {
+  std::fprintf(stderr,
+               "usage: organ_step BACKEND MESH.node FRAMES [--errors] [--material none|neo_hookean|stvk|corotational]"
+               " [--no-reorder] [--substeps N] [--iterations N] [--threads N]\n");
+  return 2;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::fprintf(stderr, "usage: organ_step BACKEND MESH.node FRAMES MEASURE_ERRORS(0|1)\n");
-    return 2;
-  }
-  const std::string backend = argv[1];
-  auto mesh = sinew::read_tet_mesh(argv[2]);
-  if (!mesh) { std::fprintf(stderr, "%s\n", mesh.error().message().c_str()); return 1; }
+  if (argc < 4) return usage();
+  const std::string backend = argv[1], path = argv[2];
   const int frames = std::atoi(argv[3]);
-  if (frames < 1) {
-    std::fprintf(stderr, "FRAMES must be >= 1\n");
-    return 2;
+  if (frames < 1) return usage();
+  bool errors = false, reorder = true;
+  int substeps = 10, iterations = 1, threads = 0;
+  std::string material = "none";
+  for (int i = 4; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--errors") errors = true;
+    else if (a == "--no-reorder") reorder = false;
+    else if (a == "--material" && i + 1 < argc) material = argv[++i];
+    else if (a == "--substeps" && i + 1 < argc) substeps = std::atoi(argv[++i]);
+    else if (a == "--iterations" && i + 1 < argc) iterations = std::atoi(argv[++i]);
+    else if (a == "--threads" && i + 1 < argc) threads = std::atoi(argv[++i]);
+    else return usage();
   }
-  const bool errors = std::atoi(argv[4]) != 0;
+  // "cube:N": the benchmark cube (bench_cube's mesh: N^3 cells of 6 tets, here 10 cm wide) at the
+  // same settings, for the per-constraint comparison.
+  auto mesh = path.rfind("cube:", 0) == 0
+                  ? sinew::make_tet_grid({.nx = std::atoi(path.c_str() + 5), .ny = std::atoi(path.c_str() + 5),
+                                          .nz = std::atoi(path.c_str() + 5), .origin = {0, 0, 0},
+                                          .cell_size = {100.0 / std::atoi(path.c_str() + 5),
+                                                        100.0 / std::atoi(path.c_str() + 5),
+                                                        100.0 / std::atoi(path.c_str() + 5)}})
+                  : sinew::read_tet_mesh(path);
+  if (!mesh) {
+    std::fprintf(stderr, "%s\n", mesh.error().message().c_str());
+    return 1;
+  }
   sinew::scale_mesh(*mesh, 1e-3);
   sinew::TetBodyDesc body;
   body.mesh = std::move(*mesh);
   body.density = 1060.0;
-  (void)body.set_elastic(3e4, 0.45);
+  sinew::Status made;
+  if (material == "none") made = body.set_elastic(3e4, 0.45);
+  else if (material == "neo_hookean") made = body.set_material(sinew::TetMaterial::neo_hookean, 3e4, 0.45);
+  else if (material == "stvk") made = body.set_material(sinew::TetMaterial::stvk, 3e4, 0.45);
+  else if (material == "corotational") made = body.set_material(sinew::TetMaterial::corotational, 3e4, 0.45);
+  else return usage();
+  if (!made) {
+    std::fprintf(stderr, "%s\n", made.error().message().c_str());
+    return 1;
+  }
   double lo = 1e30;
   for (const auto& v : body.mesh.vertices) lo = std::min(lo, v[0]);
   for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
     if (body.mesh.vertices[v][0] < lo + 0.005) body.pinned.push_back(v);
   sinew::SceneDesc scene;
-  scene.solver = {.time_step = 1.0 / 60.0, .substeps = 10, .iterations = 1, .measure_errors = errors};
+  scene.solver.time_step = 1.0 / 60.0;
+  scene.solver.substeps = substeps;
+  scene.solver.iterations = iterations;
+  scene.solver.measure_errors = errors;
+  scene.solver.reorder_particles = reorder;
   scene.tet_bodies.push_back(std::move(body));
-  auto sim = sinew::Simulation::create(scene, {.backend = backend, .quiet = true});
-  if (!sim) { std::fprintf(stderr, "%s\n", sim.error().message().c_str()); return 1; }
-  std::vector<double> t;
+  auto sim = sinew::Simulation::create(scene, {.backend = backend, .threads = threads, .quiet = true});
+  if (!sim) {
+    std::fprintf(stderr, "%s\n", sim.error().message().c_str());
+    return 1;
+  }
+  // Wall time, and the process's CPU time: with --threads 1 the latter is
+  // the frame's cost without the time other jobs on a shared machine took.
+  auto cpu_ms = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+  };
+  std::vector<double> t, cpu;
   for (int f = 0; f < frames; ++f) {
+    const double c0 = cpu_ms();
     const auto a = std::chrono::steady_clock::now();
-    if (auto s = sim->step(); !s) { std::fprintf(stderr, "%s\n", s.error().message().c_str()); return 1; }
+    if (auto s = sim->step(); !s) {
+      std::fprintf(stderr, "%s\n", s.error().message().c_str());
+      return 1;
+    }
     t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+    cpu.push_back(cpu_ms() - c0);
   }
   std::sort(t.begin(), t.end());
+  std::sort(cpu.begin(), cpu.end());
+  const double median = t[t.size() / 2];
+  const sinew::SceneInfo& info = sim->info();
+  const double projections = double(info.constraints()) * substeps * iterations;
   const auto& st = sim->last_frame();
-  std::printf("%.3f,%.6e,%.6e,%.6e\n", t[t.size() / 2], st.residual_rms, st.kinetic_energy, st.volume_change);
+  const char* name = std::strrchr(path.c_str(), '/');
+  std::printf("backend,mesh,material,reorder,particles,constraints,colors,median_ms,mprojections_per_s,"
+              "min_ms,cpu_ms,residual_rms,kinetic_energy,volume_change\n");
+  std::printf("%s,%s,%s,%d,%u,%u,%u,%.3f,%.1f,%.3f,%.3f,%.6e,%.6e,%.6e\n", backend.c_str(), name ? name + 1 : path.c_str(),
+              material.c_str(), reorder ? 1 : 0, info.particles, info.constraints(), info.colors, median,
+              projections / (median * 1e3), t.front(), cpu[cpu.size() / 2], st.residual_rms, st.kinetic_energy, st.volume_change);
 }

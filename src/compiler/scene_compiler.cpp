@@ -10,6 +10,7 @@
 #include <string>
 
 #include "coloring/greedy_coloring.h"
+#include "compiler/particle_order.h"
 #include "compiler/solve_order.h"
 #include "math/xpbd_math.h"
 
@@ -123,9 +124,15 @@ RawConstraints& SceneBuilder::constraints(Kernel kernel, std::uint32_t arity, st
 
 namespace {
 
-// Colours a block's constraints and reorders them colour by colour, keeping
-// the original order inside each colour (stable counting sort).
-ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::uint8_t> movable) {
+// Colours a block's constraints and reorders them colour by colour. The
+// colouring runs in the scene's constraint order, so it, and with it every
+// result, is the same whatever order the particles live in; inside a colour
+// the constraints are independent (no shared movable particle), so their
+// order there changes no bit either: with `by_first_particle` they are
+// sorted by their smallest particle, for a sweep that walks memory forward
+// (particle_order.h), otherwise kept in the scene's order.
+ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::uint8_t> movable,
+                               bool by_first_particle) {
   ConstraintBlock out;
   out.kernel = raw.kernel;
   out.arity = raw.arity;
@@ -138,11 +145,12 @@ ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::u
   out.color_offsets.assign(coloring.color_count() + 1, 0);
   for (std::uint32_t k = 0; k < coloring.color_count(); ++k)
     out.color_offsets[k + 1] = out.color_offsets[k] + coloring.color_sizes[k];
-  std::vector<std::uint32_t> slot(out.color_offsets.begin(), out.color_offsets.end() - 1);
+  const std::vector<std::uint32_t> order =
+      constraint_order(raw.particles, raw.arity, coloring.color_of, by_first_particle);
   out.particles.resize(raw.particles.size());
   out.data.resize(raw.data.size());
-  for (std::uint32_t c = 0; c < n; ++c) {
-    const std::uint32_t to = slot[coloring.color_of[c]]++;
+  for (std::uint32_t to = 0; to < n; ++to) {
+    const std::uint32_t c = order[to];
     std::copy_n(&raw.particles[c * raw.arity], raw.arity, &out.particles[to * raw.arity]);
     std::copy_n(&raw.data[c * raw.data_stride], raw.data_stride, &out.data[to * raw.data_stride]);
   }
@@ -193,8 +201,25 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
                    "particle " + std::to_string(p) + " has a mass of " + std::to_string(b.mass[p]) +
                    " kg, too small for a float32 inverse mass");
     b.positions[p].w = static_cast<float>(w);
-    movable[p] = b.positions[p].w > 0.0f;
   }
+  // Device order (particle_order.h): particles along a Morton curve within
+  // each body, constraints renumbered and sorted by their first particle.
+  if (scene.solver.reorder_particles) {
+    std::vector<std::uint32_t> body_first = out.tet_body_first_particle;
+    body_first.insert(body_first.end(), out.tri_body_first_particle.begin(), out.tri_body_first_particle.end());
+    body_first.insert(body_first.end(), out.line_body_first_particle.begin(), out.line_body_first_particle.end());
+    out.order = morton_order(b.positions, std::move(body_first));
+  } else {
+    out.order = identity_order(static_cast<std::uint32_t>(b.positions.size()));
+  }
+  std::vector<kernels::float4> device_positions(b.positions.size());
+  for (std::size_t slot = 0; slot < b.positions.size(); ++slot) {
+    device_positions[slot] = b.positions[out.order.user_of[slot]];
+    movable[slot] = device_positions[slot].w > 0.0f;
+  }
+  b.positions = std::move(device_positions);
+  for (RawConstraints& raw : b.raw)
+    for (std::uint32_t& p : raw.particles) p = out.order.device_of[p];
   // Gauss-Seidel order: kSolveOrder (solve_order.h; contacts last, so they win).
   for (const RawConstraints& raw : b.raw)
     if (solve_rank(raw.kernel) == kNotSolved)
@@ -205,7 +230,7 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
     return solve_rank(x.kernel) < solve_rank(y.kernel);
   });
   for (const RawConstraints& raw : b.raw)
-    if (!raw.particles.empty()) out.blocks.push_back(color_and_sort(raw, movable));
+    if (!raw.particles.empty()) out.blocks.push_back(color_and_sort(raw, movable, scene.solver.reorder_particles));
   out.positions = std::move(b.positions);
   return out;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "backends/kernel.h"
+#include "compiler/particle_order.h"
 #include "math/vec4.h"
 #include "sinew/scene.h"
 
@@ -61,6 +62,10 @@ struct CompiledScene {
   std::vector<std::uint32_t> tet_body_first_particle;
   std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;
+  /// Where each particle lives on the device (particle_order.h): every
+  /// buffer above is in device order, the *_first_particle ranges and the
+  /// public API in the user's.
+  ParticleOrder order;
 };
 
 /// What each feature's compile step adds to: particles, their masses and

@@ -41,6 +41,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
   if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
+  impl->order = compiled->order;
   impl->time_step = scene.solver.time_step;
   impl->measure_errors = scene.solver.measure_errors;
   // Every tet body's boundary (wound outward) with one particle of the body
@@ -59,7 +60,9 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     if (!impl->measure_errors) continue;
     const TriMesh boundary = extract_boundary_surface(mesh);
     for (const auto& f : boundary.triangles)
-      faces.push_back({first + f[0], first + f[1], first + f[2], first + boundary.triangles.front()[0]});
+      faces.push_back({compiled->order.device_of[first + f[0]], compiled->order.device_of[first + f[1]],
+                       compiled->order.device_of[first + f[2]],
+                       compiled->order.device_of[first + boundary.triangles.front()[0]]});
   }
   auto plan = make_stats_plan(*impl->device, *compiled, faces, impl->measure_errors,
                               static_cast<std::uint32_t>(impl->contacts.tools.size()));
@@ -111,14 +114,23 @@ Status Simulation::step() {
   return {};
 }
 
+Status Simulation::Impl::read_in_user_order(BufferHandle buffer, std::vector<float>& xyzw) const {
+  const std::size_t n = order.user_of.size();
+  xyzw.resize(n * 4);
+  std::vector<float>& slots = device_order_scratch;
+  slots.resize(n * 4);
+  if (Status s = device->read_buffer(buffer, 0, slots.data(), slots.size() * sizeof(float)); !s) return s;
+  for (std::size_t slot = 0; slot < n; ++slot)
+    std::copy_n(&slots[slot * 4], 4, &xyzw[std::size_t{order.user_of[slot]} * 4]);
+  return {};
+}
+
 Status Simulation::read_positions(std::vector<float>& xyzw) const {
-  xyzw.resize(std::size_t{impl_->info.particles} * 4);
-  return impl_->device->read_buffer(impl_->buffers.position, 0, xyzw.data(), xyzw.size() * sizeof(float));
+  return impl_->read_in_user_order(impl_->buffers.position, xyzw);
 }
 
 Status Simulation::read_velocities(std::vector<float>& xyzw) const {
-  xyzw.resize(std::size_t{impl_->info.particles} * 4);
-  return impl_->device->read_buffer(impl_->buffers.velocity, 0, xyzw.data(), xyzw.size() * sizeof(float));
+  return impl_->read_in_user_order(impl_->buffers.velocity, xyzw);
 }
 
 const SceneInfo& Simulation::info() const { return impl_->info; }

@@ -25,6 +25,11 @@ struct Simulation::Impl {
   double time_step = 0.0;
   bool measure_errors = true;
   double rest_volume = 0.0;  // every tet body's total rest volume [m^3]
+  // Device slot of each user particle (compiler/particle_order.h); reads
+  // gather through it into the user's order.
+  ParticleOrder order;
+  mutable std::vector<float> device_order_scratch;
+  Status read_in_user_order(BufferHandle buffer, std::vector<float>& xyzw) const;
   // The errors and the tools' reaction, reduced on the device at the end of
   // each frame (stats_program.h) and read back as a few words.
   StatsPlan stats_plan;
