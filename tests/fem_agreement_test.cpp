@@ -221,6 +221,14 @@ KernelCase fem_case(std::mt19937& rng, Kernel kernel, std::uint32_t count, bool 
       const double alpha_t = double(row[k]) * inv_h2;
       lambda.push_back(static_cast<float>(centre(rng) * (alpha_t > 0.0 ? 2.0 / alpha_t : 1e-3)));
     }
+    // Corotational tets keep a rotation (fem_params.h): none yet (zero,
+    // the exact rotation is taken), or a unit quaternion to refine.
+    if (kernel == Kernel::xpbd_solve_corotational) {
+      double q[4] = {gauss(rng), gauss(rng), gauss(rng), gauss(rng)};
+      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      const bool kept = rng() % 3 != 0;
+      for (double c : q) lambda.push_back(kept ? static_cast<float>(c / len) : 0.0f);
+    }
   }
   KernelCase c{kernel, count, {}, {}};
   c.bindings.push_back({x, false});

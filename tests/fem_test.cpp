@@ -693,7 +693,7 @@ struct OneTet {
   float4 x[4];
   kernels::uint4 idx{0, 1, 2, 3};
   float data[SINEW_FEM_DATA_STRIDE] = {};
-  float lambda[SINEW_FEM_LAMBDA_STRIDE] = {0, 0};
+  float lambda[SINEW_FEM_COROTATIONAL_LAMBDA_STRIDE] = {};  // neo_hookean and stvk use the first two
   float residual = 0;
   OneTet(TetMaterial model, double c, double young, double nu) {
     const Lame l = lame(young, nu);

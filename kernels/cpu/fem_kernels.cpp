@@ -60,8 +60,12 @@ namespace {
 using fem::mat3;
 using fem::TetConstraints;
 
-template <TetConstraints<float> (*Model)(const mat3<float>&, float)>
+enum class Model { neo_hookean, stvk, corotational };
+
+template <Model kModel>
 void solve_tets(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  constexpr std::uint32_t stride =
+      kModel == Model::corotational ? SINEW_FEM_COROTATIONAL_LAMBDA_STRIDE : SINEW_FEM_LAMBDA_STRIDE;
   const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float4*>(bindings[0]);
   const auto* idx = reinterpret_cast<const uint4*>(bindings[1]);
@@ -76,10 +80,25 @@ void solve_tets(const void* params, std::byte* const* bindings, std::uint32_t be
       for (int c = 0; c < 3; ++c) dm_inv.m[r][c] = d[SINEW_FEM_DM_INV + 3 * r + c];
     const float4 xs[4] = {x[t.x], x[t.y], x[t.z], x[t.w]};
     const mat3<float> f = fem::deformation_gradient(xs[0], xs[1], xs[2], xs[3], dm_inv);
-    const TetConstraints<float> c = Model(f, d[SINEW_FEM_H0]);
+    float* l = lambda + std::size_t{i} * stride;
+    TetConstraints<float> c;
+    if constexpr (kModel == Model::neo_hookean) {
+      c = fem::neo_hookean_constraints(f, d[SINEW_FEM_H0]);
+    } else if constexpr (kModel == Model::stvk) {
+      c = fem::stvk_constraints(f, d[SINEW_FEM_H0]);
+    } else {
+      // The rotation: the exact one on the first solve (no quaternion kept
+      // yet: all zero), then a few iterations from the last one. Kept by
+      // every solving pass, never by the measuring one.
+      float* kept = l + SINEW_FEM_ROTATION;
+      fem::quat<float> q{kept[0], kept[1], kept[2], kept[3]};
+      if (q.w == 0.0f && q.x == 0.0f && q.y == 0.0f && q.z == 0.0f) q = fem::rotation_quaternion(f);
+      q = fem::refine_rotation(f, q, fem::kRotationIterations);
+      if (!p.measure_only) kept[0] = q.w, kept[1] = q.x, kept[2] = q.y, kept[3] = q.z;
+      c = fem::corotational_constraints(f, fem::quaternion_matrix(q), d[SINEW_FEM_H0]);
+    }
 
     const float ad = d[SINEW_FEM_ALPHA_D] * p.inv_h2, ah = d[SINEW_FEM_ALPHA_H] * p.inv_h2;
-    float* l = lambda + std::size_t{i} * SINEW_FEM_LAMBDA_STRIDE;
     const float ld = p.reset_lambda ? 0.0f : l[0], lh = p.reset_lambda ? 0.0f : l[1];
     const float rd = c.c_d + ad * ld, rh = c.c_h + ah * lh;
     if (p.measure_only) {
@@ -139,15 +158,15 @@ void solve_tets(const void* params, std::byte* const* bindings, std::uint32_t be
 }  // namespace
 
 void xpbd_solve_neo_hookean(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
-  solve_tets<fem::neo_hookean_constraints<float>>(params, bindings, begin, end);
+  solve_tets<Model::neo_hookean>(params, bindings, begin, end);
 }
 
 void xpbd_solve_stvk(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
-  solve_tets<fem::stvk_constraints<float>>(params, bindings, begin, end);
+  solve_tets<Model::stvk>(params, bindings, begin, end);
 }
 
 void xpbd_solve_corotational(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
-  solve_tets<fem::corotational_constraints<float>>(params, bindings, begin, end);
+  solve_tets<Model::corotational>(params, bindings, begin, end);
 }
 
 }  // namespace sinew::kernels

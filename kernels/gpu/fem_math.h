@@ -46,15 +46,25 @@ SINEW_STRUCT_BEGIN(FemGradients)
   float3 g[4];
 SINEW_STRUCT_END(FemGradients)
 
+/* A quaternion (w, x, y, z). */
+SINEW_STRUCT_BEGIN(FemQuat)
+  float w;
+  float x;
+  float y;
+  float z;
+SINEW_STRUCT_END(FemQuat)
+
 /* What one tet's solve stores: the residual (measuring pass), or the new
  * multipliers and, where moved, the new positions of the movable
- * particles (x[k] is set only where xs[k].w > 0). */
+ * particles (x[k] is set only where xs[k].w > 0), and for corotational
+ * tets the rotation to keep (fem_params.h). */
 SINEW_STRUCT_BEGIN(FemTetStep)
   float residual;
   float lambda_d;
   float lambda_h;
   bool moved;
   float4 x[4];
+  FemQuat rotation;  /* corotational: the tet's rotation to keep */
 SINEW_STRUCT_END(FemTetStep)
 
 PRECISE float fem_frobenius_norm(FemMat3 a) {
@@ -111,11 +121,21 @@ FemGradients fem_position_gradients(FemMat3 g_f, FemMat3 dm_inv) {
   return g;
 }
 
+/* No rotation kept (neo_hookean and stvk tets keep none). */
+FemQuat fem_no_rotation() {
+  FemQuat q;
+  q.w = 0.0f;
+  q.x = 0.0f;
+  q.y = 0.0f;
+  q.z = 0.0f;
+  return q;
+}
+
 /* The rotation R (det R = +1) maximising tr(R^T F): Horn's quaternion
  * matrix N, whose eigenvector of largest eigenvalue is R's quaternion, by
  * cyclic Jacobi (at most 12 sweeps); ties take the first; F = 0 gives I.
- * Twin of fem::rotation_part. */
-FemMat3 fem_rotation_part(FemMat3 f) {
+ * Twin of fem::rotation_quaternion. */
+FemQuat fem_rotation_quaternion(FemMat3 f) {
   PRECISE float n[4][4];
   n[0][0] = f.m[0][0] + f.m[1][1] + f.m[2][2];
   n[0][1] = f.m[2][1] - f.m[1][2];
@@ -183,10 +203,17 @@ FemMat3 fem_rotation_part(FemMat3 f) {
     if (n[k][k] > n[best][best]) best = k;
   PRECISE float w = v[0][best], x = v[1][best], y = v[2][best], z = v[3][best];
   PRECISE float len = sqrt(w * w + x * x + y * y + z * z);  // 1 up to rounding
-  w = w / len;
-  x = x / len;
-  y = y / len;
-  z = z / len;
+  PRECISE FemQuat q;
+  q.w = w / len;
+  q.x = x / len;
+  q.y = y / len;
+  q.z = z / len;
+  return q;
+}
+
+/* The rotation matrix of a unit quaternion. Twin of fem::quaternion_matrix. */
+FemMat3 fem_quaternion_matrix(FemQuat q) {
+  const float w = q.w, x = q.x, y = q.y, z = q.z;
   PRECISE FemMat3 r;
   r.m[0][0] = 1.0f - 2.0f * (y * y + z * z);
   r.m[0][1] = 2.0f * (x * y - w * z);
@@ -198,6 +225,51 @@ FemMat3 fem_rotation_part(FemMat3 f) {
   r.m[2][1] = 2.0f * (y * z + w * x);
   r.m[2][2] = 1.0f - 2.0f * (x * x + y * y);
   return r;
+}
+
+/* The rotation refined from a unit quaternion guess by `iterations`
+ * Newton steps on the rotation group, falling back to the step of Müller,
+ * Bender, Chentanez, Macklin, "A Robust Method to Extract the Rotational
+ * Part of Deformations", MIG 2016, where the Hessian is not positive
+ * definite. Twin of fem::refine_rotation (see there). */
+FemQuat fem_refine_rotation(FemMat3 f, FemQuat q, int iterations) {
+  for (int it = 0; it < iterations; ++it) {
+    const FemMat3 r = fem_quaternion_matrix(q);
+    PRECISE float s[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) s[i][j] = r.m[0][i] * f.m[0][j] + r.m[1][i] * f.m[1][j] + r.m[2][i] * f.m[2][j];
+    PRECISE float gx = s[2][1] - s[1][2], gy = s[0][2] - s[2][0], gz = s[1][0] - s[0][1];
+    PRECISE float tr = s[0][0] + s[1][1] + s[2][2];
+    PRECISE float a = tr - s[0][0], b = tr - s[1][1], c = tr - s[2][2];
+    PRECISE float d = -0.5f * (s[0][1] + s[1][0]), e = -0.5f * (s[0][2] + s[2][0]), k = -0.5f * (s[1][2] + s[2][1]);
+    PRECISE float c00 = b * c - k * k, c01 = e * k - d * c, c02 = d * k - b * e;
+    PRECISE float c11 = a * c - e * e, c12 = d * e - a * k, c22 = a * b - d * d;
+    PRECISE float det = a * c00 + d * c01 + e * c02;
+    PRECISE float wx, wy, wz;
+    PRECISE float bound = 1e-6f * a * c22 * (a + b + c);
+    if (a > 0.0f && c22 > 0.0f && det > bound) {
+      PRECISE float inv_det = 1.0f / det;
+      wx = (c00 * gx + c01 * gy + c02 * gz) * inv_det;
+      wy = (c01 * gx + c11 * gy + c12 * gz) * inv_det;
+      wz = (c02 * gx + c12 * gy + c22 * gz) * inv_det;
+    } else {
+      PRECISE float inv = 1.0f / (fabs(tr) + 1e-9f);
+      wx = gx * inv;
+      wy = gy * inv;
+      wz = gz * inv;
+    }
+    PRECISE float hx = 0.5f * wx, hy = 0.5f * wy, hz = 0.5f * wz;
+    PRECISE float w = q.w - q.x * hx - q.y * hy - q.z * hz;
+    PRECISE float x = q.x + q.w * hx + q.y * hz - q.z * hy;
+    PRECISE float y = q.y + q.w * hy + q.z * hx - q.x * hz;
+    PRECISE float z = q.z + q.w * hz + q.x * hy - q.y * hx;
+    PRECISE float inv_len = 1.0f / sqrt(w * w + x * x + y * y + z * z);
+    q.w = w * inv_len;
+    q.x = x * inv_len;
+    q.y = y * inv_len;
+    q.z = z * inv_len;
+  }
+  return q;
 }
 
 /* Stable Neo-Hookean (Macklin, Müller 2021): C_D = |F|_F, dC_D/dF = F / |F|_F
@@ -232,12 +304,11 @@ FemConstraints fem_stvk_constraints(FemMat3 f, float h0) {
   return c;
 }
 
-/* Corotational linear: R = rotation_part(F), C_D = |F - R|_F,
+/* Corotational linear with the rotation R of F: C_D = |F - R|_F,
  * dC_D/dF = (F - R) / |F - R|_F (0 at F = R); C_H = tr(R^T F) - h0 (h0 = 3),
  * dC_H/dF = R. */
-FemConstraints fem_corotational_constraints(FemMat3 f, float h0) {
+FemConstraints fem_corotational_constraints(FemMat3 f, FemMat3 r, float h0) {
   PRECISE FemConstraints c;
-  const FemMat3 r = fem_rotation_part(f);
   PRECISE FemMat3 d;
   PRECISE float trace = 0.0f;
   for (int i = 0; i < 3; ++i)
@@ -264,8 +335,9 @@ FemConstraints fem_corotational_constraints(FemMat3 f, float h0) {
  * tet's particles; d: its SINEW_FEM_DATA_STRIDE words of data; ld, lh: its
  * multipliers at the start of the sweep (0 when reset). */
 FemTetStep fem_solve_tet(int model, const float4 xs[4], const float d[SINEW_FEM_DATA_STRIDE], float ld, float lh,
-                         float inv_h2, bool measure_only) {
+                         float inv_h2, bool measure_only, FemQuat kept) {
   FemTetStep s;
+  s.rotation = kept;
   s.residual = 0.0f;
   s.lambda_d = ld;
   s.lambda_h = lh;
@@ -280,8 +352,15 @@ FemTetStep fem_solve_tet(int model, const float4 xs[4], const float d[SINEW_FEM_
     c = fem_neo_hookean_constraints(f, h0);
   else if (model == FEM_MODEL_STVK)
     c = fem_stvk_constraints(f, h0);
-  else
-    c = fem_corotational_constraints(f, h0);
+  else {
+    // The exact rotation on the first solve (nothing kept yet), then a few
+    // iterations from the kept one (fem_kernels.cpp).
+    FemQuat q = kept;
+    if (q.w == 0.0f && q.x == 0.0f && q.y == 0.0f && q.z == 0.0f) q = fem_rotation_quaternion(f);
+    q = fem_refine_rotation(f, q, SINEW_FEM_ROTATION_ITERATIONS);
+    s.rotation = q;
+    c = fem_corotational_constraints(f, fem_quaternion_matrix(q), h0);
+  }
 
   PRECISE float ad = d[SINEW_FEM_ALPHA_D] * inv_h2, ah = d[SINEW_FEM_ALPHA_H] * inv_h2;
   PRECISE float rd = c.c_d + ad * ld, rh = c.c_h + ah * lh;

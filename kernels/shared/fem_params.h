@@ -4,7 +4,12 @@
  * and the standard solve bindings (xpbd_params.h) with:
  *   arity 4 (the tet's particles, in mesh order),
  *   data  SINEW_FEM_DATA_STRIDE floats per tet, laid out below,
- *   lambda SINEW_FEM_LAMBDA_STRIDE floats per tet: (lambda_D, lambda_H).
+ *   lambda SINEW_FEM_LAMBDA_STRIDE floats per tet: (lambda_D, lambda_H);
+ *          corotational: SINEW_FEM_COROTATIONAL_LAMBDA_STRIDE, the lambdas
+ *          then the tet's rotation as a unit quaternion (w, x, y, z) at
+ *          SINEW_FEM_ROTATION, kept from solve to solve (the warm start of
+ *          kernels/math/fem_math.h: refine_rotation); all zero before the
+ *          first solve, which starts from the exact rotation instead.
  *
  * Per tet, from its rest edge matrix Dm = [x1 - x0, x2 - x0, x3 - x0] [m]:
  *   [0..8]  Dm^-1, row-major [1/m]: F = Ds Dm^-1 with Ds the current edges;
@@ -26,6 +31,10 @@
 
 #define SINEW_FEM_DATA_STRIDE 16
 #define SINEW_FEM_LAMBDA_STRIDE 2
+#define SINEW_FEM_COROTATIONAL_LAMBDA_STRIDE 6
+#define SINEW_FEM_ROTATION 2
+/* Iterations of the warm-started rotation per corotational solve. */
+#define SINEW_FEM_ROTATION_ITERATIONS 1
 #define SINEW_FEM_DM_INV 0
 #define SINEW_FEM_REST_VOLUME 9
 #define SINEW_FEM_ALPHA_D 10

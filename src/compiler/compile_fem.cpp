@@ -72,7 +72,10 @@ Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32
                  name + ": youngs_modulus " + str(young) + " and poisson_ratio " + str(nu) +
                  " give Lame parameters that are not finite and positive");
 
-  RawConstraints& fem = b.constraints(kernel, 4, SINEW_FEM_DATA_STRIDE, SINEW_FEM_LAMBDA_STRIDE);
+  // Corotational tets also keep their rotation between solves (fem_params.h).
+  RawConstraints& fem = b.constraints(kernel, 4, SINEW_FEM_DATA_STRIDE,
+                                      kernel == Kernel::xpbd_solve_corotational ? SINEW_FEM_COROTATIONAL_LAMBDA_STRIDE
+                                                                                : SINEW_FEM_LAMBDA_STRIDE);
   const auto& tets = body.mesh.tets;
   fem.particles.reserve(fem.particles.size() + 4 * tets.size());
   fem.data.reserve(fem.data.size() + SINEW_FEM_DATA_STRIDE * tets.size());
