@@ -188,9 +188,9 @@ struct SolverSettings {
   /// constraint in the last sweep and a read-back of the residuals,
   /// velocities and positions after each frame.
   bool measure_errors = true;
-  /// Store the particles on the device in a memory-friendly order (Morton
-  /// order within each body; each colour's constraints sorted by their
-  /// first particle). Invisible to the API: read_positions and vertex
+  /// Store the particles on the device in a memory-friendly order (reverse
+  /// Cuthill-McKee within each body; each colour's constraints sorted by
+  /// their first particle). Invisible to the API: read_positions and vertex
   /// references stay in the scene's numbering, and the positions are
   /// bitwise the same either way (only the last bits of the summed
   /// FrameStats may differ). Off: the device holds them in the scene's

@@ -1,4 +1,5 @@
-// particle_order.cpp — Morton order of particles and constraint sorting.
+// particle_order.cpp — reverse Cuthill-McKee order of particles and the
+// constraint order within colours.
 // See particle_order.h for why and the references.
 #include "compiler/particle_order.h"
 
@@ -7,21 +8,6 @@
 #include <numeric>
 
 namespace sinew {
-namespace {
-
-// Spreads the low 21 bits of v so that bit i lands on bit 3i.
-std::uint64_t spread3(std::uint64_t v) {
-  v &= 0x1fffff;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
-}
-
-}  // namespace
-
 bool ParticleOrder::identity() const {
   for (std::size_t p = 0; p < device_of.size(); ++p)
     if (device_of[p] != p) return false;
@@ -36,38 +22,71 @@ ParticleOrder identity_order(std::uint32_t particles) {
   return order;
 }
 
-ParticleOrder morton_order(std::span<const kernels::float4> positions, std::vector<std::uint32_t> body_first) {
-  const auto n = static_cast<std::uint32_t>(positions.size());
+ParticleOrder bandwidth_order(std::uint32_t particles, std::span<const ConstraintList> constraints,
+                              std::vector<std::uint32_t> body_first) {
+  const std::uint32_t n = particles;
   ParticleOrder order = identity_order(n);
+  // Neighbour lists (CSR): every other particle of every constraint.
+  std::vector<std::uint32_t> offsets(std::size_t{n} + 1, 0), neighbours;
+  for (const ConstraintList& list : constraints)
+    for (std::size_t c = 0; c + list.arity <= list.particles.size(); c += list.arity)
+      for (std::uint32_t i = 0; i < list.arity; ++i) offsets[list.particles[c + i] + 1] += list.arity - 1;
+  for (std::uint32_t p = 0; p < n; ++p) offsets[p + 1] += offsets[p];
+  neighbours.resize(offsets[n]);
+  std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (const ConstraintList& list : constraints)
+    for (std::size_t c = 0; c + list.arity <= list.particles.size(); c += list.arity)
+      for (std::uint32_t i = 0; i < list.arity; ++i)
+        for (std::uint32_t j = 0; j < list.arity; ++j)
+          if (i != j) neighbours[fill[list.particles[c + i]]++] = list.particles[c + j];
+
   body_first.push_back(0);
   body_first.push_back(n);
   std::sort(body_first.begin(), body_first.end());
   body_first.erase(std::unique(body_first.begin(), body_first.end()), body_first.end());
-  std::vector<std::uint64_t> key(n);
-  for (std::size_t b = 0; b + 1 < body_first.size(); ++b) {
-    const std::uint32_t first = body_first[b], last = body_first[b + 1];
-    if (last - first < 2) continue;
-    float lo[3] = {positions[first].x, positions[first].y, positions[first].z}, hi[3] = {lo[0], lo[1], lo[2]};
-    for (std::uint32_t p = first; p < last; ++p) {
-      const float c[3] = {positions[p].x, positions[p].y, positions[p].z};
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], c[k]);
-        hi[k] = std::max(hi[k], c[k]);
+  auto degree = [&](std::uint32_t p) { return offsets[p + 1] - offsets[p]; };
+  std::vector<std::uint32_t> level(n, UINT32_MAX), queue;
+  queue.reserve(n);
+  // Breadth-first from `root` over unvisited particles of [first, last),
+  // neighbours by increasing degree; appends to `queue`, returns the last
+  // level's first entry (a candidate peripheral particle).
+  auto walk = [&](std::uint32_t root, std::uint32_t first, std::uint32_t last, std::vector<std::uint32_t>& out) {
+    std::size_t head = out.size();
+    out.push_back(root);
+    level[root] = 0;
+    std::uint32_t last_level_start = root;
+    std::vector<std::uint32_t> next;
+    while (head < out.size()) {
+      const std::uint32_t p = out[head++];
+      next.clear();
+      for (std::uint32_t j = offsets[p]; j < offsets[p + 1]; ++j) {
+        const std::uint32_t q = neighbours[j];
+        if (q < first || q >= last || level[q] != UINT32_MAX) continue;
+        level[q] = level[p] + 1;
+        next.push_back(q);
+      }
+      std::stable_sort(next.begin(), next.end(), [&](std::uint32_t a, std::uint32_t b) { return degree(a) < degree(b); });
+      for (std::uint32_t q : next) {
+        if (level[q] != level[out.back()]) last_level_start = q;
+        out.push_back(q);
       }
     }
-    // One scale for all three axes (the largest extent), so that the cells
-    // of the curve are cubes and a flat body does not get stretched ones.
-    const double extent = std::max({double(hi[0]) - lo[0], double(hi[1]) - lo[1], double(hi[2]) - lo[2]});
-    const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
-    for (std::uint32_t p = first; p < last; ++p) {
-      const float c[3] = {positions[p].x, positions[p].y, positions[p].z};
-      std::uint64_t code = 0;
-      for (int k = 0; k < 3; ++k)
-        code |= spread3(static_cast<std::uint64_t>(std::floor((double(c[k]) - lo[k]) * scale))) << k;
-      key[p] = code;
+    return last_level_start;
+  };
+  std::vector<std::uint32_t> probe;
+  for (std::size_t b = 0; b + 1 < body_first.size(); ++b) {
+    const std::uint32_t first = body_first[b], last = body_first[b + 1];
+    std::vector<std::uint32_t> body;
+    for (std::uint32_t start = first; start < last; ++start) {
+      if (level[start] != UINT32_MAX) continue;
+      // A pseudo-peripheral root: the far end of a walk from `start`.
+      probe.clear();
+      const std::uint32_t far = walk(start, first, last, probe);
+      for (std::uint32_t p : probe) level[p] = UINT32_MAX;
+      walk(far, first, last, body);
     }
-    std::stable_sort(order.user_of.begin() + first, order.user_of.begin() + last,
-                     [&](std::uint32_t u, std::uint32_t v) { return key[u] < key[v]; });
+    std::reverse(body.begin(), body.end());
+    std::copy(body.begin(), body.end(), order.user_of.begin() + first);
   }
   for (std::uint32_t slot = 0; slot < n; ++slot) order.device_of[order.user_of[slot]] = slot;
   return order;

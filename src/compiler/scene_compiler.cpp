@@ -202,13 +202,16 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
                    " kg, too small for a float32 inverse mass");
     b.positions[p].w = static_cast<float>(w);
   }
-  // Device order (particle_order.h): particles along a Morton curve within
-  // each body, constraints renumbered and sorted by their first particle.
+  // Device order (particle_order.h): each body's particles in reverse
+  // Cuthill-McKee order, constraints renumbered (and sorted by first
+  // particle within their colour, in color_and_sort).
   if (scene.solver.reorder_particles) {
     std::vector<std::uint32_t> body_first = out.tet_body_first_particle;
     body_first.insert(body_first.end(), out.tri_body_first_particle.begin(), out.tri_body_first_particle.end());
     body_first.insert(body_first.end(), out.line_body_first_particle.begin(), out.line_body_first_particle.end());
-    out.order = morton_order(b.positions, std::move(body_first));
+    std::vector<ConstraintList> lists;
+    for (const RawConstraints& raw : b.raw) lists.push_back({raw.particles, raw.arity});
+    out.order = bandwidth_order(static_cast<std::uint32_t>(b.positions.size()), lists, std::move(body_first));
   } else {
     out.order = identity_order(static_cast<std::uint32_t>(b.positions.size()));
   }
