@@ -1,20 +1,15 @@
 // cpu_device.cpp — the CPU reference backend.
 //
-// A program runs its commands in order. Each dispatch is split into chunks
-// that TBB runs on the device's own task arena; a barrier is implicit, since
-// a parallel_for returns only when all of its chunks are done. Independent
-// kernels get ranges of items; cooperative kernels (a group size in the
+// A program runs its commands in order on a team of threads (cpu_team.h)
+// that share each dispatch and meet at a barrier between dependent ones
+// (run_steps). Independent kernels get ranges of items; cooperative kernels (a group size in the
 // registry) get ranges of groups and do each group's work in order, so the
 // CPU reference of a scan or a sort is plain sequential code per group.
 // Indirect dispatches read their count from the counter word when they run.
 // The kernels (kernels/cpu) are plain scalar code and the test oracle for
 // the GPU ones.
 #include "backends/cpu/cpu_device.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
-#include <tbb/task_arena.h>
+#include "backends/cpu/cpu_team.h"
 
 #include <algorithm>
 #include <string>
@@ -56,10 +51,9 @@ kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
 // with organ_step --threads 1 on kidney_57k (10 substeps x 1 iteration):
 // distance and volume ~6.5 ns per constraint (AVX2), neo_hookean ~110 ns
 // per tet (scalar), stvk ~130, corotational ~150; the others estimated from
-// their arithmetic. Only the order of magnitude matters; distance keeps 4
-// so that its split is the one tuned before (inline below 1,024 items,
-// chunks of 256). Cube of 10,368 Neo-Hookean tets at 5 iterations, 2
-// threads: 5.2 -> 2.7 ms per frame against splitting by item count alone.
+// their arithmetic. Only the order of magnitude matters. (Cube of 10,368
+// Neo-Hookean tets at 5 iterations, 2 threads: 5.2 -> 2.7 ms per frame
+// against deciding by item count alone, which ran its colours on one thread.)
 std::uint32_t item_cost_ns(Kernel kernel) {
   switch (kernel) {
     case Kernel::xpbd_solve_distance: return 4;
@@ -100,6 +94,7 @@ struct CpuStep {
   std::uint32_t count = 0;       // items (independent) or groups (cooperative), or the capacity when indirect
   std::uint32_t group_size = 0;  // 0: independent items
   std::uint32_t cost_ns = 4;     // item_cost_ns of the kernel (per item, or per group member)
+  bool solo = false;             // known at resolve time to run on member 0 alone (see run_steps)
   const std::uint32_t* indirect = nullptr;  // the counter word of an indirect dispatch
   std::byte* bindings[Dispatch::max_bindings] = {};
   alignas(16) std::byte params[Dispatch::max_params_bytes] = {};
@@ -118,7 +113,7 @@ struct CpuProgram {
 
 class CpuDevice final : public Device {
  public:
-  CpuDevice(int threads, bool simd) : threads_(threads), simd_(simd), arena_(threads) {}
+  CpuDevice(int threads, bool simd) : threads_(threads), simd_(simd), team_(static_cast<unsigned>(threads)) {}
 
   std::string backend_name() const override { return "cpu"; }
   std::string device_name() const override {
@@ -197,9 +192,14 @@ class CpuDevice final : public Device {
     CpuProgram& p = programs_[program.id];
     if (p.resolved_at != generation_)
       if (Status s = resolve(p); !s) return s;
-    arena_.execute([&] {
-      for (const CpuStep& step : p.steps) run(step);
-    });
+    struct Job {
+      CpuDevice* device;
+      const std::vector<CpuStep>* steps;
+    } job{this, &p.steps};
+    team_.run([](void* context, unsigned member) {
+      const Job& j = *static_cast<const Job*>(context);
+      j.device->run_steps(*j.steps, member);
+    }, &job);
     counters_.resize(p.counter_words.size());
     for (std::size_t c = 0; c < counters_.size(); ++c) counters_[c] = *p.counter_words[c];
     submitted_ = program.id;
@@ -228,12 +228,10 @@ class CpuDevice final : public Device {
   }
 
  private:
-  // Small dispatches run inline: below this much work [ns, by item_cost_ns]
-  // waking other threads costs more than it saves (about 1,000 distance
-  // constraints, or 36 Neo-Hookean tets).
-  static constexpr std::uint64_t kSerialBelowNs = 4096;
-  // A chunk of a parallel dispatch holds at least this much work [ns].
-  static constexpr std::uint64_t kChunkNs = 1024;
+  // Small dispatches run on one member: below this much work [ns, by
+  // item_cost_ns] sharing it costs more than it saves (about 500 distance
+  // constraints, or 18 Neo-Hookean tets).
+  static constexpr std::uint64_t kSerialBelowNs = 2048;
 
   // Resolves a program's commands to pointers (at creation, and again
   // after a buffer was resized or destroyed).
@@ -267,6 +265,14 @@ class CpuDevice final : public Device {
       } else {
         continue;
       }
+      if (c.kind != CpuStep::Kind::dispatch) {
+        c.solo = true;
+      } else if (!c.indirect) {
+        const std::uint64_t items = c.group_size > 0 ? (std::uint64_t{c.count} + c.group_size - 1) / c.group_size
+                                                     : c.count;
+        c.solo = team_.members() == 1 ||
+                 items * c.cost_ns * (c.group_size > 0 ? c.group_size : 1) < kSerialBelowNs;
+      }
       steps.push_back(c);
     }
     p.steps = std::move(steps);
@@ -276,27 +282,42 @@ class CpuDevice final : public Device {
     return {};
   }
 
-  void run(const CpuStep& s) {
-    switch (s.kind) {
-      case CpuStep::Kind::fill: std::fill_n(s.target, s.words, s.value); return;
-      case CpuStep::Kind::copy: std::copy_n(s.source, s.words, s.target); return;
-      case CpuStep::Kind::dispatch: break;
+  // One member's walk through a program (cpu_team.h): every member visits
+  // every step in order, runs its share of it, and meets the others at a
+  // barrier before a step that may read what the previous one wrote.
+  // Fills, copies and dispatches too small to share (below kSerialBelowNs)
+  // are member 0's alone; consecutive ones need no barrier between them.
+  // The result does not depend on the split: a dispatch's items (or
+  // groups) are independent.
+  void run_steps(const std::vector<CpuStep>& steps, unsigned member) {
+    const unsigned members = team_.members();
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+      const CpuStep& s = steps[i];
+      if (i > 0 && !(steps[i - 1].solo && s.solo)) team_.barrier();
+      switch (s.kind) {
+        case CpuStep::Kind::fill:
+          if (member == 0) std::fill_n(s.target, s.words, s.value);
+          continue;
+        case CpuStep::Kind::copy:
+          if (member == 0) std::copy_n(s.source, s.words, s.target);
+          continue;
+        case CpuStep::Kind::dispatch: break;
+      }
+      // An indirect dispatch reads its count after the barrier before it
+      // (it is never solo), so every member sees the same count.
+      std::uint32_t items = s.indirect ? std::min(*s.indirect, s.count) : s.count;
+      if (s.group_size > 0)
+        items = static_cast<std::uint32_t>((std::uint64_t{items} + s.group_size - 1) / s.group_size);
+      if (items == 0) continue;
+      const std::uint64_t item_ns = std::uint64_t{s.cost_ns} * (s.group_size > 0 ? s.group_size : 1);
+      if (members == 1 || items * item_ns < kSerialBelowNs) {
+        if (member == 0) s.fn(s.params, s.bindings, 0, items);
+        continue;
+      }
+      const auto begin = static_cast<std::uint32_t>(std::uint64_t{items} * member / members);
+      const auto end = static_cast<std::uint32_t>(std::uint64_t{items} * (member + 1) / members);
+      if (begin < end) s.fn(s.params, s.bindings, begin, end);
     }
-    std::uint32_t items = s.indirect ? std::min(*s.indirect, s.count) : s.count;
-    if (s.group_size > 0) items = static_cast<std::uint32_t>((std::uint64_t{items} + s.group_size - 1) / s.group_size);
-    if (items == 0) return;
-    const std::uint64_t item_ns = std::uint64_t{s.cost_ns} * (s.group_size > 0 ? s.group_size : 1);
-    if (items * item_ns < kSerialBelowNs || threads_ == 1) {
-      s.fn(s.params, s.bindings, 0, items);
-      return;
-    }
-    // Static partition: one contiguous chunk per thread, no stealing. The
-    // result does not depend on the split (a dispatch's items, or groups,
-    // are independent).
-    const auto grain = static_cast<std::uint32_t>(std::max<std::uint64_t>(1, kChunkNs / item_ns));
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, items, grain),
-                      [&](const tbb::blocked_range<std::uint32_t>& r) { s.fn(s.params, s.bindings, r.begin(), r.end()); },
-                      tbb::static_partitioner());
   }
 
   Result<HostBuffer*> live_buffer(BufferHandle buffer, const char* what) {
@@ -314,7 +335,7 @@ class CpuDevice final : public Device {
 
   int threads_;
   bool simd_;
-  tbb::task_arena arena_;
+  CpuTeam team_;  // runs every program, threads_ members
   std::vector<HostBuffer> buffers_;
   std::vector<std::size_t> sizes_;  // bytes per buffer id, 0 when destroyed (check_program)
   std::uint64_t generation_ = 0;     // bumped by every resize and destroy
