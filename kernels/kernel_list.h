@@ -31,8 +31,8 @@
   /* xPBD solver (kernels/shared/xpbd_params.h) */                               \
   SINEW_KERNEL(xpbd_predict, 3, PredictParams, 0)                                \
   SINEW_KERNEL(xpbd_update_velocity, 3, UpdateVelocityParams, 0)                 \
-  SINEW_KERNEL(xpbd_solve_distance, 5, SolveParams, 0)                           \
-  SINEW_KERNEL(xpbd_solve_volume, 5, SolveParams, 0)                             \
+  SINEW_KERNEL(xpbd_solve_distance, 6, SolveParams, 0)                           \
+  SINEW_KERNEL(xpbd_solve_volume, 6, SolveParams, 0)                             \
   /* FEM tets (kernels/shared/fem_params.h) */                                   \
   SINEW_KERNEL(xpbd_solve_neo_hookean, 5, SolveParams, 0)                        \
   SINEW_KERNEL(xpbd_solve_stvk, 5, SolveParams, 0)                               \

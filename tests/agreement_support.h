@@ -184,12 +184,18 @@ inline std::vector<std::uint32_t> one_colour(std::mt19937& rng, std::uint32_t co
   return order;
 }
 
+/// A colour of distance or volume constraints; `damping` is SolveParams::damping
+/// (gamma of XPBD eq. 26), the previous positions a small random step away.
 inline KernelCase solve_case(std::mt19937& rng, Kernel kernel, std::uint32_t arity, std::uint32_t count, bool reset,
-                      bool measure) {
-  std::uniform_real_distribution<float> rest(0.05f, 0.5f), alpha(0.0f, 1e-4f), lam(-1e-3f, 1e-3f);
+                      bool measure, float damping = 0.0f) {
+  std::uniform_real_distribution<float> rest(0.05f, 0.5f), alpha(0.0f, 1e-4f), lam(-1e-3f, 1e-3f), step(-1e-2f, 1e-2f);
   KernelCase c{kernel, count, {}, {}};
   const std::uint32_t first = 3, total = first + count + 5;
-  c.bindings.push_back({random_particles(rng, total * arity), false, 4});
+  const std::vector<float> x = random_particles(rng, total * arity);
+  std::vector<float> prev = x;
+  for (std::size_t k = 0; k < prev.size(); ++k)
+    if (k % 4 != 3) prev[k] += step(rng);
+  c.bindings.push_back({x, false, 4});
   std::vector<std::uint32_t> idx = one_colour(rng, total, arity);
   c.bindings.push_back({as_words(idx), false});
   std::vector<float> data, lambda, residual(total, 0.0f);
@@ -200,7 +206,8 @@ inline KernelCase solve_case(std::mt19937& rng, Kernel kernel, std::uint32_t ari
   c.bindings.push_back({data, false});
   c.bindings.push_back({lambda, reset && !measure});
   c.bindings.push_back({residual, measure});
-  kernels::SolveParams p{first, count, 3600.0f, reset ? 1u : 0u, 1.0f / 60.0f, 1.0f, measure ? 1u : 0u, 0};
+  c.bindings.push_back({prev, false, 4});
+  kernels::SolveParams p{first, count, 3600.0f, reset ? 1u : 0u, 1.0f / 60.0f, 1.0f, measure ? 1u : 0u, damping};
   c.params = bytes_of(p);
   return c;
 }

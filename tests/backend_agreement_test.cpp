@@ -26,7 +26,7 @@ TEST_P(Agreement, PredictAndUpdateVelocityKernels) {
 
   KernelCase update{Kernel::xpbd_update_velocity, n,
                     {{random_particles(rng, n), false, 4}, {random_particles(rng, n), false, 4}, {std::vector<float>(4 * n), true, 4}}, {}};
-  update.params = bytes_of(kernels::UpdateVelocityParams{240.0f, n, 0, 0});
+  update.params = bytes_of(kernels::UpdateVelocityParams{240.0f, n, 1.0f / 240.0f, 0});
   expect_agree(update, run_on("cpu", update), run_on(GetParam(), update), "update_velocity");
 }
 
@@ -35,10 +35,13 @@ TEST_P(Agreement, SolveKernels) {
   for (auto [kernel, arity] : {std::pair{Kernel::xpbd_solve_distance, 2u}, std::pair{Kernel::xpbd_solve_volume, 4u}}) {
     for (bool reset : {false, true}) {
       for (bool measure : {false, true}) {
-        if (reset && measure) continue;
-        const KernelCase c = solve_case(rng, kernel, arity, 500 + rng() % 50, reset, measure);
-        expect_agree(c, run_on("cpu", c), run_on(GetParam(), c),
-                     std::string(kernel_name(kernel)) + (reset ? " reset" : "") + (measure ? " measure" : ""));
+        for (float damping : {0.0f, 6.0f}) {  // gamma = tau / h, e.g. tau = 10 ms at 1.7 ms substeps
+          if (reset && measure) continue;
+          const KernelCase c = solve_case(rng, kernel, arity, 500 + rng() % 50, reset, measure, damping);
+          expect_agree(c, run_on("cpu", c), run_on(GetParam(), c),
+                       std::string(kernel_name(kernel)) + (reset ? " reset" : "") + (measure ? " measure" : "") +
+                           (damping != 0.0f ? " damped" : ""));
+        }
       }
     }
   }

@@ -21,6 +21,7 @@ struct Case {
   std::vector<float> rest_alpha;
   std::vector<float> lambda;
   std::vector<float> residual;
+  std::vector<float4> prev;  // the substep's start: a small step from x
 };
 
 // `count` constraints of `arity` particles with no shared movable particle.
@@ -43,14 +44,16 @@ Case make_case(std::mt19937& rng, std::uint32_t arity, std::uint32_t count) {
     c.lambda.push_back(u(rng) * 1e-3f);
     c.residual.push_back(-1.0f);  // poison: every item must overwrite it when asked
   }
+  for (const float4& p : c.x) c.prev.push_back({p.x + 0.01f * u(rng), p.y + 0.01f * u(rng), p.z + 0.01f * u(rng), p.w});
   return c;
 }
 
 void run(CpuKernelFn fn, Case& c, const SolveParams& p, std::uint32_t begin, std::uint32_t end) {
-  std::byte* bindings[5] = {reinterpret_cast<std::byte*>(c.x.data()), reinterpret_cast<std::byte*>(c.idx.data()),
+  std::byte* bindings[6] = {reinterpret_cast<std::byte*>(c.x.data()), reinterpret_cast<std::byte*>(c.idx.data()),
                             reinterpret_cast<std::byte*>(c.rest_alpha.data()),
                             reinterpret_cast<std::byte*>(c.lambda.data()),
-                            reinterpret_cast<std::byte*>(c.residual.data())};
+                            reinterpret_cast<std::byte*>(c.residual.data()),
+                            reinterpret_cast<std::byte*>(c.prev.data())};
   fn(&p, bindings, begin, end);
 }
 
@@ -63,13 +66,14 @@ void compare(std::uint32_t arity, CpuKernelFn scalar, CpuKernelFn simd) {
   std::mt19937 rng(std::random_device{}());
   for (std::uint32_t count : {8u, 13u, 64u, 203u}) {
     for (std::uint32_t reset : {0u, 1u}) {
+     for (float damping : {0.0f, 6.0f}) {  // SolveParams::damping (XPBD eq. 26's gamma)
       Case ref = make_case(rng, arity, count);
       Case fast = ref;
       const Case input = ref;
       // A dispatch over constraints [first, first + n) split into two chunks,
       // as threads would split it.
       const std::uint32_t first = count % 5, n = count - first, split = n / 3;
-      const SolveParams solve{first, n, 3600.0f, reset, 1.0f / 60.0f, 1.0f, 0, 0};
+      const SolveParams solve{first, n, 3600.0f, reset, 1.0f / 60.0f, 1.0f, 0, damping};
       run(scalar, ref, solve, 0, n);
       run(simd, fast, solve, 0, split);
       run(simd, fast, solve, split, n);
@@ -90,6 +94,7 @@ void compare(std::uint32_t arity, CpuKernelFn scalar, CpuKernelFn simd) {
       for (std::uint32_t k = first; k < count; ++k) ASSERT_GE(ref.residual[k], 0.0f) << "residual not written";
       EXPECT_EQ(0, std::memcmp(solved.x.data(), fast.x.data(), ref.x.size() * sizeof(float4)));
       EXPECT_EQ(0, std::memcmp(solved.lambda.data(), fast.lambda.data(), ref.lambda.size() * sizeof(float)));
+     }
     }
   }
 }

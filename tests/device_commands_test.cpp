@@ -120,6 +120,7 @@ TEST_P(DeviceCommands, IndirectDispatchLaunchesWhatTheBackendDocuments) {
   for (std::uint32_t i = 0; i < capacity; ++i) {
     x[4 * i + 3] = 1.0f;  // movable
     v[4 * i] = 1.0f;
+    v[4 * i + 3] = 1.0f;  // velocity damping factor 1: none
   }
   auto make = [&](const std::vector<float>& data) {
     auto b = device->create_buffer(data.size() * 4, "floats");

@@ -84,7 +84,7 @@ std::vector<float> predict_chain(Device& device, std::uint32_t n, int frames) {
     program.dispatch(Kernel::xpbd_predict, n, {x, prev, v}, predict);
     program.barrier();
   }
-  program.dispatch(Kernel::xpbd_update_velocity, n, {x, prev, v}, kernels::UpdateVelocityParams{240.0f, n, 0, 0});
+  program.dispatch(Kernel::xpbd_update_velocity, n, {x, prev, v}, kernels::UpdateVelocityParams{240.0f, n, 1.0f / 240.0f, 0});
   auto prepared = device.create_program(program);
   EXPECT_TRUE(prepared.ok()) << prepared.error().message();
   if (!prepared.ok()) return {};
@@ -101,13 +101,13 @@ TEST_F(VulkanBackend, EmbeddedKernelsMakePipelinesOnEveryDevice) {
     auto device = make(std::to_string(i));
     ASSERT_TRUE(device);
     EXPECT_NE(device->device_name().find(devices_[i].name), std::string::npos) << device->device_name();
-    BufferHandle b[5];
+    BufferHandle b[6];
     for (auto& h : b) h = *device->create_buffer(256, "b");
     FrameProgram p;
     p.dispatch(Kernel::xpbd_predict, 4, {b[0], b[1], b[2]}, kernels::PredictParams{});
     p.barrier();
-    p.dispatch(Kernel::xpbd_solve_distance, 0, {b[0], b[1], b[2], b[3], b[4]}, kernels::SolveParams{});
-    p.dispatch(Kernel::xpbd_solve_volume, 0, {b[0], b[1], b[2], b[3], b[4]}, kernels::SolveParams{});
+    p.dispatch(Kernel::xpbd_solve_distance, 0, {b[0], b[1], b[2], b[3], b[4], b[5]}, kernels::SolveParams{});
+    p.dispatch(Kernel::xpbd_solve_volume, 0, {b[0], b[1], b[2], b[3], b[4], b[5]}, kernels::SolveParams{});
     p.barrier();
     p.dispatch(Kernel::xpbd_update_velocity, 4, {b[0], b[1], b[2]}, kernels::UpdateVelocityParams{});
     auto prepared = device->create_program(p);

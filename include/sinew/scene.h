@@ -59,6 +59,20 @@ struct TetBodyDesc {
   double volume_compliance = 1e-6;      ///< c_v [1/Pa], >= 0 (1/K, the bulk compliance)
   std::vector<std::uint32_t> pinned;    ///< vertices held fixed (inverse mass 0)
   TetMaterial material = TetMaterial::none;  ///< FEM constraints per tet (with E and nu below)
+  /// Velocity damping k [1/s], >= 0: every substep multiplies the velocity
+  /// of the body's particles by exp(-k h), so free motion decays as
+  /// exp(-k t) whatever the substeps (like a drag through a viscous medium:
+  /// it also slows rigid motion and falls, to a terminal speed g / k).
+  double velocity_damping = 0.0;
+  /// Constraint damping time tau [s], >= 0, of the distance and volume
+  /// constraints (Macklin et al., "XPBD", MIG 2016, eq. 26 with beta = tau
+  /// times the constraint's stiffness): stiffness-proportional (Rayleigh)
+  /// damping that resists the rate of stretch and volume change, not rigid
+  /// motion. A mode of angular frequency omega decays at tau omega^2 / 2
+  /// [1/s] (damping ratio tau omega / 2). Not applied to the FEM materials
+  /// (use velocity_damping there). Bodies with different taus get separate
+  /// constraint blocks (more dispatches per sweep).
+  double stiffness_damping = 0.0;
   double youngs_modulus = 0.0;          ///< E [Pa], > 0 when material != none
   double poisson_ratio = 0.0;           ///< nu, in (-1, 0.5) when material != none
 
@@ -88,6 +102,13 @@ struct LineBodyDesc {
   double compliance = 0.0;                              ///< per segment [m/N], >= 0
   double bending_compliance = -1.0;                     ///< [m/N], >= 0; < 0: no bending constraints
   std::vector<std::uint32_t> pinned;                    ///< vertices held fixed
+  /// Velocity damping k [1/s], >= 0: every substep multiplies the velocity
+  /// of the body's particles by exp(-k h), so free motion decays as
+  /// exp(-k t) whatever the substeps (like a drag through a viscous medium:
+  /// it also slows rigid motion and falls, to a terminal speed g / k).
+  double velocity_damping = 0.0;
+  /// Constraint damping time tau [s], >= 0, of the segments (as TetBodyDesc).
+  double stiffness_damping = 0.0;
 };
 
 /// A thin body on a triangle mesh: a membrane, a vessel wall, a ligament.
@@ -114,6 +135,14 @@ struct TriBodyDesc {
   double area_compliance = 1e-5;          ///< c_a [1/Pa], >= 0
   double bending_compliance = -1.0;       ///< [1/(N m)], >= 0; < 0: no bending constraints
   std::vector<std::uint32_t> pinned;      ///< vertices held fixed
+  /// Velocity damping k [1/s], >= 0: every substep multiplies the velocity
+  /// of the body's particles by exp(-k h), so free motion decays as
+  /// exp(-k t) whatever the substeps (like a drag through a viscous medium:
+  /// it also slows rigid motion and falls, to a terminal speed g / k).
+  double velocity_damping = 0.0;
+  /// Constraint damping time tau [s], >= 0, of the edges (as TetBodyDesc;
+  /// not of the area and bending constraints).
+  double stiffness_damping = 0.0;
 };
 
 /// Analytic collider shapes. Pose: `position` [m] and unit quaternion

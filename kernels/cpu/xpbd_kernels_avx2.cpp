@@ -115,7 +115,9 @@ std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bin
   const auto* rest_alpha = reinterpret_cast<const float*>(bindings[2]);
   auto* lambda = reinterpret_cast<float*>(bindings[3]);
   auto* residual = reinterpret_cast<float*>(bindings[4]);
+  const auto* prev = reinterpret_cast<const float*>(bindings[5]);
   const __m256 inv_h2 = _mm256_set1_ps(p.inv_h2), one = _mm256_set1_ps(1.0f);
+  const __m256 gamma = _mm256_set1_ps(p.damping), one_gamma = _mm256_set1_ps(1.0f + p.damping);
   std::uint32_t i = p.first + begin;
   for (; i + 8 <= p.first + end; i += 8) {
     std::uint32_t ia[8], ib[8];
@@ -137,8 +139,15 @@ std::uint32_t xpbd_solve_distance_avx2(const void* params, std::byte* const* bin
       store_residual(residual + i, c, alpha_t, lambda_i, rest);
       continue;
     }
-    const __m256 dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
     const Lanes n = scale(_mm256_div_ps(one, len), d);
+    __m256 dlambda;
+    if (p.damping == 0.0f) {
+      dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
+    } else {  // eq. 26, as the scalar kernel
+      const Lanes moved = minus(minus(a, load_particles(prev, ia)), minus(b, load_particles(prev, ib)));
+      dlambda = _mm256_div_ps(sub(sub(negate(c), mul(alpha_t, lambda_i)), mul(gamma, dot3(n, moved))),
+                              add(mul(one_gamma, w), alpha_t));
+    }
     const Lanes a_new = add_scaled3(a, mul(a.w, dlambda), n, valid);
     const Lanes b_new = add_scaled3(b, mul(negate(b.w), dlambda), n, valid);
     _mm256_storeu_ps(lambda + i, _mm256_blendv_ps(lambda_i, add(lambda_i, dlambda), valid));
@@ -156,7 +165,9 @@ std::uint32_t xpbd_solve_volume_avx2(const void* params, std::byte* const* bindi
   const auto* rest_alpha = reinterpret_cast<const float*>(bindings[2]);
   auto* lambda = reinterpret_cast<float*>(bindings[3]);
   auto* residual = reinterpret_cast<float*>(bindings[4]);
+  const auto* prev = reinterpret_cast<const float*>(bindings[5]);
   const __m256 inv_h2 = _mm256_set1_ps(p.inv_h2), sixth = _mm256_set1_ps(1.0f / 6.0f);
+  const __m256 gamma = _mm256_set1_ps(p.damping), one_gamma = _mm256_set1_ps(1.0f + p.damping);
   std::uint32_t i = p.first + begin;
   for (; i + 8 <= p.first + end; i += 8) {
     std::uint32_t iv[4][8];
@@ -182,7 +193,17 @@ std::uint32_t xpbd_solve_volume_avx2(const void* params, std::byte* const* bindi
       store_residual(residual + i, c, alpha_t, lambda_i, rest);
       continue;
     }
-    const __m256 dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
+    __m256 dlambda;
+    if (p.damping == 0.0f) {
+      dlambda = _mm256_div_ps(sub(negate(c), mul(alpha_t, lambda_i)), add(w, alpha_t));
+    } else {  // eq. 26, as the scalar kernel
+      const __m256 rate = add(add(add(dot3(g0, minus(x0, load_particles(prev, iv[0]))),
+                                      dot3(g1, minus(x1, load_particles(prev, iv[1])))),
+                                  dot3(g2, minus(x2, load_particles(prev, iv[2])))),
+                              dot3(g3, minus(x3, load_particles(prev, iv[3]))));
+      dlambda = _mm256_div_ps(sub(sub(negate(c), mul(alpha_t, lambda_i)), mul(gamma, rate)),
+                              add(mul(one_gamma, w), alpha_t));
+    }
     _mm256_storeu_ps(lambda + i, _mm256_blendv_ps(lambda_i, add(lambda_i, dlambda), valid));
     store_particles(x, iv[0], add_scaled3(x0, mul(x0.w, dlambda), g0, valid), _mm256_movemask_ps(positive(x0.w)));
     store_particles(x, iv[1], add_scaled3(x1, mul(x1.w, dlambda), g1, valid), _mm256_movemask_ps(positive(x1.w)));

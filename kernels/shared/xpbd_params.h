@@ -17,7 +17,10 @@ namespace sinew::kernels {
  * bindings: 0 position float4 (xyz, w = inverse mass) [in/out]
  *           1 previous position float4 [out]
  *           2 velocity float4 (xyz) [in/out]
- * v += h g; prev = x; x += h v — for particles with w > 0 only. */
+ * v = (v + h g) d; prev = x; x += h v — for particles with w > 0 only,
+ * where d = v.w is the particle's velocity damping factor per substep,
+ * exp(-k h) for a body's velocity_damping k [1/s] (1: none; then the
+ * product is exact and changes no bit). w is kept. */
 SINEW_STRUCT_BEGIN(PredictParams)
   float h;
   float gravity_x;
@@ -31,12 +34,18 @@ SINEW_STRUCT_END(PredictParams)
 
 /* xpbd_update_velocity: one item per particle.
  * bindings: 0 position float4 [in], 1 previous position float4 [in],
- *           2 velocity float4 [out]
- * v = (x - prev) / h for particles with w > 0; 0 otherwise. */
+ *           2 velocity float4 [in/out]: the predicted velocity v_p in,
+ *           the substep's velocity out
+ * v.xyz = v_p + (x - x_p) / h with x_p = prev + h v_p, the predicted
+ * position exactly as xpbd_predict rounded it; that is (x - prev) / h, but
+ * the part of the velocity that no constraint changed (inertia, gravity,
+ * damping) never goes through a float position: see xpbd_kernels.cpp.
+ * For particles with w > 0; 0 otherwise. v.w (the damping factor, see
+ * xpbd_predict) is kept. */
 SINEW_STRUCT_BEGIN(UpdateVelocityParams)
   float inv_h;
   uint count;
-  uint pad0;
+  float h;
   uint pad1;
 SINEW_STRUCT_END(UpdateVelocityParams)
 
@@ -52,6 +61,9 @@ SINEW_STRUCT_END(UpdateVelocityParams)
  *     pass (measure_only != 0): |C + alpha~ lambda| normalised by the
  *     constraint's rest value (see each kernel). A measuring pass changes
  *     nothing else, so it may run over a whole block in one dispatch.
+ * xpbd_solve_distance and xpbd_solve_volume also bind
+ *   5 previous position float4 [in]: the positions at the substep's start,
+ *     for constraint damping (SolveParams::damping).
  *
  * xpbd_solve_distance: arity 2, data (rest [m], alpha [m/N]).
  *   C = |x_a - x_b| - rest; residual / rest.
@@ -66,7 +78,12 @@ SINEW_STRUCT_BEGIN(SolveParams)
   float h;              /* substep length [s] */
   float substep_end;    /* fraction of the frame done at the end of this substep, in (0, 1] */
   uint measure_only;    /* nonzero: write the residual only, after the frame's last sweep */
-  uint pad0;
+  /* gamma = tau / h of Macklin et al., "XPBD", MIG 2016, eq. 26 (tau the
+   * body's stiffness_damping [s]): xpbd_solve_distance and xpbd_solve_volume
+   * solve dlambda = (-C - alpha~ lambda - gamma grad C . (x - x_prev)) /
+   * ((1 + gamma) sum w |grad C|^2 + alpha~). 0: undamped, and then the
+   * kernels do exactly the undamped arithmetic. Other kernels ignore it. */
+  float damping;
 SINEW_STRUCT_END(SolveParams)
 
 #ifdef __cplusplus

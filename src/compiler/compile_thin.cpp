@@ -51,7 +51,7 @@ struct HalfEdge {
 }  // namespace
 
 Status add_tri_body(SceneBuilder& b, const TriBodyDesc& body, const std::string& name) {
-  const std::uint32_t first = b.add_vertices(body.mesh.vertices);
+  const std::uint32_t first = b.add_vertices(body.mesh.vertices, body.velocity_damping);
   const auto& tris = body.mesh.triangles;
   const auto at = [&](std::uint32_t v) { return b.positions[first + v]; };
 
@@ -88,10 +88,8 @@ Status add_tri_body(SceneBuilder& b, const TriBodyDesc& body, const std::string&
     }
   std::sort(half.begin(), half.end());
 
-  // Both blocks made first: making one may move the others (b.raw grows).
-  if (body.distance_constraints) b.constraints(Kernel::xpbd_solve_distance, 2);
-  if (body.bending_compliance >= 0.0) b.constraints(Kernel::xpbd_solve_dihedral, 4, SINEW_DIHEDRAL_DATA_STRIDE);
-  RawConstraints* distance = body.distance_constraints ? &b.constraints(Kernel::xpbd_solve_distance, 2) : nullptr;
+  // (b.raw is a deque: making one block leaves references to the others valid.)
+  RawConstraints* distance = body.distance_constraints ? &b.distance_constraints(body.stiffness_damping) : nullptr;
   RawConstraints* dihedral = body.bending_compliance >= 0.0
                                  ? &b.constraints(Kernel::xpbd_solve_dihedral, 4, SINEW_DIHEDRAL_DATA_STRIDE)
                                  : nullptr;

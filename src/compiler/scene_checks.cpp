@@ -58,11 +58,19 @@ Status check_pinned(const std::string& body, const std::vector<std::uint32_t>& p
   return {};
 }
 
+// Both damping parameters: finite and >= 0 (no silent clamp of a negative
+// damping, which would add energy).
+Status check_damping(const std::string& name, double velocity_damping, double stiffness_damping) {
+  if (Status s = non_negative(name + ".velocity_damping", velocity_damping); !s) return s;
+  return non_negative(name + ".stiffness_damping", stiffness_damping);
+}
+
 Status check_tet_body(const TetBodyDesc& b, const std::string& name) {
   if (Status s = check_tet_mesh(b.mesh, name + ".mesh"); !s) return s;
   if (Status s = positive(name + ".density", b.density); !s) return s;
   if (Status s = non_negative(name + ".distance_compliance", b.distance_compliance); !s) return s;
   if (Status s = non_negative(name + ".volume_compliance", b.volume_compliance); !s) return s;
+  if (Status s = check_damping(name, b.velocity_damping, b.stiffness_damping); !s) return s;
   if (b.material != TetMaterial::none)
     if (Status s = check_elastic(name + ".", b.youngs_modulus, b.poisson_ratio); !s) return s;
   if (Status s = check_initial(name, b.initial_vertices, b.mesh.vertices.size()); !s) return s;
@@ -72,6 +80,7 @@ Status check_tet_body(const TetBodyDesc& b, const std::string& name) {
 Status check_line_body(const LineBodyDesc& b, const std::string& name) {
   const std::size_t n = b.vertices.size();
   if (n == 0) return Error(ErrorCode::bad_parameter, name + ".vertices is empty");
+  if (Status s = check_damping(name, b.velocity_damping, b.stiffness_damping); !s) return s;
   if (b.masses.size() != n)
     return Error(ErrorCode::bad_parameter,
                  name + ".masses has " + std::to_string(b.masses.size()) + " entries for " + std::to_string(n) +
@@ -150,6 +159,7 @@ Status check_tri_body(const TriBodyDesc& b, const std::string& name) {
   if (Status s = positive(name + ".density", b.density); !s) return s;
   if (Status s = non_negative(name + ".distance_compliance", b.distance_compliance); !s) return s;
   if (Status s = non_negative(name + ".area_compliance", b.area_compliance); !s) return s;
+  if (Status s = check_damping(name, b.velocity_damping, b.stiffness_damping); !s) return s;
   if (std::isnan(b.bending_compliance)) return Error(ErrorCode::bad_parameter, name + ".bending_compliance is NaN");
   if (Status s = check_initial(name, b.initial_vertices, n); !s) return s;
   return check_pinned(name, b.pinned, n);

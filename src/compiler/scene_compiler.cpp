@@ -22,7 +22,7 @@ using kernels::float4;
 }  // namespace
 
 Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string& name) {
-  const std::uint32_t first = b.add_vertices(body.mesh.vertices);
+  const std::uint32_t first = b.add_vertices(body.mesh.vertices, body.velocity_damping);
   const auto& tets = body.mesh.tets;
 
   // Rest volumes in float, as the kernel computes them; lumped masses.
@@ -40,7 +40,7 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
   }
 
   if (body.volume_constraints) {
-    RawConstraints& volume = b.constraints(Kernel::xpbd_solve_volume, 4);
+    RawConstraints& volume = b.volume_constraints(body.stiffness_damping);
     for (std::size_t t = 0; t < tets.size(); ++t) {
       for (std::uint32_t k : tets[t]) volume.particles.push_back(first + k);
       volume.data.push_back(rest_volume[t]);
@@ -66,7 +66,7 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
       each_edge(tets[t], [&](Edge e) {
         share[std::lower_bound(edges.begin(), edges.end(), e) - edges.begin()] += rest_volume[t] / 6.0;
       });
-    RawConstraints& distance = b.constraints(Kernel::xpbd_solve_distance, 2);
+    RawConstraints& distance = b.distance_constraints(body.stiffness_damping);
     for (std::size_t i = 0; i < edges.size(); ++i) {
       const float len = kernels::edge_length(b.positions[first + edges[i].first], b.positions[first + edges[i].second]);
       distance.particles.push_back(first + edges[i].first);
@@ -85,9 +85,9 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
 }
 
 Status add_line_body(SceneBuilder& b, const LineBodyDesc& body, const std::string& name) {
-  const std::uint32_t first = b.add_vertices(body.vertices);
+  const std::uint32_t first = b.add_vertices(body.vertices, body.velocity_damping);
   for (std::size_t i = 0; i < body.masses.size(); ++i) b.mass[first + i] = body.masses[i];
-  RawConstraints& distance = b.constraints(Kernel::xpbd_solve_distance, 2);
+  RawConstraints& distance = b.distance_constraints(body.stiffness_damping);
   for (std::size_t s = 0; s < body.segments.size(); ++s) {
     const auto [p, q] = body.segments[s];
     const float len = kernels::edge_length(b.positions[first + p], b.positions[first + q]);
@@ -106,20 +106,32 @@ Status add_line_body(SceneBuilder& b, const LineBodyDesc& body, const std::strin
   return {};
 }
 
-std::uint32_t SceneBuilder::add_vertices(const std::vector<Vec3d>& vertices) {
+std::uint32_t SceneBuilder::add_vertices(const std::vector<Vec3d>& vertices, double damping) {
   const auto first = static_cast<std::uint32_t>(positions.size());
   for (const Vec3d& v : vertices)
     positions.push_back({static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]), 0.0f});
   mass.resize(positions.size(), 0.0);
+  // exp(-k h) on the host, once: every backend multiplies by the same float
+  // (exp itself is not correctly rounded alike on every device).
+  velocity_damping.resize(positions.size(), static_cast<float>(std::exp(-damping * substep)));
   return first;
 }
 
 RawConstraints& SceneBuilder::constraints(Kernel kernel, std::uint32_t arity, std::uint32_t data_stride,
-                                          std::uint32_t lambda_stride, std::vector<SceneBuffer> extra_bindings) {
+                                          std::uint32_t lambda_stride, std::vector<SceneBuffer> extra_bindings,
+                                          double damping_time) {
   for (RawConstraints& r : raw)
-    if (r.kernel == kernel) return r;
-  raw.push_back({kernel, arity, data_stride, lambda_stride, std::move(extra_bindings)});
+    if (r.kernel == kernel && r.damping_time == damping_time) return r;
+  raw.push_back({kernel, arity, data_stride, lambda_stride, std::move(extra_bindings), {}, {}, damping_time});
   return raw.back();
+}
+
+RawConstraints& SceneBuilder::distance_constraints(double damping_time) {
+  return constraints(Kernel::xpbd_solve_distance, 2, 2, 1, {SceneBuffer::previous_position}, damping_time);
+}
+
+RawConstraints& SceneBuilder::volume_constraints(double damping_time) {
+  return constraints(Kernel::xpbd_solve_volume, 4, 2, 1, {SceneBuffer::previous_position}, damping_time);
 }
 
 namespace {
@@ -139,6 +151,7 @@ ConstraintBlock color_and_sort(const RawConstraints& raw, std::span<const std::u
   out.data_stride = raw.data_stride;
   out.lambda_stride = raw.lambda_stride;
   out.extra_bindings = raw.extra_bindings;
+  out.damping_time = raw.damping_time;
   const auto n = static_cast<std::uint32_t>(raw.particles.size() / raw.arity);
   if (n == 0) return out;
   const Coloring coloring = color_constraints(raw.particles, raw.arity, movable);
@@ -171,6 +184,7 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
                  "the scene has " + std::to_string(total) + " particles, more than 32-bit indices can address");
 
   SceneBuilder b;
+  b.substep = scene.solver.time_step / scene.solver.substeps;
   CompiledScene out;
   for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i) {
     out.tet_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
@@ -221,6 +235,9 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
     movable[slot] = device_positions[slot].w > 0.0f;
   }
   b.positions = std::move(device_positions);
+  out.velocity_damping.resize(b.velocity_damping.size());
+  for (std::size_t slot = 0; slot < out.velocity_damping.size(); ++slot)
+    out.velocity_damping[slot] = b.velocity_damping[out.order.user_of[slot]];
   for (RawConstraints& raw : b.raw)
     for (std::uint32_t& p : raw.particles) p = out.order.device_of[p];
   // Gauss-Seidel order: kSolveOrder (solve_order.h; contacts last, so they win).

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,9 @@ struct ConstraintBlock {
   std::vector<std::uint32_t> particles;   ///< arity per constraint
   std::vector<float> data;                ///< data_stride per constraint, e.g. (rest value, compliance alpha)
   std::vector<std::uint32_t> color_offsets{0};
+  /// Constraint damping time tau [s] of its bodies (SolveParams::damping =
+  /// tau / h): bodies with different taus get different blocks.
+  double damping_time = 0.0;
   [[nodiscard]] std::uint32_t size() const { return arity ? static_cast<std::uint32_t>(particles.size() / arity) : 0; }
   [[nodiscard]] std::uint32_t colors() const { return static_cast<std::uint32_t>(color_offsets.size() - 1); }
 };
@@ -47,6 +51,7 @@ struct RawConstraints {
   std::vector<SceneBuffer> extra_bindings = {};
   std::vector<std::uint32_t> particles = {};
   std::vector<float> data = {};
+  double damping_time = 0.0;  ///< see ConstraintBlock::damping_time
 };
 
 struct CompiledScene {
@@ -59,6 +64,10 @@ struct CompiledScene {
   std::vector<float> colliders;
   std::vector<float> targets;
   std::uint32_t contact_impulse_slots = 0;  ///< float4s in the contact_impulses buffer
+  /// Per particle (device order), the factor its velocity is multiplied by
+  /// each substep, exp(-k h) for its body's velocity_damping k (1: none);
+  /// uploaded as the velocity buffer's w (xpbd_params.h, xpbd_predict).
+  std::vector<float> velocity_damping;
   std::vector<std::uint32_t> tet_body_first_particle;
   std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;
@@ -74,16 +83,26 @@ struct CompiledScene {
 struct SceneBuilder {
   std::vector<kernels::float4> positions;  ///< w is set at the end, from mass
   std::vector<double> mass;                ///< [kg]; 0 = immovable (pinned, kinematic)
-  std::vector<RawConstraints> raw;         ///< one per kernel
+  std::deque<RawConstraints> raw;          ///< one per kernel and damping time (a deque: references stay valid)
   /// Bodies that start away from their rest shape: (first particle, start
   /// positions), applied after every rest value has been computed.
   std::vector<std::pair<std::uint32_t, const std::vector<Vec3d>*>> initial;
 
-  /// Appends vertices as particles of mass 0; returns the first one's index.
-  std::uint32_t add_vertices(const std::vector<Vec3d>& vertices);
-  /// The raw constraints of `kernel`, made with this layout on first use.
+  double substep = 0.0;  ///< h [s], for the velocity damping factors
+  /// Appends vertices as particles of mass 0 and velocity damping `k`
+  /// [1/s] (factor exp(-k h) per substep); returns the first one's index.
+  std::uint32_t add_vertices(const std::vector<Vec3d>& vertices, double velocity_damping);
+  /// The raw constraints of `kernel` (and `damping_time`), made with this
+  /// layout on first use.
   RawConstraints& constraints(Kernel kernel, std::uint32_t arity, std::uint32_t data_stride = 2,
-                              std::uint32_t lambda_stride = 1, std::vector<SceneBuffer> extra_bindings = {});
+                              std::uint32_t lambda_stride = 1, std::vector<SceneBuffer> extra_bindings = {},
+                              double damping_time = 0.0);
+  /// Distance and volume constraints of bodies with constraint damping time
+  /// tau [s] (they bind the substep's start positions, see xpbd_params.h).
+  RawConstraints& distance_constraints(double damping_time);
+  RawConstraints& volume_constraints(double damping_time);
+  /// Velocity damping factor per substep of each particle (1: none).
+  std::vector<float> velocity_damping;
 };
 
 // The compile steps of each feature, each in its own file. `first` is the

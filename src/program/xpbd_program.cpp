@@ -12,6 +12,7 @@
 #include <span>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "xpbd_params.h"
 
@@ -56,9 +57,13 @@ void sweep(FrameProgram& program, const ConstraintBlock& block, std::span<const 
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
   XpbdBuffers b;
   const std::vector<kernels::float4> zeros(scene.positions.size(), kernels::float4{0, 0, 0, 0});
+  // Velocities start at 0, with each particle's damping factor in w (xpbd_predict).
+  std::vector<kernels::float4> damped(scene.positions.size(), kernels::float4{0, 0, 0, 1});
+  for (std::size_t p = 0; p < damped.size() && p < scene.velocity_damping.size(); ++p)
+    damped[p].w = scene.velocity_damping[p];
   for (auto [handle, data, label] : {std::tuple{&b.position, &scene.positions, "position"},
                                      std::tuple{&b.previous, &zeros, "previous position"},
-                                     std::tuple{&b.velocity, &zeros, "velocity"}}) {
+                                     std::tuple{&b.velocity, &std::as_const(damped), "velocity"}}) {
     auto made = make_buffer(device, *data, label);
     if (!made) return made.error();
     *handle = *made;
@@ -104,6 +109,7 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   predict.count = particles;
   kernels::UpdateVelocityParams update{};
   update.inv_h = static_cast<float>(1.0 / h);
+  update.h = predict.h;  // the very float xpbd_predict moves by
   update.count = particles;
 
   FrameProgram program;
@@ -116,8 +122,10 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
       p.reset_lambda = it == 0 ? 1u : 0u;
       p.h = static_cast<float>(h);
       p.substep_end = static_cast<float>(double(s + 1) / solver.substeps);
-      for (std::size_t k = 0; k < scene.blocks.size(); ++k)
+      for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
+        p.damping = static_cast<float>(scene.blocks[k].damping_time / h);  // gamma of eq. 26
         sweep(program, scene.blocks[k], scene.blocks[k].color_offsets, buffers.blocks[k], buffers, p);
+      }
     }
     if (measure_errors && s + 1 == solver.substeps) {
       // Residuals of the final state: read-only, one dispatch per block.

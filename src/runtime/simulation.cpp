@@ -130,7 +130,9 @@ Status Simulation::read_positions(std::vector<float>& xyzw) const {
 }
 
 Status Simulation::read_velocities(std::vector<float>& xyzw) const {
-  return impl_->read_in_user_order(impl_->buffers.velocity, xyzw);
+  if (Status s = impl_->read_in_user_order(impl_->buffers.velocity, xyzw); !s) return s;
+  for (std::size_t p = 3; p < xyzw.size(); p += 4) xyzw[p] = 0.0f;  // the device keeps the damping factor there
+  return {};
 }
 
 const SceneInfo& Simulation::info() const { return impl_->info; }
