@@ -76,8 +76,11 @@ inline std::vector<float> as_words(const std::vector<std::uint32_t>& v) {
 }
 
 // Runs one dispatch of `c` on a device and returns every buffer after it.
-inline std::vector<std::vector<float>> run_on(const std::string& backend, const KernelCase& c) {
-  auto made = create_device({.backend = backend, .quiet = true});
+/// Runs the case on a device of `backend` (on "cpu", `threads` threads and
+/// the AVX2 solves when `cpu_simd`); returns every binding's words after.
+inline std::vector<std::vector<float>> run_on(const std::string& backend, const KernelCase& c, bool cpu_simd = true,
+                                              int threads = 0) {
+  auto made = create_device({.backend = backend, .threads = threads, .cpu_simd = cpu_simd, .quiet = true});
   EXPECT_TRUE(made.ok()) << made.error().message();
   if (!made.ok()) return {};
   Device& device = **made;

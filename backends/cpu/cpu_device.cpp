@@ -17,7 +17,8 @@
 
 #include "backends/kernel_table.h"
 #include "cpu/cpu_kernels.h"
-#include "cpu/xpbd_kernels.h"  // the AVX2 solves
+#include "cpu/fem_kernels.h"   // the AVX2 FEM solves
+#include "cpu/xpbd_kernels.h"  // the AVX2 distance and volume solves
 
 namespace sinew {
 namespace {
@@ -28,6 +29,13 @@ void solve_distance_simd(const void* params, std::byte* const* bindings, std::ui
 }
 void solve_volume_simd(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   kernels::xpbd_solve_volume(params, bindings, kernels::xpbd_solve_volume_avx2(params, bindings, begin, end), end);
+}
+void solve_neo_hookean_simd(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  kernels::xpbd_solve_neo_hookean(params, bindings, kernels::xpbd_solve_neo_hookean_avx2(params, bindings, begin, end),
+                                  end);
+}
+void solve_stvk_simd(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  kernels::xpbd_solve_stvk(params, bindings, kernels::xpbd_solve_stvk_avx2(params, bindings, begin, end), end);
 }
 
 // The CPU reference of every registered kernel: kernels::NAME.
@@ -41,6 +49,8 @@ static_assert(std::size(kReference) == kernel_count);
 kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
   if (simd && kernel == Kernel::xpbd_solve_distance) return solve_distance_simd;
   if (simd && kernel == Kernel::xpbd_solve_volume) return solve_volume_simd;
+  if (simd && kernel == Kernel::xpbd_solve_neo_hookean) return solve_neo_hookean_simd;
+  if (simd && kernel == Kernel::xpbd_solve_stvk) return solve_stvk_simd;
   return kReference[static_cast<std::size_t>(kernel)];
 }
 

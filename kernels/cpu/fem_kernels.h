@@ -10,3 +10,16 @@
 #include "cpu/cpu_kernels.h"  // the kernel entry points, declared from the registry
 #include "math/fem_math.h"
 
+
+namespace sinew::kernels {
+
+/// The neo_hookean and stvk solves eight tets at a time with AVX2, bitwise
+/// equal to the scalar kernels (fem_kernels_avx2.cpp). They do whole groups
+/// of eight from `begin` and return the first item not done, for the scalar
+/// kernel to finish [it, end). [pre] cpu_has_avx2()
+std::uint32_t xpbd_solve_neo_hookean_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                                          std::uint32_t end);
+std::uint32_t xpbd_solve_stvk_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                                   std::uint32_t end);
+
+}  // namespace sinew::kernels
