@@ -23,11 +23,20 @@ CpuTeam::~CpuTeam() {
 }
 
 void CpuTeam::await_change(const std::atomic<std::uint32_t>& value, std::uint32_t old) {
-  // ~20-50 us of spinning covers the gaps between the dispatches of a
-  // frame; past that the member sleeps until notified.
-  for (int spin = 0; spin < 2048; ++spin) {
+  // A few microseconds of spinning cover the gap between two dispatches when
+  // every member has a core. When one has none (a busy machine: ctest -j,
+  // other processes), spinning longer only keeps it off the core it waits
+  // for, so the waiter then yields its core a few times and finally sleeps.
+  // Measured on the kidney (distance + volume, 910 barriers per frame) with
+  // a parallel build running: 58.9 ms per frame spinning ~2,048 pauses
+  // before sleeping, 14.6 ms with this policy (Neo-Hookean: 47.5 -> 17.2).
+  for (int spin = 0; spin < 256; ++spin) {
     if (value.load(std::memory_order_acquire) != old) return;
     SINEW_CPU_RELAX();
+  }
+  for (int turn = 0; turn < 16; ++turn) {
+    if (value.load(std::memory_order_acquire) != old) return;
+    std::this_thread::yield();
   }
   while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
 }

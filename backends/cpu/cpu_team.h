@@ -13,9 +13,10 @@
 // Scott, "Algorithms for scalable synchronization on shared-memory
 // multiprocessors", TOCS 1991: the sense-reversing centralised barrier).
 //
-// A member that waits spins for a while and then sleeps (std::atomic::wait),
-// so a team shares a busy machine (ctest -j on two cores) without burning
-// it: spinning only pays while the partner is running.
+// A member that waits spins a few microseconds, then yields its core a few
+// times, then sleeps (std::atomic::wait): spinning only pays while the
+// partner is running, and on a busy machine (ctest -j on two cores, other
+// processes) a spinning member keeps the partner it waits for off the core.
 #pragma once
 
 #include <atomic>
