@@ -26,9 +26,13 @@ void xpbd_predict(const void* params, std::byte* const* bindings, std::uint32_t 
   for (std::uint32_t i = begin; i < end; ++i) {
     prev[i] = x[i];
     if (x[i].w == 0.0f) continue;  // pinned or kinematic: inverse mass 0
-    const float4 vi = add_scaled3(v[i], p.h, g);
+    // Damping scales the velocity carried from the last substep, not
+    // gravity's impulse: damping (v + h g) would balance a body at rest
+    // against d g instead of g, and a 1-substep frame with k = 20 1/s
+    // sagged 28% less than its material (d = exp(-k h) = 0.72).
     const float d = v[i].w;  // velocity damping factor (1: none, and then exact)
-    v[i] = float4{vi.x * d, vi.y * d, vi.z * d, d};
+    const float4 damped{v[i].x * d, v[i].y * d, v[i].z * d, d};
+    v[i] = add_scaled3(damped, p.h, g);
     x[i] = add_scaled3(x[i], p.h, v[i]);
   }
 }

@@ -17,10 +17,11 @@ namespace sinew::kernels {
  * bindings: 0 position float4 (xyz, w = inverse mass) [in/out]
  *           1 previous position float4 [out]
  *           2 velocity float4 (xyz) [in/out]
- * v = (v + h g) d; prev = x; x += h v — for particles with w > 0 only,
+ * v = d v + h g; prev = x; x += h v — for particles with w > 0 only,
  * where d = v.w is the particle's velocity damping factor per substep,
  * exp(-k h) for a body's velocity_damping k [1/s] (1: none; then the
- * product is exact and changes no bit). w is kept. */
+ * product is exact and changes no bit). Gravity's impulse is not damped,
+ * so a body at rest balances g whatever d. w is kept. */
 SINEW_STRUCT_BEGIN(PredictParams)
   float h;
   float gravity_x;
