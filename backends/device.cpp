@@ -16,6 +16,7 @@
 #include "backends/vulkan/vulkan_device.h"
 #endif
 #include "backends/kernel_table.h"
+#include "accelerator_params.h"
 #include "primitive_params.h"
 #include "stats_params.h"
 #include "xpbd_params.h"

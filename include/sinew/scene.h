@@ -225,6 +225,70 @@ struct SolverSettings {
   /// FrameStats may differ). Off: the device holds them in the scene's
   /// order, the mesher's, which is slower on large meshes.
   bool reorder_particles = true;
+
+  // ---- Residual-driven mode (off by default: exactly `iterations` sweeps).
+  /// Residual-driven mode, on when > 0 (unitless, finite, >= 0): each
+  /// substep runs `iterations` sweeps, then `check_interval` more at a time
+  /// until the RMS over all constraints of the normalised residual
+  /// |C + alpha~ lambda| / (rest value) — the measure of
+  /// FrameStats::residual_rms — is <= this, or max_iterations or
+  /// time_budget_ms is spent; FrameStats::stop says which. Each check
+  /// measures the residuals and reduces them on the device, and the host
+  /// reads back 3 words per constraint block. For statics within ~5% the
+  /// tolerance must be ~1/20 of the body's strain under its load (about
+  /// rho g L / E): see the README's stiffness table. 0: fixed mode.
+  double residual_tolerance = 0.0;
+  /// Residual mode: the most sweeps per substep, >= iterations; rounded up
+  /// to iterations plus a whole number of check_interval.
+  int max_iterations = 200;
+  /// Residual mode: sweeps between two residual checks, >= 1. Each check
+  /// costs about one sweep's reads plus a round trip to the device.
+  int check_interval = 4;
+  /// Residual mode: the wall time [ms] a frame may spend (finite, >= 0;
+  /// 0: no budget). Substep s of n stops sweeping when its next group of
+  /// sweeps would end after (s + 1) / n of the budget from the frame's
+  /// start (the group's time is estimated from the last one run).
+  double time_budget_ms = 0.0;
+
+  // ---- Lambda warm start (off by default).
+  /// Start each substep's sweeps from the last substep's lambdas instead of
+  /// 0, with the positions moved by the correction those lambdas make
+  /// (x += w lambda grad C, the gradient at the substep's start), so x and
+  /// lambda stay consistent. A body at rest then starts at its equilibrium
+  /// and its static state does not depend on how many sweeps run; without
+  /// it each substep rebuilds its lambdas from 0 and unconverged sweeps
+  /// leave stiff bodies far softer than their material. Costs about one
+  /// sweep per substep. Only in the residual-driven mode (an error
+  /// otherwise): with a fixed number of unconverged sweeps the carried
+  /// lambdas act a substep late, like an explicit force, and stiff bodies
+  /// oscillate and diverge (measured: a 12^3-cell E = 30 MPa block at 5-40
+  /// sweeps per frame); sweeping to a tolerance keeps each substep implicit.
+  /// For the same reason a substep that stops at the time budget passes
+  /// nothing on: the next substep starts from lambda = 0 (cold). One that
+  /// stops at max_iterations does pass its lambdas on (a cap far below what
+  /// converges carries the fixed mode's risk). Only for
+  /// scenes of distance and volume constraints (tet bodies without an FEM
+  /// material, line bodies without bending): others are an error naming
+  /// this setting.
+  bool warm_start = false;
+
+  // ---- Chebyshev semi-iterative accelerator (off by default).
+  /// Estimated spectral radius rho of one sweep, in [0, 1); 0: off (the
+  /// sweeps run bitwise as without it). On: after every sweep past the
+  /// first chebyshev_delay of a substep, positions AND lambdas are
+  /// extrapolated (Wang, SIGGRAPH Asia 2015, eq. 12) with omega_k from rho.
+  /// Too large a rho oscillates or diverges, too small gains little (see
+  /// the README's stiffness section for measured values). Works in fixed
+  /// and residual mode; costs one pass over positions and lambdas per sweep.
+  /// Not with warm_start (an error): together they diverged on the tests'
+  /// stiff cantilever.
+  double chebyshev_rho = 0.0;
+  /// Under-relaxation gamma of the accelerated sweeps, in (0, 1].
+  double chebyshev_gamma = 1.0;
+  /// S: plain sweeps of each substep before the acceleration starts, >= 2
+  /// (the first extrapolation, after sweep S + 1, needs the states after
+  /// sweeps S - 1 and S).
+  int chebyshev_delay = 10;
 };
 
 struct SceneDesc {

@@ -39,6 +39,14 @@ struct SceneInfo {
   }
 };
 
+/// How the last frame's sweeps ended (SolverSettings::residual_tolerance).
+enum class SolveStop {
+  fixed,          ///< fixed mode: `iterations` sweeps per substep
+  converged,      ///< residual mode: every substep's residual reached the tolerance
+  iteration_cap,  ///< residual mode: a substep ran max_iterations sweeps without converging
+  time_budget,    ///< residual mode: a substep stopped at its share of time_budget_ms
+};
+
 /// Timing and error of the last frame. The errors are measured when
 /// SolverSettings::measure_errors is set (the default), else left at 0.
 /// They are reduced on the device at the end of the frame's program, in a
@@ -59,6 +67,16 @@ struct FrameStats {
   double max_residual = 0.0;     ///< the largest of those normalised residuals
   double kinetic_energy = 0.0;   ///< sum of m |v|^2 / 2 over movable particles [J]
   double volume_change = 0.0;    ///< total tet volume / rest total - 1 (0 without tet bodies)
+  /// Gauss-Seidel sweeps (iterations) run in the last frame, over all its substeps.
+  std::uint64_t sweeps = 0;
+  /// How the sweeps ended; in residual mode the worst substep's reason
+  /// (time_budget over iteration_cap over converged).
+  SolveStop stop = SolveStop::fixed;
+  /// Residual mode: RMS normalised residual at the last check of the
+  /// frame's last substep (what the tolerance was compared with; the same
+  /// measure as residual_rms, also when measure_errors is off). 0 in fixed mode.
+  double checked_residual = 0.0;
+  std::uint32_t residual_checks = 0;  ///< residual mode: checks (round trips) in the last frame
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;

@@ -249,6 +249,41 @@ Status TetBodyDesc::set_material(TetMaterial model, double young, double poisson
   return {};
 }
 
+// The residual-driven mode and the Chebyshev accelerator (scene.h).
+static Status check_solve_modes(const SolverSettings& solver) {
+  if (Status s = non_negative("solver.residual_tolerance", solver.residual_tolerance); !s) return s;
+  if (solver.residual_tolerance > 0.0) {
+    if (solver.max_iterations < solver.iterations)
+      return Error(ErrorCode::bad_parameter, "solver.max_iterations must be >= solver.iterations (" +
+                                                 std::to_string(solver.iterations) + ") in residual mode (got " +
+                                                 std::to_string(solver.max_iterations) + ")");
+    if (solver.check_interval < 1)
+      return Error(ErrorCode::bad_parameter,
+                   "solver.check_interval must be >= 1 (got " + std::to_string(solver.check_interval) + ")");
+    if (Status s = non_negative("solver.time_budget_ms", solver.time_budget_ms); !s) return s;
+  }
+  if (solver.warm_start && solver.residual_tolerance <= 0.0)
+    return Error(ErrorCode::bad_parameter,
+                 "solver.warm_start needs the residual-driven mode (solver.residual_tolerance > 0): with a fixed "
+                 "number of unconverged sweeps the carried lambdas can oscillate and diverge on stiff bodies");
+  if (!std::isfinite(solver.chebyshev_rho) || solver.chebyshev_rho < 0.0 || solver.chebyshev_rho >= 1.0)
+    return Error(ErrorCode::bad_parameter,
+                 "solver.chebyshev_rho must be in [0, 1) (got " + str(solver.chebyshev_rho) + ")");
+  if (solver.chebyshev_rho > 0.0) {
+    if (solver.warm_start)
+      return Error(ErrorCode::bad_parameter,
+                   "solver.chebyshev_rho must be 0 with solver.warm_start (got " + str(solver.chebyshev_rho) +
+                   "): extrapolating from the warm start diverged on a stiff cantilever (tests/stiffness_test.cpp)");
+    if (!std::isfinite(solver.chebyshev_gamma) || solver.chebyshev_gamma <= 0.0 || solver.chebyshev_gamma > 1.0)
+      return Error(ErrorCode::bad_parameter,
+                   "solver.chebyshev_gamma must be in (0, 1] (got " + str(solver.chebyshev_gamma) + ")");
+    if (solver.chebyshev_delay < 2)
+      return Error(ErrorCode::bad_parameter,
+                   "solver.chebyshev_delay must be >= 2 (got " + std::to_string(solver.chebyshev_delay) + ")");
+  }
+  return {};
+}
+
 Status check_scene(const SceneDesc& scene) {
   if (Status s = finite3("gravity", scene.gravity); !s) return s;
   if (Status s = positive("solver.time_step", scene.solver.time_step); !s) return s;
@@ -258,6 +293,7 @@ Status check_scene(const SceneDesc& scene) {
   if (scene.solver.iterations < 1)
     return Error(ErrorCode::bad_parameter,
                  "solver.iterations must be >= 1 (got " + std::to_string(scene.solver.iterations) + ")");
+  if (Status s = check_solve_modes(scene.solver); !s) return s;
   if (scene.tet_bodies.empty() && scene.tri_bodies.empty() && scene.line_bodies.empty() && scene.tools.empty())
     return Error(ErrorCode::bad_parameter, "the scene has no bodies");
   if (Status s = check_all(scene.tet_bodies, "tet_bodies", check_tet_body); !s) return s;

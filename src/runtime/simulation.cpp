@@ -44,6 +44,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   impl->order = compiled->order;
   impl->time_step = scene.solver.time_step;
   impl->measure_errors = scene.solver.measure_errors;
+  impl->substeps = scene.solver.substeps;
+  impl->iterations = scene.solver.iterations;
   // Every tet body's boundary (wound outward) with one particle of the body
   // as the reference point: its volume on the device (stats_surface_volume).
   std::vector<std::array<std::uint32_t, 4>> faces;
@@ -70,9 +72,17 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   impl->stats_plan = std::move(*plan);
   impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
   append_stats(impl->program, impl->stats_plan, impl->buffers);
-  auto prepared = impl->device->create_program(impl->program);
-  if (!prepared) return prepared.error();
-  impl->prepared = *prepared;
+  if (SolveStepper::needed(scene.solver)) {
+    auto stepper = SolveStepper::create(*impl->device, *compiled, impl->buffers, scene.solver, scene.gravity,
+                                        impl->stats_plan);
+    if (!stepper) return stepper.error();
+    impl->stepper = std::move(*stepper);
+    impl->program = impl->stepper->frame_program();
+  } else {
+    auto prepared = impl->device->create_program(impl->program);
+    if (!prepared) return prepared.error();
+    impl->prepared = *prepared;
+  }
 
   SceneInfo& info = impl->info;
   info.particles = static_cast<std::uint32_t>(compiled->positions.size());
@@ -99,11 +109,17 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
 Status Simulation::step() {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = impl_->before_frame(); !s) return s;
-  if (Status s = impl_->device->run_program(impl_->prepared); !s) return s;
-  if (Status s = impl_->device->last_run_times(impl_->stats.device); !s) return s;
+  if (impl_->stepper) {
+    if (Status s = impl_->stepper->run_frame(*impl_->device, impl_->stats); !s) return s;
+  } else {
+    if (Status s = impl_->device->run_program(impl_->prepared); !s) return s;
+    if (Status s = impl_->device->last_run_times(impl_->stats.device); !s) return s;
+    impl_->stats.sweeps = std::uint64_t(impl_->substeps) * std::uint64_t(impl_->iterations);
+  }
   const auto ran = std::chrono::steady_clock::now();
   if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
-  impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4;
+  impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4 +
+                                 (impl_->stepper ? impl_->stepper->read_back_bytes() : 0);
   if (Status s = impl_->after_frame(); !s) return s;
   if (impl_->measure_errors) impl_->measure(impl_->stats);
   const auto end = std::chrono::steady_clock::now();

@@ -11,6 +11,7 @@
 #include "program/stats_program.h"
 #include "program/xpbd_program.h"
 #include "runtime/contact_state.h"
+#include "runtime/solve_stepper.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -20,10 +21,14 @@ struct Simulation::Impl {
   XpbdBuffers buffers;
   FrameProgram program;
   ProgramHandle prepared;
+  // Residual-driven mode or the accelerator (SolverSettings): the frame as
+  // several programs the host sequences; null in the fixed mode.
+  std::unique_ptr<SolveStepper> stepper;
   SceneInfo info;
   FrameStats stats;
   double time_step = 0.0;
   bool measure_errors = true;
+  int substeps = 1, iterations = 1;  // SolverSettings (FrameStats::sweeps in the fixed mode)
   double rest_volume = 0.0;  // every tet body's total rest volume [m^3]
   // Device slot of each user particle (compiler/particle_order.h); reads
   // gather through it into the user's order.

@@ -1,0 +1,66 @@
+// solve_stepper.h — runs a frame as several programs that the host
+// sequences: the residual-driven mode (sweep until the residual is below a
+// tolerance, or a cap or time budget is spent) and the Chebyshev
+// accelerator (SolverSettings). Without either, Simulation runs its one
+// fixed frame program and this is not made.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "program/solve_programs.h"
+#include "program/stats_program.h"
+#include "sinew/simulation.h"
+
+namespace sinew {
+
+class SolveStepper {
+ public:
+  /// Whether a solver needs this (residual mode or the accelerator on).
+  static bool needed(const SolverSettings& solver) {
+    return solver.residual_tolerance > 0.0 || solver.chebyshev_rho > 0.0 || solver.warm_start;
+  }
+  /// Builds and prepares the programs; the last one ends with the
+  /// statistics of `stats` (append_stats). [in] scene, buffers must outlive
+  /// the call only.
+  static Result<std::unique_ptr<SolveStepper>> create(Device& device, const CompiledScene& scene,
+                                                      const XpbdBuffers& buffers, const SolverSettings& solver,
+                                                      const std::array<double, 3>& gravity, const StatsPlan& stats);
+
+  /// Runs one frame; fills stats.sweeps, stop, checked_residual,
+  /// residual_checks and the device times (summed over the programs run).
+  Status run_frame(Device& device, FrameStats& stats);
+
+  /// The frame's commands when every substep stops at its first check
+  /// (fixed mode with the accelerator: the whole frame): what SceneInfo
+  /// counts and what tests inspect.
+  [[nodiscard]] const FrameProgram& frame_program() const { return shortest_frame_; }
+  /// Bytes the residual checks of the last frame read back.
+  [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
+
+ private:
+  Status run(Device& device, ProgramHandle program, DeviceTimes& times, bool first);
+
+  SolverSettings solver_;
+  bool residual_mode_ = false;
+  ChebyshevBuffers chebyshev_;
+  ResidualCheck check_;
+  FrameProgram shortest_frame_;
+  // Fixed mode: whole_ only. Residual mode: begin_[s] = (update of s - 1,)
+  // predict and the first `iterations` sweeps of substep s, then a check;
+  // chunks_[s][j]: check_interval more sweeps and a check (j past the end
+  // reuses the last); end_: the last update and the statistics.
+  ProgramHandle whole_;
+  std::vector<ProgramHandle> begin_;
+  // warm_start: begin_ warm-starts; begin_cold_[s] starts from lambda = 0,
+  // run after a substep that the time budget stopped (warm_ false).
+  std::vector<ProgramHandle> begin_cold_;
+  bool warm_ = true;
+  std::vector<std::vector<ProgramHandle>> chunks_;
+  ProgramHandle end_;
+  std::uint64_t read_back_bytes_ = 0;
+  double chunk_ms_ = -1.0;  // wall time of the last chunk run (< 0: none yet)
+};
+
+}  // namespace sinew
