@@ -14,7 +14,7 @@
 // multiprocessors", TOCS 1991: the sense-reversing centralised barrier).
 //
 // A member that waits spins a few microseconds, then yields its core a few
-// times, then sleeps (std::atomic::wait): spinning only pays while the
+// times, then sleeps (a futex; see cpu_team.cpp): spinning only pays while the
 // partner is running, and on a busy machine (ctest -j on two cores, other
 // processes) a spinning member keeps the partner it waits for off the core.
 #pragma once
@@ -47,8 +47,10 @@ class CpuTeam {
 
  private:
   void worker(unsigned member);
-  // Waits until `value` no longer holds `old`: spins, then sleeps.
-  static void await_change(const std::atomic<std::uint32_t>& value, std::uint32_t old);
+  // Waits until `value` no longer holds `old`: spins, yields, then sleeps
+  // on a futex (Linux); wake() after every change of job_ or phase_.
+  void await_change(const std::atomic<std::uint32_t>& value, std::uint32_t old);
+  void wake(const std::atomic<std::uint32_t>& value);
 
   unsigned members_;
   std::vector<std::thread> workers_;
@@ -60,6 +62,8 @@ class CpuTeam {
   // The barrier: members arriving in this phase, and the phase.
   alignas(64) std::atomic<std::uint32_t> arrived_{0};
   alignas(64) std::atomic<std::uint32_t> phase_{0};
+  // Members asleep (or about to sleep) in await_change.
+  alignas(64) std::atomic<std::uint32_t> sleepers_{0};
 };
 
 }  // namespace sinew
