@@ -3,7 +3,7 @@
 // cube, and the projections per second that compare the two per constraint.
 //
 //   organ_step BACKEND MESH.node FRAMES [--errors] [--material none|neo_hookean|stvk|corotational]
-//              [--no-reorder] [--substeps N] [--iterations N] [--threads N]
+//              [--no-reorder] [--no-simd] [--substeps N] [--iterations N] [--threads N]
 //   e.g. organ_step cpu build/data/meshes/tet/liver_382k.node 10 --errors
 //   MESH.node may be cube:N, the benchmark cube of N^3 cells (100 mm wide) at the same settings.
 //
@@ -30,7 +30,7 @@ namespace {
 int usage() {
   std::fprintf(stderr,
                "usage: organ_step BACKEND MESH.node FRAMES [--errors] [--material none|neo_hookean|stvk|corotational]"
-               " [--no-reorder] [--substeps N] [--iterations N] [--threads N]\n");
+               " [--no-reorder] [--no-simd] [--substeps N] [--iterations N] [--threads N]\n");
   return 2;
 }
 
@@ -43,11 +43,13 @@ int main(int argc, char** argv) {
   if (frames < 1) return usage();
   bool errors = false, reorder = true;
   int substeps = 10, iterations = 1, threads = 0;
+  bool simd = true;
   std::string material = "none";
   for (int i = 4; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--errors") errors = true;
     else if (a == "--no-reorder") reorder = false;
+    else if (a == "--no-simd") simd = false;  // cpu: the scalar reference solves (DeviceOptions::cpu_simd)
     else if (a == "--material" && i + 1 < argc) material = argv[++i];
     else if (a == "--substeps" && i + 1 < argc) substeps = std::atoi(argv[++i]);
     else if (a == "--iterations" && i + 1 < argc) iterations = std::atoi(argv[++i]);
@@ -92,7 +94,7 @@ int main(int argc, char** argv) {
   scene.solver.measure_errors = errors;
   scene.solver.reorder_particles = reorder;
   scene.tet_bodies.push_back(std::move(body));
-  auto sim = sinew::Simulation::create(scene, {.backend = backend, .threads = threads, .quiet = true});
+  auto sim = sinew::Simulation::create(scene, {.backend = backend, .threads = threads, .cpu_simd = simd, .quiet = true});
   if (!sim) {
     std::fprintf(stderr, "%s\n", sim.error().message().c_str());
     return 1;

@@ -37,6 +37,10 @@ void solve_neo_hookean_simd(const void* params, std::byte* const* bindings, std:
 void solve_stvk_simd(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   kernels::xpbd_solve_stvk(params, bindings, kernels::xpbd_solve_stvk_avx2(params, bindings, begin, end), end);
 }
+void solve_corotational_simd(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  kernels::xpbd_solve_corotational(params, bindings,
+                                   kernels::xpbd_solve_corotational_avx2(params, bindings, begin, end), end);
+}
 
 // The CPU reference of every registered kernel: kernels::NAME.
 constexpr kernels::CpuKernelFn kReference[] = {
@@ -51,6 +55,7 @@ kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
   if (simd && kernel == Kernel::xpbd_solve_volume) return solve_volume_simd;
   if (simd && kernel == Kernel::xpbd_solve_neo_hookean) return solve_neo_hookean_simd;
   if (simd && kernel == Kernel::xpbd_solve_stvk) return solve_stvk_simd;
+  if (simd && kernel == Kernel::xpbd_solve_corotational) return solve_corotational_simd;
   return kReference[static_cast<std::size_t>(kernel)];
 }
 

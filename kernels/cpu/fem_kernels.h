@@ -13,13 +13,17 @@
 
 namespace sinew::kernels {
 
-/// The neo_hookean and stvk solves eight tets at a time with AVX2, bitwise
-/// equal to the scalar kernels (fem_kernels_avx2.cpp). They do whole groups
-/// of eight from `begin` and return the first item not done, for the scalar
-/// kernel to finish [it, end). [pre] cpu_has_avx2()
+/// The neo_hookean, stvk and corotational solves eight tets at a time with
+/// AVX2 (corotational: groups holding a tet on its first solve run the
+/// scalar kernel), bitwise equal to the scalar kernels
+/// (fem_kernels_avx2.cpp). They do whole groups of eight from `begin` and
+/// return the first item not done, for the scalar kernel to finish
+/// [it, end). [pre] cpu_has_avx2()
 std::uint32_t xpbd_solve_neo_hookean_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
                                           std::uint32_t end);
 std::uint32_t xpbd_solve_stvk_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
                                    std::uint32_t end);
+std::uint32_t xpbd_solve_corotational_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                                           std::uint32_t end);
 
 }  // namespace sinew::kernels

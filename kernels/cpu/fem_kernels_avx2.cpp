@@ -13,9 +13,13 @@
 // on the system's scale and determinant a mask of the lanes that move (the
 // others keep their multipliers, as the scalar code stores them).
 //
-// Corotational tets stay scalar (their rotation's Jacobi start and its
-// Newton refinement branch per tet). Only the functions between the
-// target("avx2") pragmas use AVX2; callers check cpu_has_avx2() first.
+// Corotational tets too: the Newton refinement of their kept rotation
+// (fem::refine_rotation) computes both of its branches in every lane and
+// blends them by the scalar test; a group of eight in which any tet has no
+// rotation kept yet (its first solve, where the exact rotation comes from a
+// Jacobi eigen-solve with data-dependent sweeps) runs the scalar kernel for
+// those eight. Only the functions between the target("avx2") pragmas use
+// AVX2; callers check cpu_has_avx2() first.
 #include <immintrin.h>
 
 #include <cstdint>
@@ -23,6 +27,7 @@
 #include "cpu/avx2_lanes.h"
 #include "cpu/fem_kernels.h"
 #include "fem_params.h"
+#include "math/fem_math.h"
 #include "xpbd_params.h"
 
 namespace sinew::kernels {
@@ -139,7 +144,90 @@ inline Constraints stvk(const M3& f, __m256 h0) {
   return c;
 }
 
-template <bool kNeoHookean>
+struct Quat {  // fem::quat per lane
+  __m256 w, x, y, z;
+};
+
+// fem::quaternion_matrix.
+inline M3 quaternion_matrix(const Quat& q) {
+  const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+  const __m256 w = q.w, x = q.x, y = q.y, z = q.z;
+  M3 r;
+  r.m[0][0] = sub(one, mul(two, add(mul(y, y), mul(z, z))));
+  r.m[0][1] = mul(two, sub(mul(x, y), mul(w, z)));
+  r.m[0][2] = mul(two, add(mul(x, z), mul(w, y)));
+  r.m[1][0] = mul(two, add(mul(x, y), mul(w, z)));
+  r.m[1][1] = sub(one, mul(two, add(mul(x, x), mul(z, z))));
+  r.m[1][2] = mul(two, sub(mul(y, z), mul(w, x)));
+  r.m[2][0] = mul(two, sub(mul(x, z), mul(w, y)));
+  r.m[2][1] = mul(two, add(mul(y, z), mul(w, x)));
+  r.m[2][2] = sub(one, mul(two, add(mul(x, x), mul(y, y))));
+  return r;
+}
+
+// fem::refine_rotation: each iteration computes the Newton turn and the
+// fallback turn in every lane and keeps the one the scalar test picks.
+inline Quat refine_rotation(const M3& f, Quat q, int iterations) {
+  const __m256 one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f);
+  const __m256 minus_half = _mm256_set1_ps(-0.5f), tiny = _mm256_set1_ps(1e-6f), eps = _mm256_set1_ps(1e-9f);
+  for (int it = 0; it < iterations; ++it) {
+    const M3 r = quaternion_matrix(q);
+    __m256 s[3][3];  // R^T F
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        s[i][j] = add(add(mul(r.m[0][i], f.m[0][j]), mul(r.m[1][i], f.m[1][j])), mul(r.m[2][i], f.m[2][j]));
+    const __m256 gx = sub(s[2][1], s[1][2]), gy = sub(s[0][2], s[2][0]), gz = sub(s[1][0], s[0][1]);
+    const __m256 tr = add(add(s[0][0], s[1][1]), s[2][2]);
+    const __m256 a = sub(tr, s[0][0]), b = sub(tr, s[1][1]), c = sub(tr, s[2][2]);
+    const __m256 d = mul(minus_half, add(s[0][1], s[1][0])), e = mul(minus_half, add(s[0][2], s[2][0]));
+    const __m256 k = mul(minus_half, add(s[1][2], s[2][1]));
+    const __m256 c00 = sub(mul(b, c), mul(k, k)), c01 = sub(mul(e, k), mul(d, c)), c02 = sub(mul(d, k), mul(b, e));
+    const __m256 c11 = sub(mul(a, c), mul(e, e)), c12 = sub(mul(d, e), mul(a, k)), c22 = sub(mul(a, b), mul(d, d));
+    const __m256 det = add(add(mul(a, c00), mul(d, c01)), mul(e, c02));
+    // a > 0 && c22 > 0 && det > 1e-6 a c22 (a + b + c), ordered (NaN: fallback).
+    const __m256 bound = mul(mul(mul(tiny, a), c22), add(add(a, b), c));
+    const __m256 newton = _mm256_and_ps(_mm256_and_ps(positive(a), positive(c22)), _mm256_cmp_ps(det, bound, _CMP_GT_OQ));
+    const __m256 inv_det = div(one, det);
+    const __m256 nx = mul(add(add(mul(c00, gx), mul(c01, gy)), mul(c02, gz)), inv_det);
+    const __m256 ny = mul(add(add(mul(c01, gx), mul(c11, gy)), mul(c12, gz)), inv_det);
+    const __m256 nz = mul(add(add(mul(c02, gx), mul(c12, gy)), mul(c22, gz)), inv_det);
+    const __m256 abs_tr = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), tr);
+    const __m256 inv = div(one, add(abs_tr, eps));
+    const __m256 wx = select(newton, nx, mul(gx, inv)), wy = select(newton, ny, mul(gy, inv));
+    const __m256 wz = select(newton, nz, mul(gz, inv));
+    const __m256 hx = mul(half, wx), hy = mul(half, wy), hz = mul(half, wz);  // q * (1, w / 2)
+    const __m256 w = sub(sub(sub(q.w, mul(q.x, hx)), mul(q.y, hy)), mul(q.z, hz));
+    const __m256 x = sub(add(add(q.x, mul(q.w, hx)), mul(q.y, hz)), mul(q.z, hy));
+    const __m256 y = sub(add(add(q.y, mul(q.w, hy)), mul(q.z, hx)), mul(q.x, hz));
+    const __m256 z = sub(add(add(q.z, mul(q.w, hz)), mul(q.x, hy)), mul(q.y, hx));
+    const __m256 inv_len = div(one, _mm256_sqrt_ps(add(add(add(mul(w, w), mul(x, x)), mul(y, y)), mul(z, z))));
+    q = {mul(w, inv_len), mul(x, inv_len), mul(y, inv_len), mul(z, inv_len)};
+  }
+  return q;
+}
+
+// fem::corotational_constraints with the rotation r.
+inline Constraints corotational(const M3& f, const M3& r, __m256 h0) {
+  Constraints c;
+  M3 d;
+  __m256 trace = _mm256_setzero_ps();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      d.m[i][j] = sub(f.m[i][j], r.m[i][j]);
+      trace = add(trace, mul(r.m[i][j], f.m[i][j]));
+    }
+  c.c_d = frobenius_norm(d);
+  const __m256 inv = inverse_or_zero(c.c_d);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) c.dc_d.m[i][j] = mul(d.m[i][j], inv);
+  c.c_h = sub(trace, h0);
+  c.dc_h = r;
+  return c;
+}
+
+enum class Model { neo_hookean, stvk, corotational };
+
+template <Model kModel>
 std::uint32_t solve_tets(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float*>(bindings[0]);
@@ -149,17 +237,32 @@ std::uint32_t solve_tets(const void* params, std::byte* const* bindings, std::ui
   auto* residual = reinterpret_cast<float*>(bindings[4]);
   const __m256 inv_h2 = _mm256_set1_ps(p.inv_h2), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
   const __m256 infinity = _mm256_set1_ps(__builtin_inff());
+  constexpr std::uint32_t stride =
+      kModel == Model::corotational ? SINEW_FEM_COROTATIONAL_LAMBDA_STRIDE : SINEW_FEM_LAMBDA_STRIDE;
   std::uint32_t i = p.first + begin;
   for (; i + 8 <= p.first + end; i += 8) {
     // Gather: particles (transposed), the per-tet data and multipliers.
     std::uint32_t iv[4][8];
-    alignas(32) float col[13][8], l0[8], l1[8];
+    alignas(32) float col[13][8], l0[8], l1[8], kept[4][8];
+    bool first_solve = false;  // corotational: a tet without a kept rotation
     for (int j = 0; j < 8; ++j) {
       for (int k = 0; k < 4; ++k) iv[k][j] = idx[4 * (i + j) + k];
       const float* d = data + std::size_t{i + j} * SINEW_FEM_DATA_STRIDE;
       for (int k = 0; k < 13; ++k) col[k][j] = d[k];
-      l0[j] = p.reset_lambda ? 0.0f : lambda[2 * (i + j)];
-      l1[j] = p.reset_lambda ? 0.0f : lambda[2 * (i + j) + 1];
+      const float* l = lambda + std::size_t{i + j} * stride;
+      l0[j] = p.reset_lambda ? 0.0f : l[0];
+      l1[j] = p.reset_lambda ? 0.0f : l[1];
+      if constexpr (kModel == Model::corotational) {
+        for (int k = 0; k < 4; ++k) kept[k][j] = l[SINEW_FEM_ROTATION + k];
+        first_solve = first_solve || (kept[0][j] == 0.0f && kept[1][j] == 0.0f && kept[2][j] == 0.0f &&
+                                      kept[3][j] == 0.0f);
+      }
+    }
+    if constexpr (kModel == Model::corotational) {
+      if (first_solve) {  // the exact rotation: the scalar kernel does these eight
+        xpbd_solve_corotational(params, bindings, i - p.first, i - p.first + 8);
+        continue;
+      }
     }
     const Lanes xs[4] = {load_particles(x, iv[0]), load_particles(x, iv[1]), load_particles(x, iv[2]),
                          load_particles(x, iv[3])};
@@ -168,7 +271,22 @@ std::uint32_t solve_tets(const void* params, std::byte* const* bindings, std::ui
       for (int c = 0; c < 3; ++c) dm_inv.m[r][c] = _mm256_load_ps(col[SINEW_FEM_DM_INV + 3 * r + c]);
     const M3 f = deformation_gradient(xs, dm_inv);
     const __m256 h0 = _mm256_load_ps(col[SINEW_FEM_H0]);
-    const Constraints c = kNeoHookean ? neo_hookean(f, h0) : stvk(f, h0);
+    Constraints c;
+    if constexpr (kModel == Model::neo_hookean) {
+      c = neo_hookean(f, h0);
+    } else if constexpr (kModel == Model::stvk) {
+      c = stvk(f, h0);
+    } else {
+      Quat q{_mm256_load_ps(kept[0]), _mm256_load_ps(kept[1]), _mm256_load_ps(kept[2]), _mm256_load_ps(kept[3])};
+      q = refine_rotation(f, q, fem::kRotationIterations);
+      if (!p.measure_only) {  // kept by every solving pass, never by the measuring one
+        _mm256_store_ps(kept[0], q.w), _mm256_store_ps(kept[1], q.x);
+        _mm256_store_ps(kept[2], q.y), _mm256_store_ps(kept[3], q.z);
+        for (int j = 0; j < 8; ++j)
+          for (int k = 0; k < 4; ++k) lambda[std::size_t{i + j} * stride + SINEW_FEM_ROTATION + k] = kept[k][j];
+      }
+      c = corotational(f, quaternion_matrix(q), h0);
+    }
 
     const __m256 ad = mul(_mm256_load_ps(col[SINEW_FEM_ALPHA_D]), inv_h2);
     const __m256 ah = mul(_mm256_load_ps(col[SINEW_FEM_ALPHA_H]), inv_h2);
@@ -216,8 +334,8 @@ std::uint32_t solve_tets(const void* params, std::byte* const* bindings, std::ui
     _mm256_store_ps(l0, select(moves, add(ld, sub(mu1, mul(beta, mu2))), ld));
     _mm256_store_ps(l1, select(moves, add(lh, mu2), lh));
     for (int j = 0; j < 8; ++j) {
-      lambda[2 * (i + j)] = l0[j];
-      lambda[2 * (i + j) + 1] = l1[j];
+      lambda[std::size_t{i + j} * stride] = l0[j];
+      lambda[std::size_t{i + j} * stride + 1] = l1[j];
     }
   }
   return i - p.first;  // the first item not done; the scalar kernel finishes [it, end)
@@ -227,12 +345,17 @@ std::uint32_t solve_tets(const void* params, std::byte* const* bindings, std::ui
 
 std::uint32_t xpbd_solve_neo_hookean_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
                                           std::uint32_t end) {
-  return solve_tets<true>(params, bindings, begin, end);
+  return solve_tets<Model::neo_hookean>(params, bindings, begin, end);
 }
 
 std::uint32_t xpbd_solve_stvk_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
                                    std::uint32_t end) {
-  return solve_tets<false>(params, bindings, begin, end);
+  return solve_tets<Model::stvk>(params, bindings, begin, end);
+}
+
+std::uint32_t xpbd_solve_corotational_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                                           std::uint32_t end) {
+  return solve_tets<Model::corotational>(params, bindings, begin, end);
 }
 
 #pragma GCC pop_options
