@@ -1,0 +1,163 @@
+// bvh.h — the CPU reference bounding-volume hierarchy of the broad phase
+// (issue 12): built top-down over primitive boxes, refitted bottom-up when
+// the primitives move, rebuilt when refitting has let its quality decay;
+// pairs of overlapping primitive boxes found BVH against BVH and within one
+// BVH (self-collision). Simple and obviously right on purpose: it is the
+// oracle the fast paths (Embree on the CPU, Karras's Morton-code BVH in the
+// GPU kernels) are checked against, together with brute_force_pairs.
+//
+// Build: median split of the primitives' centroids along the longest axis
+// of their centroid bounds, leaves of at most kLeafSize primitives (the
+// classic object-median BVH; Wald, Boulos, Shirley, "Ray tracing
+// deformable scenes using dynamic bounding volume hierarchies", TOG 26(1),
+// 2007, for refitting and the rebuild heuristic). Quality: the sum of the
+// nodes' surface areas over the root's (the SAH cost of an overlap query
+// up to constants); rebuild when a refit has grown it past a factor of the
+// cost right after the last build.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "collision/aabb.h"
+
+namespace sinew::collision {
+
+/// A pair of primitive indices (first from the first set, second from the
+/// second; within one set first < second).
+using Pair = std::pair<std::uint32_t, std::uint32_t>;
+
+class Bvh {
+ public:
+  static constexpr std::uint32_t kLeafSize = 4;
+
+  struct Node {
+    Aabb box;
+    std::uint32_t left = 0;   ///< inner: index of the first child (the second is left + 1)
+    std::uint32_t first = 0;  ///< leaf: first slot in order()
+    std::uint32_t count = 0;  ///< leaf: primitives (> 0); inner: 0
+  };
+
+  /// Builds over `boxes` (one per primitive; none: an empty hierarchy).
+  void build(std::span<const Aabb> boxes);
+  /// Recomputes every node's box from the primitives' new boxes (same
+  /// count as at build) bottom-up; the tree's shape is kept.
+  void refit(std::span<const Aabb> boxes);
+  /// Sum of node half-areas over the root's: grows as a refitted tree's
+  /// boxes swell and overlap. 0 for an empty tree.
+  [[nodiscard]] double cost() const;
+  /// cost() over the cost right after the last build.
+  [[nodiscard]] double degradation() const;
+
+  [[nodiscard]] const std::vector<Node>& nodes() const { return nodes_; }
+  /// Primitive indices in leaf order: leaf n holds order()[first .. first + count).
+  [[nodiscard]] const std::vector<std::uint32_t>& order() const { return order_; }
+  [[nodiscard]] bool empty() const { return nodes_.empty(); }
+
+ private:
+  void build_node(std::span<const Aabb> boxes, const std::vector<float>& centroids, std::uint32_t index,
+                  std::uint32_t first, std::uint32_t count);
+  std::vector<Node> nodes_;
+  std::vector<std::uint32_t> order_;
+  double built_cost_ = 0.0;
+};
+
+/// Every (i, j) with boxes_a[i] overlapping boxes_b[j]: a traversal of both
+/// trees (built over those boxes). [out] pairs, sorted.
+void overlapping_pairs(const Bvh& a, std::span<const Aabb> boxes_a, const Bvh& b, std::span<const Aabb> boxes_b,
+                       std::vector<Pair>& pairs);
+
+/// Every (i, j), i < j, of one set with overlapping boxes, skipping pairs
+/// for which skip(i, j) is true (e.g. triangles sharing a vertex). [out]
+/// pairs, sorted.
+template <class Skip>
+void self_overlapping_pairs(const Bvh& tree, std::span<const Aabb> boxes, Skip skip, std::vector<Pair>& pairs);
+
+/// The oracles: every pair tested, O(n m) and O(n^2 / 2). [out] pairs, sorted.
+void brute_force_pairs(std::span<const Aabb> boxes_a, std::span<const Aabb> boxes_b, std::vector<Pair>& pairs);
+template <class Skip>
+void brute_force_self_pairs(std::span<const Aabb> boxes, Skip skip, std::vector<Pair>& pairs);
+
+/// skip() for triangles: whether triangles i and j share a vertex.
+struct SharesVertex {
+  std::span<const std::uint32_t> indices;  ///< arity per primitive
+  int arity = 3;
+  bool operator()(std::uint32_t i, std::uint32_t j) const {
+    for (int a = 0; a < arity; ++a)
+      for (int b = 0; b < arity; ++b)
+        if (indices[std::size_t{i} * arity + a] == indices[std::size_t{j} * arity + b]) return true;
+    return false;
+  }
+};
+
+// ---- templates
+
+namespace detail {
+// Visits every pair of leaves whose boxes overlap, within one tree
+// (self = true: each unordered pair of distinct leaves once, and every leaf
+// with itself) or across two.
+template <class Visit>
+void traverse(const Bvh& a, const Bvh& b, bool self, Visit visit) {
+  if (a.empty() || b.empty()) return;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0, 0}};
+  const auto& na = a.nodes();
+  const auto& nb = b.nodes();
+  while (!stack.empty()) {
+    const auto [i, j] = stack.back();
+    stack.pop_back();
+    const Bvh::Node& x = na[i];
+    const Bvh::Node& y = nb[j];
+    if (self && i == j) {  // a node against itself: its children against themselves and each other
+      if (x.count > 0) {
+        visit(x, x);
+        continue;
+      }
+      stack.push_back({x.left, x.left});
+      stack.push_back({x.left + 1, x.left + 1});
+      stack.push_back({x.left, x.left + 1});
+      continue;
+    }
+    if (!overlap(x.box, y.box)) continue;
+    if (x.count > 0 && y.count > 0) {
+      visit(x, y);
+    } else if (y.count > 0 || (x.count == 0 && half_area(x.box) >= half_area(y.box))) {
+      stack.push_back({x.left, j});  // descend the larger (or the only inner) node
+      stack.push_back({x.left + 1, j});
+    } else {
+      stack.push_back({i, y.left});
+      stack.push_back({i, y.left + 1});
+    }
+  }
+}
+
+void sort_unique(std::vector<Pair>& pairs);
+}  // namespace detail
+
+template <class Skip>
+void self_overlapping_pairs(const Bvh& tree, std::span<const Aabb> boxes, Skip skip, std::vector<Pair>& pairs) {
+  pairs.clear();
+  const auto& order = tree.order();
+  detail::traverse(tree, tree, true, [&](const Bvh::Node& x, const Bvh::Node& y) {
+    const bool same = &x == &y;
+    for (std::uint32_t s = 0; s < x.count; ++s)
+      for (std::uint32_t t = same ? s + 1 : 0; t < y.count; ++t) {
+        std::uint32_t i = order[x.first + s], j = order[y.first + t];
+        if (i > j) std::swap(i, j);
+        if (overlap(boxes[i], boxes[j]) && !skip(i, j)) pairs.push_back({i, j});
+      }
+  });
+  detail::sort_unique(pairs);
+}
+
+template <class Skip>
+void brute_force_self_pairs(std::span<const Aabb> boxes, Skip skip, std::vector<Pair>& pairs) {
+  pairs.clear();
+  const auto n = static_cast<std::uint32_t>(boxes.size());
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = i + 1; j < n; ++j)
+      if (overlap(boxes[i], boxes[j]) && !skip(i, j)) pairs.push_back({i, j});
+}
+
+}  // namespace sinew::collision
