@@ -73,6 +73,17 @@ void expect_self_pairs_equal_brute_force(const Surface& s, float inflate, const 
               tree.nodes().size());
 }
 
+// Pairs across two box sets from their BVHs and from the brute force.
+std::pair<std::vector<Pair>, std::vector<Pair>> cross_pairs(const std::vector<Aabb>& a, const std::vector<Aabb>& b) {
+  Bvh ta, tb;
+  ta.build(a);
+  tb.build(b);
+  std::vector<Pair> fast, slow;
+  overlapping_pairs(ta, a, tb, b, fast);
+  brute_force_pairs(a, b, slow);
+  return {fast, slow};
+}
+
 TEST(Bvh, SelfPairsOnRealSurfacesEqualBruteForce) {
   for (const char* file : {"meshes/tet/armadillo_4k.node", "meshes/tet/kidney_57k.node"}) {
     const Surface s = surface_of(file);
@@ -142,12 +153,7 @@ TEST(Bvh, PairsBetweenTwoSurfacesEqualBruteForce) {
     }
   const float inflate = 0.5f * kidney.mean_edge;
   const std::vector<Aabb> a = boxes_of(kidney, inflate), b = boxes_of(armadillo, inflate);
-  Bvh ta, tb;
-  ta.build(a);
-  tb.build(b);
-  std::vector<Pair> fast, slow;
-  overlapping_pairs(ta, a, tb, b, fast);
-  brute_force_pairs(a, b, slow);
+  const auto [fast, slow] = cross_pairs(a, b);
   EXPECT_EQ(fast, slow);
   EXPECT_GT(slow.size(), 100u) << "the surfaces should cross";
   std::printf("[ bvh ] kidney x armadillo: %zu x %zu triangles, %zu pairs\n", a.size(), b.size(), slow.size());
@@ -173,13 +179,10 @@ TEST(Bvh, RandomAndDegenerateBoxesEqualBruteForce) {
       return boxes;
     };
     const std::vector<Aabb> a = make(n), b = make(m);
-    Bvh ta, tb;
-    ta.build(a);
-    tb.build(b);
-    std::vector<Pair> fast, slow;
-    overlapping_pairs(ta, a, tb, b, fast);
-    brute_force_pairs(a, b, slow);
+    auto [fast, slow] = cross_pairs(a, b);
     ASSERT_EQ(fast, slow) << "round " << round << ", " << n << " x " << m;
+    Bvh ta;
+    ta.build(a);
     const auto none = [](std::uint32_t, std::uint32_t) { return false; };
     self_overlapping_pairs(ta, a, none, fast);
     brute_force_self_pairs(a, none, slow);
