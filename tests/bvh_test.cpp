@@ -9,10 +9,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
 #include "collision/bvh.h"
+#if SINEW_HAS_EMBREE
+#include "collision/embree_broad_phase.h"
+#endif
 #include "test_support.h"
 
 namespace sinew::collision {
@@ -51,6 +55,14 @@ std::vector<Aabb> boxes_of(const Surface& s, float inflate) {
   return boxes;
 }
 
+#if SINEW_HAS_EMBREE
+std::unique_ptr<EmbreeBoxes> embree_set() {
+  auto made = EmbreeBoxes::create();
+  EXPECT_TRUE(made.ok()) << (made.ok() ? "" : made.error().message());
+  return made.ok() ? std::move(*made) : nullptr;
+}
+#endif
+
 // Moves every vertex by up to `amount` [m] per axis (a deformation: the
 // refitted tree must still find exactly the brute-force pairs).
 void jiggle(Surface& s, float amount, std::mt19937& rng) {
@@ -68,6 +80,14 @@ void expect_self_pairs_equal_brute_force(const Surface& s, float inflate, const 
   self_overlapping_pairs(tree, boxes, skip, fast);
   brute_force_self_pairs(boxes, skip, slow);
   EXPECT_EQ(fast, slow) << what << ": " << fast.size() << " BVH pairs, " << slow.size() << " brute force";
+#if SINEW_HAS_EMBREE
+  auto set = embree_set();
+  ASSERT_TRUE(set);
+  ASSERT_TRUE(set->build(boxes).ok());
+  std::vector<Pair> embree;
+  ASSERT_TRUE(embree_self_pairs(*set, skip, embree).ok());
+  EXPECT_EQ(embree, slow) << what << ": " << embree.size() << " Embree pairs, " << slow.size() << " brute force";
+#endif
   EXPECT_GT(slow.size(), 0u) << what << ": the inflation should make some non-adjacent triangles candidates";
   std::printf("[ bvh ] %s: %zu triangles, %zu self pairs, %zu nodes\n", what, boxes.size(), slow.size(),
               tree.nodes().size());
@@ -108,6 +128,11 @@ TEST(Bvh, RefitAfterDeformationStillEqualsBruteForce) {
   std::vector<Aabb> boxes = boxes_of(s, inflate);
   Bvh tree;
   tree.build(boxes);
+#if SINEW_HAS_EMBREE
+  auto set = embree_set();
+  ASSERT_TRUE(set);
+  ASSERT_TRUE(set->build(boxes).ok());
+#endif
   const SharesVertex skip{s.triangles, 3};
   for (int step = 0; step < 3; ++step) {
     jiggle(s, 0.5f * s.mean_edge, rng);
@@ -117,6 +142,12 @@ TEST(Bvh, RefitAfterDeformationStillEqualsBruteForce) {
     self_overlapping_pairs(tree, boxes, skip, fast);
     brute_force_self_pairs(boxes, skip, slow);
     EXPECT_EQ(fast, slow) << "after deformation " << step;
+#if SINEW_HAS_EMBREE
+    ASSERT_TRUE(set->refit(boxes).ok());
+    std::vector<Pair> embree;
+    ASSERT_TRUE(embree_self_pairs(*set, skip, embree).ok());
+    EXPECT_EQ(embree, slow) << "Embree refitted, after deformation " << step;
+#endif
     EXPECT_GT(tree.degradation(), 1.0) << "jiggled boxes swell: the refitted tree's cost grows";
   }
   // The root bounds every box after the refit.
@@ -155,6 +186,19 @@ TEST(Bvh, PairsBetweenTwoSurfacesEqualBruteForce) {
   const std::vector<Aabb> a = boxes_of(kidney, inflate), b = boxes_of(armadillo, inflate);
   const auto [fast, slow] = cross_pairs(a, b);
   EXPECT_EQ(fast, slow);
+#if SINEW_HAS_EMBREE
+  auto ea = embree_set(), eb = embree_set();
+  ASSERT_TRUE(ea && eb);
+  ASSERT_TRUE(ea->build(a).ok());
+  ASSERT_TRUE(eb->build(b).ok());
+  std::vector<Pair> embree;
+  ASSERT_TRUE(embree_pairs(*ea, *eb, embree).ok());
+  EXPECT_EQ(embree, slow) << "Embree";
+  // A refit with a different count is an error naming what to do.
+  const Status wrong = ea->refit(b);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().message().find("build again"), std::string::npos);
+#endif
   EXPECT_GT(slow.size(), 100u) << "the surfaces should cross";
   std::printf("[ bvh ] kidney x armadillo: %zu x %zu triangles, %zu pairs\n", a.size(), b.size(), slow.size());
 }
@@ -187,6 +231,18 @@ TEST(Bvh, RandomAndDegenerateBoxesEqualBruteForce) {
     self_overlapping_pairs(ta, a, none, fast);
     brute_force_self_pairs(a, none, slow);
     ASSERT_EQ(fast, slow) << "self, round " << round << ", " << n << " boxes";
+#if SINEW_HAS_EMBREE
+    auto ea = embree_set(), eb = embree_set();
+    ASSERT_TRUE(ea && eb);
+    ASSERT_TRUE(ea->build(a).ok());
+    ASSERT_TRUE(eb->build(b).ok());
+    std::vector<Pair> embree;
+    ASSERT_TRUE(embree_self_pairs(*ea, none, embree).ok());
+    ASSERT_EQ(embree, slow) << "Embree self, round " << round;
+    ASSERT_TRUE(embree_pairs(*ea, *eb, embree).ok());
+    brute_force_pairs(a, b, slow);
+    ASSERT_EQ(embree, slow) << "Embree, round " << round;
+#endif
   }
   // Empty sets: no pairs, no crash.
   Bvh empty;
