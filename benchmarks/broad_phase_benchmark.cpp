@@ -122,7 +122,7 @@ void BM_SelfBroadPhase(benchmark::State& state) {
 #endif
     }
     if (variant <= kReferenceRebuild) {
-      self_overlapping_pairs(tree, boxes, skip, pairs);
+      self_overlapping_pairs(tree, skip, pairs);
     } else {
 #if SINEW_HAS_EMBREE
       (void)embree_self_pairs(*set, skip, pairs);

@@ -77,7 +77,7 @@ void expect_self_pairs_equal_brute_force(const Surface& s, float inflate, const 
   tree.build(boxes);
   const SharesVertex skip{s.triangles, 3};
   std::vector<Pair> fast, slow;
-  self_overlapping_pairs(tree, boxes, skip, fast);
+  self_overlapping_pairs(tree, skip, fast);
   brute_force_self_pairs(boxes, skip, slow);
   EXPECT_EQ(fast, slow) << what << ": " << fast.size() << " BVH pairs, " << slow.size() << " brute force";
 #if SINEW_HAS_EMBREE
@@ -99,7 +99,7 @@ std::pair<std::vector<Pair>, std::vector<Pair>> cross_pairs(const std::vector<Aa
   ta.build(a);
   tb.build(b);
   std::vector<Pair> fast, slow;
-  overlapping_pairs(ta, a, tb, b, fast);
+  overlapping_pairs(ta, tb, fast);
   brute_force_pairs(a, b, slow);
   return {fast, slow};
 }
@@ -139,7 +139,7 @@ TEST(Bvh, RefitAfterDeformationStillEqualsBruteForce) {
     boxes = boxes_of(s, inflate);
     tree.refit(boxes);
     std::vector<Pair> fast, slow;
-    self_overlapping_pairs(tree, boxes, skip, fast);
+    self_overlapping_pairs(tree, skip, fast);
     brute_force_self_pairs(boxes, skip, slow);
     EXPECT_EQ(fast, slow) << "after deformation " << step;
 #if SINEW_HAS_EMBREE
@@ -228,7 +228,7 @@ TEST(Bvh, RandomAndDegenerateBoxesEqualBruteForce) {
     Bvh ta;
     ta.build(a);
     const auto none = [](std::uint32_t, std::uint32_t) { return false; };
-    self_overlapping_pairs(ta, a, none, fast);
+    self_overlapping_pairs(ta, none, fast);
     brute_force_self_pairs(a, none, slow);
     ASSERT_EQ(fast, slow) << "self, round " << round << ", " << n << " boxes";
 #if SINEW_HAS_EMBREE
@@ -248,7 +248,7 @@ TEST(Bvh, RandomAndDegenerateBoxesEqualBruteForce) {
   Bvh empty;
   empty.build({});
   std::vector<Pair> pairs{{1, 2}};
-  overlapping_pairs(empty, {}, empty, {}, pairs);
+  overlapping_pairs(empty, empty, pairs);
   EXPECT_TRUE(pairs.empty());
 }
 

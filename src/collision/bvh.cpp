@@ -54,6 +54,8 @@ void Bvh::build(std::span<const Aabb> boxes) {
   nodes_.reserve(2 * (boxes.size() / kLeafSize + 1));
   nodes_.emplace_back();
   build_node(boxes, centroids, 0, 0, static_cast<std::uint32_t>(boxes.size()));
+  leaf_boxes_.resize(boxes.size());
+  for (std::size_t k = 0; k < boxes.size(); ++k) leaf_boxes_[k] = boxes[order_[k]];
   built_cost_ = cost();
 }
 
@@ -98,11 +100,12 @@ void Bvh::build_node(std::span<const Aabb> boxes, const std::vector<float>& cent
 }
 
 void Bvh::refit(std::span<const Aabb> boxes) {
+  for (std::size_t k = 0; k < leaf_boxes_.size(); ++k) leaf_boxes_[k] = boxes[order_[k]];
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     Node& node = nodes_[n];
     if (node.count > 0) {
-      Aabb box = boxes[order_[node.first]];
-      for (std::uint32_t s = 1; s < node.count; ++s) box = merge(box, boxes[order_[node.first + s]]);
+      Aabb box = leaf_boxes_[node.first];
+      for (std::uint32_t s = 1; s < node.count; ++s) box = merge(box, leaf_boxes_[node.first + s]);
       node.box = box;
     } else {
       node.box = merge(nodes_[node.left].box, nodes_[node.left + 1].box);
@@ -127,15 +130,13 @@ void sort_unique(std::vector<Pair>& pairs) {
 }
 }  // namespace detail
 
-void overlapping_pairs(const Bvh& a, std::span<const Aabb> boxes_a, const Bvh& b, std::span<const Aabb> boxes_b,
-                       std::vector<Pair>& pairs) {
+void overlapping_pairs(const Bvh& a, const Bvh& b, std::vector<Pair>& pairs) {
   pairs.clear();
   detail::traverse(a, b, false, [&](const Bvh::Node& x, const Bvh::Node& y) {
     for (std::uint32_t s = 0; s < x.count; ++s)
-      for (std::uint32_t t = 0; t < y.count; ++t) {
-        const std::uint32_t i = a.order()[x.first + s], j = b.order()[y.first + t];
-        if (overlap(boxes_a[i], boxes_b[j])) pairs.push_back({i, j});
-      }
+      for (std::uint32_t t = 0; t < y.count; ++t)
+        if (overlap(a.leaf_boxes()[x.first + s], b.leaf_boxes()[y.first + t]))
+          pairs.push_back({a.order()[x.first + s], b.order()[y.first + t]});
   });
   detail::sort_unique(pairs);
 }

@@ -54,6 +54,12 @@ class Bvh {
   [[nodiscard]] const std::vector<Node>& nodes() const { return nodes_; }
   /// Primitive indices in leaf order: leaf n holds order()[first .. first + count).
   [[nodiscard]] const std::vector<std::uint32_t>& order() const { return order_; }
+  /// The primitives' boxes in leaf order (leaf_boxes()[k] = boxes[order()[k]]
+  /// as of the last build or refit): traversals read a leaf's boxes from
+  /// consecutive memory instead of through order() (the liver's surface,
+  /// 2.1M primitive tests: the traversal took 30 ms without this copy, 20
+  /// with it).
+  [[nodiscard]] const std::vector<Aabb>& leaf_boxes() const { return leaf_boxes_; }
   [[nodiscard]] bool empty() const { return nodes_.empty(); }
 
  private:
@@ -61,19 +67,20 @@ class Bvh {
                   std::uint32_t first, std::uint32_t count);
   std::vector<Node> nodes_;
   std::vector<std::uint32_t> order_;
+  std::vector<Aabb> leaf_boxes_;
   double built_cost_ = 0.0;
 };
 
-/// Every (i, j) with boxes_a[i] overlapping boxes_b[j]: a traversal of both
-/// trees (built over those boxes). [out] pairs, sorted.
-void overlapping_pairs(const Bvh& a, std::span<const Aabb> boxes_a, const Bvh& b, std::span<const Aabb> boxes_b,
-                       std::vector<Pair>& pairs);
+/// Every (i, j) with primitive i of `a` overlapping primitive j of `b`, for
+/// the boxes of each tree's last build() or refit(): a traversal of both
+/// trees. [out] pairs, sorted.
+void overlapping_pairs(const Bvh& a, const Bvh& b, std::vector<Pair>& pairs);
 
-/// Every (i, j), i < j, of one set with overlapping boxes, skipping pairs
-/// for which skip(i, j) is true (e.g. triangles sharing a vertex). [out]
-/// pairs, sorted.
+/// Every (i, j), i < j, of one tree's primitives with overlapping boxes (as
+/// of its last build or refit), skipping pairs for which skip(i, j) is true
+/// (e.g. triangles sharing a vertex). [out] pairs, sorted.
 template <class Skip>
-void self_overlapping_pairs(const Bvh& tree, std::span<const Aabb> boxes, Skip skip, std::vector<Pair>& pairs);
+void self_overlapping_pairs(const Bvh& tree, Skip skip, std::vector<Pair>& pairs);
 
 /// The oracles: every pair tested, O(n m) and O(n^2 / 2). [out] pairs, sorted.
 void brute_force_pairs(std::span<const Aabb> boxes_a, std::span<const Aabb> boxes_b, std::vector<Pair>& pairs);
@@ -136,16 +143,18 @@ void sort_unique(std::vector<Pair>& pairs);
 }  // namespace detail
 
 template <class Skip>
-void self_overlapping_pairs(const Bvh& tree, std::span<const Aabb> boxes, Skip skip, std::vector<Pair>& pairs) {
+void self_overlapping_pairs(const Bvh& tree, Skip skip, std::vector<Pair>& pairs) {
   pairs.clear();
   const auto& order = tree.order();
+  const auto& leaf = tree.leaf_boxes();
   detail::traverse(tree, tree, true, [&](const Bvh::Node& x, const Bvh::Node& y) {
     const bool same = &x == &y;
     for (std::uint32_t s = 0; s < x.count; ++s)
       for (std::uint32_t t = same ? s + 1 : 0; t < y.count; ++t) {
+        if (!overlap(leaf[x.first + s], leaf[y.first + t])) continue;
         std::uint32_t i = order[x.first + s], j = order[y.first + t];
         if (i > j) std::swap(i, j);
-        if (overlap(boxes[i], boxes[j]) && !skip(i, j)) pairs.push_back({i, j});
+        if (!skip(i, j)) pairs.push_back({i, j});
       }
   });
   detail::sort_unique(pairs);
