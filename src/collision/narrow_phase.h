@@ -1,0 +1,54 @@
+// narrow_phase.h — contacts between triangles of deformable surfaces
+// (issue 12, part 2: deformable against deformable, and self-collision):
+// for each candidate pair of the broad phase, every vertex of one triangle
+// against the other triangle and every edge against every edge, kept when
+// closer than the thickness. Closest points: kernels/math/proximity_math.h
+// (Ericson 2005, 5.1.5 and 5.1.9).
+//
+// Broad phase to narrow phase: boxes inflated by thickness / 2 on every
+// side overlap whenever two primitives are closer than the thickness (the
+// gap along any axis is at most the distance), so no contact is lost
+// between the two phases (tests/narrow_phase_test.cpp checks it against
+// all pairs of a real surface).
+//
+// Normals are two-sided, from the closest points (the second primitive
+// towards the first): right for thin tissue and for surfaces that have not
+// yet passed through each other; a vertex already deep inside another body
+// is pushed the way it is nearest to, which CCD (issue 13) prevents.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "collision/bvh.h"
+
+namespace sinew::collision {
+
+struct Contact {
+  enum class Kind : std::uint8_t { vertex_triangle, edge_edge };
+  Kind kind = Kind::vertex_triangle;
+  /// vertex_triangle: the vertex, then the triangle's three; edge_edge: the
+  /// first edge's two vertices, then the second's.
+  std::array<std::uint32_t, 4> v{};
+  /// The weights that place the two closest points on the primitives:
+  /// vertex_triangle (1, wa, wb, wc); edge_edge (1 - s, s, 1 - t, t).
+  std::array<float, 4> w{};
+  std::array<float, 3> normal{};  ///< unit, from the second primitive towards the first
+  float distance = 0.0f;          ///< between the closest points [m], < thickness
+};
+
+/// Contacts of the candidate triangle pairs `pairs` (indices into
+/// `triangles`, three vertex indices each, into `positions`, xyzw per
+/// vertex) closer than `thickness` [m] (> 0, finite). Vertex-triangle
+/// contacts skip a vertex of the triangle itself, edge-edge contacts skip
+/// edges that share a vertex; each (vertex, triangle) and each pair of
+/// edges appears once however many candidate pairs find it. [out]
+/// contacts, sorted by kind then vertices. Errors: a bad thickness, a
+/// non-finite position, a zero-area triangle in a pair (it has no normal to
+/// push along), each named.
+Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
+                         std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts);
+
+}  // namespace sinew::collision
