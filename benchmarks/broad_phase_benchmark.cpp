@@ -83,7 +83,7 @@ void BM_SelfBroadPhase(benchmark::State& state) {
     return;
   }
   const float inflate = 0.1f * s.mean_edge;  // a contact distance of a tenth of an edge
-  const SharesVertex skip{s.triangles, 3};
+  const SharesVertex skip{s.triangles};
   std::vector<float> x;
   std::vector<Aabb> boxes;
   deform(s, x, 0);

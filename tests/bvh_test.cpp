@@ -75,7 +75,7 @@ void expect_self_pairs_equal_brute_force(const Surface& s, float inflate, const 
   const std::vector<Aabb> boxes = boxes_of(s, inflate);
   Bvh tree;
   tree.build(boxes);
-  const SharesVertex skip{s.triangles, 3};
+  const SharesVertex skip{s.triangles};
   std::vector<Pair> fast, slow;
   self_overlapping_pairs(tree, skip, fast);
   brute_force_self_pairs(boxes, skip, slow);
@@ -133,7 +133,7 @@ TEST(Bvh, RefitAfterDeformationStillEqualsBruteForce) {
   ASSERT_TRUE(set);
   ASSERT_TRUE(set->build(boxes).ok());
 #endif
-  const SharesVertex skip{s.triangles, 3};
+  const SharesVertex skip{s.triangles};
   for (int step = 0; step < 3; ++step) {
     jiggle(s, 0.5f * s.mean_edge, rng);
     boxes = boxes_of(s, inflate);

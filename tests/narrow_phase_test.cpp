@@ -191,13 +191,13 @@ TEST(NarrowPhase, BroadThenNarrowEqualsNarrowOnEveryPair) {
   Bvh tree;
   tree.build(boxes);
   std::vector<Pair> candidates;
-  self_overlapping_pairs(tree, SharesVertex{tris, 3}, candidates);
+  self_overlapping_pairs(tree, SharesVertex{tris}, candidates);
   std::vector<Contact> fast;
   ASSERT_TRUE(triangle_contacts(x, tris, candidates, thickness, fast).ok());
 
   std::vector<Pair> every;
   const auto n = static_cast<std::uint32_t>(tri.triangles.size());
-  const SharesVertex shares{tris, 3};
+  const SharesVertex shares{tris};
   for (std::uint32_t i = 0; i < n; ++i)
     for (std::uint32_t j = i + 1; j < n; ++j)
       if (!shares(i, j)) every.push_back({i, j});
