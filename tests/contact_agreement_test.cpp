@@ -129,6 +129,15 @@ Surfaces contact_surfaces(std::mt19937& rng, bool friction) {
   e.half_y = 0.2f;
   e.half_z = 0.25f;
   add(e, {0.38, 0.28, 0.33});
+  // A cylinder, moving and turning (particles over its caps, its side and
+  // its rims, and inside it).
+  const Rigid cylinder{{2.0f, 0.5f, -2.0f}, random_rotation(rng)};
+  Rigid cylinder_end = moved(cylinder, 0.05f);
+  cylinder_end.q = blend(0.95, cylinder.q, 0.05, random_rotation(rng));
+  e = collider(SINEW_SHAPE_CYLINDER, cylinder, cylinder_end);
+  e.radius = 0.2f;
+  e.half_height = 0.15f;
+  add(e, {0.3, 0.3, 0.3});
   s.colliders = static_cast<std::uint32_t>(s.entries.size());
   // Tools: capsules, one moving and turning, one still.
   const Rigid tool{{0.0f, 0.5f, -2.0f}, random_rotation(rng)};

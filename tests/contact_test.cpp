@@ -122,6 +122,10 @@ double signed_distance(const ColliderDesc& c, const V3& p) {
       }
       return outside > 0 ? std::sqrt(outside) : inside;
     }
+    case ColliderShape::cylinder: {  // flat caps: the distance to the disc-capped solid, another way
+      const double dr = std::hypot(l[0], l[2]) - c.radius, dy = std::abs(l[1]) - c.half_height;
+      return dr > 0 && dy > 0 ? std::hypot(dr, dy) : std::max(dr, dy);
+    }
   }
   return 0;
 }
@@ -149,7 +153,17 @@ std::vector<ShapeCase> shape_cases() {
   box.half_extents = {0.1, 0.02, 0.08};
   box.position = {0, -0.02, 0};
   box.rotation = axis_angle({0, 1, 0}, 0.3);
-  return {{"plane", plane, 0.0}, {"sphere", sphere, 0.0}, {"capsule", capsule, 0.0}, {"box", box, 0.0}};
+  ColliderDesc standing;  // a cylinder on its cap, tilted about y (its top stays level)
+  standing.shape = ColliderShape::cylinder;
+  standing.radius = 0.05;
+  standing.half_height = 0.03;
+  standing.position = {0, -0.03, 0};
+  standing.rotation = axis_angle({0, 1, 0}, 0.4);
+  ColliderDesc lying = standing;  // on its side, along x: a curved top at y = 0
+  lying.position = {0, -0.05, 0};
+  lying.rotation = axis_angle({0, 0, 1}, kPi / 2);
+  return {{"plane", plane, 0.0},   {"sphere", sphere, 0.0},          {"capsule", capsule, 0.0},
+          {"box", box, 0.0},       {"cylinder on its cap", standing, 0.0}, {"cylinder on its side", lying, 0.0}};
 }
 
 TEST_P(Contact, ParticleDroppedOnEachColliderComesToRestOnIt) {
@@ -181,11 +195,13 @@ TEST_P(Contact, ParticleDroppedOnEachColliderComesToRestOnIt) {
 }
 
 TEST_P(Contact, BlockDroppedOnPlaneAndBoxComesToRest) {
-  // A 2 cm tet block dropped from 2 cm lands flat on a plane and on the
-  // (level) top face of a box collider: every vertex ends within 1e-5 m of
+  // A 2 cm tet block dropped from 2 cm lands flat on a plane, on the
+  // (level) top face of a box collider and on a standing cylinder's cap: every vertex ends within 1e-5 m of
   // the surface, none below -1e-5 m at any frame, and the block is at rest.
   for (const ShapeCase& c : shape_cases()) {
-    if (c.collider.shape != ColliderShape::plane && c.collider.shape != ColliderShape::box) continue;
+    const bool flat_top = c.collider.shape == ColliderShape::plane || c.collider.shape == ColliderShape::box ||
+                          (c.collider.shape == ColliderShape::cylinder && c.collider.position[1] == -c.collider.half_height);
+    if (!flat_top) continue;
     SCOPED_TRACE(c.name);
     SceneDesc scene;
     scene.solver = {.time_step = 1.0 / 60.0, .substeps = 4, .iterations = 4};
@@ -662,6 +678,16 @@ TEST_P(Contact, BadArgumentsAreErrorsNamingTheParameter) {
   auto state = sim.tool_state(2);
   ASSERT_FALSE(state.ok());
   EXPECT_NE(state.error().message().find("index 2"), std::string::npos) << state.error().message();
+  // A cylinder needs a radius and a height.
+  SceneDesc bad = scene;
+  bad.colliders[0].shape = ColliderShape::cylinder;
+  bad.colliders[0].radius = 0.1;
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].half_height"));
+  bad.colliders[0].half_height = 0.1;
+  bad.colliders[0].radius = -1.0;
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].radius"));
+  bad.colliders[0].radius = 0.1;
+  EXPECT_TRUE(check_scene(bad).ok());
   // Rejected calls change nothing; good ones still work.
   SINEW_ASSERT_OK(sim.set_collider_pose(0, {0, -0.5, 0}, {std::sqrt(0.5), 0, std::sqrt(0.5), 0}));
   SINEW_ASSERT_OK(sim.set_target(0, {1, 2, 3}));

@@ -149,8 +149,9 @@ struct TriBodyDesc {
 /// `rotation` (w, x, y, z). In the collider's frame: a plane is y = 0 with
 /// solid below (normal +y); a sphere has `radius`; a capsule is the segment
 /// from (0, -half_height, 0) to (0, +half_height, 0) swollen by `radius`; a
-/// box has `half_extents`.
-enum class ColliderShape { plane, sphere, capsule, box };
+/// box has `half_extents`; a cylinder has flat caps at y = +-half_height and
+/// `radius` about the y axis.
+enum class ColliderShape { plane, sphere, capsule, box, cylinder };
 
 /// A static or kinematic collider that every body's particles collide with,
 /// as xPBD contact constraints C = signed distance >= 0 with `compliance`
@@ -161,8 +162,8 @@ struct ColliderDesc {
   ColliderShape shape = ColliderShape::plane;
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< [m]
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
-  double radius = 0.0;                                  ///< sphere, capsule [m], > 0
-  double half_height = 0.0;                             ///< capsule [m], >= 0
+  double radius = 0.0;                                  ///< sphere, capsule, cylinder [m], > 0
+  double half_height = 0.0;                             ///< capsule [m], >= 0; cylinder [m], > 0
   std::array<double, 3> half_extents{0.0, 0.0, 0.0};    ///< box [m], > 0
   double static_friction = 0.5;                         ///< >= 0
   double dynamic_friction = 0.4;                        ///< >= 0, <= static_friction

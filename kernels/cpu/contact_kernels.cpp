@@ -76,6 +76,21 @@ SignedDistance collider_distance(const ColliderEntry& e, float4 local) {
       n[nearest] = p[nearest] < 0.0f ? -1.0f : 1.0f;
       return {q[nearest], {n[0], n[1], n[2], 0.0f}};
     }
+    case SINEW_SHAPE_CYLINDER: {
+      // Radial and axial excess: outside the side (dr > 0), the caps
+      // (dy > 0), both (the rim: the distance to the circle), or inside
+      // (the nearer of side and cap).
+      const float r = std::sqrt(local.x * local.x + local.z * local.z);
+      const float dr = r - e.radius, dy = std::abs(local.y) - e.half_height;
+      const float sy = local.y < 0.0f ? -1.0f : 1.0f;
+      const float ux = r > 0.0f ? local.x / r : 1.0f, uz = r > 0.0f ? local.z / r : 0.0f;
+      if (dr > 0.0f && dy > 0.0f) {
+        const float d = std::sqrt(dr * dr + dy * dy);
+        return {d, {dr * ux / d, dy * sy / d, dr * uz / d, 0.0f}};
+      }
+      if (dr > dy) return {dr, {ux, 0.0f, uz, 0.0f}};
+      return {dy, {0.0f, sy, 0.0f, 0.0f}};
+    }
     case SINEW_SHAPE_PLANE:
     default: return {local.y, {0.0f, 1.0f, 0.0f, 0.0f}};
   }

@@ -193,6 +193,29 @@ ContactDistance contact_collider_distance(ContactCollider e, float3 point) {
       sd.normal = make_float3(n[0], n[1], n[2]);
       return sd;
     }
+    case SINEW_SHAPE_CYLINDER: {
+      PRECISE float r = sqrt(point.x * point.x + point.z * point.z);
+      PRECISE float dr = r - e.radius;
+      PRECISE float dy = fabs(point.y) - e.half_height;
+      const float sy = point.y < 0.0f ? -1.0f : 1.0f;
+      PRECISE float ux = r > 0.0f ? point.x / r : 1.0f;
+      PRECISE float uz = r > 0.0f ? point.z / r : 0.0f;
+      if (dr > 0.0f && dy > 0.0f) {
+        PRECISE float d = sqrt(dr * dr + dy * dy);
+        PRECISE float3 nn = make_float3(dr * ux / d, dy * sy / d, dr * uz / d);
+        sd.distance = d;
+        sd.normal = nn;
+        return sd;
+      }
+      if (dr > dy) {
+        sd.distance = dr;
+        sd.normal = make_float3(ux, 0.0f, uz);
+        return sd;
+      }
+      sd.distance = dy;
+      sd.normal = make_float3(0.0f, sy, 0.0f);
+      return sd;
+    }
     case SINEW_SHAPE_PLANE:
     default:
       sd.distance = point.y;

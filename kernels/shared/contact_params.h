@@ -20,7 +20,8 @@
  *   plane   y = 0, solid below (normal +y);
  *   sphere  centre 0, `radius`;
  *   capsule segment (0, -half_height, 0)..(0, +half_height, 0) swollen by `radius`;
- *   box     |x| <= half_x, |y| <= half_y, |z| <= half_z.
+ *   box     |x| <= half_x, |y| <= half_y, |z| <= half_z;
+ *   cylinder x^2 + z^2 <= radius^2, |y| <= half_height (flat caps).
  *
  * ------------------------------------------------------------ xpbd_solve_contacts
  * arity 1: one constraint per movable particle, all in one colour (a particle
@@ -86,6 +87,7 @@
 #define SINEW_SHAPE_SPHERE 1u
 #define SINEW_SHAPE_CAPSULE 2u
 #define SINEW_SHAPE_BOX 3u
+#define SINEW_SHAPE_CYLINDER 4u
 
 #define SINEW_CONTACT_DATA_STRIDE 1
 #define SINEW_CONTACT_LAMBDA_PER_COLLIDER 4
@@ -106,8 +108,8 @@ SINEW_STRUCT_END(ColliderHeader)
 
 SINEW_STRUCT_BEGIN(ColliderEntry)
   uint shape;              /* SINEW_SHAPE_* */
-  float radius;            /* sphere, capsule [m] */
-  float half_height;       /* capsule [m] */
+  float radius;            /* sphere, capsule, cylinder [m] */
+  float half_height;       /* capsule, cylinder [m] */
   float compliance;        /* alpha of its contacts [m/N] */
   float half_x;            /* box half extents [m] */
   float half_y;

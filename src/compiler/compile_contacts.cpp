@@ -37,6 +37,7 @@ std::uint32_t shape_code(ColliderShape shape) {
     case ColliderShape::sphere: return SINEW_SHAPE_SPHERE;
     case ColliderShape::capsule: return SINEW_SHAPE_CAPSULE;
     case ColliderShape::box: return SINEW_SHAPE_BOX;
+    case ColliderShape::cylinder: return SINEW_SHAPE_CYLINDER;
   }
   return SINEW_SHAPE_PLANE;
 }

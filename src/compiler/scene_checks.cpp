@@ -177,6 +177,10 @@ Status check_collider(const ColliderDesc& c, const std::string& name) {
       if (Status s = positive(name + ".radius", c.radius); !s) return s;
       if (Status s = non_negative(name + ".half_height", c.half_height); !s) return s;
       break;
+    case ColliderShape::cylinder:
+      if (Status s = positive(name + ".radius", c.radius); !s) return s;
+      if (Status s = positive(name + ".half_height", c.half_height); !s) return s;
+      break;
     case ColliderShape::box:
       for (int k = 0; k < 3; ++k)
         if (Status s = positive(name + ".half_extents[" + std::to_string(k) + "]", c.half_extents[k]); !s) return s;
