@@ -214,5 +214,106 @@ TEST(NarrowPhase, BroadThenNarrowEqualsNarrowOnEveryPair) {
               candidates.size(), every.size(), fast.size());
 }
 
+// A thread: a random walk of `n` segments of ~1 cm that keeps turning back
+// on itself, so parts of it pass within the thickness of others.
+std::vector<float> random_thread(std::mt19937& rng, int n, std::array<float, 3> start, std::vector<std::uint32_t>& segments) {
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  std::vector<float> x = {start[0], start[1], start[2], 0.0f};
+  float dir[3] = {1, 0, 0};
+  for (int k = 0; k < n; ++k) {
+    for (float& d : dir) d = 0.6f * d + 0.8f * g(rng);
+    const float len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    const std::size_t last = x.size() - 4;
+    for (int a = 0; a < 3; ++a) x.push_back(x[last + std::size_t(a)] + 0.01f * dir[a] / len);
+    x.push_back(0.0f);
+    segments.insert(segments.end(), {std::uint32_t(k), std::uint32_t(k + 1)});
+  }
+  return x;
+}
+
+void expect_same_contacts(const std::vector<Contact>& fast, const std::vector<Contact>& slow, const char* what) {
+  ASSERT_EQ(fast.size(), slow.size()) << what;
+  for (std::size_t k = 0; k < fast.size(); ++k) {
+    ASSERT_EQ(fast[k].kind, slow[k].kind) << what << " " << k;
+    ASSERT_EQ(fast[k].v, slow[k].v) << what << " " << k;
+    ASSERT_EQ(fast[k].distance, slow[k].distance) << what << " " << k;
+  }
+}
+
+// A thread against itself: segment boxes inflated by thickness / 2,
+// neighbours (sharing a vertex) skipped, equal to every pair's contacts.
+TEST(NarrowPhase, ThreadAgainstItselfEqualsEveryPair) {
+  std::mt19937 rng(17);
+  std::vector<std::uint32_t> segs;
+  const std::vector<float> x = random_thread(rng, 600, {0, 0, 0}, segs);
+  const float thickness = 0.005f;
+  std::vector<Aabb> boxes;
+  ASSERT_TRUE(primitive_boxes(x, segs, 2, 0.5f * thickness, boxes).ok());
+  Bvh tree;
+  tree.build(boxes);
+  const SharesVertexOf<2> shares{segs};
+  std::vector<Pair> candidates, every;
+  self_overlapping_pairs(tree, shares, candidates);
+  for (std::uint32_t i = 0; i < boxes.size(); ++i)
+    for (std::uint32_t j = i + 1; j < boxes.size(); ++j)
+      if (!shares(i, j)) every.push_back({i, j});
+  std::vector<Contact> fast, slow;
+  ASSERT_TRUE(segment_contacts(x, segs, candidates, thickness, fast).ok());
+  ASSERT_TRUE(segment_contacts(x, segs, every, thickness, slow).ok());
+  expect_same_contacts(fast, slow, "thread self");
+  EXPECT_GT(fast.size(), 10u) << "the walk should pass near itself";
+  for (const Contact& c : fast) {
+    EXPECT_EQ(c.kind, Contact::Kind::edge_edge);
+    EXPECT_LT(c.distance, thickness);
+    EXPECT_NEAR(std::hypot(c.normal[0], c.normal[1], c.normal[2]), 1.0, 1e-5);
+  }
+  std::printf("[ narrow ] thread of 600 segments: %zu candidate pairs, %zu contacts\n", candidates.size(), fast.size());
+}
+
+// A thread lying across a surface (the armadillo's, scaled to ~10 cm):
+// segment-triangle contacts from the two trees equal every pair's.
+TEST(NarrowPhase, ThreadAgainstSurfaceEqualsEveryPair) {
+  auto mesh = read_tet_mesh(test::data_path("meshes/tet/armadillo_4k.node"));
+  ASSERT_TRUE(mesh.ok());
+  const TriMesh tri = extract_boundary_surface(*mesh);
+  double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
+  for (const auto& v : tri.vertices)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+  const double scale = 0.1 / (hi[0] - lo[0]);
+  std::mt19937 rng(23);
+  std::vector<std::uint32_t> segs, tris;
+  // The thread starts at the surface's middle, its vertices first in the
+  // position array, the surface's after them.
+  std::vector<float> x = random_thread(rng, 300, {0.05f, float(0.5 * (hi[1] - lo[1]) * scale), float(0.5 * (hi[2] - lo[2]) * scale)}, segs);
+  const auto offset = static_cast<std::uint32_t>(x.size() / 4);
+  for (const auto& v : tri.vertices)
+    x.insert(x.end(), {float((v[0] - lo[0]) * scale), float((v[1] - lo[1]) * scale), float((v[2] - lo[2]) * scale), 0.0f});
+  for (const auto& t : tri.triangles) tris.insert(tris.end(), {t[0] + offset, t[1] + offset, t[2] + offset});
+  const float thickness = 0.004f;
+  std::vector<Aabb> sb, tb;
+  ASSERT_TRUE(primitive_boxes(x, segs, 2, 0.5f * thickness, sb).ok());
+  ASSERT_TRUE(primitive_boxes(x, tris, 3, 0.5f * thickness, tb).ok());
+  Bvh st, tt;
+  st.build(sb);
+  tt.build(tb);
+  std::vector<Pair> candidates, every;
+  overlapping_pairs(st, tt, candidates);
+  for (std::uint32_t i = 0; i < sb.size(); ++i)
+    for (std::uint32_t j = 0; j < tb.size(); ++j) every.push_back({i, j});
+  std::vector<Contact> fast, slow;
+  ASSERT_TRUE(segment_triangle_contacts(x, segs, tris, candidates, thickness, fast).ok());
+  ASSERT_TRUE(segment_triangle_contacts(x, segs, tris, every, thickness, slow).ok());
+  expect_same_contacts(fast, slow, "thread on surface");
+  EXPECT_GT(fast.size(), 10u) << "the thread should pass near the surface";
+  std::printf("[ narrow ] thread of 300 segments on a %zu-triangle surface: %zu candidate pairs, %zu contacts\n",
+              tri.triangles.size(), candidates.size(), fast.size());
+  // Bad input: a NaN thread vertex is named by the first pair that reads it.
+  x[4 * 7 + 1] = NAN;
+  std::vector<Pair> with7 = {{6, 0}};
+  const Status named = segment_triangle_contacts(x, segs, tris, with7, thickness, fast);
+  ASSERT_FALSE(named.ok());
+  EXPECT_NE(named.error().message().find("segment 6: vertex 7"), std::string::npos) << named.error().message();
+}
+
 }  // namespace
 }  // namespace sinew::collision

@@ -36,92 +36,165 @@ std::array<float, 3> direction(float4 from, float4 to, float4 fallback) {
 
 }  // namespace
 
-Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
-                         std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
-  contacts.clear();
+namespace {
+
+Status check_thickness(float thickness) {
   if (!(thickness > 0.0f) || !std::isfinite(thickness))
     return Error(ErrorCode::bad_parameter,
                  "the collision thickness must be finite and > 0 [m] (got " + std::to_string(thickness) + ")");
-  const std::size_t vertices = positions.size() / 4, count = triangles.size() / 3;
-  const auto corners = [&](std::uint32_t t, std::array<std::uint32_t, 3>& v, float4 (&p)[3]) -> Status {
-    if (t >= count) return Error(ErrorCode::bad_parameter, "candidate pair names triangle " + std::to_string(t) + " of " + std::to_string(count));
-    for (int k = 0; k < 3; ++k) {
-      v[std::size_t(k)] = triangles[3 * std::size_t{t} + std::size_t(k)];
-      if (v[std::size_t(k)] >= vertices)
-        return Error(ErrorCode::bad_parameter, "triangle " + std::to_string(t) + " names vertex " + std::to_string(v[std::size_t(k)]) + " of " + std::to_string(vertices));
-      p[k] = vertex(positions, v[std::size_t(k)]);
-      if (!std::isfinite(p[k].x) || !std::isfinite(p[k].y) || !std::isfinite(p[k].z))
-        return Error(ErrorCode::bad_parameter, "triangle " + std::to_string(t) + ": vertex " + std::to_string(v[std::size_t(k)]) + " has a non-finite position");
-    }
-    if (length3(kernels::cross3(p[1] - p[0], p[2] - p[0])) <= 0.0f)
-      return Error(ErrorCode::bad_parameter, "triangle " + std::to_string(t) + " has zero area: a colliding triangle needs a normal");
-    return {};
-  };
-  for (const auto& [ti, tj] : pairs) {
-    std::array<std::uint32_t, 3> vi, vj;
-    float4 pi[3], pj[3];
-    if (Status s = corners(ti, vi, pi); !s) return s;
-    if (Status s = corners(tj, vj, pj); !s) return s;
-    // Vertices of each triangle against the other.
-    for (int side = 0; side < 2; ++side) {
-      const auto& va = side == 0 ? vi : vj;
-      const auto& vb = side == 0 ? vj : vi;
-      const float4* pa = side == 0 ? pi : pj;
-      const float4* pb = side == 0 ? pj : pi;
-      const float4 nb = face_normal(pb[0], pb[1], pb[2]);
-      for (int k = 0; k < 3; ++k) {
-        if (std::find(vb.begin(), vb.end(), va[std::size_t(k)]) != vb.end()) continue;
-        const auto w = px::closest_on_triangle(pa[k], pb[0], pb[1], pb[2]);
-        const float4 q = px::at(w, pb[0], pb[1], pb[2]);
-        const float d = length3(pa[k] - q);
-        if (d >= thickness) continue;
-        Contact c;
-        c.kind = Contact::Kind::vertex_triangle;
-        c.v = {va[std::size_t(k)], vb[0], vb[1], vb[2]};
-        c.w = {1.0f, w.wa, w.wb, w.wc};
-        c.normal = direction(q, pa[k], nb);
-        c.distance = d;
-        contacts.push_back(c);
-      }
-    }
-    // Edges against edges.
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        std::uint32_t e[4] = {vi[std::size_t(a)], vi[std::size_t((a + 1) % 3)], vj[std::size_t(b)], vj[std::size_t((b + 1) % 3)]};
-        if (e[0] == e[2] || e[0] == e[3] || e[1] == e[2] || e[1] == e[3]) continue;
-        // One orientation per edge (lower vertex first), so both triangles
-        // sharing an edge name it alike and duplicates collapse.
-        float4 p1 = pi[a], q1 = pi[(a + 1) % 3], p2 = pj[b], q2 = pj[(b + 1) % 3];
-        if (e[0] > e[1]) std::swap(e[0], e[1]), std::swap(p1, q1);
-        if (e[2] > e[3]) std::swap(e[2], e[3]), std::swap(p2, q2);
-        bool flip = false;  // the edge with the lower first vertex goes first
-        if (e[2] < e[0] || (e[2] == e[0] && e[3] < e[1])) {
-          std::swap(e[0], e[2]), std::swap(e[1], e[3]), std::swap(p1, p2), std::swap(q1, q2);
-          flip = true;
-        }
-        const auto st = px::closest_between_segments(p1, q1, p2, q2);
-        const float4 c1 = px::lerp3(p1, q1, st.s), c2 = px::lerp3(p2, q2, st.t);
-        const float d = length3(c1 - c2);
-        if (d >= thickness) continue;
-        float4 fallback = kernels::cross3(q1 - p1, q2 - p2);
-        const float fl = length3(fallback);
-        // Touching edges: their common normal; parallel and touching: the
-        // second edge's triangle's face normal.
-        fallback = fl > 0.0f ? (1.0f / fl) * fallback : face_normal(flip ? pi[0] : pj[0], flip ? pi[1] : pj[1], flip ? pi[2] : pj[2]);
-        Contact c;
-        c.kind = Contact::Kind::edge_edge;
-        c.v = {e[0], e[1], e[2], e[3]};
-        c.w = {1.0f - st.s, st.s, 1.0f - st.t, st.t};
-        c.normal = direction(c2, c1, fallback);
-        c.distance = d;
-        contacts.push_back(c);
-      }
+  return {};
+}
+
+// Reads primitive `t` (arity 2 or 3) of `indices`: its vertex indices and
+// positions, checked; triangles must have an area (a normal).
+Status corners(std::span<const float> positions, std::span<const std::uint32_t> indices, int arity, const char* kind,
+               std::uint32_t t, std::uint32_t (&v)[3], float4 (&p)[3]) {
+  const std::size_t vertices = positions.size() / 4, count = indices.size() / std::size_t(arity);
+  if (t >= count)
+    return Error(ErrorCode::bad_parameter, std::string("candidate pair names ") + kind + " " + std::to_string(t) +
+                                               " of " + std::to_string(count));
+  for (int k = 0; k < arity; ++k) {
+    v[k] = indices[std::size_t(arity) * t + std::size_t(k)];
+    if (v[k] >= vertices)
+      return Error(ErrorCode::bad_parameter, std::string(kind) + " " + std::to_string(t) + " names vertex " +
+                                                 std::to_string(v[k]) + " of " + std::to_string(vertices));
+    p[k] = vertex(positions, v[k]);
+    if (!std::isfinite(p[k].x) || !std::isfinite(p[k].y) || !std::isfinite(p[k].z))
+      return Error(ErrorCode::bad_parameter, std::string(kind) + " " + std::to_string(t) + ": vertex " +
+                                                 std::to_string(v[k]) + " has a non-finite position");
   }
-  // One contact per (vertex, triangle) and per pair of edges.
+  if (arity == 3 && length3(kernels::cross3(p[1] - p[0], p[2] - p[0])) <= 0.0f)
+    return Error(ErrorCode::bad_parameter,
+                 "triangle " + std::to_string(t) + " has zero area: a colliding triangle needs a normal");
+  return {};
+}
+
+// Vertex `vertex_id` at `p` against triangle (tv, tp): a contact if closer
+// than the thickness.
+void vertex_triangle(std::uint32_t vertex_id, float4 p, const std::uint32_t (&tv)[3], const float4 (&tp)[3],
+                     float thickness, std::vector<Contact>& contacts) {
+  const auto w = px::closest_on_triangle(p, tp[0], tp[1], tp[2]);
+  const float4 q = px::at(w, tp[0], tp[1], tp[2]);
+  const float d = length3(p - q);
+  if (d >= thickness) return;
+  Contact c;
+  c.kind = Contact::Kind::vertex_triangle;
+  c.v = {vertex_id, tv[0], tv[1], tv[2]};
+  c.w = {1.0f, w.wa, w.wb, w.wc};
+  c.normal = direction(q, p, face_normal(tp[0], tp[1], tp[2]));
+  c.distance = d;
+  contacts.push_back(c);
+}
+
+// Edge (e0, e1) at (p1, q1) against edge (e2, e3) at (p2, q2): a contact if
+// closer than the thickness and sharing no vertex. `face` is the normal to
+// fall back on when the edges touch and are parallel (zero for none: then
+// no contact, there is no direction to push along).
+void edge_edge(std::uint32_t e0, std::uint32_t e1, float4 p1, float4 q1, std::uint32_t e2, std::uint32_t e3,
+               float4 p2, float4 q2, float4 face, float thickness, std::vector<Contact>& contacts) {
+  if (e0 == e2 || e0 == e3 || e1 == e2 || e1 == e3) return;
+  // One orientation per edge (lower vertex first), so every primitive
+  // naming an edge names it alike and duplicates collapse.
+  if (e0 > e1) std::swap(e0, e1), std::swap(p1, q1);
+  if (e2 > e3) std::swap(e2, e3), std::swap(p2, q2);
+  const auto st = px::closest_between_segments(p1, q1, p2, q2);
+  const float4 c1 = px::lerp3(p1, q1, st.s), c2 = px::lerp3(p2, q2, st.t);
+  const float d = length3(c1 - c2);
+  if (d >= thickness) return;
+  float4 fallback = kernels::cross3(q1 - p1, q2 - p2);  // touching edges: their common normal
+  const float fl = length3(fallback);
+  fallback = fl > 0.0f ? (1.0f / fl) * fallback : face;
+  if (d <= 0.0f && length3(fallback) <= 0.0f) return;
+  Contact c;
+  c.kind = Contact::Kind::edge_edge;
+  c.v = {e0, e1, e2, e3};
+  c.w = {1.0f - st.s, st.s, 1.0f - st.t, st.t};
+  c.normal = direction(c2, c1, fallback);
+  c.distance = d;
+  contacts.push_back(c);
+}
+
+// One contact per (vertex, triangle) and per pair of edges, in a fixed order.
+void sort_unique(std::vector<Contact>& contacts) {
   const auto key = [](const Contact& c) { return std::tuple(c.kind, c.v[0], c.v[1], c.v[2], c.v[3]); };
   std::stable_sort(contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
-  contacts.erase(std::unique(contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) { return key(a) == key(b); }),
-                 contacts.end());
+  contacts.erase(
+      std::unique(contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) { return key(a) == key(b); }),
+      contacts.end());
+}
+
+bool contains(const std::uint32_t* v, int n, std::uint32_t x) { return std::find(v, v + n, x) != v + n; }
+
+}  // namespace
+
+Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
+                         std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
+  contacts.clear();
+  if (Status s = check_thickness(thickness); !s) return s;
+  for (const auto& [ti, tj] : pairs) {
+    std::uint32_t vi[3], vj[3];
+    float4 pi[3], pj[3];
+    if (Status s = corners(positions, triangles, 3, "triangle", ti, vi, pi); !s) return s;
+    if (Status s = corners(positions, triangles, 3, "triangle", tj, vj, pj); !s) return s;
+    for (int k = 0; k < 3; ++k) {
+      if (!contains(vj, 3, vi[k])) vertex_triangle(vi[k], pi[k], vj, pj, thickness, contacts);
+      if (!contains(vi, 3, vj[k])) vertex_triangle(vj[k], pj[k], vi, pi, thickness, contacts);
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        // The pair's edges ordered by vertex, so (edge of i, edge of j) and
+        // (edge of j, edge of i) make one contact; the face normal of the
+        // second edge's triangle is the fallback.
+        std::uint32_t a0 = vi[a], a1 = vi[(a + 1) % 3], b0 = vj[b], b1 = vj[(b + 1) % 3];
+        float4 pa0 = pi[a], pa1 = pi[(a + 1) % 3], pb0 = pj[b], pb1 = pj[(b + 1) % 3];
+        float4 face = face_normal(pj[0], pj[1], pj[2]);
+        if (std::min(b0, b1) < std::min(a0, a1) || (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1))) {
+          std::swap(a0, b0), std::swap(a1, b1), std::swap(pa0, pb0), std::swap(pa1, pb1);
+          face = face_normal(pi[0], pi[1], pi[2]);
+        }
+        edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, face, thickness, contacts);
+      }
+  }
+  sort_unique(contacts);
+  return {};
+}
+
+Status segment_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
+                        std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
+  contacts.clear();
+  if (Status s = check_thickness(thickness); !s) return s;
+  for (const auto& [si, sj] : pairs) {
+    std::uint32_t vi[3], vj[3];
+    float4 pi[3], pj[3];
+    if (Status s = corners(positions, segments, 2, "segment", si, vi, pi); !s) return s;
+    if (Status s = corners(positions, segments, 2, "segment", sj, vj, pj); !s) return s;
+    std::uint32_t a0 = vi[0], a1 = vi[1], b0 = vj[0], b1 = vj[1];
+    float4 pa0 = pi[0], pa1 = pi[1], pb0 = pj[0], pb1 = pj[1];
+    if (std::min(b0, b1) < std::min(a0, a1) || (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1)))
+      std::swap(a0, b0), std::swap(a1, b1), std::swap(pa0, pb0), std::swap(pa1, pb1);
+    edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, float4{0, 0, 0, 0}, thickness, contacts);
+  }
+  sort_unique(contacts);
+  return {};
+}
+
+Status segment_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
+                                 std::span<const std::uint32_t> triangles, std::span<const Pair> pairs,
+                                 float thickness, std::vector<Contact>& contacts) {
+  contacts.clear();
+  if (Status s = check_thickness(thickness); !s) return s;
+  for (const auto& [si, tj] : pairs) {
+    std::uint32_t vs[3], vt[3];
+    float4 ps[3], pt[3];
+    if (Status s = corners(positions, segments, 2, "segment", si, vs, ps); !s) return s;
+    if (Status s = corners(positions, triangles, 3, "triangle", tj, vt, pt); !s) return s;
+    for (int k = 0; k < 2; ++k)
+      if (!contains(vt, 3, vs[k])) vertex_triangle(vs[k], ps[k], vt, pt, thickness, contacts);
+    const float4 face = face_normal(pt[0], pt[1], pt[2]);
+    for (int b = 0; b < 3; ++b)
+      edge_edge(vs[0], vs[1], ps[0], ps[1], vt[b], vt[(b + 1) % 3], pt[b], pt[(b + 1) % 3], face, thickness, contacts);
+  }
+  sort_unique(contacts);
   return {};
 }
 

@@ -51,4 +51,21 @@ struct Contact {
 Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
                          std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts);
 
+/// Contacts of candidate segment pairs (indices into `segments`, two vertex
+/// indices each) closer than `thickness` [m]: edge-edge contacts between
+/// segments that share no vertex (a thread against itself or another line
+/// mesh). Each pair of segments appears once. [out] contacts, sorted. Errors:
+/// a bad thickness, a non-finite position or a bad index, named.
+Status segment_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
+                        std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts);
+
+/// Contacts of candidate (segment, triangle) pairs closer than `thickness`:
+/// each segment end against the triangle (vertex_triangle, the segment's
+/// vertex first) and the segment against each triangle edge (edge_edge, the
+/// segment first), skipping what shares a vertex (a thread attached to the
+/// surface at a vertex). [out] contacts, sorted. Errors as triangle_contacts.
+Status segment_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
+                                 std::span<const std::uint32_t> triangles, std::span<const Pair> pairs,
+                                 float thickness, std::vector<Contact>& contacts);
+
 }  // namespace sinew::collision
