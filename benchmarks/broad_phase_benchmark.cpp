@@ -7,6 +7,7 @@
 //   Reference/rebuild  collision::Bvh build + self traversal
 //   Embree/refit       Embree refit + rtcCollide + exact re-test
 //   Embree/rebuild     Embree build + rtcCollide + exact re-test
+//   Parallel/refit     collision::Bvh refit + the TBB self query (unsorted)
 // Each counts the boxes' computation too, and reports the pairs found.
 //   bench_broad_phase --benchmark_out=broad.csv --benchmark_out_format=csv
 #include <benchmark/benchmark.h>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "collision/bvh.h"
+#include "collision/parallel_pairs.h"
 #if SINEW_HAS_EMBREE
 #include "collision/embree_broad_phase.h"
 #endif
@@ -73,7 +75,7 @@ void deform(const Surface& s, std::vector<float>& x, int frame) {
   }
 }
 
-enum Variant { kReferenceRefit, kReferenceRebuild, kEmbreeRefit, kEmbreeRebuild };
+enum Variant { kReferenceRefit, kReferenceRebuild, kEmbreeRefit, kEmbreeRebuild, kParallelRefit };
 
 void BM_SelfBroadPhase(benchmark::State& state) {
   const Surface& s = surface(int(state.range(0)));
@@ -99,7 +101,7 @@ void BM_SelfBroadPhase(benchmark::State& state) {
   auto& set = *made;
   (void)set->build(boxes);
 #else
-  if (variant >= kEmbreeRefit) {
+  if (variant == kEmbreeRefit || variant == kEmbreeRebuild) {
     state.SkipWithError("built without Embree");
     return;
   }
@@ -112,7 +114,8 @@ void BM_SelfBroadPhase(benchmark::State& state) {
     state.ResumeTiming();
     (void)primitive_boxes(x, s.triangles, 3, inflate, boxes);
     switch (variant) {
-      case kReferenceRefit: tree.refit(boxes); break;
+      case kReferenceRefit:
+      case kParallelRefit: tree.refit(boxes); break;
       case kReferenceRebuild: tree.build(boxes); break;
 #if SINEW_HAS_EMBREE
       case kEmbreeRefit: (void)set->refit(boxes); break;
@@ -123,6 +126,8 @@ void BM_SelfBroadPhase(benchmark::State& state) {
     }
     if (variant <= kReferenceRebuild) {
       self_overlapping_pairs(tree, skip, pairs);
+    } else if (variant == kParallelRefit) {
+      self_overlapping_pairs_parallel(tree, skip, pairs);
     } else {
 #if SINEW_HAS_EMBREE
       (void)embree_self_pairs(*set, skip, pairs);
@@ -130,14 +135,15 @@ void BM_SelfBroadPhase(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(pairs.data());
   }
-  static const char* names[] = {"reference refit", "reference rebuild", "Embree refit", "Embree rebuild"};
+  static const char* names[] = {"reference refit", "reference rebuild", "Embree refit", "Embree rebuild",
+                                "parallel refit (TBB, unsorted)"};
   state.SetLabel(std::string(state.range(0) == 0 ? "kidney_57k" : "liver_382k") + " surface, " + names[variant]);
   state.counters["triangles"] = double(s.triangles.size() / 3);
   state.counters["pairs"] = double(pairs.size());
 }
 
 BENCHMARK(BM_SelfBroadPhase)
-    ->ArgsProduct({{0, 1}, {kReferenceRefit, kReferenceRebuild, kEmbreeRefit, kEmbreeRebuild}})
+    ->ArgsProduct({{0, 1}, {kReferenceRefit, kReferenceRebuild, kEmbreeRefit, kEmbreeRebuild, kParallelRefit}})
     ->ArgNames({"mesh", "variant"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

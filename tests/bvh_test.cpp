@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "collision/bvh.h"
+#include "collision/parallel_pairs.h"
 #if SINEW_HAS_EMBREE
 #include "collision/embree_broad_phase.h"
 #endif
@@ -80,6 +81,10 @@ void expect_self_pairs_equal_brute_force(const Surface& s, float inflate, const 
   self_overlapping_pairs(tree, skip, fast);
   brute_force_self_pairs(boxes, skip, slow);
   EXPECT_EQ(fast, slow) << what << ": " << fast.size() << " BVH pairs, " << slow.size() << " brute force";
+  std::vector<Pair> parallel;
+  self_overlapping_pairs_parallel(tree, skip, parallel);
+  std::sort(parallel.begin(), parallel.end());
+  EXPECT_EQ(parallel, slow) << what << ": the parallel query";
 #if SINEW_HAS_EMBREE
   auto set = embree_set();
   ASSERT_TRUE(set);
@@ -231,6 +236,10 @@ TEST(Bvh, RandomAndDegenerateBoxesEqualBruteForce) {
     self_overlapping_pairs(ta, none, fast);
     brute_force_self_pairs(a, none, slow);
     ASSERT_EQ(fast, slow) << "self, round " << round << ", " << n << " boxes";
+    std::vector<Pair> parallel;
+    self_overlapping_pairs_parallel(ta, none, parallel);
+    std::sort(parallel.begin(), parallel.end());
+    ASSERT_EQ(parallel, slow) << "parallel self, round " << round;
 #if SINEW_HAS_EMBREE
     auto ea = embree_set(), eb = embree_set();
     ASSERT_TRUE(ea && eb);

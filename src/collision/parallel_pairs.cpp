@@ -1,0 +1,47 @@
+// parallel_pairs.cpp — the task split and the TBB loop of the parallel
+// self-pair query (see parallel_pairs.h).
+#include "collision/parallel_pairs.h"
+
+#include <tbb/parallel_for.h>
+
+namespace sinew::collision::detail {
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree, std::size_t wanted) {
+  // Expand the self traversal breadth-first until there are enough tasks:
+  // (n, n) becomes its children with themselves and with each other; a
+  // cross pair becomes its children against the other side (after the
+  // same overlap test the traversal makes, so no task is empty for a reason
+  // the traversal would not skip).
+  const auto& nodes = tree.nodes();
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> tasks{{0, 0}}, next;
+  while (tasks.size() < wanted) {
+    next.clear();
+    bool split = false;
+    for (const auto& [a, b] : tasks) {
+      const Bvh::Node& x = nodes[a];
+      const Bvh::Node& y = nodes[b];
+      if (a == b && x.count == 0) {
+        next.push_back({x.left, x.left});
+        next.push_back({x.left + 1, x.left + 1});
+        next.push_back({x.left, x.left + 1});
+        split = true;
+      } else if (a != b && x.count == 0 && y.count == 0) {
+        if (!overlap(x.box, y.box)) continue;  // the traversal would stop here too
+        next.push_back({x.left, b});
+        next.push_back({x.left + 1, b});
+        split = true;
+      } else {
+        next.push_back({a, b});
+      }
+    }
+    tasks.swap(next);
+    if (!split) break;
+  }
+  return tasks;
+}
+
+void run_tasks(std::size_t count, void (*work)(void*, std::size_t), void* context) {
+  tbb::parallel_for(std::size_t{0}, count, [&](std::size_t k) { work(context, k); });
+}
+
+}  // namespace sinew::collision::detail
