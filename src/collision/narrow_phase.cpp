@@ -6,6 +6,8 @@
 #include <string>
 #include <tuple>
 
+#include <tbb/parallel_for.h>
+
 #include "math/proximity_math.h"
 
 namespace sinew::collision {
@@ -71,8 +73,31 @@ Status corners(std::span<const float> positions, std::span<const std::uint32_t> 
 
 // Vertex `vertex_id` at `p` against triangle (tv, tp): a contact if closer
 // than the thickness.
+// Whether p is farther than `gap` from the box of the points along an axis
+// (then it is farther than `gap` from anything they span): a quick reject
+// before the closest-point queries.
+bool outside_box(float4 p, const float4* q, int n, float gap) {
+  const float c[3] = {p.x, p.y, p.z};
+  for (int a = 0; a < 3; ++a) {
+    float lo = (&q[0].x)[a], hi = lo;
+    for (int k = 1; k < n; ++k) lo = std::min(lo, (&q[k].x)[a]), hi = std::max(hi, (&q[k].x)[a]);
+    if (c[a] < lo - gap || c[a] > hi + gap) return true;
+  }
+  return false;
+}
+
+// Whether the boxes of two segments are farther apart than `gap` along an axis.
+bool apart(float4 p1, float4 q1, float4 p2, float4 q2, float gap) {
+  for (int a = 0; a < 3; ++a) {
+    const float a0 = (&p1.x)[a], a1 = (&q1.x)[a], b0 = (&p2.x)[a], b1 = (&q2.x)[a];
+    if (std::max(a0, a1) + gap < std::min(b0, b1) || std::max(b0, b1) + gap < std::min(a0, a1)) return true;
+  }
+  return false;
+}
+
 void vertex_triangle(std::uint32_t vertex_id, float4 p, const std::uint32_t (&tv)[3], const float4 (&tp)[3],
                      float thickness, std::vector<Contact>& contacts) {
+  if (outside_box(p, tp, 3, thickness)) return;
   const auto w = px::closest_on_triangle(p, tp[0], tp[1], tp[2]);
   const float4 q = px::at(w, tp[0], tp[1], tp[2]);
   const float d = length3(p - q);
@@ -93,6 +118,7 @@ void vertex_triangle(std::uint32_t vertex_id, float4 p, const std::uint32_t (&tv
 void edge_edge(std::uint32_t e0, std::uint32_t e1, float4 p1, float4 q1, std::uint32_t e2, std::uint32_t e3,
                float4 p2, float4 q2, float4 face, float thickness, std::vector<Contact>& contacts) {
   if (e0 == e2 || e0 == e3 || e1 == e2 || e1 == e3) return;
+  if (apart(p1, q1, p2, q2, thickness)) return;
   // One orientation per edge (lower vertex first), so every primitive
   // naming an edge names it alike and duplicates collapse.
   if (e0 > e1) std::swap(e0, e1), std::swap(p1, q1);
@@ -127,19 +153,49 @@ bool contains(const std::uint32_t* v, int n, std::uint32_t x) { return std::find
 
 }  // namespace
 
+// The pairs in chunks of kChunk on TBB's threads, each chunk's contacts in
+// its own list; joined and deduplicated, so the result is the same on any
+// thread count; the first error in pair order is returned. (The liver
+// surface's 105,000 candidate pairs: ~85 ms on one thread.)
+constexpr std::size_t kChunk = 1024;
+
+template <class PerPair>
+Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, PerPair per_pair) {
+  const std::size_t chunks = (pairs + kChunk - 1) / kChunk;
+  std::vector<std::vector<Contact>> found(chunks);
+  std::vector<Status> errors(chunks);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    for (std::size_t k = c * kChunk; k < std::min(pairs, (c + 1) * kChunk); ++k)
+      if (Status s = per_pair(k, found[c]); !s) {
+        errors[c] = s;
+        return;
+      }
+  });
+  for (const Status& e : errors)
+    if (!e) return e;
+  std::size_t total = 0;
+  for (const auto& f : found) total += f.size();
+  contacts.reserve(total);
+  for (const auto& f : found) contacts.insert(contacts.end(), f.begin(), f.end());
+  sort_unique(contacts);
+  return {};
+}
+
 Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
                          std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
   contacts.clear();
   if (Status s = check_thickness(thickness); !s) return s;
-  for (const auto& [ti, tj] : pairs) {
+  return in_chunks(pairs.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+    const auto [ti, tj] = pairs[k];
     std::uint32_t vi[3], vj[3];
     float4 pi[3], pj[3];
     if (Status s = corners(positions, triangles, 3, "triangle", ti, vi, pi); !s) return s;
     if (Status s = corners(positions, triangles, 3, "triangle", tj, vj, pj); !s) return s;
-    for (int k = 0; k < 3; ++k) {
-      if (!contains(vj, 3, vi[k])) vertex_triangle(vi[k], pi[k], vj, pj, thickness, contacts);
-      if (!contains(vi, 3, vj[k])) vertex_triangle(vj[k], pj[k], vi, pi, thickness, contacts);
+    for (int c = 0; c < 3; ++c) {
+      if (!contains(vj, 3, vi[c])) vertex_triangle(vi[c], pi[c], vj, pj, thickness, out);
+      if (!contains(vi, 3, vj[c])) vertex_triangle(vj[c], pj[c], vi, pi, thickness, out);
     }
+    const float4 ni = face_normal(pi[0], pi[1], pi[2]), nj = face_normal(pj[0], pj[1], pj[2]);
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
         // The pair's edges ordered by vertex, so (edge of i, edge of j) and
@@ -147,16 +203,15 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
         // second edge's triangle is the fallback.
         std::uint32_t a0 = vi[a], a1 = vi[(a + 1) % 3], b0 = vj[b], b1 = vj[(b + 1) % 3];
         float4 pa0 = pi[a], pa1 = pi[(a + 1) % 3], pb0 = pj[b], pb1 = pj[(b + 1) % 3];
-        float4 face = face_normal(pj[0], pj[1], pj[2]);
+        float4 face = nj;
         if (std::min(b0, b1) < std::min(a0, a1) || (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1))) {
           std::swap(a0, b0), std::swap(a1, b1), std::swap(pa0, pb0), std::swap(pa1, pb1);
-          face = face_normal(pi[0], pi[1], pi[2]);
+          face = ni;
         }
-        edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, face, thickness, contacts);
+        edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, face, thickness, out);
       }
-  }
-  sort_unique(contacts);
-  return {};
+    return {};
+  });
 }
 
 Status segment_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
