@@ -1,4 +1,7 @@
-// narrow_phase.cpp — triangle-pair contacts (see narrow_phase.h).
+// narrow_phase.cpp — contacts of candidate triangle, segment and
+// segment-triangle pairs (see narrow_phase.h): per pair, vertex-triangle
+// and edge-edge closest points (kernels/math/proximity_math.h), after a box
+// reject; pairs in chunks on TBB's threads, joined and deduplicated.
 #include "collision/narrow_phase.h"
 
 #include <algorithm>
@@ -35,10 +38,6 @@ std::array<float, 3> direction(float4 from, float4 to, float4 fallback) {
   const float4 n = len > 0.0f ? (1.0f / len) * d : fallback;
   return {n.x, n.y, n.z};
 }
-
-}  // namespace
-
-namespace {
 
 Status check_thickness(float thickness) {
   if (!(thickness > 0.0f) || !std::isfinite(thickness))
@@ -151,8 +150,6 @@ void sort_unique(std::vector<Contact>& contacts) {
 
 bool contains(const std::uint32_t* v, int n, std::uint32_t x) { return std::find(v, v + n, x) != v + n; }
 
-}  // namespace
-
 // The pairs in chunks of kChunk on TBB's threads, each chunk's contacts in
 // its own list; joined and deduplicated, so the result is the same on any
 // thread count; the first error in pair order is returned. (The liver
@@ -180,6 +177,8 @@ Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, PerPair per_
   sort_unique(contacts);
   return {};
 }
+
+}  // namespace
 
 Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
                          std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
@@ -218,7 +217,8 @@ Status segment_contacts(std::span<const float> positions, std::span<const std::u
                         std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
   contacts.clear();
   if (Status s = check_thickness(thickness); !s) return s;
-  for (const auto& [si, sj] : pairs) {
+  return in_chunks(pairs.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+    const auto [si, sj] = pairs[k];
     std::uint32_t vi[3], vj[3];
     float4 pi[3], pj[3];
     if (Status s = corners(positions, segments, 2, "segment", si, vi, pi); !s) return s;
@@ -227,10 +227,9 @@ Status segment_contacts(std::span<const float> positions, std::span<const std::u
     float4 pa0 = pi[0], pa1 = pi[1], pb0 = pj[0], pb1 = pj[1];
     if (std::min(b0, b1) < std::min(a0, a1) || (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1)))
       std::swap(a0, b0), std::swap(a1, b1), std::swap(pa0, pb0), std::swap(pa1, pb1);
-    edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, float4{0, 0, 0, 0}, thickness, contacts);
-  }
-  sort_unique(contacts);
-  return {};
+    edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, float4{0, 0, 0, 0}, thickness, out);
+    return {};
+  });
 }
 
 Status segment_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
@@ -238,19 +237,19 @@ Status segment_triangle_contacts(std::span<const float> positions, std::span<con
                                  float thickness, std::vector<Contact>& contacts) {
   contacts.clear();
   if (Status s = check_thickness(thickness); !s) return s;
-  for (const auto& [si, tj] : pairs) {
+  return in_chunks(pairs.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+    const auto [si, tj] = pairs[k];
     std::uint32_t vs[3], vt[3];
     float4 ps[3], pt[3];
     if (Status s = corners(positions, segments, 2, "segment", si, vs, ps); !s) return s;
     if (Status s = corners(positions, triangles, 3, "triangle", tj, vt, pt); !s) return s;
-    for (int k = 0; k < 2; ++k)
-      if (!contains(vt, 3, vs[k])) vertex_triangle(vs[k], ps[k], vt, pt, thickness, contacts);
+    for (int c = 0; c < 2; ++c)
+      if (!contains(vt, 3, vs[c])) vertex_triangle(vs[c], ps[c], vt, pt, thickness, out);
     const float4 face = face_normal(pt[0], pt[1], pt[2]);
     for (int b = 0; b < 3; ++b)
-      edge_edge(vs[0], vs[1], ps[0], ps[1], vt[b], vt[(b + 1) % 3], pt[b], pt[(b + 1) % 3], face, thickness, contacts);
-  }
-  sort_unique(contacts);
-  return {};
+      edge_edge(vs[0], vs[1], ps[0], ps[1], vt[b], vt[(b + 1) % 3], pt[b], pt[(b + 1) % 3], face, thickness, out);
+    return {};
+  });
 }
 
 }  // namespace sinew::collision
