@@ -1,7 +1,8 @@
 // proximity_math.h — closest points between a point and a triangle and
 // between two segments: the narrow phase of mesh collision (issue 12),
-// written once for the CPU kernels (float), the double oracle's checks in
-// the tests, and the GPU kernels' twins.
+// templated on the scalar: float in the CPU narrow phase
+// (src/collision/narrow_phase.cpp), double in the tests. The GPU narrow
+// phase does not exist yet; its kernels must round like this code.
 //
 // Ericson, "Real-Time Collision Detection", Morgan Kaufmann 2005:
 // section 5.1.5 (closest point on a triangle by Voronoi regions, the
