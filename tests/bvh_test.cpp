@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -162,6 +163,46 @@ TEST(Bvh, RefitAfterDeformationStillEqualsBruteForce) {
       ASSERT_LE(root.lo[k], b.lo[k]);
       ASSERT_GE(root.hi[k], b.hi[k]);
     }
+}
+
+// update() refits while the tree stays good and rebuilds when refitting
+// has let it degrade: the armadillo surface bent a little keeps its tree;
+// the same surface with its vertices shuffled (every triangle now spans the
+// body) rebuilds, and the pairs stay those of the brute force.
+TEST(Bvh, UpdateRebuildsOnlyWhenTheTreeDegrades) {
+  std::mt19937 rng(29);
+  Surface s = surface_of("meshes/tet/armadillo_4k.node");
+  ASSERT_FALSE(s.triangles.empty());
+  const float inflate = 0.1f * s.mean_edge;
+  std::vector<Aabb> boxes = boxes_of(s, inflate);
+  Bvh tree;
+  tree.build(boxes);
+  jiggle(s, 0.1f * s.mean_edge, rng);
+  boxes = boxes_of(s, inflate);
+  EXPECT_FALSE(tree.update(boxes)) << "a small deformation: refit only (degradation " << tree.degradation() << ")";
+  // Shuffle the vertices' positions: the surface's triangles become long
+  // slivers across the organ, the old tree's boxes overlap everywhere.
+  std::vector<std::size_t> perm(s.positions.size() / 4);
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), rng);
+  std::vector<float> shuffled(s.positions.size());
+  for (std::size_t v = 0; v < perm.size(); ++v)
+    for (int k = 0; k < 4; ++k) shuffled[4 * v + std::size_t(k)] = s.positions[4 * perm[v] + std::size_t(k)];
+  s.positions = shuffled;
+  boxes = boxes_of(s, inflate);
+  Bvh refitted = tree;
+  refitted.refit(boxes);
+  EXPECT_GT(refitted.degradation(), 2.0);
+  EXPECT_TRUE(tree.update(boxes)) << "a scrambled surface: rebuilt";
+  EXPECT_LE(tree.degradation(), 1.0 + 1e-12);
+  std::vector<Pair> a, b, c;
+  const SharesVertex skip{s.triangles};
+  self_overlapping_pairs(tree, skip, a);
+  self_overlapping_pairs(refitted, skip, b);
+  brute_force_self_pairs(boxes, skip, c);
+  EXPECT_EQ(a, c);
+  EXPECT_EQ(b, c) << "a degraded tree is slow, never wrong";
+  EXPECT_GE(tree.cost(), 1.0);
 }
 
 TEST(Bvh, PairsBetweenTwoSurfacesEqualBruteForce) {

@@ -121,6 +121,13 @@ double Bvh::cost() const {
   return root > 0.0 ? sum / root : double(nodes_.size());
 }
 
+bool Bvh::update(std::span<const Aabb> boxes, double max_degradation) {
+  refit(boxes);
+  if (degradation() <= max_degradation) return false;
+  build(boxes);
+  return true;
+}
+
 double Bvh::degradation() const { return built_cost_ > 0.0 ? cost() / built_cost_ : 1.0; }
 
 namespace detail {
