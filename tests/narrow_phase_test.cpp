@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -126,6 +127,38 @@ TEST(Proximity, SegmentSegmentMatchesTheOracle) {
     const double got = norm(px::lerp3(p1, q1, st.s) - px::lerp3(p2, q2, st.t));
     const double want = segment_segment(p1, q1, p2, q2);
     ASSERT_NEAR(got, want, 1e-9 * (1.0 + want)) << "case " << n;
+  }
+}
+
+// Segment against triangle: against an oracle that samples the segment
+// (2,001 points, each against the triangle by the point oracle): the query
+// is never farther than the samples' best and at most one sample spacing
+// nearer; crossing segments give 0.
+TEST(Proximity, SegmentTriangleMatchesTheOracle) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int n = 0; n < 3000; ++n) {
+    double4 a = random_point(rng), b = random_point(rng), c = random_point(rng);
+    double4 p = random_point(rng, 1.5), q = random_point(rng, 1.5);
+    if (n % 4 == 1) {  // through the triangle
+      const double w0 = 0.2 + 0.2 * u(rng);
+      const double4 x = px::at<double>({w0, 0.3, 0.7 - w0}, a, b, c);
+      const double4 dir = random_point(rng);
+      p = kernels::add_scaled3(x, -u(rng), dir), q = kernels::add_scaled3(x, u(rng), dir);
+    }
+    if (n % 4 == 2) q = kernels::add_scaled3(p, 1.0, b - a);  // parallel to an edge
+    const auto r = px::closest_segment_triangle(p, q, a, b, c);
+    ASSERT_NEAR(r.w.wa + r.w.wb + r.w.wc, 1.0, 1e-12);
+    const double got = norm(px::lerp3(p, q, r.s) - px::at(r.w, a, b, c));
+    double sampled = 1e30;
+    const int samples = 2000;
+    for (int k = 0; k <= samples; ++k) sampled = std::min(sampled, point_triangle(px::lerp3(p, q, double(k) / samples), a, b, c));
+    const double spacing = norm(q - p) / samples;
+    ASSERT_LE(got, sampled + 1e-9) << "case " << n;
+    ASSERT_GE(got, sampled - spacing - 1e-9) << "case " << n;
+    if (n % 4 == 1) {
+      ASSERT_LT(got, 1e-9) << "crossing, case " << n;
+    }
   }
 }
 
@@ -313,6 +346,64 @@ TEST(NarrowPhase, ThreadAgainstSurfaceEqualsEveryPair) {
   const Status named = segment_triangle_contacts(x, segs, tris, with7, thickness, fast);
   ASSERT_FALSE(named.ok());
   EXPECT_NE(named.error().message().find("segment 6: vertex 7"), std::string::npos) << named.error().message();
+}
+
+// A capsule lying 2 mm above the top of a block's surface: contacts with
+// the top triangles under it, gap 2 mm, pushing down; the BVH's candidates
+// (triangle boxes and the capsule's, inflated) give exactly the contacts of
+// all triangles; bad radius and axis are named.
+TEST(NarrowPhase, CapsuleOverASurface) {
+  auto grid = make_tet_grid({.nx = 10, .ny = 2, .nz = 10, .origin = {0, 0, 0}, .cell_size = {0.01, 0.01, 0.01}});
+  ASSERT_TRUE(grid.ok());
+  const TriMesh tri = extract_boundary_surface(*grid);
+  std::vector<float> x;
+  std::vector<std::uint32_t> tris;
+  for (const auto& v : tri.vertices) x.insert(x.end(), {float(v[0]), float(v[1]), float(v[2]), 0.0f});
+  for (const auto& t : tri.triangles) tris.insert(tris.end(), t.begin(), t.end());
+  const float radius = 0.003f, thickness = 0.004f, top = 0.02f;
+  const std::array<float, 4> p0{0.02f, top + 0.005f, 0.05f, 0.0f}, p1{0.08f, top + 0.005f, 0.05f, 0.0f};
+  std::vector<Aabb> boxes;
+  ASSERT_TRUE(primitive_boxes(x, tris, 3, 0.5f * thickness, boxes).ok());
+  Bvh tree;
+  tree.build(boxes);
+  const float grow = radius + 0.5f * thickness;
+  std::vector<Aabb> capsule = {{{std::min(p0[0], p1[0]) - grow, std::min(p0[1], p1[1]) - grow, std::min(p0[2], p1[2]) - grow},
+                                {std::max(p0[0], p1[0]) + grow, std::max(p0[1], p1[1]) + grow, std::max(p0[2], p1[2]) + grow}}};
+  Bvh capsule_tree;
+  capsule_tree.build(capsule);
+  std::vector<Pair> pairs;
+  overlapping_pairs(tree, capsule_tree, pairs);
+  std::vector<std::uint32_t> candidates, all(tri.triangles.size());
+  for (const auto& [t, c] : pairs) candidates.push_back(t);
+  std::iota(all.begin(), all.end(), 0u);
+  std::vector<Contact> fast, slow;
+  ASSERT_TRUE(capsule_triangle_contacts(x, tris, candidates, p0, p1, radius, thickness, fast).ok());
+  ASSERT_TRUE(capsule_triangle_contacts(x, tris, all, p0, p1, radius, thickness, slow).ok());
+  expect_same_contacts(fast, slow, "capsule");
+  ASSERT_GT(fast.size(), 10u);
+  int under = 0;
+  for (const Contact& c : fast) {
+    EXPECT_EQ(c.kind, Contact::Kind::capsule_triangle);
+    EXPECT_LT(c.distance, thickness);
+    EXPECT_GE(c.distance, 0.002f - 1e-6f) << "nothing is closer than the top face";
+    if (std::abs(c.distance - 0.002f) < 1e-5f) {
+      ++under;
+      EXPECT_NEAR(c.normal[1], -1.0f, 1e-5f) << "pushes the top face down";
+    }
+  }
+  EXPECT_GE(under, 20) << "the triangles right under the axis";
+  const Status bad_radius = capsule_triangle_contacts(x, tris, all, p0, p1, 0.0f, thickness, fast);
+  ASSERT_FALSE(bad_radius.ok());
+  EXPECT_NE(bad_radius.error().message().find("radius"), std::string::npos);
+  const std::array<float, 4> nan_end{NAN, 0, 0, 0};
+  EXPECT_FALSE(capsule_triangle_contacts(x, tris, all, p0, nan_end, radius, thickness, fast).ok());
+  // Pressed 1 mm into the surface: negative gaps.
+  std::array<float, 4> q0 = p0, q1 = p1;
+  q0[1] = q1[1] = top + radius - 0.001f;
+  ASSERT_TRUE(capsule_triangle_contacts(x, tris, all, q0, q1, radius, thickness, fast).ok());
+  float deepest = 1.0f;
+  for (const Contact& c : fast) deepest = std::min(deepest, c.distance);
+  EXPECT_NEAR(deepest, -0.001f, 1e-5f);
 }
 
 }  // namespace

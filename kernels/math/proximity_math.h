@@ -141,4 +141,51 @@ inline vec4<T> at(const Barycentric<T>& w, vec4<T> a, vec4<T> b, vec4<T> c) {
           w.wa * a.z + w.wb * b.z + w.wc * c.z, T(0)};
 }
 
+/// The closest points of segment (p, q) and triangle (a, b, c): the
+/// parameter s on the segment and the triangle's barycentric weights.
+/// Candidates (Ericson 5.1.10's approach): the segment's ends against the
+/// triangle, the segment against the triangle's three edges, and the
+/// point where the segment crosses the triangle (distance 0), if it does.
+template <class T>
+struct SegmentTriangle {
+  T s;
+  Barycentric<T> w;
+};
+
+template <class T>
+inline SegmentTriangle<T> closest_segment_triangle(vec4<T> p, vec4<T> q, vec4<T> a, vec4<T> b, vec4<T> c) {
+  // The crossing: p + s (q - p) on the triangle's plane, inside it.
+  const vec4<T> n = cross3(b - a, c - a), d = q - p;
+  const T nd = dot3(n, d);
+  if (nd != T(0)) {
+    const T s = dot3(n, a - p) / nd;
+    if (s >= T(0) && s <= T(1)) {  // inside the triangle: barycentric weights by signed areas
+      const vec4<T> x = add_scaled3(p, s, d);
+      const T n2 = dot3(n, n);
+      const T u = dot3(cross3(c - b, x - b), n) / n2, v = dot3(cross3(a - c, x - c), n) / n2;
+      const T w = T(1) - u - v;
+      if (u >= T(0) && v >= T(0) && w >= T(0)) return {s, {u, v, w}};
+    }
+  }
+  SegmentTriangle<T> best{T(0), closest_on_triangle(p, a, b, c)};
+  T best_d2 = distance2(p, at(best.w, a, b, c));
+  const auto wq = closest_on_triangle(q, a, b, c);
+  if (const T d2 = distance2(q, at(wq, a, b, c)); d2 < best_d2) best = {T(1), wq}, best_d2 = d2;
+  const vec4<T> corner[3] = {a, b, c};
+  for (int e = 0; e < 3; ++e) {
+    const vec4<T> e0 = corner[e], e1 = corner[(e + 1) % 3];
+    const auto st = closest_between_segments(p, q, e0, e1);
+    const T d2 = distance2(add_scaled3(p, st.s, d), add_scaled3(e0, st.t, e1 - e0));
+    if (d2 < best_d2) {
+      Barycentric<T> w{T(0), T(0), T(0)};
+      T* weights[3] = {&w.wa, &w.wb, &w.wc};
+      *weights[e] = T(1) - st.t;
+      *weights[(e + 1) % 3] = st.t;
+      best = {st.s, w};
+      best_d2 = d2;
+    }
+  }
+  return best;
+}
+
 }  // namespace sinew::kernels::proximity

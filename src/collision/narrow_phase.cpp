@@ -252,4 +252,40 @@ Status segment_triangle_contacts(std::span<const float> positions, std::span<con
   });
 }
 
+Status capsule_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
+                                 std::span<const std::uint32_t> candidates, const std::array<float, 4>& p0,
+                                 const std::array<float, 4>& p1, float radius, float thickness,
+                                 std::vector<Contact>& contacts) {
+  contacts.clear();
+  if (Status s = check_thickness(thickness); !s) return s;
+  if (!(radius > 0.0f) || !std::isfinite(radius))
+    return Error(ErrorCode::bad_parameter, "the capsule's radius must be finite and > 0 [m] (got " + std::to_string(radius) + ")");
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(p0[std::size_t(k)]) || !std::isfinite(p1[std::size_t(k)]))
+      return Error(ErrorCode::bad_parameter, "the capsule's axis has a non-finite coordinate");
+  const float4 a{p0[0], p0[1], p0[2], 0.0f}, b{p1[0], p1[1], p1[2], 0.0f};
+  return in_chunks(candidates.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+    const std::uint32_t t = candidates[k];
+    std::uint32_t v[3];
+    float4 p[3];
+    if (Status s = corners(positions, triangles, 3, "triangle", t, v, p); !s) return s;
+    const auto r = px::closest_segment_triangle(a, b, p[0], p[1], p[2]);
+    const float4 on_axis = px::lerp3(a, b, r.s), on_triangle = px::at(r.w, p[0], p[1], p[2]);
+    const float gap = length3(on_triangle - on_axis) - radius;
+    if (gap >= thickness) return {};
+    Contact c;
+    c.kind = Contact::Kind::capsule_triangle;
+    c.v = {0, v[0], v[1], v[2]};
+    c.w = {r.s, r.w.wa, r.w.wb, r.w.wc};
+    // The axis crossing the triangle: push along the face normal, to the
+    // side the capsule's centre is not on.
+    float4 face = face_normal(p[0], p[1], p[2]);
+    if (kernels::dot3(face, px::lerp3(a, b, 0.5f) - p[0]) > 0.0f) face = -1.0f * face;
+    c.normal = direction(on_axis, on_triangle, face);
+    c.distance = gap;
+    out.push_back(c);
+    return {};
+  });
+}
+
 }  // namespace sinew::collision

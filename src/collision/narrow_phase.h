@@ -27,16 +27,24 @@
 namespace sinew::collision {
 
 struct Contact {
-  enum class Kind : std::uint8_t { vertex_triangle, edge_edge };
+  enum class Kind : std::uint8_t { vertex_triangle, edge_edge, capsule_triangle };
   Kind kind = Kind::vertex_triangle;
   /// vertex_triangle: the vertex, then the triangle's three; edge_edge: the
-  /// first edge's two vertices, then the second's.
+  /// first edge's two vertices, then the second's; capsule_triangle: the
+  /// capsule's index (0 for a single one), then the triangle's three.
   std::array<std::uint32_t, 4> v{};
   /// The weights that place the two closest points on the primitives:
-  /// vertex_triangle (1, wa, wb, wc); edge_edge (1 - s, s, 1 - t, t).
+  /// vertex_triangle (1, wa, wb, wc); edge_edge (1 - s, s, 1 - t, t);
+  /// capsule_triangle (s along the capsule's axis, wa, wb, wc).
   std::array<float, 4> w{};
-  std::array<float, 3> normal{};  ///< unit, from the second primitive towards the first
-  float distance = 0.0f;          ///< between the closest points [m], < thickness
+  /// Unit, from the second primitive towards the first; capsule_triangle:
+  /// from the capsule's axis towards the triangle (the way the tissue is
+  /// pushed).
+  std::array<float, 3> normal{};
+  /// Between the closest points [m], < thickness; capsule_triangle: the gap
+  /// between the capsule's surface and the triangle, negative when the
+  /// triangle reaches inside the capsule.
+  float distance = 0.0f;
 };
 
 /// Contacts of the candidate triangle pairs `pairs` (indices into
@@ -67,5 +75,18 @@ Status segment_contacts(std::span<const float> positions, std::span<const std::u
 Status segment_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
                                  std::span<const std::uint32_t> triangles, std::span<const Pair> pairs,
                                  float thickness, std::vector<Contact>& contacts);
+
+/// A capsule (axis from `p0` to `p1`, xyzw, and `radius` [m] > 0) against
+/// the candidate triangles `candidates` (indices into `triangles`): one
+/// capsule_triangle contact per triangle whose gap to the capsule's surface
+/// is below `thickness` (closest points by proximity::closest_segment_triangle).
+/// A tool's faces against tissue faces, where a tool's contacts with the
+/// tissue's vertices alone let its vertices slip past (README, heavy tool).
+/// [out] contacts, sorted by triangle. Errors as triangle_contacts, and a
+/// bad radius or a non-finite axis, named.
+Status capsule_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
+                                 std::span<const std::uint32_t> candidates, const std::array<float, 4>& p0,
+                                 const std::array<float, 4>& p1, float radius, float thickness,
+                                 std::vector<Contact>& contacts);
 
 }  // namespace sinew::collision
