@@ -114,13 +114,13 @@ using SharesVertex = SharesVertexOf<3>;
 // ---- templates
 
 namespace detail {
-// Visits every pair of leaves whose boxes overlap, within one tree
-// (self = true: each unordered pair of distinct leaves once, and every leaf
-// with itself) or across two.
+// Visits every pair of leaves whose boxes overlap, from the node pair
+// (i, j): within one tree (self = true, a == b: node i with itself visits
+// each unordered pair of its distinct leaves once and every leaf with
+// itself) or across two.
 template <class Visit>
-void traverse(const Bvh& a, const Bvh& b, bool self, Visit visit) {
-  if (a.empty() || b.empty()) return;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0, 0}};
+void traverse_from(const Bvh& a, const Bvh& b, bool self, std::uint32_t i0, std::uint32_t j0, Visit visit) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{i0, j0}};
   const auto& na = a.nodes();
   const auto& nb = b.nodes();
   while (!stack.empty()) {
@@ -149,6 +149,13 @@ void traverse(const Bvh& a, const Bvh& b, bool self, Visit visit) {
       stack.push_back({i, y.left + 1});
     }
   }
+}
+
+// The whole traversal, from the roots.
+template <class Visit>
+void traverse(const Bvh& a, const Bvh& b, bool self, Visit visit) {
+  if (a.empty() || b.empty()) return;
+  traverse_from(a, b, self, 0, 0, visit);
 }
 
 void sort_unique(std::vector<Pair>& pairs);

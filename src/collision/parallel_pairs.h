@@ -30,37 +30,6 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree,
 // Runs work(k) for k in [0, count) on TBB's threads.
 void run_tasks(std::size_t count, void (*work)(void*, std::size_t), void* context);
 
-template <class Visit>
-void traverse_from(const Bvh& tree, std::uint32_t i, std::uint32_t j, Visit visit) {
-  const auto& nodes = tree.nodes();
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{i, j}};
-  while (!stack.empty()) {
-    const auto [a, b] = stack.back();
-    stack.pop_back();
-    const Bvh::Node& x = nodes[a];
-    const Bvh::Node& y = nodes[b];
-    if (a == b) {
-      if (x.count > 0) {
-        visit(x, x);
-        continue;
-      }
-      stack.push_back({x.left, x.left});
-      stack.push_back({x.left + 1, x.left + 1});
-      stack.push_back({x.left, x.left + 1});
-      continue;
-    }
-    if (!overlap(x.box, y.box)) continue;
-    if (x.count > 0 && y.count > 0) {
-      visit(x, y);
-    } else if (y.count > 0 || (x.count == 0 && half_area(x.box) >= half_area(y.box))) {
-      stack.push_back({x.left, b});
-      stack.push_back({x.left + 1, b});
-    } else {
-      stack.push_back({a, y.left});
-      stack.push_back({a, y.left + 1});
-    }
-  }
-}
 }  // namespace detail
 
 template <class Skip>
@@ -81,7 +50,7 @@ void self_overlapping_pairs_parallel(const Bvh& tree, Skip skip, std::vector<Pai
     const auto& leaf = ctx.tree->leaf_boxes();
     std::vector<Pair>& out = (*ctx.found)[k];
     const auto [i, j] = (*ctx.tasks)[k];
-    detail::traverse_from(*ctx.tree, i, j, [&](const Bvh::Node& x, const Bvh::Node& y) {
+    detail::traverse_from(*ctx.tree, *ctx.tree, true, i, j, [&](const Bvh::Node& x, const Bvh::Node& y) {
       const bool same = &x == &y;
       for (std::uint32_t s = 0; s < x.count; ++s)
         for (std::uint32_t t = same ? s + 1 : 0; t < y.count; ++t) {
