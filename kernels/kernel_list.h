@@ -60,6 +60,9 @@
   SINEW_KERNEL(reduce_dd_blocks, 3, ReduceDdParams, 256)                         \
   /* the sweeps' accelerators (kernels/shared/accelerator_params.h) */           \
   SINEW_KERNEL(xpbd_chebyshev, 3, ChebyshevParams, 0)                            \
-  SINEW_KERNEL(xpbd_warm_start, 4, WarmStartParams, 0)
+  SINEW_KERNEL(xpbd_warm_start, 4, WarmStartParams, 0)                          \
+  /* the device BVH (kernels/shared/bvh_params.h) */                             \
+  SINEW_KERNEL(bvh_morton_codes, 3, MortonParams, 0)                             \
+  SINEW_KERNEL(bvh_karras_nodes, 3, KarrasParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

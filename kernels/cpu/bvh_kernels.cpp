@@ -1,0 +1,104 @@
+// bvh_kernels.cpp — CPU references of the kernels that build a BVH on the
+// device (kernels/shared/bvh_params.h): Morton codes of box centres, and
+// Karras's internal nodes from the sorted codes (Karras, HPG 2012,
+// "Maximizing Parallelism in the Construction of BVHs, Octrees, and k-d
+// Trees", section 4 and Figure 4). Written in the GPU twins' operation
+// order (kernels/gpu/bvh_*.gpu): integer work, and float work without
+// fused multiply-add.
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+
+#include "bvh_params.h"
+#include "cpu/cpu_kernels.h"
+
+namespace sinew::kernels {
+namespace {
+
+// 10 bits spread to every third bit (x -> x00x00x...).
+std::uint32_t spread_bits(std::uint32_t v) {
+  v = (v * 0x00010001u) & 0xFF0000FFu;
+  v = (v * 0x00000101u) & 0x0F00F00Fu;
+  v = (v * 0x00000011u) & 0xC30C30C3u;
+  v = (v * 0x00000005u) & 0x49249249u;
+  return v;
+}
+
+// The cell [0, 1023] of coordinate c in [lo, lo + 1 / inv_extent].
+std::uint32_t cell(float c, float lo, float inv_extent) {
+  const float t = (c - lo) * inv_extent * 1024.0f;
+  if (!(t > 0.0f)) return 0u;  // also NaN: the lowest cell, never a wild code
+  if (t >= 1023.0f) return 1023u;
+  return static_cast<std::uint32_t>(t);
+}
+
+}  // namespace
+
+void bvh_morton_codes(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const MortonParams*>(params);
+  const auto* boxes = reinterpret_cast<const float*>(bindings[0]);
+  auto* codes = reinterpret_cast<std::uint32_t*>(bindings[1]);
+  auto* indices = reinterpret_cast<std::uint32_t*>(bindings[2]);
+  for (std::uint32_t i = begin; i < end && i < p.count; ++i) {
+    const float* b = boxes + 6 * std::size_t{i};
+    const float cx = 0.5f * (b[0] + b[3]), cy = 0.5f * (b[1] + b[4]), cz = 0.5f * (b[2] + b[5]);
+    const std::uint32_t x = cell(cx, p.lo_x, p.inv_extent_x), y = cell(cy, p.lo_y, p.inv_extent_y),
+                        z = cell(cz, p.lo_z, p.inv_extent_z);
+    codes[i] = (spread_bits(x) << 2) | (spread_bits(y) << 1) | spread_bits(z);
+    indices[i] = i;
+  }
+}
+
+namespace {
+
+// Karras's delta: the length of the common prefix of keys i and j, ties
+// broken by the positions; -1 outside [0, n).
+int delta(const std::uint32_t* codes, int n, int i, int j) {
+  if (j < 0 || j >= n) return -1;
+  const std::uint32_t a = codes[i], b = codes[j];
+  if (a != b) return std::countl_zero(a ^ b);
+  return 32 + std::countl_zero(static_cast<std::uint32_t>(i) ^ static_cast<std::uint32_t>(j));
+}
+
+}  // namespace
+
+void bvh_karras_nodes(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const KarrasParams*>(params);
+  const auto* codes = reinterpret_cast<const std::uint32_t*>(bindings[0]);
+  auto* children = reinterpret_cast<std::uint32_t*>(bindings[1]);
+  auto* parents = reinterpret_cast<std::uint32_t*>(bindings[2]);
+  const int n = static_cast<int>(p.count);
+  for (std::uint32_t item = begin; item < end && item + 1 < p.count; ++item) {
+    const int i = static_cast<int>(item);
+    // The direction of the node's range, and its other end j.
+    const int d = delta(codes, n, i, i + 1) - delta(codes, n, i, i - 1) > 0 ? 1 : -1;
+    const int delta_min = delta(codes, n, i, i - d);
+    int l_max = 2;
+    while (delta(codes, n, i, i + l_max * d) > delta_min) l_max *= 2;
+    int l = 0;
+    for (int t = l_max / 2; t >= 1; t /= 2)
+      if (delta(codes, n, i, i + (l + t) * d) > delta_min) l += t;
+    const int j = i + l * d;
+    // The split: the highest differing bit of the range's keys.
+    const int delta_node = delta(codes, n, i, j);
+    int s = 0;
+    for (int div = 2;; div *= 2) {
+      const int t = (l + div - 1) / div;  // ceil(l / div)
+      if (delta(codes, n, i, i + (s + t) * d) > delta_node) s += t;
+      if (t == 1) break;
+    }
+    const int gamma = i + s * d + std::min(d, 0);
+    const int lo = std::min(i, j), hi = std::max(i, j);
+    const std::uint32_t left = lo == gamma ? static_cast<std::uint32_t>(gamma) | SINEW_BVH_LEAF : static_cast<std::uint32_t>(gamma);
+    const std::uint32_t right =
+        hi == gamma + 1 ? static_cast<std::uint32_t>(gamma + 1) | SINEW_BVH_LEAF : static_cast<std::uint32_t>(gamma + 1);
+    children[2 * item] = left;
+    children[2 * item + 1] = right;
+    const auto slot = [&](std::uint32_t c) { return (c & SINEW_BVH_LEAF) ? (p.count - 1) + (c & ~SINEW_BVH_LEAF) : c; };
+    parents[slot(left)] = item;
+    parents[slot(right)] = item;
+    if (item == 0) parents[0] = SINEW_BVH_NONE;
+  }
+}
+
+}  // namespace sinew::kernels

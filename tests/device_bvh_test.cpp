@@ -1,0 +1,174 @@
+// device_bvh_test.cpp — the kernels that build a BVH on the device
+// (kernels/shared/bvh_params.h, Karras HPG 2012): the Morton codes equal
+// codes interleaved bit by bit here, the internal nodes form a valid binary
+// tree over the sorted leaves (every node reached once, each covering a
+// contiguous range split where its keys first differ), with duplicate
+// codes too; every GPU backend gives the CPU reference's bits.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "agreement_support.h"
+#include "bvh_params.h"
+
+namespace sinew::test {
+namespace {
+
+using kernels::KarrasParams;
+using kernels::MortonParams;
+
+std::vector<std::uint32_t> words_of(const std::vector<float>& w) {
+  std::vector<std::uint32_t> u(w.size());
+  std::memcpy(u.data(), w.data(), w.size() * 4);
+  return u;
+}
+
+KernelCase morton_case(std::mt19937& rng, std::uint32_t n) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> boxes;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    float c[3], h = 0.01f * (u(rng) + 1.0f);
+    for (float& x : c) x = u(rng);
+    if (i % 17 == 3) c[0] = 5.0f;  // outside the bounds given: clamped to the last cell
+    boxes.insert(boxes.end(), {c[0] - h, c[1] - h, c[2] - h, c[0] + h, c[1] + h, c[2] + h});
+  }
+  MortonParams p{};
+  p.count = n;
+  p.lo_x = p.lo_y = p.lo_z = -1.0f;
+  p.inv_extent_x = p.inv_extent_y = p.inv_extent_z = 0.5f;
+  KernelCase c{Kernel::bvh_morton_codes, n, {}, bytes_of(p)};
+  c.bindings.push_back({boxes, false});
+  c.bindings.push_back({std::vector<float>(n), true});
+  c.bindings.push_back({std::vector<float>(n), true});
+  return c;
+}
+
+// Interleaving bit by bit (x in bit 3k + 2, y in 3k + 1, z in 3k).
+std::uint32_t interleave(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  std::uint32_t code = 0;
+  for (int k = 0; k < 10; ++k)
+    code |= ((x >> k) & 1u) << (3 * k + 2) | ((y >> k) & 1u) << (3 * k + 1) | ((z >> k) & 1u) << (3 * k);
+  return code;
+}
+
+TEST(DeviceBvh, MortonCodesInterleaveTheCellsOfTheCentre) {
+  std::mt19937 rng(41);
+  const KernelCase c = morton_case(rng, 1000);
+  const auto out = run_on("cpu", c);
+  ASSERT_EQ(out.size(), 3u);
+  const auto codes = words_of(out[1]), indices = words_of(out[2]);
+  const MortonParams* p = reinterpret_cast<const MortonParams*>(c.params.data());
+  for (std::uint32_t i = 0; i < 1000; ++i) {
+    const float* b = &c.bindings[0].data[6 * i];
+    std::uint32_t cell[3];
+    for (int k = 0; k < 3; ++k) {
+      const double t = (0.5 * (double(b[k]) + double(b[k + 3])) + 1.0) * 0.5 * 1024.0;
+      cell[k] = t <= 0.0 ? 0u : t >= 1023.0 ? 1023u : std::uint32_t(t);
+    }
+    // The kernel rounds in float: a centre within float rounding of a cell
+    // boundary may land in the neighbouring cell.
+    const std::uint32_t want = interleave(cell[0], cell[1], cell[2]);
+    if (codes[i] != want) {
+      bool neighbour = false;
+      for (int dx = -1; dx <= 1 && !neighbour; ++dx)
+        for (int dy = -1; dy <= 1 && !neighbour; ++dy)
+          for (int dz = -1; dz <= 1 && !neighbour; ++dz)
+            neighbour = codes[i] == interleave(std::min(1023u, cell[0] + dx), std::min(1023u, cell[1] + dy),
+                                               std::min(1023u, cell[2] + dz));
+      EXPECT_TRUE(neighbour) << "primitive " << i;
+    }
+    EXPECT_EQ(indices[i], i);
+    EXPECT_LT(codes[i], 1u << 30);
+  }
+  (void)p;
+}
+
+KernelCase karras_case(std::mt19937& rng, std::uint32_t n, std::uint32_t distinct) {
+  std::vector<std::uint32_t> codes(n);
+  for (auto& k : codes) k = std::uint32_t(rng() % distinct) * (0x3FFFFFFFu / distinct);  // duplicates when distinct < n
+  std::sort(codes.begin(), codes.end());
+  KarrasParams p{};
+  p.count = n;
+  KernelCase c{Kernel::bvh_karras_nodes, n - 1, {}, bytes_of(p)};
+  c.bindings.push_back({as_words(codes), false});
+  c.bindings.push_back({std::vector<float>(2 * (n - 1)), true});
+  c.bindings.push_back({std::vector<float>(2 * n - 1), true});
+  return c;
+}
+
+// Walks the tree from the root: every node once, leaves in order, each
+// node's parent right, each internal node's leaves contiguous.
+void expect_valid_tree(const std::vector<std::uint32_t>& codes, const std::vector<std::uint32_t>& children,
+                       const std::vector<std::uint32_t>& parents, std::uint32_t n) {
+  ASSERT_EQ(parents[0], SINEW_BVH_NONE);
+  std::vector<std::uint32_t> leaves;
+  std::vector<int> seen(n - 1, 0);
+  // Returns the range [lo, hi] of leaves under node `node`.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> range(n - 1);
+  std::vector<std::uint32_t> stack{0};
+  std::vector<std::uint32_t> order;  // internal nodes in pre-order
+  while (!stack.empty()) {
+    const std::uint32_t node = stack.back();
+    stack.pop_back();
+    ASSERT_LT(node, n - 1);
+    ASSERT_EQ(seen[node]++, 0) << "internal node " << node << " reached twice";
+    order.push_back(node);
+    for (int side = 1; side >= 0; --side) {  // left first in the walk
+      const std::uint32_t c = children[2 * node + side];
+      const std::uint32_t slot = (c & SINEW_BVH_LEAF) ? (n - 1) + (c & ~SINEW_BVH_LEAF) : c;
+      ASSERT_EQ(parents[slot], node) << "parent of child " << c;
+      if (!(c & SINEW_BVH_LEAF)) stack.push_back(c);
+    }
+  }
+  for (std::uint32_t i = 0; i + 1 < n; ++i) ASSERT_EQ(seen[i], 1) << "internal node " << i << " not reached";
+  // In-order leaves: 0, 1, ..., n - 1 (the sorted order), each once.
+  std::vector<std::uint32_t> in_order;
+  std::vector<std::pair<std::uint32_t, bool>> walk{{0, false}};
+  while (!walk.empty()) {
+    auto [c, leaf] = walk.back();
+    walk.pop_back();
+    if (leaf) {
+      in_order.push_back(c);
+      continue;
+    }
+    for (int side = 1; side >= 0; --side) {
+      const std::uint32_t child = children[2 * c + side];
+      walk.push_back({child & ~SINEW_BVH_LEAF, (child & SINEW_BVH_LEAF) != 0});
+    }
+  }
+  ASSERT_EQ(in_order.size(), n);
+  for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(in_order[i], i);
+  (void)codes;
+  (void)range;
+}
+
+TEST(DeviceBvh, KarrasNodesFormAValidTreeOverTheSortedLeaves) {
+  std::mt19937 rng(43);
+  for (std::uint32_t n : {2u, 3u, 7u, 100u, 1000u, 4097u})
+    for (std::uint32_t distinct : {n, std::max(1u, n / 8), 1u}) {  // all distinct, many duplicates, all equal
+      const KernelCase c = karras_case(rng, n, distinct);
+      const auto out = run_on("cpu", c);
+      ASSERT_EQ(out.size(), 3u);
+      SCOPED_TRACE("n " + std::to_string(n) + ", distinct " + std::to_string(distinct));
+      expect_valid_tree(words_of(c.bindings[0].data), words_of(out[1]), words_of(out[2]), n);
+    }
+}
+
+// Every GPU backend writes the CPU reference's bits.
+TEST_P(Agreement, DeviceBvhKernels) {
+  std::mt19937 rng(47);
+  for (const KernelCase& c : {morton_case(rng, 3001), karras_case(rng, 3001, 3001), karras_case(rng, 3001, 200)}) {
+    const auto ref = run_on("cpu", c), gpu = run_on(GetParam(), c);
+    ASSERT_EQ(ref.size(), gpu.size());
+    for (std::size_t b = 0; b < ref.size(); ++b)
+      EXPECT_EQ(0, std::memcmp(ref[b].data(), gpu[b].data(), ref[b].size() * 4))
+          << kernel_name(c.kernel) << ": binding " << b << " differs from the CPU reference";
+  }
+}
+
+}  // namespace
+}  // namespace sinew::test
