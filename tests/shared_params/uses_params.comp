@@ -5,6 +5,8 @@
 #include "contact_params.h"
 #include "fem_params.h"
 #include "thin_params.h"
+#include "accelerator_params.h"
+#include "bvh_params.h"
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { SolveParams p; };
 layout(std430, binding = 0) buffer Positions { vec4 x[]; };
