@@ -14,6 +14,9 @@
 
 #include "agreement_support.h"
 #include "bvh_params.h"
+#include "collision/device_bvh.h"
+#include "program/primitives.h"
+#include "test_support.h"
 
 namespace sinew::test {
 namespace {
@@ -168,6 +171,93 @@ TEST_P(Agreement, DeviceBvhKernels) {
       EXPECT_EQ(0, std::memcmp(ref[b].data(), gpu[b].data(), ref[b].size() * 4))
           << kernel_name(c.kernel) << ": binding " << b << " differs from the CPU reference";
   }
+}
+
+struct BuiltBvh {
+  std::vector<std::uint32_t> codes, indices, children, parents;
+};
+
+// The whole build on one backend: boxes in, sorted codes, leaf order and
+// the tree out.
+BuiltBvh build_on(const std::string& backend, const std::vector<float>& boxes, std::uint32_t n) {
+  BuiltBvh r;
+  auto made = create_device({.backend = backend, .quiet = true});
+  EXPECT_TRUE(made.ok()) << made.error().message();
+  if (!made.ok()) return r;
+  Device& device = **made;
+  auto bvh = collision::make_device_bvh(device, n + 5);  // a little spare capacity
+  EXPECT_TRUE(bvh.ok());
+  if (!bvh.ok()) return r;
+  EXPECT_TRUE(device.write_buffer(bvh->boxes, 0, boxes.data(), boxes.size() * 4).ok());
+  FrameProgram program;
+  EXPECT_TRUE(collision::append_device_bvh_build(program, *bvh, n, {-1, -1, -1}, {1, 1, 1}).ok());
+  auto prepared = device.create_program(program);
+  EXPECT_TRUE(prepared.ok()) << (prepared.ok() ? "" : prepared.error().message());
+  if (!prepared.ok()) return r;
+  EXPECT_TRUE(device.run_program(*prepared).ok());
+  const auto read = [&](BufferHandle b, std::size_t words) {
+    std::vector<std::uint32_t> w(words);
+    EXPECT_TRUE(device.read_buffer(b, 0, w.data(), words * 4).ok());
+    return w;
+  };
+  r.codes = read(bvh->codes, n);
+  r.indices = read(bvh->indices, n);
+  r.children = read(bvh->children, 2 * (n - 1));
+  r.parents = read(bvh->parents, 2 * n - 1);
+  return r;
+}
+
+// The assembled build (Morton codes, radix sort, Karras nodes) gives a
+// valid tree whose leaves are the primitives sorted by code, and every
+// backend gives the CPU's bits. Bad sizes and bounds are named errors.
+TEST(DeviceBvh, BuildOnEveryBackendGivesOneValidTree) {
+  std::mt19937 rng(53);
+  const std::uint32_t n = 5000;
+  const KernelCase m = morton_case(rng, n);  // the boxes (some centres outside the bounds)
+  const std::vector<float>& boxes = m.bindings[0].data;
+  const auto reference_codes = words_of(run_on("cpu", m)[1]);
+  BuiltBvh cpu;
+  for (const std::string& backend : backends()) {
+    if (const std::string why = missing_device(backend); !why.empty()) {
+      std::printf("[ skipped ] %s: %s\n", backend.c_str(), why.c_str());
+      continue;
+    }
+    SCOPED_TRACE(backend);
+    const BuiltBvh r = build_on(backend, boxes, n);
+    ASSERT_EQ(r.codes.size(), n);
+    // The leaves: a permutation of the primitives, sorted by code, stable.
+    std::vector<std::uint32_t> seen(n, 0);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      ASSERT_LT(r.indices[i], n);
+      ++seen[r.indices[i]];
+      ASSERT_EQ(r.codes[i], reference_codes[r.indices[i]]);
+      if (i > 0) {
+        ASSERT_LE(r.codes[i - 1], r.codes[i]);
+        if (r.codes[i - 1] == r.codes[i]) {
+          ASSERT_LT(r.indices[i - 1], r.indices[i]) << "the sort is stable";
+        }
+      }
+    }
+    for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(seen[i], 1u);
+    expect_valid_tree(r.codes, r.children, r.parents, n);
+    if (backend == "cpu") {
+      cpu = r;
+    } else {
+      EXPECT_EQ(r.indices, cpu.indices);
+      EXPECT_EQ(r.children, cpu.children);
+      EXPECT_EQ(r.parents, cpu.parents);
+    }
+  }
+  auto device = create_device({.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(device.ok());
+  auto bvh = collision::make_device_bvh(**device, 10);
+  ASSERT_TRUE(bvh.ok());
+  FrameProgram program;
+  EXPECT_FALSE(collision::append_device_bvh_build(program, *bvh, 11, {0, 0, 0}, {1, 1, 1}).ok());
+  EXPECT_FALSE(collision::append_device_bvh_build(program, *bvh, 1, {0, 0, 0}, {1, 1, 1}).ok());
+  EXPECT_FALSE(collision::append_device_bvh_build(program, *bvh, 5, {0, 0, 0}, {1, NAN, 1}).ok());
+  EXPECT_FALSE(collision::append_device_bvh_build(program, *bvh, 5, {0, 2, 0}, {1, 1, 1}).ok());
+  EXPECT_FALSE(collision::make_device_bvh(**device, 1).ok());
 }
 
 }  // namespace
