@@ -63,6 +63,7 @@
   SINEW_KERNEL(xpbd_warm_start, 4, WarmStartParams, 0)                          \
   /* the device BVH (kernels/shared/bvh_params.h) */                             \
   SINEW_KERNEL(bvh_morton_codes, 3, MortonParams, 0)                             \
-  SINEW_KERNEL(bvh_karras_nodes, 3, KarrasParams, 0)
+  SINEW_KERNEL(bvh_karras_nodes, 3, KarrasParams, 0)                             \
+  SINEW_KERNEL(bvh_refit_pass, 6, RefitParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstring>
 #include <random>
@@ -175,6 +176,7 @@ TEST_P(Agreement, DeviceBvhKernels) {
 
 struct BuiltBvh {
   std::vector<std::uint32_t> codes, indices, children, parents;
+  std::vector<float> node_boxes;
 };
 
 // The whole build on one backend: boxes in, sorted codes, leaf order and
@@ -191,6 +193,7 @@ BuiltBvh build_on(const std::string& backend, const std::vector<float>& boxes, s
   EXPECT_TRUE(device.write_buffer(bvh->boxes, 0, boxes.data(), boxes.size() * 4).ok());
   FrameProgram program;
   EXPECT_TRUE(collision::append_device_bvh_build(program, *bvh, n, {-1, -1, -1}, {1, 1, 1}).ok());
+  EXPECT_TRUE(collision::append_device_bvh_refit(program, *bvh, n).ok());
   auto prepared = device.create_program(program);
   EXPECT_TRUE(prepared.ok()) << (prepared.ok() ? "" : prepared.error().message());
   if (!prepared.ok()) return r;
@@ -204,12 +207,15 @@ BuiltBvh build_on(const std::string& backend, const std::vector<float>& boxes, s
   r.indices = read(bvh->indices, n);
   r.children = read(bvh->children, 2 * (n - 1));
   r.parents = read(bvh->parents, 2 * n - 1);
+  r.node_boxes.resize(6 * (n - 1));
+  EXPECT_TRUE(device.read_buffer(bvh->node_boxes, 0, r.node_boxes.data(), r.node_boxes.size() * 4).ok());
   return r;
 }
 
-// The assembled build (Morton codes, radix sort, Karras nodes) gives a
-// valid tree whose leaves are the primitives sorted by code, and every
-// backend gives the CPU's bits. Bad sizes and bounds are named errors.
+// The assembled build (Morton codes, radix sort, Karras nodes) and refit
+// give a valid tree whose leaves are the primitives sorted by code and
+// whose node boxes are exactly their leaves' unions; every backend gives
+// the CPU's bits. Bad sizes and bounds are named errors.
 TEST(DeviceBvh, BuildOnEveryBackendGivesOneValidTree) {
   std::mt19937 rng(53);
   const std::uint32_t n = 5000;
@@ -240,12 +246,40 @@ TEST(DeviceBvh, BuildOnEveryBackendGivesOneValidTree) {
     }
     for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(seen[i], 1u);
     expect_valid_tree(r.codes, r.children, r.parents, n);
+    // Every node's box is exactly the union of its leaves' boxes (the
+    // refit's 64 passes reached the root).
+    std::vector<std::array<float, 6>> want(n - 1);
+    std::vector<int> done(n - 1, 0);
+    const auto box_of = [&](std::uint32_t c, std::array<float, 6>& b) -> bool {
+      if (c & SINEW_BVH_LEAF) {
+        for (int k = 0; k < 6; ++k) b[std::size_t(k)] = boxes[6 * std::size_t{r.indices[c & ~SINEW_BVH_LEAF]} + std::size_t(k)];
+        return true;
+      }
+      if (!done[c]) return false;
+      b = want[c];
+      return true;
+    };
+    for (bool progress = true; progress;) {  // bottom-up on the host, in any order
+      progress = false;
+      for (std::uint32_t i = 0; i + 1 < n; ++i) {
+        std::array<float, 6> a, b;
+        if (done[i] || !box_of(r.children[2 * i], a) || !box_of(r.children[2 * i + 1], b)) continue;
+        for (int k = 0; k < 3; ++k) want[i][std::size_t(k)] = std::min(a[std::size_t(k)], b[std::size_t(k)]);
+        for (int k = 3; k < 6; ++k) want[i][std::size_t(k)] = std::max(a[std::size_t(k)], b[std::size_t(k)]);
+        done[i] = 1;
+        progress = true;
+      }
+    }
+    for (std::uint32_t i = 0; i + 1 < n; ++i)
+      for (int k = 0; k < 6; ++k)
+        ASSERT_EQ(r.node_boxes[6 * std::size_t{i} + std::size_t(k)], want[i][std::size_t(k)]) << "node " << i << " word " << k;
     if (backend == "cpu") {
       cpu = r;
     } else {
       EXPECT_EQ(r.indices, cpu.indices);
       EXPECT_EQ(r.children, cpu.children);
       EXPECT_EQ(r.parents, cpu.parents);
+      EXPECT_EQ(0, std::memcmp(r.node_boxes.data(), cpu.node_boxes.data(), r.node_boxes.size() * 4));
     }
   }
   auto device = create_device({.backend = "cpu", .quiet = true});
@@ -258,6 +292,7 @@ TEST(DeviceBvh, BuildOnEveryBackendGivesOneValidTree) {
   EXPECT_FALSE(collision::append_device_bvh_build(program, *bvh, 5, {0, 0, 0}, {1, NAN, 1}).ok());
   EXPECT_FALSE(collision::append_device_bvh_build(program, *bvh, 5, {0, 2, 0}, {1, 1, 1}).ok());
   EXPECT_FALSE(collision::make_device_bvh(**device, 1).ok());
+  EXPECT_FALSE(collision::append_device_bvh_refit(program, *bvh, 11).ok());
 }
 
 }  // namespace

@@ -101,4 +101,25 @@ void bvh_karras_nodes(const void* params, std::byte* const* bindings, std::uint3
   }
 }
 
+void bvh_refit_pass(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const RefitParams*>(params);
+  const auto* children = reinterpret_cast<const std::uint32_t*>(bindings[0]);
+  const auto* indices = reinterpret_cast<const std::uint32_t*>(bindings[1]);
+  const auto* boxes = reinterpret_cast<const float*>(bindings[2]);
+  auto* node_boxes = reinterpret_cast<float*>(bindings[3]);
+  const auto* ready_in = reinterpret_cast<const std::uint32_t*>(bindings[4]);
+  auto* ready_out = reinterpret_cast<std::uint32_t*>(bindings[5]);
+  for (std::uint32_t i = begin; i < end && i + 1 < p.count; ++i) {
+    if (ready_in[i] != 0u) continue;
+    const std::uint32_t a = children[2 * i], b = children[2 * i + 1];
+    if ((!(a & SINEW_BVH_LEAF) && ready_in[a] == 0u) || (!(b & SINEW_BVH_LEAF) && ready_in[b] == 0u)) continue;
+    const float* ba = (a & SINEW_BVH_LEAF) ? boxes + 6 * std::size_t{indices[a & ~SINEW_BVH_LEAF]} : node_boxes + 6 * std::size_t{a};
+    const float* bb = (b & SINEW_BVH_LEAF) ? boxes + 6 * std::size_t{indices[b & ~SINEW_BVH_LEAF]} : node_boxes + 6 * std::size_t{b};
+    float* out = node_boxes + 6 * std::size_t{i};
+    for (int k = 0; k < 3; ++k) out[k] = ba[k] < bb[k] ? ba[k] : bb[k];
+    for (int k = 3; k < 6; ++k) out[k] = ba[k] > bb[k] ? ba[k] : bb[k];
+    ready_out[i] = 1u;
+  }
+}
+
 }  // namespace sinew::kernels

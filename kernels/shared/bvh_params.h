@@ -24,7 +24,22 @@
  *             position) | SINEW_BVH_LEAF
  *           2 parents uint [out]: internal node c's parent at [c], sorted
  *             leaf c's at [count - 1 + c]; the root's (node 0) is
- *             SINEW_BVH_NONE */
+ *             SINEW_BVH_NONE
+ *
+ * ------------------------------------------------------------ bvh_refit_pass
+ * One item per internal node i < count - 1: one pass of the bottom-up box
+ * computation. A node whose two children were ready before this pass
+ * (`ready_in`; leaves always are) writes its box, the union of theirs, and
+ * marks itself in `ready_out`, which the host has made a copy of
+ * `ready_in` first. Reading the flags of the previous pass only, never the
+ * ones being written, needs no atomics and is the same on every backend;
+ * a tree's depth is at most 64 (each level lengthens the common prefix of
+ * the 32-bit code and 32-bit position keys), so 64 passes finish any tree.
+ * bindings: 0 children uint [in], 1 indices uint (sorted position ->
+ *           primitive) [in], 2 boxes float, 6 per primitive [in],
+ *           3 node boxes float, 6 per internal node [in/out],
+ *           4 ready_in uint per internal node [in],
+ *           5 ready_out uint per internal node [out] */
 #ifndef SINEW_BVH_PARAMS_H
 #define SINEW_BVH_PARAMS_H
 
@@ -54,6 +69,13 @@ SINEW_STRUCT_BEGIN(KarrasParams)
   uint pad1;
   uint pad2;
 SINEW_STRUCT_END(KarrasParams)
+
+SINEW_STRUCT_BEGIN(RefitParams)
+  uint count; /* leaves, >= 2 */
+  uint pad0;
+  uint pad1;
+  uint pad2;
+SINEW_STRUCT_END(RefitParams)
 
 #ifdef __cplusplus
 }  /* namespace sinew::kernels */

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "bvh_params.h"
 #include "program/primitives.h"
@@ -25,7 +26,8 @@ Result<DeviceBvh> make_device_bvh(Device& device, std::uint32_t capacity) {
       {&b.indices, n, "bvh indices"},          {&b.children, 2 * (n - 1), "bvh children"},
       {&b.parents, 2 * n - 1, "bvh parents"},  {&b.codes_tmp, n, "bvh codes (sort)"},
       {&b.indices_tmp, n, "bvh indices (sort)"}, {&b.scratch, radix_sort_scratch_words(capacity), "bvh sort scratch"},
-      {&b.count, 1, "bvh count"},
+      {&b.count, 1, "bvh count"},              {&b.node_boxes, 6 * (n - 1), "bvh node boxes"},
+      {&b.ready_a, n - 1, "bvh refit flags a"}, {&b.ready_b, n - 1, "bvh refit flags b"},
   };
   for (const auto& buffer : buffers) {
     auto made = device.create_buffer(buffer.words * 4, buffer.label);
@@ -62,6 +64,28 @@ Status append_device_bvh_build(FrameProgram& program, const DeviceBvh& bvh, std:
   k.count = n;
   program.dispatch(Kernel::bvh_karras_nodes, n - 1, {bvh.codes, bvh.children, bvh.parents}, k);
   program.barrier();
+  return {};
+}
+
+Status append_device_bvh_refit(FrameProgram& program, const DeviceBvh& bvh, std::uint32_t n) {
+  if (n < 2 || n > bvh.capacity)
+    return Error(ErrorCode::bad_parameter, "device BVH refit over " + std::to_string(n) +
+                                               " primitives: needs 2 .. capacity (" + std::to_string(bvh.capacity) + ")");
+  // 64 passes: a tree is at most 64 levels deep (bvh_params.h); an even
+  // count leaves the flags in ready_a.
+  constexpr int kPasses = 64;
+  kernels::RefitParams r{};
+  r.count = n;
+  program.fill(bvh.ready_a, 0, n - 1, 0u);
+  program.barrier();
+  BufferHandle in = bvh.ready_a, out = bvh.ready_b;
+  for (int pass = 0; pass < kPasses; ++pass) {
+    program.copy(in, 0, out, 0, n - 1);
+    program.barrier();
+    program.dispatch(Kernel::bvh_refit_pass, n - 1, {bvh.children, bvh.indices, bvh.boxes, bvh.node_boxes, in, out}, r);
+    program.barrier();
+    std::swap(in, out);
+  }
   return {};
 }
 

@@ -3,9 +3,9 @@
 // k-d Trees", HPG 2012): Morton codes of the primitives' box centres
 // (bvh_morton_codes), the stable radix sort of program/primitives.h with
 // the primitive indices as payload, then every internal node at once
-// (bvh_karras_nodes). Bitwise the same on every backend
-// (tests/device_bvh_test.cpp). Not yet: the node boxes (a bottom-up refit)
-// and the traversal, which the broad phase on the device needs next.
+// (bvh_karras_nodes); the node boxes bottom-up in passes (bvh_refit_pass).
+// Bitwise the same on every backend (tests/device_bvh_test.cpp). Not yet:
+// the traversal, which the broad phase on the device needs next.
 #pragma once
 
 #include <array>
@@ -23,6 +23,8 @@ struct DeviceBvh {
   BufferHandle indices;   ///< [out] the primitive at each sorted position (the leaves' order)
   BufferHandle children;  ///< [out] 2 per internal node (bvh_params.h: SINEW_BVH_LEAF marks leaves)
   BufferHandle parents;   ///< [out] internal nodes, then leaves (bvh_params.h)
+  BufferHandle node_boxes;  ///< [out] 6 floats per internal node (after a refit)
+  BufferHandle ready_a, ready_b;  // the refit's flags, one per internal node (ping-pong)
   BufferHandle codes_tmp, indices_tmp, scratch, count;  // the sort's
 };
 
@@ -35,5 +37,11 @@ Result<DeviceBvh> make_device_bvh(Device& device, std::uint32_t capacity);
 /// bad n or bounds.
 Status append_device_bvh_build(FrameProgram& program, const DeviceBvh& bvh, std::uint32_t n,
                                const std::array<float, 3>& lo, const std::array<float, 3>& hi);
+
+/// Appends the node boxes' computation from the primitives' current boxes
+/// over the tree of the last build (same n): 64 passes
+/// of bvh_refit_pass, enough for any tree (bvh_params.h). After a build, or
+/// each substep when only the boxes moved.
+Status append_device_bvh_refit(FrameProgram& program, const DeviceBvh& bvh, std::uint32_t n);
 
 }  // namespace sinew::collision
