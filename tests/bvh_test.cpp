@@ -19,36 +19,13 @@
 #if SINEW_HAS_EMBREE
 #include "collision/embree_broad_phase.h"
 #endif
-#include "test_support.h"
+#include "surface_support.h"
 
 namespace sinew::collision {
 namespace {
 
-struct Surface {
-  std::vector<float> positions;  // xyzw per vertex
-  std::vector<std::uint32_t> triangles;
-  float mean_edge = 0.0f;
-};
-
-Surface surface_of(const std::string& mesh_file) {
-  Surface s;
-  auto mesh = read_tet_mesh(test::data_path(mesh_file));
-  EXPECT_TRUE(mesh.ok()) << mesh_file << ": " << (mesh.ok() ? "" : mesh.error().message());
-  if (!mesh.ok()) return s;
-  const TriMesh tri = extract_boundary_surface(*mesh);
-  for (const auto& v : tri.vertices) s.positions.insert(s.positions.end(), {float(v[0]), float(v[1]), float(v[2]), 0.0f});
-  double sum = 0.0;
-  for (const auto& t : tri.triangles) {
-    s.triangles.insert(s.triangles.end(), t.begin(), t.end());
-    for (int e = 0; e < 3; ++e) {
-      const auto& a = tri.vertices[t[e]];
-      const auto& b = tri.vertices[t[(e + 1) % 3]];
-      sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-    }
-  }
-  s.mean_edge = tri.triangles.empty() ? 0.0f : float(sum / (3.0 * double(tri.triangles.size())));
-  return s;
-}
+using test::Surface;
+using test::surface_of;
 
 std::vector<Aabb> boxes_of(const Surface& s, float inflate) {
   std::vector<Aabb> boxes;

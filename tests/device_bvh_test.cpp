@@ -10,6 +10,7 @@
 #include <array>
 #include <bit>
 #include <cstring>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -65,7 +66,6 @@ TEST(DeviceBvh, MortonCodesInterleaveTheCellsOfTheCentre) {
   const auto out = run_on("cpu", c);
   ASSERT_EQ(out.size(), 3u);
   const auto codes = words_of(out[1]), indices = words_of(out[2]);
-  const MortonParams* p = reinterpret_cast<const MortonParams*>(c.params.data());
   for (std::uint32_t i = 0; i < 1000; ++i) {
     const float* b = &c.bindings[0].data[6 * i];
     std::uint32_t cell[3];
@@ -88,7 +88,6 @@ TEST(DeviceBvh, MortonCodesInterleaveTheCellsOfTheCentre) {
     EXPECT_EQ(indices[i], i);
     EXPECT_LT(codes[i], 1u << 30);
   }
-  (void)p;
 }
 
 KernelCase karras_case(std::mt19937& rng, std::uint32_t n, std::uint32_t distinct) {
@@ -104,23 +103,20 @@ KernelCase karras_case(std::mt19937& rng, std::uint32_t n, std::uint32_t distinc
   return c;
 }
 
-// Walks the tree from the root: every node once, leaves in order, each
-// node's parent right, each internal node's leaves contiguous.
+// Walks the tree from the root: every node once, each node's parent
+// right, leaves in sorted order (so each node covers a contiguous range),
+// and each node whose range holds different codes split where their
+// highest differing bit flips (Karras's construction).
 void expect_valid_tree(const std::vector<std::uint32_t>& codes, const std::vector<std::uint32_t>& children,
                        const std::vector<std::uint32_t>& parents, std::uint32_t n) {
   ASSERT_EQ(parents[0], SINEW_BVH_NONE);
-  std::vector<std::uint32_t> leaves;
   std::vector<int> seen(n - 1, 0);
-  // Returns the range [lo, hi] of leaves under node `node`.
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> range(n - 1);
   std::vector<std::uint32_t> stack{0};
-  std::vector<std::uint32_t> order;  // internal nodes in pre-order
   while (!stack.empty()) {
     const std::uint32_t node = stack.back();
     stack.pop_back();
     ASSERT_LT(node, n - 1);
     ASSERT_EQ(seen[node]++, 0) << "internal node " << node << " reached twice";
-    order.push_back(node);
     for (int side = 1; side >= 0; --side) {  // left first in the walk
       const std::uint32_t c = children[2 * node + side];
       const std::uint32_t slot = (c & SINEW_BVH_LEAF) ? (n - 1) + (c & ~SINEW_BVH_LEAF) : c;
@@ -146,8 +142,19 @@ void expect_valid_tree(const std::vector<std::uint32_t>& codes, const std::vecto
   }
   ASSERT_EQ(in_order.size(), n);
   for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(in_order[i], i);
-  (void)codes;
-  (void)range;
+  // The first and last leaf under each child (depth <= 64: recursion is fine).
+  const std::function<std::uint32_t(std::uint32_t, int)> end_leaf = [&](std::uint32_t c, int side) -> std::uint32_t {
+    return (c & SINEW_BVH_LEAF) ? (c & ~SINEW_BVH_LEAF) : end_leaf(children[2 * c + std::uint32_t(side)], side);
+  };
+  for (std::uint32_t i = 0; i + 1 < n; ++i) {
+    const std::uint32_t first = end_leaf(children[2 * i], 0), split = end_leaf(children[2 * i], 1);
+    const std::uint32_t last = end_leaf(children[2 * i + 1], 1);
+    ASSERT_EQ(end_leaf(children[2 * i + 1], 0), split + 1) << "node " << i << ": its children's ranges meet";
+    if (codes[first] == codes[last]) continue;  // equal codes: split by position
+    const int bit = 31 - std::countl_zero(codes[first] ^ codes[last]);
+    ASSERT_EQ((codes[split] >> bit) & 1u, 0u) << "node " << i << ": left child past the split bit";
+    ASSERT_EQ((codes[split + 1] >> bit) & 1u, 1u) << "node " << i << ": right child before the split bit";
+  }
 }
 
 TEST(DeviceBvh, KarrasNodesFormAValidTreeOverTheSortedLeaves) {

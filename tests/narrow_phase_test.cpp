@@ -13,7 +13,7 @@
 
 #include "collision/narrow_phase.h"
 #include "math/proximity_math.h"
-#include "test_support.h"
+#include "surface_support.h"
 
 namespace sinew::collision {
 namespace {
@@ -199,26 +199,25 @@ TEST(NarrowPhase, TwoTrianglesAcrossAGapAndBadInput) {
   EXPECT_NE(bad.error().message().find("vertex 4"), std::string::npos) << bad.error().message();
 }
 
+void expect_same_contacts(const std::vector<Contact>& fast, const std::vector<Contact>& slow, const char* what) {
+  ASSERT_EQ(fast.size(), slow.size()) << what;
+  for (std::size_t k = 0; k < fast.size(); ++k) {
+    ASSERT_EQ(fast[k].kind, slow[k].kind) << what << " " << k;
+    ASSERT_EQ(fast[k].v, slow[k].v) << what << " " << k;
+    ASSERT_EQ(fast[k].distance, slow[k].distance) << what << " " << k;
+  }
+}
+
 // The broad phase (boxes inflated by thickness / 2, shared-vertex pairs
 // skipped) followed by the narrow phase finds exactly the contacts of the
 // narrow phase run on every pair of triangles, on the armadillo's
-// surface bent so that parts of it come within the thickness.
+// surface with a thickness of one mean edge (many near pairs).
 TEST(NarrowPhase, BroadThenNarrowEqualsNarrowOnEveryPair) {
-  auto mesh = read_tet_mesh(test::data_path("meshes/tet/armadillo_4k.node"));
-  ASSERT_TRUE(mesh.ok());
-  const TriMesh tri = extract_boundary_surface(*mesh);
-  std::vector<float> x;
-  std::vector<std::uint32_t> tris;
-  for (const auto& v : tri.vertices) x.insert(x.end(), {float(v[0]), float(v[1]), float(v[2]), 0.0f});
-  for (const auto& t : tri.triangles) tris.insert(tris.end(), t.begin(), t.end());
-  // A thickness of about one edge: many near pairs.
-  double edge = 0.0;
-  for (const auto& t : tri.triangles) {
-    const auto& a = tri.vertices[t[0]];
-    const auto& b = tri.vertices[t[1]];
-    edge += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-  }
-  const float thickness = float(edge / double(tri.triangles.size()));
+  const test::Surface surface = test::surface_of("meshes/tet/armadillo_4k.node");
+  ASSERT_FALSE(surface.triangles.empty());
+  const std::vector<float>& x = surface.positions;
+  const std::vector<std::uint32_t>& tris = surface.triangles;
+  const float thickness = surface.mean_edge;  // about one edge: many near pairs
   std::vector<Aabb> boxes;
   ASSERT_TRUE(primitive_boxes(x, tris, 3, 0.5f * thickness, boxes).ok());
   Bvh tree;
@@ -229,19 +228,14 @@ TEST(NarrowPhase, BroadThenNarrowEqualsNarrowOnEveryPair) {
   ASSERT_TRUE(triangle_contacts(x, tris, candidates, thickness, fast).ok());
 
   std::vector<Pair> every;
-  const auto n = static_cast<std::uint32_t>(tri.triangles.size());
+  const auto n = static_cast<std::uint32_t>(tris.size() / 3);
   const SharesVertex shares{tris};
   for (std::uint32_t i = 0; i < n; ++i)
     for (std::uint32_t j = i + 1; j < n; ++j)
       if (!shares(i, j)) every.push_back({i, j});
   std::vector<Contact> slow;
   ASSERT_TRUE(triangle_contacts(x, tris, every, thickness, slow).ok());
-  ASSERT_EQ(fast.size(), slow.size());
-  for (std::size_t k = 0; k < fast.size(); ++k) {
-    ASSERT_EQ(fast[k].kind, slow[k].kind) << k;
-    ASSERT_EQ(fast[k].v, slow[k].v) << k;
-    ASSERT_EQ(fast[k].distance, slow[k].distance) << k;
-  }
+  expect_same_contacts(fast, slow, "armadillo surface");
   EXPECT_GT(fast.size(), 100u);
   std::printf("[ narrow ] armadillo surface, thickness %.3g: %zu candidate pairs of %zu, %zu contacts\n", thickness,
               candidates.size(), every.size(), fast.size());
@@ -262,15 +256,6 @@ std::vector<float> random_thread(std::mt19937& rng, int n, std::array<float, 3> 
     segments.insert(segments.end(), {std::uint32_t(k), std::uint32_t(k + 1)});
   }
   return x;
-}
-
-void expect_same_contacts(const std::vector<Contact>& fast, const std::vector<Contact>& slow, const char* what) {
-  ASSERT_EQ(fast.size(), slow.size()) << what;
-  for (std::size_t k = 0; k < fast.size(); ++k) {
-    ASSERT_EQ(fast[k].kind, slow[k].kind) << what << " " << k;
-    ASSERT_EQ(fast[k].v, slow[k].v) << what << " " << k;
-    ASSERT_EQ(fast[k].distance, slow[k].distance) << what << " " << k;
-  }
 }
 
 // A thread against itself: segment boxes inflated by thickness / 2,
@@ -355,11 +340,9 @@ TEST(NarrowPhase, ThreadAgainstSurfaceEqualsEveryPair) {
 TEST(NarrowPhase, CapsuleOverASurface) {
   auto grid = make_tet_grid({.nx = 10, .ny = 2, .nz = 10, .origin = {0, 0, 0}, .cell_size = {0.01, 0.01, 0.01}});
   ASSERT_TRUE(grid.ok());
-  const TriMesh tri = extract_boundary_surface(*grid);
-  std::vector<float> x;
-  std::vector<std::uint32_t> tris;
-  for (const auto& v : tri.vertices) x.insert(x.end(), {float(v[0]), float(v[1]), float(v[2]), 0.0f});
-  for (const auto& t : tri.triangles) tris.insert(tris.end(), t.begin(), t.end());
+  const test::Surface surface = test::surface_of(extract_boundary_surface(*grid));
+  const std::vector<float>& x = surface.positions;
+  const std::vector<std::uint32_t>& tris = surface.triangles;
   const float radius = 0.003f, thickness = 0.004f, top = 0.02f;
   const std::array<float, 4> p0{0.02f, top + 0.005f, 0.05f, 0.0f}, p1{0.08f, top + 0.005f, 0.05f, 0.0f};
   std::vector<Aabb> boxes;
@@ -373,7 +356,7 @@ TEST(NarrowPhase, CapsuleOverASurface) {
   capsule_tree.build(capsule);
   std::vector<Pair> pairs;
   overlapping_pairs(tree, capsule_tree, pairs);
-  std::vector<std::uint32_t> candidates, all(tri.triangles.size());
+  std::vector<std::uint32_t> candidates, all(tris.size() / 3);
   for (const auto& [t, c] : pairs) candidates.push_back(t);
   std::iota(all.begin(), all.end(), 0u);
   std::vector<Contact> fast, slow;

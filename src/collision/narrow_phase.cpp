@@ -139,6 +139,20 @@ void edge_edge(std::uint32_t e0, std::uint32_t e1, float4 p1, float4 q1, std::ui
   contacts.push_back(c);
 }
 
+// Two edges of one set (a surface or a thread against itself): ordered by
+// their vertices first, so (a, b) and (b, a) make the same contact; the
+// fallback normal is that of the second edge's face (zero for none).
+void edge_edge_within_one_set(std::uint32_t a0, std::uint32_t a1, float4 pa0, float4 pa1, float4 face_a,
+                              std::uint32_t b0, std::uint32_t b1, float4 pb0, float4 pb1, float4 face_b,
+                              float thickness, std::vector<Contact>& contacts) {
+  const bool b_first = std::min(b0, b1) < std::min(a0, a1) ||
+                       (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1));
+  if (b_first)
+    edge_edge(b0, b1, pb0, pb1, a0, a1, pa0, pa1, face_a, thickness, contacts);
+  else
+    edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, face_b, thickness, contacts);
+}
+
 // One contact per (vertex, triangle) and per pair of edges, in a fixed order.
 void sort_unique(std::vector<Contact>& contacts) {
   const auto key = [](const Contact& c) { return std::tuple(c.kind, c.v[0], c.v[1], c.v[2], c.v[3]); };
@@ -196,19 +210,9 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
     }
     const float4 ni = face_normal(pi[0], pi[1], pi[2]), nj = face_normal(pj[0], pj[1], pj[2]);
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        // The pair's edges ordered by vertex, so (edge of i, edge of j) and
-        // (edge of j, edge of i) make one contact; the face normal of the
-        // second edge's triangle is the fallback.
-        std::uint32_t a0 = vi[a], a1 = vi[(a + 1) % 3], b0 = vj[b], b1 = vj[(b + 1) % 3];
-        float4 pa0 = pi[a], pa1 = pi[(a + 1) % 3], pb0 = pj[b], pb1 = pj[(b + 1) % 3];
-        float4 face = nj;
-        if (std::min(b0, b1) < std::min(a0, a1) || (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1))) {
-          std::swap(a0, b0), std::swap(a1, b1), std::swap(pa0, pb0), std::swap(pa1, pb1);
-          face = ni;
-        }
-        edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, face, thickness, out);
-      }
+      for (int b = 0; b < 3; ++b)
+        edge_edge_within_one_set(vi[a], vi[(a + 1) % 3], pi[a], pi[(a + 1) % 3], ni, vj[b], vj[(b + 1) % 3], pj[b],
+                                 pj[(b + 1) % 3], nj, thickness, out);
     return {};
   });
 }
@@ -223,11 +227,8 @@ Status segment_contacts(std::span<const float> positions, std::span<const std::u
     float4 pi[3], pj[3];
     if (Status s = corners(positions, segments, 2, "segment", si, vi, pi); !s) return s;
     if (Status s = corners(positions, segments, 2, "segment", sj, vj, pj); !s) return s;
-    std::uint32_t a0 = vi[0], a1 = vi[1], b0 = vj[0], b1 = vj[1];
-    float4 pa0 = pi[0], pa1 = pi[1], pb0 = pj[0], pb1 = pj[1];
-    if (std::min(b0, b1) < std::min(a0, a1) || (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1)))
-      std::swap(a0, b0), std::swap(a1, b1), std::swap(pa0, pb0), std::swap(pa1, pb1);
-    edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, float4{0, 0, 0, 0}, thickness, out);
+    const float4 none{0, 0, 0, 0};  // segments have no face: touching parallel segments make no contact
+    edge_edge_within_one_set(vi[0], vi[1], pi[0], pi[1], none, vj[0], vj[1], pj[0], pj[1], none, thickness, out);
     return {};
   });
 }

@@ -62,7 +62,8 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
 /// Contacts of candidate segment pairs (indices into `segments`, two vertex
 /// indices each) closer than `thickness` [m]: edge-edge contacts between
 /// segments that share no vertex (a thread against itself or another line
-/// mesh). Each pair of segments appears once. [out] contacts, sorted. Errors:
+/// mesh). Each pair of segments appears once; touching parallel segments
+/// (no direction to push along) make none. [out] contacts, sorted. Errors:
 /// a bad thickness, a non-finite position or a bad index, named.
 Status segment_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
                         std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts);
