@@ -45,6 +45,8 @@
    * colliders, contact impulses */                                              \
   SINEW_KERNEL(xpbd_solve_attachment, 6, SolveParams, 0)                         \
   SINEW_KERNEL(xpbd_solve_contacts, 8, SolveParams, 0)                           \
+  /* contacts between meshes (kernels/shared/mesh_contact_params.h) */           \
+  SINEW_KERNEL(xpbd_solve_mesh_contacts, 7, MeshContactParams, 0)                \
   /* device-side work of data-dependent size (kernels/shared/primitive_params.h) */ \
   SINEW_KERNEL(indirect_args, 2, IndirectArgsParams, 0)                          \
   SINEW_KERNEL(scan_blocks, 4, ScanParams, 256)                                  \

@@ -77,6 +77,14 @@ struct FrameStats {
   /// measure as residual_rms, also when measure_errors is off). 0 in fixed mode.
   double checked_residual = 0.0;
   std::uint32_t residual_checks = 0;  ///< residual mode: checks (round trips) in the last frame
+  /// Mesh collision (SceneDesc::mesh_collision), 0 without: the frame's
+  /// contacts, their colours (dispatches per sweep), the motion margin they
+  /// were found within [m], and the wall time [ms] of reading the
+  /// particles back, finding, colouring and uploading them (part of wall_ms).
+  std::uint32_t mesh_contacts = 0;
+  std::uint32_t mesh_contact_colors = 0;
+  double collision_margin = 0.0;
+  double collision_ms = 0.0;
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;

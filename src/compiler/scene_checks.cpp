@@ -234,6 +234,24 @@ Status check_all(const std::vector<T>& items, const std::string& name, Check&& c
   return {};
 }
 
+Status check_mesh_collision(const SceneDesc& scene) {
+  const MeshCollisionDesc& c = scene.mesh_collision;
+  if (!c.enabled) return {};
+  if (Status s = positive("mesh_collision.thickness", c.thickness); !s) return s;
+  if (Status s = non_negative("mesh_collision.margin", c.margin); !s) return s;
+  if (Status s = non_negative("mesh_collision.compliance", c.compliance); !s) return s;
+  if (Status s = check_friction("mesh_collision", c.static_friction, c.dynamic_friction); !s) return s;
+  if (scene.solver.residual_tolerance > 0.0)
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.enabled is not supported with solver.residual_tolerance > 0 yet (got " +
+                     str(scene.solver.residual_tolerance) + "): use the fixed mode");
+  if (scene.solver.chebyshev_rho > 0.0)
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.enabled is not supported with solver.chebyshev_rho > 0 yet (got " +
+                     str(scene.solver.chebyshev_rho) + ")");
+  return {};
+}
+
 }  // namespace
 
 Status TetBodyDesc::set_elastic(double young, double poisson) {
@@ -305,6 +323,7 @@ Status check_scene(const SceneDesc& scene) {
   if (Status s = check_all(scene.line_bodies, "line_bodies", check_line_body); !s) return s;
   if (Status s = check_all(scene.colliders, "colliders", check_collider); !s) return s;
   if (Status s = check_all(scene.tools, "tools", check_tool); !s) return s;
+  if (Status s = check_mesh_collision(scene); !s) return s;
   for (std::size_t i = 0; i < scene.targets.size(); ++i)
     if (Status s = finite3("targets[" + std::to_string(i) + "]", scene.targets[i]); !s) return s;
   for (std::size_t i = 0; i < scene.attachments.size(); ++i)

@@ -95,7 +95,7 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
 }
 
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
-                                const std::array<double, 3>& gravity) {
+                                const std::array<double, 3>& gravity, const MeshContactBuffers* mesh_contacts) {
   const bool measure_errors = solver.measure_errors;
   const double h = solver.time_step / solver.substeps;
   const auto particles = static_cast<std::uint32_t>(scene.positions.size());
@@ -113,6 +113,13 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   update.count = particles;
 
   FrameProgram program;
+  // Mesh contacts: colour k's count is word k of the table, which the host
+  // writes before each frame (at most the capacity, checked after the run).
+  std::vector<std::uint32_t> contact_counters;
+  if (mesh_contacts)
+    for (std::uint32_t k = 0; k < mesh_contacts->colors; ++k)
+      contact_counters.push_back(program.counter("mesh contacts of colour " + std::to_string(k),
+                                                 mesh_contacts->table, k, mesh_contacts->capacity));
   for (int s = 0; s < solver.substeps; ++s) {
     program.dispatch(Kernel::xpbd_predict, particles, {buffers.position, buffers.previous, buffers.velocity}, predict);
     program.barrier();
@@ -125,6 +132,21 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
       for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
         p.damping = static_cast<float>(scene.blocks[k].damping_time / h);  // gamma of eq. 26
         sweep(program, scene.blocks[k], scene.blocks[k].color_offsets, buffers.blocks[k], buffers, p);
+      }
+      if (mesh_contacts) {  // after the bodies' constraints, colour by colour
+        kernels::MeshContactParams m = mesh_contacts->params;
+        m.colors = mesh_contacts->colors;
+        m.inv_h2 = inv_h2;
+        m.reset_lambda = p.reset_lambda;
+        for (std::uint32_t k = 0; k < mesh_contacts->colors; ++k) {
+          m.color = k;
+          program.dispatch_indirect(Kernel::xpbd_solve_mesh_contacts, contact_counters[k],
+                                    {buffers.position, buffers.previous, mesh_contacts->table,
+                                     mesh_contacts->particles, mesh_contacts->coefficients, mesh_contacts->normals,
+                                     mesh_contacts->lambda},
+                                    m);
+          program.barrier();
+        }
       }
     }
     if (measure_errors && s + 1 == solver.substeps) {

@@ -5,6 +5,7 @@
 
 #include "compiler/scene_compiler.h"
 #include "backends/backend.h"
+#include "mesh_contact_params.h"
 
 namespace sinew {
 
@@ -20,11 +21,24 @@ struct XpbdBuffers {
   std::vector<BlockBuffers> blocks;  ///< one per CompiledScene::blocks entry
 };
 
+/// The buffers of the contacts between meshes (mesh_contact_params.h),
+/// rewritten by the host every frame (runtime/mesh_collision.h): room for
+/// `capacity` contacts and `colors` colours.
+struct MeshContactBuffers {
+  BufferHandle table, particles, coefficients, normals, lambda;
+  std::uint32_t capacity = 0;
+  std::uint32_t colors = 0;
+  kernels::MeshContactParams params{};  ///< thickness, compliance, friction (the rest set per dispatch)
+};
+
 /// Creates the buffers on `device` and uploads the compiled scene.
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
 
 /// The dispatches of one frame of `solver`, with `gravity` [m/s^2].
+/// With `mesh_contacts`, every sweep ends with one indirect dispatch per
+/// contact colour (counts from its table, declared as counters).
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
-                                const std::array<double, 3>& gravity);
+                                const std::array<double, 3>& gravity,
+                                const MeshContactBuffers* mesh_contacts = nullptr);
 
 }  // namespace sinew

@@ -70,18 +70,25 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
                               static_cast<std::uint32_t>(impl->contacts.tools.size()));
   if (!plan) return plan.error();
   impl->stats_plan = std::move(*plan);
-  impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
-  append_stats(impl->program, impl->stats_plan, impl->buffers);
+  impl->solver = scene.solver;
+  impl->gravity = scene.gravity;
+  if (scene.mesh_collision.enabled) {
+    auto mesh_collision = MeshCollision::create(scene, *compiled, *impl->device);
+    if (!mesh_collision) return mesh_collision.error();
+    impl->mesh_collision = std::move(*mesh_collision);
+    impl->program_shape = *compiled;
+    for (ConstraintBlock& block : impl->program_shape.blocks) block.data = {};
+  }
   if (SolveStepper::needed(scene.solver)) {
+    impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
+    append_stats(impl->program, impl->stats_plan, impl->buffers);
     auto stepper = SolveStepper::create(*impl->device, *compiled, impl->buffers, scene.solver, scene.gravity,
                                         impl->stats_plan);
     if (!stepper) return stepper.error();
     impl->stepper = std::move(*stepper);
     impl->program = impl->stepper->frame_program();
-  } else {
-    auto prepared = impl->device->create_program(impl->program);
-    if (!prepared) return prepared.error();
-    impl->prepared = *prepared;
+  } else if (Status s = impl->prepare_program(*compiled); !s) {
+    return s.error();
   }
 
   SceneInfo& info = impl->info;
@@ -106,9 +113,34 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   return Simulation(std::move(impl));
 }
 
+Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
+  program = build_xpbd_program(compiled, buffers, solver, gravity,
+                               mesh_collision ? &mesh_collision->buffers() : nullptr);
+  append_stats(program, stats_plan, buffers);
+  if (prepared.id != UINT32_MAX)
+    if (Status s = device->destroy_program(prepared); !s) return s;
+  auto made = device->create_program(program);
+  if (!made) return made.error();
+  prepared = *made;
+  info.dispatches_per_frame = static_cast<std::uint32_t>(program.dispatch_count());
+  info.barriers_per_frame = static_cast<std::uint32_t>(program.barrier_count());
+  return {};
+}
+
 Status Simulation::step() {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = impl_->before_frame(); !s) return s;
+  if (impl_->mesh_collision) {
+    bool grew = false;
+    if (Status s = impl_->mesh_collision->before_frame(*impl_->device, impl_->buffers, grew); !s) return s;
+    if (grew)
+      if (Status s = impl_->prepare_program(impl_->program_shape); !s) return s;
+    impl_->stats.mesh_contacts = impl_->mesh_collision->contacts();
+    impl_->stats.mesh_contact_colors = impl_->mesh_collision->colors();
+    impl_->stats.collision_margin = impl_->mesh_collision->margin();
+  }
+  const auto collided = std::chrono::steady_clock::now();
+  impl_->stats.collision_ms = std::chrono::duration<double, std::milli>(collided - start).count();
   if (impl_->stepper) {
     if (Status s = impl_->stepper->run_frame(*impl_->device, impl_->stats); !s) return s;
   } else {

@@ -11,6 +11,7 @@
 #include "program/stats_program.h"
 #include "program/xpbd_program.h"
 #include "runtime/contact_state.h"
+#include "runtime/mesh_collision.h"
 #include "runtime/solve_stepper.h"
 #include "sinew/simulation.h"
 
@@ -41,6 +42,16 @@ struct Simulation::Impl {
   DeviceStats device_stats;
 
   void measure(FrameStats& stats) const;
+
+  // Contacts between meshes (mesh_collision.h; null when the scene has
+  // none). The program is rebuilt when they outgrow it, from the compiled
+  // scene's shape (its blocks without their data) kept here for that.
+  std::unique_ptr<MeshCollision> mesh_collision;
+  CompiledScene program_shape;
+  SolverSettings solver;
+  std::array<double, 3> gravity{};
+  /// Builds the fixed-mode frame program (solve + statistics) and prepares it on the device.
+  Status prepare_program(const CompiledScene& compiled);
 
   // simulation_contacts.cpp: host copies of the collider and target
   // buffers (rewritten before each frame) and the tools' rigid state.

@@ -7,6 +7,7 @@
 #include "thin_params.h"
 #include "accelerator_params.h"
 #include "bvh_params.h"
+#include "mesh_contact_params.h"
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { SolveParams p; };
 layout(std430, binding = 0) buffer Positions { vec4 x[]; };

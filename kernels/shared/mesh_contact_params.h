@@ -1,0 +1,71 @@
+/* mesh_contact_params.h — contacts between deformable meshes in the solver
+ * (issue 12, part 3): the layout the host writes every frame and the kernel
+ * that solves them, shared by every kernel language (see sinew_lang.h).
+ * Units: SI (metres, kilograms, seconds); compliance [m/N].
+ *
+ * A mesh contact joins up to four particles: a vertex and a triangle
+ * (vertex-triangle) or two edges (edge-edge), found by the host at the start
+ * of the frame (src/runtime/mesh_collision.cpp) and kept for the whole
+ * frame. Each has fixed coefficients c_k and a fixed unit normal n, both
+ * from the closest points at the frame's start:
+ *   vertex-triangle  c = (1, -wa, -wb, -wc): the vertex minus its closest
+ *                    point on the triangle (barycentric wa, wb, wc);
+ *   edge-edge        c = (1 - s, s, -(1 - t), -t): the first edge's closest
+ *                    point minus the second's;
+ * n points from the second primitive to the first. The constraint
+ *   C = n . sum_k c_k x_k - thickness >= 0
+ * keeps the first primitive on its side of the plane through the second's
+ * closest point (a separating plane at the frame's start: conservative),
+ * at least `thickness` away. Gradient for particle k: c_k n; with
+ * W = sum_k w_k c_k^2 the xPBD step for an inequality (Macklin, Müller,
+ * Chentanez, "XPBD", MIG 2016) is
+ *   lambda_n' = max(lambda_n + (-C - alpha~ lambda_n) / (W + alpha~), 0),
+ *   x_k += w_k c_k (lambda_n' - lambda_n) n.
+ * Friction (Macklin, Müller, Chentanez, Kim, "Unified Particle Physics for
+ * Real-Time Applications", SIGGRAPH 2014, eq. 24-25), as for the colliders
+ * (contact_params.h) with the relative motion of the two closest points:
+ * d = sum_k c_k (x_k - prev_k), tangential part d_t; lambda_t' =
+ * lambda_t - d_t / W, kept if |lambda_t'| <= mu_s lambda_n', else scaled to
+ * mu_k lambda_n'; x_k += w_k c_k (lambda_t' - lambda_t).
+ * Contacts that are apart (C > 0) and were not pushed in this substep
+ * (lambda_n = 0) do nothing: they are speculative, found within the
+ * frame's motion margin, and act only if the surfaces come closer.
+ *
+ * --------------------------------------------------- xpbd_solve_mesh_contacts
+ * One work item per contact of one colour (no two contacts of a colour
+ * share a movable particle), an indirect dispatch whose count is
+ * table[color]; the colour's contacts are [table[colors + color], + count).
+ * bindings:
+ *   0 position float4 (xyz, w = inverse mass) [in/out]
+ *   1 previous position float4 (the substep's start) [in]
+ *   2 table uint [in]: colors counts, then colors firsts
+ *   3 particles uint4 per contact [in]
+ *   4 coefficients float4 per contact (c_0..c_3) [in]
+ *   5 normal float4 per contact (xyz unit, w unused) [in]
+ *   6 lambda float4 per contact [in/out]: (lambda_n, lambda_t xyz), [kg m],
+ *     reset to 0 in a substep's first sweep (reset_lambda) */
+#ifndef SINEW_MESH_CONTACT_PARAMS_H
+#define SINEW_MESH_CONTACT_PARAMS_H
+
+#include "sinew_lang.h"
+
+#ifdef __cplusplus
+namespace sinew::kernels {
+#endif
+
+SINEW_STRUCT_BEGIN(MeshContactParams)
+  uint color;              /* this dispatch's colour */
+  uint colors;             /* colours in the table */
+  float inv_h2;            /* 1 / h^2 [1/s^2] */
+  uint reset_lambda;       /* nonzero in a substep's first sweep */
+  float thickness;         /* [m], > 0: the distance the surfaces keep */
+  float compliance;        /* alpha [m/N], >= 0 */
+  float static_friction;   /* mu_s */
+  float dynamic_friction;  /* mu_k <= mu_s */
+SINEW_STRUCT_END(MeshContactParams)
+
+#ifdef __cplusplus
+}  /* namespace sinew::kernels */
+#endif
+
+#endif /* SINEW_MESH_CONTACT_PARAMS_H */

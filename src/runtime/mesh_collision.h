@@ -1,0 +1,69 @@
+// mesh_collision.h — contacts between the bodies' meshes in the solver
+// (issue 12, part 3; SceneDesc::mesh_collision): before every frame the
+// host reads the particles back, finds the frame's contacts (BVH broad
+// phase and narrow phase of src/collision), colours them and writes them to
+// the device, where xpbd_solve_mesh_contacts solves them in every sweep
+// (kernels/shared/mesh_contact_params.h).
+//
+// Why per frame, inflated by the motion: one detection serves all the
+// substeps and sweeps, and contacts found within thickness + margin hold
+// the surfaces apart wherever they come closer during the frame. Why
+// coloured Gauss-Seidel: contacts are solved like the bodies' own
+// constraints, each seeing its neighbours' corrections at once (the README
+// compares it with a Jacobi pass, "Mesh collision").
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "collision/bvh.h"
+#include "collision/narrow_phase.h"
+#include "compiler/scene_compiler.h"
+#include "program/xpbd_program.h"
+#include "sinew/scene.h"
+
+namespace sinew {
+
+class MeshCollision {
+ public:
+  /// The collidable primitives of `scene` (device particle indices) and
+  /// the contact buffers on `device`, sized for a first guess.
+  static Result<std::unique_ptr<MeshCollision>> create(const SceneDesc& scene, const CompiledScene& compiled,
+                                                       Device& device);
+
+  /// Finds this frame's contacts from the positions and velocities now on
+  /// the device and uploads them. [out] grew: the buffers or the colours
+  /// outgrew the frame program, which must be rebuilt with buffers().
+  /// Errors: a non-finite position or a collapsed triangle, named.
+  Status before_frame(Device& device, const XpbdBuffers& scene_buffers, bool& grew);
+
+  [[nodiscard]] const MeshContactBuffers& buffers() const { return buffers_; }
+  [[nodiscard]] std::uint32_t contacts() const { return contact_count_; }  ///< this frame's
+  [[nodiscard]] std::uint32_t colors() const { return color_count_; }      ///< this frame's
+  /// This frame's largest motion margin [m]: the reach of the fastest pair beyond the thickness.
+  [[nodiscard]] double margin() const { return margin_; }
+
+ private:
+  MeshCollisionDesc desc_;
+  double time_step_ = 0.0;
+  double gravity_ = 0.0;  // |g| [m/s^2]
+  std::vector<std::uint32_t> triangles_, triangle_body_;  // device particles, 3 per triangle; body per triangle
+  std::vector<std::uint32_t> segments_, segment_body_;    // 2 per segment
+  std::vector<std::uint32_t> collidable_;                 // particles of any primitive
+  collision::Bvh triangle_tree_, segment_tree_;
+  MeshContactBuffers buffers_;
+  std::uint32_t contact_count_ = 0, color_count_ = 0;
+  double margin_ = 0.0;
+  // Per-frame scratch, kept to avoid reallocating.
+  std::vector<float> positions_, velocities_, speed_;
+  std::vector<collision::Aabb> boxes_;
+  std::vector<collision::Pair> pairs_;
+  std::vector<collision::Contact> found_, all_;
+  std::vector<std::uint8_t> movable_;  // per particle (device order): inverse mass > 0
+  std::vector<std::uint32_t> kept_, contact_particles_, table_, upload_particles_;
+  std::vector<float> upload_coefficients_, upload_normals_;
+};
+
+}  // namespace sinew

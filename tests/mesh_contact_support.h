@@ -1,0 +1,99 @@
+// mesh_contact_support.h — measuring contact between simulated bodies in
+// the tests (tests/mesh_contact_test.cpp): how deep any body's surface
+// vertex sits inside another tet body, from the positions alone.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "sinew/mesh.h"
+
+namespace sinew::test {
+
+using P3 = std::array<double, 3>;
+
+inline P3 sub(const P3& a, const P3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline double dot(const P3& a, const P3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline P3 cross(const P3& a, const P3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+/// Distance from p to triangle (a, b, c), in double (Ericson 2005, 5.1.5).
+inline double point_triangle_distance(const P3& p, const P3& a, const P3& b, const P3& c) {
+  const P3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  auto dist = [&](const P3& q) { const P3 d = sub(p, q); return std::sqrt(dot(d, d)); };
+  auto along = [](const P3& o, const P3& e, double t) { return P3{o[0] + t * e[0], o[1] + t * e[1], o[2] + t * e[2]}; };
+  if (d1 <= 0 && d2 <= 0) return dist(a);
+  const P3 bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return dist(b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return dist(along(a, ab, d1 / (d1 - d3)));
+  const P3 cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return dist(c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return dist(along(a, ac, d2 / (d2 - d6)));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return dist(along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+  const double denom = 1.0 / (va + vb + vc);
+  const P3 q = along(along(a, ab, vb * denom), ac, vc * denom);
+  return dist(q);
+}
+
+/// A tet body as the test sees it after a run: its mesh and the positions
+/// of its vertices (from Simulation::read_positions, from `first` on).
+struct PlacedBody {
+  const TetMesh* mesh;
+  std::uint32_t first;
+};
+
+inline P3 at(const std::vector<float>& xyzw, std::uint32_t p) {
+  return {xyzw[4 * std::size_t{p}], xyzw[4 * std::size_t{p} + 1], xyzw[4 * std::size_t{p} + 2]};
+}
+
+/// Whether p is inside tet (a, b, c, d), by the signs of the four sub-volumes.
+inline bool inside_tet(const P3& p, const P3& a, const P3& b, const P3& c, const P3& d) {
+  const double v = dot(sub(b, a), cross(sub(c, a), sub(d, a)));
+  const double s[4] = {dot(sub(b, p), cross(sub(c, p), sub(d, p))), dot(sub(p, a), cross(sub(c, a), sub(d, a))),
+                       dot(sub(b, a), cross(sub(p, a), sub(d, a))), dot(sub(b, a), cross(sub(c, a), sub(p, a)))};
+  for (double x : s)
+    if ((v > 0 && x < 0) || (v < 0 && x > 0)) return false;
+  return true;
+}
+
+/// The deepest any boundary vertex of `a` lies inside `b`'s tets [m]: its
+/// distance to b's boundary surface (0 when none is inside).
+inline double penetration(const std::vector<float>& x, const PlacedBody& a, const PlacedBody& b) {
+  const TriMesh sa = extract_boundary_surface(*a.mesh), sb = extract_boundary_surface(*b.mesh);
+  std::vector<char> on_surface(a.mesh->vertices.size(), 0);
+  for (const auto& t : sa.triangles)
+    for (auto v : t) on_surface[v] = 1;
+  double deepest = 0.0;
+  for (std::uint32_t v = 0; v < on_surface.size(); ++v) {
+    if (!on_surface[v]) continue;
+    const P3 p = at(x, a.first + v);
+    bool in = false;
+    for (const auto& t : b.mesh->tets) {
+      if (inside_tet(p, at(x, b.first + t[0]), at(x, b.first + t[1]), at(x, b.first + t[2]), at(x, b.first + t[3]))) {
+        in = true;
+        break;
+      }
+    }
+    if (!in) continue;
+    double depth = std::numeric_limits<double>::infinity();
+    for (const auto& f : sb.triangles)
+      depth = std::min(depth, point_triangle_distance(p, at(x, b.first + f[0]), at(x, b.first + f[1]),
+                                                      at(x, b.first + f[2])));
+    deepest = std::max(deepest, depth);
+  }
+  return deepest;
+}
+
+}  // namespace sinew::test
