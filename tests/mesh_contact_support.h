@@ -97,3 +97,57 @@ inline double penetration(const std::vector<float>& x, const PlacedBody& a, cons
 }
 
 }  // namespace sinew::test
+
+namespace sinew::test {
+
+/// A flat rectangular membrane in the y = `height` plane: nx * nz cells of
+/// `cell` [m] from the origin along +x and +z, two triangles per cell.
+inline TriMesh membrane(int nx, int nz, double cell, double height) {
+  TriMesh m;
+  for (int i = 0; i <= nx; ++i)
+    for (int k = 0; k <= nz; ++k) m.vertices.push_back({i * cell, height, k * cell});
+  const auto id = [&](int i, int k) { return static_cast<std::uint32_t>(i * (nz + 1) + k); };
+  for (int i = 0; i < nx; ++i)
+    for (int k = 0; k < nz; ++k) {
+      m.triangles.push_back({id(i, k), id(i + 1, k), id(i + 1, k + 1)});
+      m.triangles.push_back({id(i, k), id(i + 1, k + 1), id(i, k + 1)});
+    }
+  return m;
+}
+
+/// Whether segment (p, q) crosses triangle (a, b, c) (touching counts), in double.
+inline bool segment_crosses_triangle(const P3& p, const P3& q, const P3& a, const P3& b, const P3& c) {
+  const P3 n = cross(sub(b, a), sub(c, a));
+  const double dp = dot(n, sub(p, a)), dq = dot(n, sub(q, a));
+  if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || dp == dq) return false;
+  const double t = dp / (dp - dq);
+  const P3 x{p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]), p[2] + t * (q[2] - p[2])};
+  const double s0 = dot(n, cross(sub(b, a), sub(x, a))), s1 = dot(n, cross(sub(c, b), sub(x, b))),
+               s2 = dot(n, cross(sub(a, c), sub(x, c)));
+  return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
+}
+
+/// Pairs of triangles of one surface that share no vertex yet intersect
+/// (an edge of one crosses the other): where it has passed through itself.
+/// Brute force over all pairs, for small test meshes.
+inline int self_intersections(const std::vector<float>& x, const TriMesh& mesh, std::uint32_t first) {
+  int found = 0;
+  const auto& t = mesh.triangles;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (std::size_t j = i + 1; j < t.size(); ++j) {
+      bool shared = false;
+      for (auto a : t[i])
+        for (auto b : t[j]) shared |= a == b;
+      if (shared) continue;
+      const P3 pi[3] = {at(x, first + t[i][0]), at(x, first + t[i][1]), at(x, first + t[i][2])};
+      const P3 pj[3] = {at(x, first + t[j][0]), at(x, first + t[j][1]), at(x, first + t[j][2])};
+      bool hit = false;
+      for (int e = 0; e < 3 && !hit; ++e)
+        hit = segment_crosses_triangle(pi[e], pi[(e + 1) % 3], pj[0], pj[1], pj[2]) ||
+              segment_crosses_triangle(pj[e], pj[(e + 1) % 3], pi[0], pi[1], pi[2]);
+      found += hit;
+    }
+  return found;
+}
+
+}  // namespace sinew::test
