@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sinew/mesh.h"
+#include "sinew/scene.h"
 
 namespace sinew::test {
 
@@ -149,5 +150,87 @@ inline int self_intersections(const std::vector<float>& x, const TriMesh& mesh, 
     }
   return found;
 }
+
+}  // namespace sinew::test
+
+namespace sinew::test {
+
+/// A tet block of cells^3 cubes of `cell` [m] with its corner at `origin`,
+/// E = 2 MPa, nu = 0.3, lightly damped.
+inline TetBodyDesc soft_block(int cells, double cell, const std::array<double, 3>& origin) {
+  TetBodyDesc body;
+  body.mesh = *make_tet_grid({.nx = cells, .ny = cells, .nz = cells, .origin = {0, 0, 0},
+                              .cell_size = {cell, cell, cell}});
+  for (auto& v : body.mesh.vertices)
+    for (int k = 0; k < 3; ++k) v[k] += origin[k];
+  (void)body.set_elastic(2e6, 0.3);
+  body.density = 1000.0;
+  body.velocity_damping = 2.0;
+  return body;
+}
+
+/// Two tissue blocks dropped onto each other (tests/mesh_contact_test.cpp,
+/// benchmarks/mesh_contact_benchmark.cpp): a 3 cm block 1 cm above a 4 cm
+/// block resting on the floor, offset so that its edges and corners meet
+/// the lower block's faces and its vertices fall between the lower one's.
+/// 60 Hz frames of 10 substeps of 2 sweeps; 1 mm thickness.
+inline SceneDesc dropped_blocks_scene(ContactSchedule schedule) {
+  SceneDesc scene;
+  scene.solver.time_step = 1.0 / 60.0;
+  scene.solver.substeps = 10;
+  scene.solver.iterations = 2;
+  scene.tet_bodies.push_back(soft_block(4, 0.01, {0.0, 0.0, 0.0}));
+  scene.tet_bodies.push_back(soft_block(4, 0.0075, {0.005, 0.05, 0.0065}));
+  scene.colliders.push_back(ColliderDesc{});  // the floor, y = 0
+  scene.mesh_collision.enabled = true;
+  scene.mesh_collision.thickness = 1e-3;
+  scene.mesh_collision.schedule = schedule;
+  return scene;
+}
+
+/// A membrane strip (12 x 3 cm, 5 mm cells, no bending) lying on the floor
+/// with one end lifted by its edge's vertices (attached to targets) over
+/// the rest and laid down on it: the fold's upper layer settles onto the
+/// lower one. Its far edge's targets follow a half circle about x = 5.75
+/// cm over fold_frames frames, ending just past the strip's other end
+/// (x = -0.5 cm), 3 mm up, so the upper layer is pulled taut over the lower.
+struct FoldedStrip {
+  static constexpr int nx = 24, nz = 6, fold_frames = 90;
+  static constexpr double cell = 0.005;
+  static SceneDesc scene(ContactSchedule schedule) {
+    SceneDesc scene;
+    scene.solver.time_step = 1.0 / 60.0;
+    scene.solver.substeps = 10;
+    scene.solver.iterations = 2;
+    TriBodyDesc strip;
+    strip.mesh = membrane(nx, nz, cell, 0.002);
+    strip.thickness = 1e-3;
+    strip.distance_compliance = 1e-6;
+    strip.area_compliance = 1e-6;
+    // No bending constraints: like cloth, the fold lies flat under its weight.
+    strip.velocity_damping = 3.0;
+    scene.tri_bodies.push_back(strip);
+    scene.colliders.push_back(ColliderDesc{});  // the floor
+    for (int k = 0; k <= nz; ++k) {
+      scene.targets.push_back({nx * cell, 0.002, k * cell});
+      AttachmentDesc a;
+      a.vertex = {BodyKind::tri, 0, static_cast<std::uint32_t>(nx * (nz + 1) + k)};
+      a.target = static_cast<std::uint32_t>(k);
+      a.compliance = 1e-6;
+      scene.attachments.push_back(a);
+    }
+    scene.mesh_collision.enabled = true;
+    scene.mesh_collision.thickness = 1.5e-3;
+    scene.mesh_collision.schedule = schedule;
+    return scene;
+  }
+  /// Where target k is at the end of frame f [m].
+  static std::array<double, 3> target(int f, int k) {
+    const double centre = 0.0575, radius = nx * cell - centre;
+    const double done = std::min(1.0, double(f + 1) / fold_frames);
+    const double angle = 3.14159265358979 * done;
+    return {centre + radius * std::cos(angle), 0.002 + 0.001 * done + radius * std::sin(angle), k * cell};
+  }
+};
 
 }  // namespace sinew::test

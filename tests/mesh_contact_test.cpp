@@ -15,31 +15,11 @@ namespace {
 
 class MeshContact : public BackendTest {};
 
-TetBodyDesc soft_block(int cells, double cell, const std::array<double, 3>& origin) {
-  TetBodyDesc body;
-  body.mesh = box_mesh(cells, cells, cells, cell);
-  for (auto& v : body.mesh.vertices)
-    for (int k = 0; k < 3; ++k) v[k] += origin[k];
-  EXPECT_TRUE(body.set_elastic(2e6, 0.3).ok());
-  body.density = 1000.0;
-  body.velocity_damping = 2.0;
-  return body;
-}
-
 // A 3 cm block dropped from 1 cm onto a 4 cm block resting on the floor,
 // offset so that its edges and corners meet the lower block's faces and its
 // vertices fall between the lower one's (finer and coarser meshes).
 TEST_P(MeshContact, DroppedBlocksRestOnEachOtherWithinTheThickness) {
-  SceneDesc scene;
-  scene.solver.time_step = 1.0 / 60.0;
-  scene.solver.substeps = 10;
-  scene.solver.iterations = 2;
-  scene.tet_bodies.push_back(soft_block(4, 0.01, {0.0, 0.0, 0.0}));
-  scene.tet_bodies.push_back(soft_block(4, 0.0075, {0.005, 0.05, 0.0065}));
-  ColliderDesc floor;
-  scene.colliders.push_back(floor);
-  scene.mesh_collision.enabled = true;
-  scene.mesh_collision.thickness = 1e-3;
+  const SceneDesc scene = dropped_blocks_scene(ContactSchedule::colored);
   auto sim = create_or_skip(scene, GetParam());
   SINEW_ASSERT_OK(sim);
   for (int f = 0; f < 120; ++f) SINEW_ASSERT_OK(sim->step());
@@ -67,47 +47,17 @@ TEST_P(MeshContact, DroppedBlocksRestOnEachOtherWithinTheThickness) {
 // pass through it (no two triangles sharing no vertex ever intersect), and
 // ends resting on it.
 TEST_P(MeshContact, MembraneFoldedOntoItselfNeverPassesThroughItself) {
-  constexpr int nx = 24, nz = 6;
-  constexpr double cell = 0.005;
-  SceneDesc scene;
-  scene.solver.time_step = 1.0 / 60.0;
-  scene.solver.substeps = 10;
-  scene.solver.iterations = 2;
-  TriBodyDesc strip;
-  strip.mesh = membrane(nx, nz, cell, 0.002);
-  strip.thickness = 1e-3;
-  strip.distance_compliance = 1e-6;
-  strip.area_compliance = 1e-6;
-  // No bending constraints: like cloth, the fold lies flat under its weight.
-  strip.velocity_damping = 3.0;
-  scene.tri_bodies.push_back(strip);
-  ColliderDesc floor;
-  scene.colliders.push_back(floor);
-  // The far edge (x = nx * cell = 12 cm) held by targets that follow a half
-  // circle about x = 5.75 cm over 1.5 s, ending just past the strip's other
-  // end (x = -0.5 cm), 3 mm up: the upper layer is pulled taut over the lower.
-  const double centre = 0.0575, radius = nx * cell - centre;
-  for (int k = 0; k <= nz; ++k) {
-    scene.targets.push_back({nx * cell, 0.002, k * cell});
-    AttachmentDesc a;
-    a.vertex = {BodyKind::tri, 0, static_cast<std::uint32_t>(nx * (nz + 1) + k)};
-    a.target = static_cast<std::uint32_t>(k);
-    a.compliance = 1e-6;
-    scene.attachments.push_back(a);
-  }
-  scene.mesh_collision.enabled = true;
-  scene.mesh_collision.thickness = 1.5e-3;
+  constexpr int nz = FoldedStrip::nz;
+  const SceneDesc scene = FoldedStrip::scene(ContactSchedule::colored);
   auto sim = create_or_skip(scene, GetParam());
   SINEW_ASSERT_OK(sim);
   const std::uint32_t first = sim->info().tri_body_first_particle[0];
   std::vector<float> x;
   int worst = 0;
   std::uint32_t most_contacts = 0;
-  constexpr int fold_frames = 90, total = 180;
+  constexpr int total = 2 * FoldedStrip::fold_frames;
   for (int f = 0; f < total; ++f) {
-    const double angle = 3.14159265358979 * std::min(1.0, double(f + 1) / fold_frames);
-    for (int k = 0; k <= nz; ++k)
-      SINEW_ASSERT_OK(sim->set_target(k, {centre + radius * std::cos(angle), 0.002 + 0.001 * std::min(1.0, double(f + 1) / fold_frames) + radius * std::sin(angle), k * cell}));
+    for (int k = 0; k <= nz; ++k) SINEW_ASSERT_OK(sim->set_target(k, FoldedStrip::target(f, k)));
     SINEW_ASSERT_OK(sim->step());
     most_contacts = std::max(most_contacts, sim->last_frame().mesh_contacts);
     if (f % 6 == 5 || f + 1 == total) {
@@ -128,6 +78,45 @@ TEST_P(MeshContact, MembraneFoldedOntoItselfNeverPassesThroughItself) {
   EXPECT_GT(most_contacts, 0u);
   EXPECT_GT(lowest, 0.5 * scene.mesh_collision.thickness);
   EXPECT_LT(lowest, 3.0 * scene.mesh_collision.thickness);
+}
+
+// Every backend against the CPU reference on the dropped blocks, 60 frames
+// (contacts from the third on), with either schedule: positions within
+// 1e-5 m (the kernels follow the CPU's operation order without fused
+// multiply-adds, so they are expected to agree bitwise; the test prints how
+// many coordinates do). The contacts are found on the host from each
+// backend's own positions, so any difference would also change contacts.
+TEST_P(MeshContact, BackendsAgreeWithTheCpuReference) {
+  if (GetParam() == "cpu") GTEST_SKIP() << "the reference itself";
+  for (ContactSchedule schedule : {ContactSchedule::colored, ContactSchedule::jacobi}) {
+    const SceneDesc scene = dropped_blocks_scene(schedule);
+    auto reference = create_or_skip(scene, "cpu");
+    auto sim = create_or_skip(scene, GetParam());
+    SINEW_ASSERT_OK(reference);
+    SINEW_ASSERT_OK(sim);
+    std::uint64_t contacts = 0;
+    for (int f = 0; f < 60; ++f) {
+      SINEW_ASSERT_OK(reference->step());
+      SINEW_ASSERT_OK(sim->step());
+      contacts += sim->last_frame().mesh_contacts;
+      EXPECT_EQ(sim->last_frame().mesh_contacts, reference->last_frame().mesh_contacts) << "frame " << f;
+    }
+    std::vector<float> a, b;
+    SINEW_ASSERT_OK(reference->read_positions(a));
+    SINEW_ASSERT_OK(sim->read_positions(b));
+    ASSERT_EQ(a.size(), b.size());
+    double worst = 0.0;
+    std::size_t equal = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      worst = std::max(worst, std::abs(double(a[i]) - double(b[i])));
+      equal += a[i] == b[i];
+    }
+    std::printf("[%s, %s] %zu of %zu words bitwise equal, largest difference %.3g m, %llu contacts in all\n",
+                GetParam().c_str(), schedule == ContactSchedule::jacobi ? "jacobi" : "colored", equal, a.size(), worst,
+                static_cast<unsigned long long>(contacts));
+    EXPECT_GT(contacts, 0u);
+    EXPECT_LE(worst, 1e-5);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, MeshContact, ::testing::ValuesIn(backends()), backend_name);

@@ -307,15 +307,26 @@ struct SolverSettings {
 /// primitive on its side of the separating plane through the second's
 /// closest point, `thickness` away from it, so surfaces that start a frame
 /// apart cannot pass through each other as long as no particle moves more
-/// than half the margin within it. Contacts are coloured on the host every
-/// frame and solved after the bodies' constraints in every sweep
-/// (graph-coloured Gauss-Seidel, like the bodies).
+/// than half the margin within it. Contacts are solved after the bodies'
+/// constraints in every sweep, scheduled by `schedule`.
 ///
 /// Not yet: with the residual-driven mode or the Chebyshev accelerator
 /// (an error names the setting), and on the device (the host finds the
 /// contacts; GPU backends read the positions back once per frame).
+/// How the contacts between meshes are scheduled within a sweep (README,
+/// "Mesh collision", compares them):
+///  - colored: coloured on the host every frame so that no two contacts of
+///    a colour share a movable particle, one dispatch per colour
+///    (Gauss-Seidel, like the bodies' constraints);
+///  - jacobi: every contact solved from the same positions, then each
+///    particle moved by the mean of its contacts' corrections (Macklin et
+///    al., "Unified Particle Physics", 2014, section 4.2): two dispatches
+///    per sweep however many colours the contacts would need.
+enum class ContactSchedule { colored, jacobi };
+
 struct MeshCollisionDesc {
   bool enabled = false;
+  ContactSchedule schedule = ContactSchedule::colored;
   /// The distance the surfaces keep from each other [m], > 0. Also the
   /// tissue's collision thickness in self-contact.
   double thickness = 1e-3;

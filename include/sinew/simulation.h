@@ -82,9 +82,13 @@ struct FrameStats {
   /// were found within [m], and the wall time [ms] of reading the
   /// particles back, finding, colouring and uploading them (part of wall_ms).
   std::uint32_t mesh_contacts = 0;
-  std::uint32_t mesh_contact_colors = 0;
+  std::uint32_t mesh_contact_colors = 0;  ///< 0 with ContactSchedule::jacobi
   double collision_margin = 0.0;
   double collision_ms = 0.0;
+  /// The deepest any of the frame's mesh contacts ended inside the
+  /// thickness [m], max(thickness - gap) at the frame's end (0 when none
+  /// touches): how well the sweeps converged on the contacts.
+  double contact_violation = 0.0;
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;

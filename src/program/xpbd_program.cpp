@@ -116,10 +116,15 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   // Mesh contacts: colour k's count is word k of the table, which the host
   // writes before each frame (at most the capacity, checked after the run).
   std::vector<std::uint32_t> contact_counters;
-  if (mesh_contacts)
+  if (mesh_contacts && mesh_contacts->jacobi) {
+    contact_counters.push_back(program.counter("mesh contacts", mesh_contacts->table, 0, mesh_contacts->capacity));
+    contact_counters.push_back(program.counter("particles touched by mesh contacts", mesh_contacts->table, 1,
+                                               mesh_contacts->touched_capacity));
+  } else if (mesh_contacts) {
     for (std::uint32_t k = 0; k < mesh_contacts->colors; ++k)
       contact_counters.push_back(program.counter("mesh contacts of colour " + std::to_string(k),
                                                  mesh_contacts->table, k, mesh_contacts->capacity));
+  }
   for (int s = 0; s < solver.substeps; ++s) {
     program.dispatch(Kernel::xpbd_predict, particles, {buffers.position, buffers.previous, buffers.velocity}, predict);
     program.barrier();
@@ -138,7 +143,20 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
         m.colors = mesh_contacts->colors;
         m.inv_h2 = inv_h2;
         m.reset_lambda = p.reset_lambda;
-        for (std::uint32_t k = 0; k < mesh_contacts->colors; ++k) {
+        if (mesh_contacts->jacobi) {
+          program.dispatch_indirect(Kernel::xpbd_mesh_contacts_jacobi, contact_counters[0],
+                                    {buffers.position, buffers.previous, mesh_contacts->table,
+                                     mesh_contacts->particles, mesh_contacts->coefficients, mesh_contacts->normals,
+                                     mesh_contacts->lambda, mesh_contacts->delta},
+                                    m);
+          program.barrier();
+          program.dispatch_indirect(Kernel::xpbd_mesh_contacts_gather, contact_counters[1],
+                                    {buffers.position, mesh_contacts->table, mesh_contacts->touched,
+                                     mesh_contacts->offsets, mesh_contacts->slots, mesh_contacts->delta},
+                                    m);
+          program.barrier();
+        }
+        for (std::uint32_t k = 0; !mesh_contacts->jacobi && k < mesh_contacts->colors; ++k) {
           m.color = k;
           program.dispatch_indirect(Kernel::xpbd_solve_mesh_contacts, contact_counters[k],
                                     {buffers.position, buffers.previous, mesh_contacts->table,

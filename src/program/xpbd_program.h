@@ -28,6 +28,13 @@ struct MeshContactBuffers {
   BufferHandle table, particles, coefficients, normals, lambda;
   std::uint32_t capacity = 0;
   std::uint32_t colors = 0;
+  /// The Jacobi schedule (ContactSchedule::jacobi): table word 0 counts the
+  /// contacts, word 1 the particles they touch; 4 corrections per contact,
+  /// and per touched particle its slots among them (CSR: touched, offsets,
+  /// slots; mesh_contact_params.h).
+  bool jacobi = false;
+  BufferHandle delta, touched, offsets, slots;
+  std::uint32_t touched_capacity = 0;
   kernels::MeshContactParams params{};  ///< thickness, compliance, friction (the rest set per dispatch)
 };
 

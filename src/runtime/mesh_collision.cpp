@@ -82,6 +82,14 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
         std::tuple{&b.normals, contact_bytes, "mesh contact normals"},
         std::tuple{&b.lambda, contact_bytes, "mesh contact lambdas"}})
     if (Status s = make(device, bytes, label, *handle); !s) return s.error();
+  b.jacobi = mc->desc_.schedule == ContactSchedule::jacobi;
+  b.touched_capacity = static_cast<std::uint32_t>(mc->collidable_.size());
+  for (auto [handle, bytes, label] :
+       {std::tuple{&b.delta, b.jacobi ? 4 * contact_bytes : 16, "mesh contact corrections"},
+        std::tuple{&b.touched, b.jacobi ? std::size_t{b.touched_capacity} * 4 : 16, "mesh contact particles touched"},
+        std::tuple{&b.offsets, b.jacobi ? std::size_t{b.touched_capacity + 1} * 4 : 16, "mesh contact offsets"},
+        std::tuple{&b.slots, b.jacobi ? contact_bytes : 16, "mesh contact slots"}})
+    if (Status s = make(device, bytes, label, *handle); !s) return s.error();
   b.params.thickness = static_cast<float>(mc->desc_.thickness);
   b.params.compliance = static_cast<float>(mc->desc_.compliance);
   b.params.static_friction = static_cast<float>(mc->desc_.static_friction);
@@ -89,14 +97,45 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   return mc;
 }
 
-Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buffers, bool& grew) {
-  grew = false;
+Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers) {
   const std::size_t particles = movable_.size();
   positions_.resize(particles * 4);
   velocities_.resize(particles * 4);
   if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
   if (Status s = device.read_buffer(scene_buffers.velocity, 0, velocities_.data(), velocities_.size() * 4); !s)
     return s;
+  fresh_ = true;
+  return {};
+}
+
+Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffers) {
+  if (Status s = read_back(device, scene_buffers); !s) return s;
+  // How far the frame's contacts ended inside their thickness, from the
+  // very positions the next frame's detection starts from.
+  double worst = 0.0;
+  for (std::uint32_t k = 0; k < contact_count_; ++k) {
+    double gap = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      double along = 0.0;
+      for (int j = 0; j < 4; ++j)
+        along += double(upload_coefficients_[4 * std::size_t{k} + j]) *
+                 positions_[4 * std::size_t{upload_particles_[4 * std::size_t{k} + j]} + a];
+      gap += along * upload_normals_[4 * std::size_t{k} + a];
+    }
+    worst = std::max(worst, desc_.thickness - gap);
+  }
+  violation_ = worst;
+  return {};
+}
+
+Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buffers, bool& grew) {
+  grew = false;
+  const std::size_t particles = movable_.size();
+  // The positions and velocities the last frame ended with (after_frame);
+  // read here only before the first frame.
+  if (!fresh_)
+    if (Status s = read_back(device, scene_buffers); !s) return s;
+  fresh_ = false;
 
   // How close two primitives must be at the frame's start to become a
   // contact (mesh_collision.h): the thickness, the user's margin and
@@ -206,8 +245,8 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     }
   }
 
-  // Coefficients c_k and the colouring (mesh_contact_params.h); contacts
-  // of immovable particles only are dropped (nothing to solve).
+  // Coefficients c_k (mesh_contact_params.h); contacts of immovable
+  // particles only are dropped (nothing to solve).
   std::vector<std::uint32_t>& vertices = contact_particles_;
   vertices.clear();
   kept_.clear();
@@ -219,36 +258,49 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     kept_.push_back(static_cast<std::uint32_t>(k));
     vertices.insert(vertices.end(), c.v.begin(), c.v.end());
   }
-  const Coloring coloring = color_constraints(vertices, 4, movable_);
   const auto count = static_cast<std::uint32_t>(kept_.size());
-  const std::uint32_t colors = coloring.color_count();
   contact_count_ = count;
-  color_count_ = colors;
-
   MeshContactBuffers& b = buffers_;
   if (count > b.capacity) {
     b.capacity = std::max(count, 2 * b.capacity);
     for (BufferHandle h : {b.particles, b.coefficients, b.normals, b.lambda})
       if (Status s = device.resize_buffer(h, std::size_t{b.capacity} * 16); !s) return s;
-    grew = true;
-  }
-  if (colors > b.colors) {
-    b.colors = std::max(colors, 2 * b.colors);
-    if (Status s = device.resize_buffer(b.table, std::size_t{2} * b.colors * 4); !s) return s;
+    if (b.jacobi) {
+      if (Status s = device.resize_buffer(b.delta, std::size_t{b.capacity} * 64); !s) return s;
+      if (Status s = device.resize_buffer(b.slots, std::size_t{b.capacity} * 16); !s) return s;
+    }
     grew = true;
   }
 
-  // Colour-sorted upload: colour k's contacts at [first_k, first_k + size_k).
-  table_.assign(std::size_t{2} * b.colors, 0);
-  for (std::uint32_t k = 0; k < colors; ++k) table_[k] = coloring.color_sizes[k];
-  for (std::uint32_t k = 1; k < colors; ++k) table_[b.colors + k] = table_[b.colors + k - 1] + table_[k - 1];
-  std::vector<std::uint32_t> next(table_.begin() + b.colors, table_.begin() + b.colors + colors);
+  // Where each contact goes: colour-sorted (colour k's contacts at
+  // [first_k, first_k + size_k)), or in order for the Jacobi schedule.
+  std::vector<std::uint32_t> slot_of(count);
+  if (b.jacobi) {
+    color_count_ = 0;
+    for (std::uint32_t k = 0; k < count; ++k) slot_of[k] = k;
+    table_.assign(std::size_t{2} * b.colors, 0);
+    table_[0] = count;
+  } else {
+    const Coloring coloring = color_constraints(vertices, 4, movable_);
+    const std::uint32_t colors = coloring.color_count();
+    color_count_ = colors;
+    if (colors > b.colors) {
+      b.colors = std::max(colors, 2 * b.colors);
+      if (Status s = device.resize_buffer(b.table, std::size_t{2} * b.colors * 4); !s) return s;
+      grew = true;
+    }
+    table_.assign(std::size_t{2} * b.colors, 0);
+    for (std::uint32_t k = 0; k < colors; ++k) table_[k] = coloring.color_sizes[k];
+    for (std::uint32_t k = 1; k < colors; ++k) table_[b.colors + k] = table_[b.colors + k - 1] + table_[k - 1];
+    std::vector<std::uint32_t> next(table_.begin() + b.colors, table_.begin() + b.colors + colors);
+    for (std::uint32_t k = 0; k < count; ++k) slot_of[k] = next[coloring.color_of[k]]++;
+  }
   upload_particles_.resize(std::size_t{count} * 4);
   upload_coefficients_.resize(std::size_t{count} * 4);
   upload_normals_.resize(std::size_t{count} * 4);
   for (std::uint32_t k = 0; k < count; ++k) {
     const Contact& c = all_[kept_[k]];
-    const std::size_t at = std::size_t{next[coloring.color_of[k]]++} * 4;
+    const std::size_t at = std::size_t{slot_of[k]} * 4;
     const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
     const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], -c.w[2], -c.w[3]};
     for (int j = 0; j < 4; ++j) {
@@ -259,6 +311,35 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     upload_normals_[at + 1] = c.normal[1];
     upload_normals_[at + 2] = c.normal[2];
     upload_normals_[at + 3] = 0.0f;
+  }
+  if (b.jacobi) {
+    // Per touched (movable) particle, its correction slots 4 i + k in
+    // increasing order: a counting sort by particle, so the gather sums
+    // them in a fixed order.
+    upload_offsets_.assign(particles + 1, 0);
+    for (std::size_t s = 0; s < upload_particles_.size(); ++s)
+      if (movable_[upload_particles_[s]]) ++upload_offsets_[upload_particles_[s] + 1];
+    upload_touched_.clear();
+    for (std::size_t p = 0; p < particles; ++p) {
+      if (upload_offsets_[p + 1] > 0) upload_touched_.push_back(static_cast<std::uint32_t>(p));
+      upload_offsets_[p + 1] += upload_offsets_[p];
+    }
+    upload_slots_.resize(upload_offsets_[particles]);
+    std::vector<std::uint32_t> next(upload_offsets_.begin(), upload_offsets_.end() - 1);
+    for (std::size_t s = 0; s < upload_particles_.size(); ++s)
+      if (movable_[upload_particles_[s]]) upload_slots_[next[upload_particles_[s]]++] = static_cast<std::uint32_t>(s);
+    // Offsets of the touched particles only (the gather's CSR rows).
+    compact_offsets_.clear();
+    for (std::uint32_t p : upload_touched_) compact_offsets_.push_back(upload_offsets_[p]);
+    compact_offsets_.push_back(upload_offsets_[particles]);
+    table_[1] = static_cast<std::uint32_t>(upload_touched_.size());
+    if (!upload_touched_.empty()) {
+      if (Status s = device.write_buffer(b.touched, 0, upload_touched_.data(), upload_touched_.size() * 4); !s)
+        return s;
+      if (Status s = device.write_buffer(b.offsets, 0, compact_offsets_.data(), compact_offsets_.size() * 4); !s)
+        return s;
+      if (Status s = device.write_buffer(b.slots, 0, upload_slots_.data(), upload_slots_.size() * 4); !s) return s;
+    }
   }
   if (Status s = device.write_buffer(b.table, 0, table_.data(), table_.size() * 4); !s) return s;
   if (count > 0) {

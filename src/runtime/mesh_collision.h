@@ -39,6 +39,13 @@ class MeshCollision {
   /// Errors: a non-finite position or a collapsed triangle, named.
   Status before_frame(Device& device, const XpbdBuffers& scene_buffers, bool& grew);
 
+  /// Reads the positions and velocities the frame ended with (the next
+  /// frame's detection starts from them) and measures violation().
+  Status after_frame(Device& device, const XpbdBuffers& scene_buffers);
+  /// How far the last frame's contacts ended inside their thickness [m]:
+  /// the largest thickness - gap over them, 0 when none is inside.
+  [[nodiscard]] double violation() const { return violation_; }
+
   [[nodiscard]] const MeshContactBuffers& buffers() const { return buffers_; }
   [[nodiscard]] std::uint32_t contacts() const { return contact_count_; }  ///< this frame's
   [[nodiscard]] std::uint32_t colors() const { return color_count_; }      ///< this frame's
@@ -56,6 +63,9 @@ class MeshCollision {
   MeshContactBuffers buffers_;
   std::uint32_t contact_count_ = 0, color_count_ = 0;
   double margin_ = 0.0;
+  double violation_ = 0.0;
+  bool fresh_ = false;  // positions_ and velocities_ hold the device's current state
+  Status read_back(Device& device, const XpbdBuffers& scene_buffers);
   // Per-frame scratch, kept to avoid reallocating.
   std::vector<float> positions_, velocities_, speed_;
   std::vector<collision::Aabb> boxes_;
@@ -64,6 +74,7 @@ class MeshCollision {
   std::vector<std::uint8_t> movable_;  // per particle (device order): inverse mass > 0
   std::vector<std::uint32_t> kept_, contact_particles_, table_, upload_particles_;
   std::vector<float> upload_coefficients_, upload_normals_;
+  std::vector<std::uint32_t> upload_offsets_, upload_touched_, upload_slots_, compact_offsets_;  // Jacobi
 };
 
 }  // namespace sinew

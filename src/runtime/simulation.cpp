@@ -148,6 +148,10 @@ Status Simulation::step() {
     if (Status s = impl_->device->last_run_times(impl_->stats.device); !s) return s;
     impl_->stats.sweeps = std::uint64_t(impl_->substeps) * std::uint64_t(impl_->iterations);
   }
+  if (impl_->mesh_collision) {
+    if (Status s = impl_->mesh_collision->after_frame(*impl_->device, impl_->buffers); !s) return s;
+    impl_->stats.contact_violation = impl_->mesh_collision->violation();
+  }
   const auto ran = std::chrono::steady_clock::now();
   if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
   impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4 +

@@ -1,0 +1,100 @@
+// mesh_contact_benchmark.cpp — the two schedules of the contacts between
+// meshes (MeshCollisionDesc::schedule, issue 12 part 3) on the tests' two
+// contact scenes, measured on convergence and cost:
+//   blocks  a 3 cm block dropped onto a 4 cm block (120 frames, 2 s);
+//   fold    a membrane strip folded onto itself (180 frames, 3 s).
+// Per run (one whole scene = one iteration): wall time per frame (median
+// over frames) and its collision part; penetration: blocks, the deepest a
+// surface vertex of either block lies inside the other at any 10th frame
+// [mm]; fold, the most intersecting triangle pairs at any 6th frame; the
+// worst contact violation (thickness - gap at a frame's end) over the run
+// [mm]; mean contacts and colours per frame.
+//
+//   SINEW_BACKEND=cpu build/benchmarks/bench_mesh_contacts --benchmark_repetitions=3
+//       --benchmark_format=csv > benchmarks/results/mesh_contacts_<date>.csv
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "mesh_contact_support.h"
+#include "sinew/simulation.h"
+
+namespace {
+
+using namespace sinew;
+
+std::string backend() {
+  const char* v = std::getenv("SINEW_BACKEND");
+  return v ? v : "auto";
+}
+
+void BM_MeshContacts(benchmark::State& state) {
+  const bool fold = state.range(0) == 1;
+  const auto schedule = state.range(1) == 1 ? ContactSchedule::jacobi : ContactSchedule::colored;
+  const SceneDesc scene = fold ? test::FoldedStrip::scene(schedule) : test::dropped_blocks_scene(schedule);
+  const int frames = fold ? 2 * test::FoldedStrip::fold_frames : 120;
+  std::vector<double> wall, collision;
+  double penetration = 0.0, violation = 0.0, contacts = 0.0, colors = 0.0;
+  for (auto _ : state) {
+    auto sim = Simulation::create(scene, {.backend = backend(), .quiet = true});
+    if (!sim) {
+      state.SkipWithError(sim.error().message().c_str());
+      return;
+    }
+    std::vector<float> x;
+    wall.clear();
+    collision.clear();
+    penetration = violation = contacts = colors = 0.0;
+    for (int f = 0; f < frames; ++f) {
+      if (fold)
+        for (int k = 0; k <= test::FoldedStrip::nz; ++k)
+          (void)sim->set_target(k, test::FoldedStrip::target(f, k));
+      if (Status s = sim->step(); !s) {
+        state.SkipWithError(s.error().message().c_str());
+        return;
+      }
+      const FrameStats& st = sim->last_frame();
+      wall.push_back(st.wall_ms);
+      collision.push_back(st.collision_ms);
+      violation = std::max(violation, st.contact_violation);
+      contacts += st.mesh_contacts;
+      colors += st.mesh_contact_colors;
+      state.PauseTiming();
+      if (fold && f % 6 == 5) {
+        (void)sim->read_positions(x);
+        penetration = std::max<double>(
+            penetration, test::self_intersections(x, scene.tri_bodies[0].mesh, sim->info().tri_body_first_particle[0]));
+      } else if (!fold && f % 10 == 9) {
+        (void)sim->read_positions(x);
+        const test::PlacedBody a{&scene.tet_bodies[0].mesh, sim->info().tet_body_first_particle[0]};
+        const test::PlacedBody b{&scene.tet_bodies[1].mesh, sim->info().tet_body_first_particle[1]};
+        penetration = std::max({penetration, 1e3 * test::penetration(x, a, b), 1e3 * test::penetration(x, b, a)});
+      }
+      state.ResumeTiming();
+    }
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  state.counters["frame_ms"] = median(wall);
+  state.counters["collision_ms"] = median(collision);
+  state.counters["penetration"] = penetration;  // blocks: [mm]; fold: intersecting triangle pairs
+  state.counters["violation_mm"] = 1e3 * violation;
+  state.counters["contacts"] = contacts / frames;
+  state.counters["colors"] = colors / frames;
+  state.SetLabel(std::string(fold ? "fold" : "blocks") + (schedule == ContactSchedule::jacobi ? "/jacobi" : "/colored"));
+}
+
+BENCHMARK(BM_MeshContacts)
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->ArgNames({"scene", "jacobi"})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
