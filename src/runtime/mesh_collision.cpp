@@ -23,6 +23,8 @@ constexpr std::uint32_t kFirstColors = 16;
 // cos 25 degrees: how far a contact's normal may turn from the direction
 // its primitives face (see `facing` in before_frame).
 constexpr float kFacing = 0.9f;
+// The most candidate pairs one query may hand the narrow phase (see check_pairs).
+constexpr std::size_t kMaxPairs = std::size_t{1} << 23;
 
 Status make(Device& device, std::size_t bytes, const char* label, BufferHandle& handle) {
   auto made = device.create_buffer(std::max<std::size_t>(bytes, 16), label);
@@ -62,6 +64,16 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
       mc->segment_body_.push_back(body);
     }
   }
+  // One tree per body: contiguous runs of triangle_body_ / segment_body_.
+  const auto ranges = [](const std::vector<std::uint32_t>& body_of, std::vector<BodyTree>& trees) {
+    for (std::uint32_t k = 0; k < body_of.size(); ++k)
+      if (k == 0 || body_of[k] != body_of[k - 1]) trees.push_back({k, 0, {}});
+    for (std::size_t t = 0; t < trees.size(); ++t)
+      trees[t].count = (t + 1 < trees.size() ? trees[t + 1].first : static_cast<std::uint32_t>(body_of.size())) -
+                       trees[t].first;
+  };
+  ranges(mc->triangle_body_, mc->triangle_trees_);
+  ranges(mc->segment_body_, mc->segment_trees_);
   mc->collidable_ = mc->triangles_;
   mc->collidable_.insert(mc->collidable_.end(), mc->segments_.begin(), mc->segments_.end());
   std::sort(mc->collidable_.begin(), mc->collidable_.end());
@@ -95,6 +107,39 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   b.params.static_friction = static_cast<float>(mc->desc_.static_friction);
   b.params.dynamic_friction = static_cast<float>(mc->desc_.dynamic_friction);
   return mc;
+}
+
+void MeshCollision::refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes) {
+  for (BodyTree& t : trees) {
+    const auto mine = boxes.subspan(t.first, t.count);
+    if (t.tree.empty()) t.tree.build(mine);
+    else t.tree.update(mine);
+  }
+}
+
+// Candidate pairs (global primitive indices) between the bodies of `a`
+// (primitives of `Arity` vertices in `indices`) and those of `b`: when a
+// and b are the same set, every body against every later one, and each
+// against itself when self-collision is on (skipping primitives that share
+// a vertex); otherwise every body of a against every body of b. A body's
+// own pairs are never visited when self-collision is off, so a scene pays
+// nothing for the self-pairs it does not want.
+template <int Arity>
+void MeshCollision::candidate_pairs(const std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
+                                    const std::vector<BodyTree>& b, std::vector<collision::Pair>& pairs) {
+  pairs.clear();
+  const bool same = &a == &b;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (same && desc_.self_collision) {
+      const collision::SharesVertexOf<Arity> shares{indices.subspan(std::size_t{a[i].first} * Arity)};
+      collision::self_overlapping_pairs_parallel(a[i].tree, shares, local_);
+      for (const auto& [p, q] : local_) pairs.push_back({a[i].first + p, a[i].first + q});
+    }
+    for (std::size_t j = same ? i + 1 : 0; j < b.size(); ++j) {
+      collision::overlapping_pairs(a[i].tree, b[j].tree, local_);
+      for (const auto& [p, q] : local_) pairs.push_back({a[i].first + p, b[j].first + q});
+    }
+  }
 }
 
 Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers) {
@@ -204,40 +249,39 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     }
   };
 
+  // Boxes swollen by fast motion can pair most of two surfaces, and every
+  // pair may make up to 15 contacts: past kMaxPairs the frame stops with an
+  // error that says why, rather than exhausting memory.
+  const auto check_pairs = [&]() -> Status {
+    if (pairs_.size() <= kMaxPairs) return {};
+    return Error(ErrorCode::capacity_exceeded,
+                 "mesh collision: " + std::to_string(pairs_.size()) + " candidate pairs (at most " +
+                     std::to_string(kMaxPairs) + ") within the frame's reach of " + std::to_string(1e3 * reach) +
+                     " mm: the fastest collidable particle moves " + std::to_string(fastest) +
+                     " m/s; smaller time steps or slower bodies keep the reach short");
+  };
   all_.clear();
-  const bool self = desc_.self_collision;
   const auto half = static_cast<float>(0.5 * common);
   if (!triangles_.empty()) {
     if (Status s = collision::primitive_boxes(positions_, triangles_, 3, half, boxes_); !s) return s;
     swell(triangles_, 3);
-    if (triangle_tree_.empty()) triangle_tree_.build(boxes_);
-    else triangle_tree_.update(boxes_);
-    const collision::SharesVertexOf<3> shares{triangles_};
-    collision::self_overlapping_pairs_parallel(
-        triangle_tree_,
-        [&](std::uint32_t i, std::uint32_t j) {
-          return (!self && triangle_body_[i] == triangle_body_[j]) || shares(i, j);
-        },
-        pairs_);
+    refit(triangle_trees_, boxes_);
+    candidate_pairs<3>(triangle_trees_, triangles_, triangle_trees_, pairs_);
+    if (Status s = check_pairs(); !s) return s;
     if (Status s = collision::triangle_contacts(positions_, triangles_, pairs_, reach, found_); !s) return s;
     keep();
   }
   if (!segments_.empty()) {
     if (Status s = collision::primitive_boxes(positions_, segments_, 2, half, boxes_); !s) return s;
     swell(segments_, 2);
-    if (segment_tree_.empty()) segment_tree_.build(boxes_);
-    else segment_tree_.update(boxes_);
-    const collision::SharesVertexOf<2> shares{segments_};
-    collision::self_overlapping_pairs_parallel(
-        segment_tree_,
-        [&](std::uint32_t i, std::uint32_t j) {
-          return (!self && segment_body_[i] == segment_body_[j]) || shares(i, j);
-        },
-        pairs_);
+    refit(segment_trees_, boxes_);
+    candidate_pairs<2>(segment_trees_, segments_, segment_trees_, pairs_);
+    if (Status s = check_pairs(); !s) return s;
     if (Status s = collision::segment_contacts(positions_, segments_, pairs_, reach, found_); !s) return s;
     keep();
     if (!triangles_.empty()) {
-      collision::overlapping_pairs(segment_tree_, triangle_tree_, pairs_);
+      candidate_pairs<2>(segment_trees_, segments_, triangle_trees_, pairs_);
+      if (Status s = check_pairs(); !s) return s;
       if (Status s = collision::segment_triangle_contacts(positions_, segments_, triangles_, pairs_, reach, found_);
           !s)
         return s;

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "collision/bvh.h"
@@ -59,7 +60,17 @@ class MeshCollision {
   std::vector<std::uint32_t> triangles_, triangle_body_;  // device particles, 3 per triangle; body per triangle
   std::vector<std::uint32_t> segments_, segment_body_;    // 2 per segment
   std::vector<std::uint32_t> collidable_;                 // particles of any primitive
-  collision::Bvh triangle_tree_, segment_tree_;
+  // A BVH per body over its primitives [first, first + count).
+  struct BodyTree {
+    std::uint32_t first = 0, count = 0;
+    collision::Bvh tree;
+  };
+  std::vector<BodyTree> triangle_trees_, segment_trees_;
+  std::vector<collision::Pair> local_;
+  static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
+  template <int Arity>
+  void candidate_pairs(const std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
+                       const std::vector<BodyTree>& b, std::vector<collision::Pair>& pairs);
   MeshContactBuffers buffers_;
   std::uint32_t contact_count_ = 0, color_count_ = 0;
   double margin_ = 0.0;

@@ -1,0 +1,163 @@
+// organ_contact — tissue against tissue on the real organ meshes: a probe
+// (a kinematic capsule) presses the kidney down onto the liver and slides
+// it along the liver's surface. Both organs are tet bodies (the meshes
+// under data/meshes/tet, mesher's order, millimetres scaled to metres);
+// they touch through their boundary surfaces (SceneDesc::mesh_collision:
+// vertex-triangle and edge-edge contacts found each frame, solved colour by
+// colour in every sweep). The liver is pinned along its lowest fifth.
+// Writes two VTU series (open kidney.pvd and liver.pvd in ParaView) and
+// prints per frame the wall time, the collision's share, the contacts and
+// their colours, and the deepest contact violation: while it stays below
+// the thickness the surfaces have not passed through each other.
+//
+//   organ_contact [--backend auto|cpu|opencl|vulkan] [--frames N] [--out DIR]
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sinew/mesh.h"
+#include "sinew/simulation.h"
+
+namespace {
+
+struct Box {
+  std::array<double, 3> lo{1e9, 1e9, 1e9}, hi{-1e9, -1e9, -1e9};
+};
+
+Box bounds(const sinew::TetMesh& m) {
+  Box b;
+  for (const auto& v : m.vertices)
+    for (int k = 0; k < 3; ++k) b.lo[k] = std::min(b.lo[k], v[k]), b.hi[k] = std::max(b.hi[k], v[k]);
+  return b;
+}
+
+sinew::Result<sinew::TetMesh> organ(const char* name) {
+  auto m = sinew::read_tet_mesh(std::string(SINEW_DATA_DIR) + "/meshes/tet/" + name + ".node");
+  if (m) sinew::scale_mesh(*m, 1e-3);  // the meshes are in millimetres
+  return m;
+}
+
+int fail(const sinew::Error& e) {
+  std::fprintf(stderr, "organ_contact: %s\n", e.message().c_str());
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string backend = "auto", out = "organ_contact_out";
+  int frames = 60;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    if (a == "--backend") backend = argv[i + 1];
+    else if (a == "--frames") frames = std::atoi(argv[i + 1]);
+    else if (a == "--out") out = argv[i + 1];
+    else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 1; }
+  }
+  auto liver = organ("liver_382k");
+  if (!liver) return fail(liver.error());
+  auto kidney = organ("kidney_57k");
+  if (!kidney) return fail(kidney.error());
+
+  // The kidney above the middle of the liver, 3 mm clear of the liver's
+  // highest point under the kidney's footprint.
+  const Box lb = bounds(*liver), kb0 = bounds(*kidney);
+  const double cx = 0.5 * (lb.lo[0] + lb.hi[0]), cz = 0.5 * (lb.lo[2] + lb.hi[2]);
+  const double hx = 0.5 * (kb0.hi[0] - kb0.lo[0]), hz = 0.5 * (kb0.hi[2] - kb0.lo[2]);
+  double under = lb.lo[1];
+  for (const auto& v : liver->vertices)
+    if (std::abs(v[0] - cx) <= hx && std::abs(v[2] - cz) <= hz) under = std::max(under, v[1]);
+  const std::array<double, 3> shift{cx - 0.5 * (kb0.lo[0] + kb0.hi[0]), under + 0.003 - kb0.lo[1],
+                                    cz - 0.5 * (kb0.lo[2] + kb0.hi[2])};
+  for (auto& v : kidney->vertices)
+    for (int k = 0; k < 3; ++k) v[k] += shift[k];
+  const Box kb = bounds(*kidney);
+
+  sinew::SceneDesc scene;
+  scene.solver.time_step = 1.0 / 60.0;
+  scene.solver.substeps = 10;
+  scene.solver.iterations = 3;
+  scene.solver.measure_errors = false;
+  // No gravity: the organs lie supported in the abdomen, and the probe's
+  // push is what brings them together (with gravity the jelly-soft liver,
+  // pinned only at its base, would sag as a whole at tens of cm/s).
+  scene.gravity = {0.0, 0.0, 0.0};
+  for (auto* mesh : {&*liver, &*kidney}) {
+    sinew::TetBodyDesc body;
+    body.mesh = *mesh;
+    if (auto s = body.set_elastic(5e4, 0.4); !s) return fail(s.error());  // soft tissue, 50 kPa
+    body.density = 1060.0;
+    body.velocity_damping = 5.0;
+    scene.tet_bodies.push_back(std::move(body));
+  }
+  for (std::uint32_t v = 0; v < liver->vertices.size(); ++v)
+    if (liver->vertices[v][1] < lb.lo[1] + 0.2 * (lb.hi[1] - lb.lo[1])) scene.tet_bodies[0].pinned.push_back(v);
+  scene.mesh_collision.enabled = true;
+  scene.mesh_collision.thickness = 1e-3;
+  scene.mesh_collision.self_collision = false;  // organ against organ only
+  // The probe: a capsule of radius 8 mm lying along x, starting 1 cm above the kidney.
+  sinew::ColliderDesc probe;
+  probe.shape = sinew::ColliderShape::capsule;
+  probe.radius = 0.008;
+  probe.half_height = 0.02;
+  const double s = std::sqrt(0.5);
+  probe.rotation = {s, 0.0, 0.0, s};  // y axis onto x
+  // Above the kidney's highest point.
+  std::array<double, 3> top = kidney->vertices.front();
+  for (const auto& v : kidney->vertices)
+    if (v[1] > top[1]) top = v;
+  const std::array<double, 3> start{top[0], top[1] + probe.radius + 0.005, top[2]};
+  probe.position = start;
+  scene.colliders.push_back(probe);
+
+  auto sim = sinew::Simulation::create(scene, {.backend = backend});
+  if (!sim) return fail(sim.error());
+  std::printf("%s on %s: liver %zu tets, kidney %zu tets, %u particles\n", backend.c_str(),
+              sim->device_name().c_str(), liver->tets.size(), kidney->tets.size(), sim->info().particles);
+  std::filesystem::create_directories(out);
+  std::vector<std::filesystem::path> kidney_files, liver_files;
+  std::vector<double> times;
+  std::vector<float> x;
+  double worst = 0.0, total_ms = 0.0, collision_ms = 0.0;
+  const std::uint32_t kidney_first = sim->info().tet_body_first_particle[1];
+  for (int f = 0; f < frames; ++f) {
+    // Down by 2 cm over the first quarter (the probe starts 5 mm above the
+    // kidney, the kidney 3 mm above the liver: it is pressed about 1.2 cm
+    // into the liver's surface), then 3 cm along x.
+    const double press = std::min(1.0, (f + 1) / (0.25 * frames)), slide = std::max(0.0, (f + 1 - 0.25 * frames) / (0.75 * frames));
+    if (auto st = sim->set_collider_pose(0, {start[0] + 0.03 * slide, start[1] - 0.02 * press, start[2]}, probe.rotation); !st)
+      return fail(st.error());
+    if (auto st = sim->step(); !st) return fail(st.error());
+    const sinew::FrameStats& st = sim->last_frame();
+    total_ms += st.wall_ms;
+    collision_ms += st.collision_ms;
+    worst = std::max(worst, st.contact_violation);
+    if (std::getenv("SINEW_EXAMPLE_VERBOSE")) std::fprintf(stderr, "f %d %.1f ms contacts %u colours %u margin %.2f mm\n", f + 1, st.wall_ms, st.mesh_contacts, st.mesh_contact_colors, 1e3 * st.collision_margin);
+    if ((f + 1) % 10 != 0 && f + 1 != frames) continue;
+    if (auto r = sim->read_positions(x); !r) return fail(r.error());
+    const std::span<const float> all(x);
+    kidney_files.push_back(out + "/kidney_" + std::to_string(f + 1) + ".vtu");
+    liver_files.push_back(out + "/liver_" + std::to_string(f + 1) + ".vtu");
+    times.push_back(st.time);
+    if (auto w = sinew::write_vtu(liver_files.back(), all.subspan(0, std::size_t{kidney_first} * 4), 4, liver->tets); !w)
+      return fail(w.error());
+    if (auto w = sinew::write_vtu(kidney_files.back(), all.subspan(std::size_t{kidney_first} * 4), 4, kidney->tets); !w)
+      return fail(w.error());
+    std::printf("frame %4d  %.1f ms (collision %.1f)  %u contacts in %u colours  contact violation %.3f mm "
+                "(thickness 1 mm)\n",
+                f + 1, st.wall_ms, st.collision_ms, st.mesh_contacts, st.mesh_contact_colors, 1e3 * st.contact_violation);
+  }
+  if (auto w = sinew::write_pvd(out + "/kidney.pvd", kidney_files, times); !w) return fail(w.error());
+  if (auto w = sinew::write_pvd(out + "/liver.pvd", liver_files, times); !w) return fail(w.error());
+  std::printf("mean %.1f ms/frame, of which collision %.1f; deepest contact violation %.3f mm: %s\n", total_ms / frames,
+              collision_ms / frames, 1e3 * worst,
+              worst < scene.mesh_collision.thickness ? "the organs never passed through each other"
+                                                      : "the organs came closer than the thickness allows");
+  std::printf("open %s/kidney.pvd and %s/liver.pvd in ParaView\n", out.c_str(), out.c_str());
+  return 0;
+}
