@@ -76,7 +76,6 @@ int main(int argc, char** argv) {
                                     cz - 0.5 * (kb0.lo[2] + kb0.hi[2])};
   for (auto& v : kidney->vertices)
     for (int k = 0; k < 3; ++k) v[k] += shift[k];
-  const Box kb = bounds(*kidney);
 
   sinew::SceneDesc scene;
   scene.solver.time_step = 1.0 / 60.0;
@@ -137,7 +136,7 @@ int main(int argc, char** argv) {
     total_ms += st.wall_ms;
     collision_ms += st.collision_ms;
     worst = std::max(worst, st.contact_violation);
-    if (std::getenv("SINEW_EXAMPLE_VERBOSE")) std::fprintf(stderr, "f %d %.1f ms contacts %u colours %u margin %.2f mm\n", f + 1, st.wall_ms, st.mesh_contacts, st.mesh_contact_colors, 1e3 * st.collision_margin);
+
     if ((f + 1) % 10 != 0 && f + 1 != frames) continue;
     if (auto r = sim->read_positions(x); !r) return fail(r.error());
     const std::span<const float> all(x);

@@ -52,6 +52,17 @@ TEST(SceneBadInput, SolverAndGravity) {
   expect_error([](SceneDesc& s) { s.tet_bodies.clear(); s.line_bodies.clear(); }, "no bodies");
 }
 
+TEST(SceneBadInput, MeshCollision) {
+  const auto on = [](SceneDesc& s) { s.mesh_collision.enabled = true; };
+  expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.thickness = 0.0; }, "mesh_collision.thickness");
+  expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.thickness = kNaN; }, "mesh_collision.thickness");
+  expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.margin = -1e-3; }, "mesh_collision.margin");
+  expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.compliance = kInf; }, "mesh_collision.compliance");
+  expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.dynamic_friction = 0.9; }, "mesh_collision.dynamic_friction");
+  expect_error([&](SceneDesc& s) { on(s); s.solver.residual_tolerance = 1e-3; }, "solver.residual_tolerance");
+  expect_error([&](SceneDesc& s) { on(s); s.solver.chebyshev_rho = 0.5; }, "solver.chebyshev_rho");
+}
+
 TEST(SceneBadInput, TetBodyParameters) {
   expect_error([](SceneDesc& s) { s.tet_bodies[0].density = -1.0; }, "tet_bodies[0].density");
   expect_error([](SceneDesc& s) { s.tet_bodies[0].density = kNaN; }, "tet_bodies[0].density");
