@@ -234,3 +234,4 @@ struct FoldedStrip {
 };
 
 }  // namespace sinew::test
+

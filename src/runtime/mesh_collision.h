@@ -78,7 +78,7 @@ class MeshCollision {
   bool fresh_ = false;  // positions_ and velocities_ hold the device's current state
   Status read_back(Device& device, const XpbdBuffers& scene_buffers);
   // Per-frame scratch, kept to avoid reallocating.
-  std::vector<float> positions_, velocities_, speed_;
+  std::vector<float> positions_, start_positions_, velocities_, speed_;
   std::vector<collision::Aabb> boxes_;
   std::vector<collision::Pair> pairs_;
   std::vector<collision::Contact> found_, all_;
