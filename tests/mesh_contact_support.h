@@ -234,4 +234,3 @@ struct FoldedStrip {
 };
 
 }  // namespace sinew::test
-

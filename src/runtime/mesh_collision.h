@@ -1,7 +1,9 @@
 // mesh_collision.h — contacts between the bodies' meshes in the solver
 // (issue 12, part 3; SceneDesc::mesh_collision): before every frame the
 // host reads the particles back, finds the frame's contacts (BVH broad
-// phase and narrow phase of src/collision), colours them and writes them to
+// phase and narrow phase of src/collision), keeps the nearest of each
+// vertex's and edge's contacts against each other body, colours them and
+// writes them to
 // the device, where xpbd_solve_mesh_contacts solves them in every sweep
 // (kernels/shared/mesh_contact_params.h).
 //
@@ -67,6 +69,22 @@ class MeshCollision {
   };
   std::vector<BodyTree> triangle_trees_, segment_trees_;
   std::vector<collision::Pair> local_;
+  std::vector<std::uint32_t> body_of_;  // per particle: the collidable body it belongs to
+  struct PruneKey {
+    std::uint64_t primitive;  // a vertex, or an edge's two vertices
+    std::uint32_t body;       // the other side's body (edges: | 2^31)
+    float distance;
+    std::uint32_t contact;
+    bool operator<(const PruneKey& o) const {
+      if (primitive != o.primitive) return primitive < o.primitive;
+      if (body != o.body) return body < o.body;
+      if (distance != o.distance) return distance < o.distance;
+      return contact < o.contact;
+    }
+  };
+  std::vector<PruneKey> keys_;
+  std::vector<std::uint8_t> chosen_;
+  void prune();
   static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
   template <int Arity>
   void candidate_pairs(const std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
