@@ -3,9 +3,8 @@
 // host reads the particles back, finds the frame's contacts (BVH broad
 // phase and narrow phase of src/collision), keeps the nearest of each
 // vertex's and edge's contacts against each other body, colours them and
-// writes them to
-// the device, where xpbd_solve_mesh_contacts solves them in every sweep
-// (kernels/shared/mesh_contact_params.h).
+// writes them to the device, where xpbd_solve_mesh_contacts solves them in
+// every sweep (kernels/shared/mesh_contact_params.h).
 //
 // Why per frame, inflated by the motion: one detection serves all the
 // substeps and sweeps, and contacts found within thickness + margin hold
