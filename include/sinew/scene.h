@@ -307,9 +307,9 @@ struct SolverSettings {
 /// primitive on its side of the separating plane through the second's
 /// closest point, `thickness` away from it, so surfaces that start a frame
 /// apart cannot pass through each other as long as no particle moves more
-/// than half the margin within it. Of a vertex's contacts against another
-/// body only the nearest is kept, and of an edge's the nearest (README,
-/// "Mesh collision"). Contacts are solved after the bodies'
+/// than half the margin within it. Redundant contacts are pruned: a
+/// vertex keeps its nearest against another body, a triangle its 3
+/// nearest, an edge its 2 nearest (README, "Mesh collision"). Contacts are solved after the bodies'
 /// constraints in every sweep, scheduled by `schedule`.
 ///
 /// Not yet: with the residual-driven mode or the Chebyshev accelerator

@@ -1,8 +1,8 @@
 // mesh_collision.h — contacts between the bodies' meshes in the solver
 // (issue 12, part 3; SceneDesc::mesh_collision): before every frame the
 // host reads the particles back, finds the frame's contacts (BVH broad
-// phase and narrow phase of src/collision), keeps the nearest of each
-// vertex's and edge's contacts against each other body, colours them and
+// phase and narrow phase of src/collision), keeps the nearest few of each
+// vertex's, triangle's and edge's contacts against each other body, colours them and
 // writes them to the device, where xpbd_solve_mesh_contacts solves them in
 // every sweep (kernels/shared/mesh_contact_params.h).
 //
@@ -82,6 +82,19 @@ class MeshCollision {
     }
   };
   std::vector<PruneKey> keys_;
+  struct TriangleKey {
+    std::array<std::uint32_t, 3> triangle;  // its vertices, sorted
+    std::uint32_t body;                      // the vertex's body
+    float distance;
+    std::uint32_t contact;
+    bool operator<(const TriangleKey& o) const {
+      if (triangle != o.triangle) return triangle < o.triangle;
+      if (body != o.body) return body < o.body;
+      if (distance != o.distance) return distance < o.distance;
+      return contact < o.contact;
+    }
+  };
+  std::vector<TriangleKey> triangle_keys_;
   std::vector<std::uint8_t> chosen_;
   void prune();
   static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
