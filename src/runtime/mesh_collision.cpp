@@ -207,7 +207,7 @@ void MeshCollision::prune() {
   // contacts in 638 colours).
   rank = 0;
   for (std::size_t i = 0; i < triangle_keys_.size(); ++i) {
-    const bool same = i > 0 && triangle_keys_[i].triangle == triangle_keys_[i - 1].triangle &&
+    const bool same = i > 0 && triangle_keys_[i].primitive == triangle_keys_[i - 1].primitive &&
                       triangle_keys_[i].body == triangle_keys_[i - 1].body;
     rank = same ? rank + 1 : 0;
     if (rank >= kPerTriangle) chosen_[triangle_keys_[i].contact] = 0;

@@ -69,31 +69,23 @@ class MeshCollision {
   std::vector<BodyTree> triangle_trees_, segment_trees_;
   std::vector<collision::Pair> local_;
   std::vector<std::uint32_t> body_of_;  // per particle: the collidable body it belongs to
-  struct PruneKey {
-    std::uint64_t primitive;  // a vertex, or an edge's two vertices
-    std::uint32_t body;       // the other side's body (edges: | 2^31)
+  // A contact ranked among those of one primitive (a vertex, an edge's two
+  // vertices, a triangle's three, sorted) against one other body, nearest first.
+  template <class Primitive>
+  struct RankKey {
+    Primitive primitive;
+    std::uint32_t body;  // the other side's body (edges: | 2^31)
     float distance;
     std::uint32_t contact;
-    bool operator<(const PruneKey& o) const {
+    bool operator<(const RankKey& o) const {
       if (primitive != o.primitive) return primitive < o.primitive;
       if (body != o.body) return body < o.body;
       if (distance != o.distance) return distance < o.distance;
       return contact < o.contact;
     }
   };
-  std::vector<PruneKey> keys_;
-  struct TriangleKey {
-    std::array<std::uint32_t, 3> triangle;  // its vertices, sorted
-    std::uint32_t body;                      // the vertex's body
-    float distance;
-    std::uint32_t contact;
-    bool operator<(const TriangleKey& o) const {
-      if (triangle != o.triangle) return triangle < o.triangle;
-      if (body != o.body) return body < o.body;
-      if (distance != o.distance) return distance < o.distance;
-      return contact < o.contact;
-    }
-  };
+  std::vector<RankKey<std::uint64_t>> keys_;
+  using TriangleKey = RankKey<std::array<std::uint32_t, 3>>;
   std::vector<TriangleKey> triangle_keys_;
   std::vector<std::uint8_t> chosen_;
   void prune();
