@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
   sinew::SceneDesc scene;
   scene.solver.time_step = 1.0 / 60.0;
   scene.solver.substeps = 10;
-  scene.solver.iterations = 3;
+  scene.solver.iterations = 5;
   scene.solver.measure_errors = false;
   // No gravity: the organs lie supported in the abdomen, and the probe's
   // push is what brings them together (with gravity the jelly-soft liver,

@@ -309,7 +309,8 @@ struct SolverSettings {
 /// apart cannot pass through each other as long as no particle moves more
 /// than half the margin within it. Redundant contacts are pruned: a
 /// vertex keeps its nearest against another body, a triangle its 3
-/// nearest, an edge its 2 nearest (README, "Mesh collision"). Contacts are solved after the bodies'
+/// nearest immovable vertices, an edge its 4 nearest edges (README, "Mesh
+/// collision"). Contacts are solved after the bodies'
 /// constraints in every sweep, scheduled by `schedule`.
 ///
 /// Not yet: with the residual-driven mode or the Chebyshev accelerator

@@ -26,7 +26,7 @@ constexpr float kFacing = 0.9f;
 // Vertex-triangle contacts kept per triangle and other body (see prune).
 constexpr std::size_t kPerTriangle = 3;
 // Edge-edge contacts kept per edge and other body (see prune).
-constexpr std::size_t kPerEdge = 2;
+constexpr std::size_t kPerEdge = 4;
 // The most candidate pairs one query may hand the narrow phase (see check_pairs).
 constexpr std::size_t kMaxPairs = std::size_t{1} << 23;
 
@@ -163,8 +163,8 @@ void MeshCollision::candidate_pairs(const std::vector<BodyTree>& a, std::span<co
 // reach, hundreds of contacts per vertex that say the same thing (measured:
 // the kidney landing on the liver's surface, 538 contacts on one vertex, as
 // many colours). A vertex-triangle contact stays when it is its vertex's
-// nearest against that other body and among its triangle's kPerTriangle
-// nearest; an edge-edge contact when it is among the kPerEdge nearest of
+// nearest against that other body and, for an immovable vertex, among its
+// triangle's kPerTriangle nearest; an edge-edge contact when it is among the kPerEdge nearest of
 // both its edges against the other edge's body. Ties go to
 // the earlier contact (the narrow phase's sorted order), so the result is
 // deterministic.
@@ -200,17 +200,21 @@ void MeshCollision::prune() {
     const bool edge_key = (keys_[i].body & 0x80000000u) != 0;
     if (rank >= (edge_key ? kPerEdge : 1)) chosen_[keys_[i].contact] = 0;
   }
-  // A vertex-triangle contact also has to be among its triangle's
-  // kPerTriangle nearest against the vertex's body: a coarse triangle over
-  // a fine surface otherwise keeps one contact per fine vertex under it,
-  // all on the same three particles (a coarse block on a 1 mm grid: 4,562
-  // contacts in 638 colours).
+  // A vertex-triangle contact of an immovable vertex also has to be among
+  // its triangle's kPerTriangle nearest against the vertex's body: a coarse
+  // triangle over a fine fixed surface otherwise keeps one contact per
+  // fine vertex under it, all on the same three particles (a coarse block
+  // on a pinned 1 mm grid: 4,562 contacts in 638 colours). A movable vertex
+  // keeps its nearest whatever the triangle's count: it is what holds that
+  // vertex out (capping those too let the kidney, pressed by the example's
+  // probe, into the liver by 0.8 mm).
   rank = 0;
   for (std::size_t i = 0; i < triangle_keys_.size(); ++i) {
     const bool same = i > 0 && triangle_keys_[i].primitive == triangle_keys_[i - 1].primitive &&
                       triangle_keys_[i].body == triangle_keys_[i - 1].body;
     rank = same ? rank + 1 : 0;
-    if (rank >= kPerTriangle) chosen_[triangle_keys_[i].contact] = 0;
+    if (rank >= kPerTriangle && !movable_[all_[triangle_keys_[i].contact].v[0]])
+      chosen_[triangle_keys_[i].contact] = 0;
   }
   std::size_t kept = 0;
   for (std::size_t k = 0; k < all_.size(); ++k)
