@@ -10,6 +10,7 @@
 #include <limits>
 #include <vector>
 
+#include "math/proximity_math.h"
 #include "sinew/mesh.h"
 #include "sinew/scene.h"
 
@@ -23,29 +24,14 @@ inline P3 cross(const P3& a, const P3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-/// Distance from p to triangle (a, b, c), in double (Ericson 2005, 5.1.5).
+/// Distance from p to triangle (a, b, c), in double: the closest point of
+/// the narrow phase's own query (kernels/math/proximity_math.h).
 inline double point_triangle_distance(const P3& p, const P3& a, const P3& b, const P3& c) {
-  const P3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  auto dist = [&](const P3& q) { const P3 d = sub(p, q); return std::sqrt(dot(d, d)); };
-  auto along = [](const P3& o, const P3& e, double t) { return P3{o[0] + t * e[0], o[1] + t * e[1], o[2] + t * e[2]}; };
-  if (d1 <= 0 && d2 <= 0) return dist(a);
-  const P3 bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return dist(b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return dist(along(a, ab, d1 / (d1 - d3)));
-  const P3 cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return dist(c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return dist(along(a, ac, d2 / (d2 - d6)));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return dist(along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
-  const double denom = 1.0 / (va + vb + vc);
-  const P3 q = along(along(a, ab, vb * denom), ac, vc * denom);
-  return dist(q);
+  using kernels::double4;
+  const auto d4 = [](const P3& q) { return double4{q[0], q[1], q[2], 0.0}; };
+  const double4 q = kernels::proximity::at(kernels::proximity::closest_on_triangle(d4(p), d4(a), d4(b), d4(c)),
+                                           d4(a), d4(b), d4(c));
+  return std::sqrt((p[0] - q.x) * (p[0] - q.x) + (p[1] - q.y) * (p[1] - q.y) + (p[2] - q.z) * (p[2] - q.z));
 }
 
 /// A tet body as the test sees it after a run: its mesh and the positions

@@ -18,6 +18,7 @@ class MeshContact : public BackendTest {};
 // A 3 cm block dropped from 1 cm onto a 4 cm block resting on the floor,
 // offset so that its edges and corners meet the lower block's faces and its
 // vertices fall between the lower one's (finer and coarser meshes).
+// Without mesh collision the measured depth after 60 frames is 10 mm.
 TEST_P(MeshContact, DroppedBlocksRestOnEachOtherWithinTheThickness) {
   const SceneDesc scene = dropped_blocks_scene(ContactSchedule::colored);
   auto sim = create_or_skip(scene, GetParam());
