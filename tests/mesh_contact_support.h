@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "math/proximity_math.h"
@@ -216,6 +218,175 @@ struct FoldedStrip {
     const double done = std::min(1.0, double(f + 1) / fold_frames);
     const double angle = 3.14159265358979 * done;
     return {centre + radius * std::cos(angle), 0.002 + 0.001 * done + radius * std::sin(angle), k * cell};
+  }
+};
+
+}  // namespace sinew::test
+
+namespace sinew::test {
+
+/// How many (segment, triangle) pairs cross (`segment_crosses_triangle`),
+/// both given as particle indices into `x`. Candidates come from a uniform
+/// grid of `cell` [m] over the triangles' boxes: every pair whose boxes
+/// share a cell is tested exactly, so nothing is missed, only skipped
+/// where the boxes are apart.
+inline int crossings(const std::vector<float>& x, const std::vector<std::array<std::uint32_t, 2>>& segments,
+                     const std::vector<std::array<std::uint32_t, 3>>& triangles, double cell) {
+  auto key = [cell](const P3& p, int k) { return static_cast<std::int64_t>(std::floor(p[k] / cell)); };
+  auto pack = [](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+  };
+  auto box = [&](std::initializer_list<std::uint32_t> ids, std::array<std::int64_t, 3>& lo, std::array<std::int64_t, 3>& hi) {
+    for (int k = 0; k < 3; ++k) lo[k] = INT64_MAX, hi[k] = INT64_MIN;
+    for (auto id : ids) {
+      const P3 p = at(x, id);
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], key(p, k)), hi[k] = std::max(hi[k], key(p, k));
+    }
+  };
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> grid;
+  std::array<std::int64_t, 3> lo, hi;
+  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+    box({triangles[t][0], triangles[t][1], triangles[t][2]}, lo, hi);
+    for (auto i = lo[0]; i <= hi[0]; ++i)
+      for (auto j = lo[1]; j <= hi[1]; ++j)
+        for (auto k = lo[2]; k <= hi[2]; ++k) grid[pack(i, j, k)].push_back(t);
+  }
+  int found = 0;
+  std::vector<std::uint32_t> seen(triangles.size(), UINT32_MAX);
+  for (std::uint32_t s = 0; s < segments.size(); ++s) {
+    box({segments[s][0], segments[s][1]}, lo, hi);
+    for (auto i = lo[0]; i <= hi[0]; ++i)
+      for (auto j = lo[1]; j <= hi[1]; ++j)
+        for (auto k = lo[2]; k <= hi[2]; ++k) {
+          const auto cell_triangles = grid.find(pack(i, j, k));
+          if (cell_triangles == grid.end()) continue;
+          for (std::uint32_t t : cell_triangles->second) {
+            if (seen[t] == s) continue;
+            seen[t] = s;
+            const auto& tri = triangles[t];
+            found += segment_crosses_triangle(at(x, segments[s][0]), at(x, segments[s][1]), at(x, tri[0]), at(x, tri[1]),
+                                              at(x, tri[2]));
+          }
+        }
+  }
+  return found;
+}
+
+/// The edges of a triangle mesh, each once, offset by `first` (a body's
+/// first particle).
+inline std::vector<std::array<std::uint32_t, 2>> edges_of(const TriMesh& mesh, std::uint32_t first) {
+  std::vector<std::array<std::uint32_t, 2>> edges;
+  for (const auto& t : mesh.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+      if (a < b) edges.push_back({first + a, first + b});
+      else if (a != b) edges.push_back({first + b, first + a});
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+/// The kidney pressed onto the liver by a probe (issue 12's organ scene,
+/// cheap enough for a test): the kidney_57k tet body (millimetres scaled to
+/// metres, mesher's order, 50 kPa) 3 mm above the liver_382k's boundary
+/// triangles under the kidney's footprint (+ 1 cm each side, down to 3 cm
+/// below the highest), pinned: the liver as a fixed surface. No gravity
+/// (the organs lie supported in the abdomen). A kinematic capsule probe
+/// (radius 8 mm along x) starts 5 mm above the kidney's highest point and
+/// moves down `depth` beyond touching over `press_frames`, then holds.
+/// 60 Hz frames of 10 substeps of 5 sweeps, 1 mm thickness, no
+/// self-collision.
+struct KidneyOnLiver {
+  TetMesh kidney;
+  TriMesh liver;                      ///< the fixed patch of the liver's surface
+  std::array<double, 3> probe_start;  ///< [m]
+  static constexpr int press_frames = 20;
+  static constexpr double depth = 0.012;  ///< [m] the probe's travel past touching the kidney
+
+  /// [in] data: the data folder (SINEW_DATA_DIR).
+  static Result<KidneyOnLiver> load(const std::string& data) {
+    auto liver = read_tet_mesh(data + "/meshes/tet/liver_382k.node");
+    if (!liver) return liver.error();
+    auto kidney = read_tet_mesh(data + "/meshes/tet/kidney_57k.node");
+    if (!kidney) return kidney.error();
+    scale_mesh(*liver, 1e-3);
+    scale_mesh(*kidney, 1e-3);
+    P3 klo{1e9, 1e9, 1e9}, khi{-1e9, -1e9, -1e9}, lo = klo, hi = khi;
+    for (const auto& v : liver->vertices)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+    for (const auto& v : kidney->vertices)
+      for (int k = 0; k < 3; ++k) klo[k] = std::min(klo[k], v[k]), khi[k] = std::max(khi[k], v[k]);
+    const double cx = 0.5 * (lo[0] + hi[0]), cz = 0.5 * (lo[2] + hi[2]);
+    const double hx = 0.5 * (khi[0] - klo[0]), hz = 0.5 * (khi[2] - klo[2]);
+    double top = lo[1];
+    for (const auto& v : liver->vertices)
+      if (std::abs(v[0] - cx) <= hx && std::abs(v[2] - cz) <= hz) top = std::max(top, v[1]);
+    const P3 shift{cx - 0.5 * (klo[0] + khi[0]), top + 0.003 - klo[1], cz - 0.5 * (klo[2] + khi[2])};
+    for (auto& v : kidney->vertices)
+      for (int k = 0; k < 3; ++k) v[k] += shift[k];
+
+    KidneyOnLiver s;
+    const TriMesh surface = extract_boundary_surface(*liver);
+    std::vector<std::int64_t> index(surface.vertices.size(), -1);
+    for (const auto& t : surface.triangles) {
+      bool under = true;
+      for (auto v : t) {
+        const auto& p = surface.vertices[v];
+        under &= std::abs(p[0] - cx) <= hx + 0.01 && std::abs(p[2] - cz) <= hz + 0.01 && p[1] >= top - 0.03;
+      }
+      if (!under) continue;
+      std::array<std::uint32_t, 3> kept;
+      for (int k = 0; k < 3; ++k) {
+        if (index[t[k]] < 0) {
+          index[t[k]] = static_cast<std::int64_t>(s.liver.vertices.size());
+          s.liver.vertices.push_back(surface.vertices[t[k]]);
+        }
+        kept[k] = static_cast<std::uint32_t>(index[t[k]]);
+      }
+      s.liver.triangles.push_back(kept);
+    }
+    P3 highest = kidney->vertices.front();
+    for (const auto& v : kidney->vertices)
+      if (v[1] > highest[1]) highest = v;
+    s.probe_start = {highest[0], highest[1] + 0.008 + 0.005, highest[2]};
+    s.kidney = std::move(*kidney);
+    return s;
+  }
+
+  SceneDesc scene() const {
+    SceneDesc scene;
+    scene.solver.time_step = 1.0 / 60.0;
+    scene.solver.substeps = 10;
+    scene.solver.iterations = 5;
+    scene.gravity = {0.0, 0.0, 0.0};
+    TetBodyDesc organ;
+    organ.mesh = kidney;
+    (void)organ.set_elastic(5e4, 0.4);
+    organ.density = 1060.0;
+    organ.velocity_damping = 5.0;
+    scene.tet_bodies.push_back(std::move(organ));
+    TriBodyDesc surface;
+    surface.mesh = liver;
+    for (std::uint32_t v = 0; v < liver.vertices.size(); ++v) surface.pinned.push_back(v);
+    scene.tri_bodies.push_back(std::move(surface));
+    ColliderDesc probe;
+    probe.shape = ColliderShape::capsule;
+    probe.radius = 0.008;
+    probe.half_height = 0.02;
+    probe.rotation = {std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};  // its axis along x
+    probe.position = probe_start;
+    scene.colliders.push_back(probe);
+    scene.mesh_collision.enabled = true;
+    scene.mesh_collision.thickness = 1e-3;
+    scene.mesh_collision.self_collision = false;  // organ against organ
+    return scene;
+  }
+
+  /// The probe's centre at the end of frame f [m].
+  std::array<double, 3> probe_at(int f) const {
+    const double done = std::min(1.0, double(f + 1) / press_frames);
+    return {probe_start[0], probe_start[1] - (0.005 + depth) * done, probe_start[2]};
   }
 };
 
