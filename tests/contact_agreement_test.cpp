@@ -5,7 +5,8 @@
 //    their target) pulled to static and moving targets, compliances 0 and
 //    not, first and later iterations, the measuring pass;
 //  - xpbd_solve_contacts: random particles near and inside a plane, two
-//    spheres, a capsule, a box and two tools (capsules), moving and static,
+//    spheres, a capsule, a box, a cylinder, an implicit CSG shape (every
+//    primitive and operation) and two tools (capsules), moving and static,
 //    rotated, one rotation flipped to the other hemisphere (the shorter-arc
 //    branch), particles exactly on a sphere's centre and a capsule's axis,
 //    some immovable, margins, warm-started multipliers, friction off and on
@@ -31,6 +32,7 @@ namespace {
 
 using kernels::ColliderEntry;
 using kernels::ColliderHeader;
+using kernels::ImplicitEntry;
 using kernels::SolveParams;
 using kernels::TargetEntry;
 
@@ -80,6 +82,7 @@ struct Surfaces {
   std::vector<std::array<double, 3>> around;
   std::uint32_t colliders = 0, tools = 0;
   std::vector<std::uint32_t> centres;  // entries whose exact centre a particle sits on (static sphere, capsule)
+  std::vector<ImplicitEntry> nodes;    // the implicit shapes' nodes, after the entries in the buffer
 };
 
 Surfaces contact_surfaces(std::mt19937& rng, bool friction) {
@@ -138,6 +141,40 @@ Surfaces contact_surfaces(std::mt19937& rng, bool friction) {
   e.radius = 0.2f;
   e.half_height = 0.15f;
   add(e, {0.3, 0.3, 0.3});
+  // An implicit shape, moving and turning, with every primitive and
+  // operation: ((rounded box - sphere) u torus u (capsule u cylinder)) n
+  // a tilted half-space, the primitives in their own poses.
+  const Rigid blob{{0.0f, 0.5f, 0.0f}, random_rotation(rng)};
+  Rigid blob_end = moved(blob, 0.05f);
+  blob_end.q = blend(0.95, blob.q, 0.05, random_rotation(rng));
+  e = collider(SINEW_SHAPE_IMPLICIT, blob, blob_end);
+  e.implicit_first = static_cast<std::uint32_t>(s.nodes.size());
+  auto node = [&](std::uint32_t op, std::array<float, 3> at, bool turned) {
+    ImplicitEntry n{};
+    n.op = op;
+    n.px = at[0], n.py = at[1], n.pz = at[2];
+    const std::array<float, 4> q = turned ? random_rotation(rng) : std::array<float, 4>{1.0f, 0.0f, 0.0f, 0.0f};
+    n.qw = q[0], n.qx = q[1], n.qy = q[2], n.qz = q[3];
+    s.nodes.push_back(n);
+    return &s.nodes.back();
+  };
+  ImplicitEntry* n = node(SINEW_IMPLICIT_BOX, {0.0f, 0.0f, 0.0f}, true);
+  n->half_x = 0.25f, n->half_y = 0.15f, n->half_z = 0.2f, n->rounding = 0.02f;
+  node(SINEW_IMPLICIT_SPHERE, {0.1f, 0.15f, 0.0f}, false)->radius = 0.12f;
+  node(SINEW_IMPLICIT_SUBTRACT, {}, false);
+  n = node(SINEW_IMPLICIT_TORUS, {0.0f, -0.1f, 0.0f}, true);
+  n->radius = 0.2f, n->minor_radius = 0.05f;
+  node(SINEW_IMPLICIT_UNITE, {}, false);
+  n = node(SINEW_IMPLICIT_CAPSULE, {-0.15f, 0.1f, 0.1f}, true);
+  n->radius = 0.06f, n->half_height = 0.15f;
+  n = node(SINEW_IMPLICIT_CYLINDER, {0.15f, -0.05f, -0.1f}, true);
+  n->radius = 0.1f, n->half_height = 0.08f, n->rounding = 0.01f;
+  node(SINEW_IMPLICIT_UNITE, {}, false);
+  node(SINEW_IMPLICIT_UNITE, {}, false);
+  node(SINEW_IMPLICIT_HALF_SPACE, {0.0f, 0.12f, 0.0f}, true);
+  node(SINEW_IMPLICIT_INTERSECT, {}, false);
+  e.implicit_count = static_cast<std::uint32_t>(s.nodes.size()) - e.implicit_first;
+  add(e, {0.35, 0.3, 0.35});
   s.colliders = static_cast<std::uint32_t>(s.entries.size());
   // Tools: capsules, one moving and turning, one still.
   const Rigid tool{{0.0f, 0.5f, -2.0f}, random_rotation(rng)};
@@ -199,6 +236,7 @@ ContactSetup contact_setup(std::mt19937& rng, bool friction, float substep_fract
   }
   append_words(c.colliders, ColliderHeader{s.colliders, s.tools, substep_fraction, 0});
   for (const ColliderEntry& e : s.entries) append_words(c.colliders, e);
+  for (const ImplicitEntry& n : s.nodes) append_words(c.colliders, n);
   c.impulses.resize(std::size_t{n} * s.tools * SINEW_CONTACT_IMPULSE_FLOAT4S * 4);
   for (float& v : c.impulses) v = uf(rng);
   return c;

@@ -1,7 +1,8 @@
 // Contacts with analytic colliders, friction, attachments and tools, against
 // physics on every built backend:
-//  - a particle or a block dropped on a plane, sphere, capsule or box comes
-//    to rest on it without sinking in;
+//  - a particle or a block dropped on a plane, sphere, capsule, box,
+//    cylinder or implicit CSG shape comes to rest on it without sinking in;
+//    the CPU kernel's implicit shapes match a double-precision oracle;
 //  - a block on an incline sticks while tan(theta) < mu_s and otherwise
 //    slides with the acceleration g (sin(theta) - mu_k cos(theta));
 //  - a contact of compliance alpha under a resting weight m g gives way by
@@ -21,9 +22,13 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "contact_params.h"
+#include "cpu/contact_kernels.h"
+#include "implicit_oracle.h"
 #include "runtime/simulation_internals.h"
 #include "test_support.h"
 
@@ -108,26 +113,70 @@ V3 centroid(const std::vector<float>& x, std::size_t first, std::size_t count) {
 double signed_distance(const ColliderDesc& c, const V3& p) {
   const Q4 inverse{c.rotation[0], -c.rotation[1], -c.rotation[2], -c.rotation[3]};
   const V3 l = rotate(inverse, {p[0] - c.position[0], p[1] - c.position[1], p[2] - c.position[2]});
-  switch (c.shape) {
-    case ColliderShape::plane: return l[1];
-    case ColliderShape::sphere: return std::hypot(l[0], l[1], l[2]) - c.radius;
-    case ColliderShape::capsule:
-      return std::hypot(l[0], l[1] - std::clamp(l[1], -c.half_height, c.half_height), l[2]) - c.radius;
-    case ColliderShape::box: {
-      double q[3], outside = 0, inside = -1e30;
-      for (int k = 0; k < 3; ++k) {
-        q[k] = std::abs(l[k]) - c.half_extents[k];
-        outside += std::max(q[k], 0.0) * std::max(q[k], 0.0);
-        inside = std::max(inside, q[k]);
-      }
-      return outside > 0 ? std::sqrt(outside) : inside;
-    }
-    case ColliderShape::cylinder: {  // flat caps: the distance to the disc-capped solid, another way
-      const double dr = std::hypot(l[0], l[2]) - c.radius, dy = std::abs(l[1]) - c.half_height;
-      return dr > 0 && dy > 0 ? std::hypot(dr, dy) : std::max(dr, dy);
-    }
-  }
-  return 0;
+  if (c.shape == ColliderShape::implicit) return test::oracle_implicit(c.implicit, l);
+  // The analytic shapes as the oracle's primitives (tests/implicit_oracle.h).
+  ImplicitNode shape;
+  shape.op = c.shape == ColliderShape::plane     ? ImplicitOp::half_space
+             : c.shape == ColliderShape::sphere  ? ImplicitOp::sphere
+             : c.shape == ColliderShape::capsule ? ImplicitOp::capsule
+             : c.shape == ColliderShape::box     ? ImplicitOp::box
+                                                 : ImplicitOp::cylinder;
+  shape.radius = c.radius;
+  shape.half_height = c.half_height;
+  shape.half_extents = c.half_extents;
+  return test::oracle_primitive(shape, l);
+}
+
+ImplicitNode primitive(ImplicitOp op, const V3& at, const Q4& q = {1, 0, 0, 0}) {
+  ImplicitNode n;
+  n.op = op;
+  n.position = at;
+  n.rotation = q;
+  return n;
+}
+
+ImplicitNode operation(ImplicitOp op) { return primitive(op, {0, 0, 0}); }
+
+// Implicit shapes whose top at x = z = 0 is at y = 0 with a level normal there.
+ColliderDesc implicit_collider(std::vector<ImplicitNode> nodes, const V3& at = {0, 0, 0}, const Q4& q = {1, 0, 0, 0}) {
+  ColliderDesc c;
+  c.shape = ColliderShape::implicit;
+  c.implicit = std::move(nodes);
+  c.position = at;
+  c.rotation = q;
+  return c;
+}
+
+// A slab (box, top at y = 0.02 in its frame) with a spherical bite whose
+// bottom is at y = 0: subtract; a particle rests at the bite's bottom.
+ColliderDesc bitten_slab() {
+  ImplicitNode slab = primitive(ImplicitOp::box, {0, 0, 0}, axis_angle({0, 1, 0}, 0.5));
+  slab.half_extents = {0.1, 0.02, 0.08};
+  ImplicitNode bite = primitive(ImplicitOp::sphere, {0, 0.03, 0});
+  bite.radius = 0.03;
+  return implicit_collider({slab, bite, operation(ImplicitOp::subtract)}, {0, -0.0, 0});
+}
+
+// A torus ring (its tube's top at y = 0.01) around a sphere whose top is at
+// y = 0, turned about y: unite, torus; the particle lands on the sphere.
+ColliderDesc ringed_ball() {
+  ImplicitNode ring = primitive(ImplicitOp::torus, {0, 0, 0});
+  ring.radius = 0.05;
+  ring.minor_radius = 0.01;
+  ImplicitNode ball = primitive(ImplicitOp::sphere, {0, -0.02, 0});
+  ball.radius = 0.02;
+  return implicit_collider({ring, ball, operation(ImplicitOp::unite)}, {0, 0, 0}, axis_angle({0, 1, 0}, 0.7));
+}
+
+// A rounded capsule lying along x cut flat at y = 0 by a tilted-frame
+// half-space (a rotation about y keeps it level): intersect, rounding.
+ColliderDesc cut_capsule() {
+  ImplicitNode rod = primitive(ImplicitOp::capsule, {0, -0.01, 0}, axis_angle({0, 0, 1}, kPi / 2));
+  rod.radius = 0.025;
+  rod.half_height = 0.05;
+  rod.rounding = 0.005;
+  ImplicitNode cut = primitive(ImplicitOp::half_space, {0, 0, 0}, axis_angle({0, 1, 0}, 1.1));
+  return implicit_collider({rod, cut, operation(ImplicitOp::intersect)}, {0, 0, 0});
 }
 
 struct ShapeCase {
@@ -162,8 +211,99 @@ std::vector<ShapeCase> shape_cases() {
   ColliderDesc lying = standing;  // on its side, along x: a curved top at y = 0
   lying.position = {0, -0.05, 0};
   lying.rotation = axis_angle({0, 0, 1}, kPi / 2);
-  return {{"plane", plane, 0.0},   {"sphere", sphere, 0.0},          {"capsule", capsule, 0.0},
-          {"box", box, 0.0},       {"cylinder on its cap", standing, 0.0}, {"cylinder on its side", lying, 0.0}};
+  return {{"plane", plane, 0.0},
+          {"sphere", sphere, 0.0},
+          {"capsule", capsule, 0.0},
+          {"box", box, 0.0},
+          {"cylinder on its cap", standing, 0.0},
+          {"cylinder on its side", lying, 0.0},
+          {"implicit: slab with a spherical bite (subtract)", bitten_slab(), 0.0},
+          {"implicit: ball in a torus ring (unite)", ringed_ball(), 0.0},
+          {"implicit: rounded capsule cut flat (intersect)", cut_capsule(), 0.0}};
+}
+
+// The CPU reference kernel's implicit shapes (kernels/cpu/contact_kernels.cpp)
+// against the double-precision oracle (implicit_oracle.h) at 20,000 random
+// points around a shape with every primitive (turned in their own frames,
+// some rounded) and every operation: distances within 1e-6 m (float on a
+// 0.3 m shape), and where the oracle's central-difference gradient is a
+// unit vector (away from ties between primitives, edges and medial axes)
+// the kernel's normal along it within 0.5 degrees. The GPU kernels equal
+// this one bitwise (Agreement.ContactKernel).
+TEST(ImplicitShape, CpuKernelMatchesTheDoublePrecisionOracle) {
+  std::vector<ImplicitNode> nodes;
+  ImplicitNode n = primitive(ImplicitOp::box, {0.0, 0.0, 0.0}, axis_angle({0.6, 0.8, 0.0}, 0.4));
+  n.half_extents = {0.25, 0.15, 0.2};
+  n.rounding = 0.02;
+  nodes.push_back(n);
+  n = primitive(ImplicitOp::sphere, {0.1, 0.15, 0.0});
+  n.radius = 0.12;
+  nodes.push_back(n);
+  nodes.push_back(operation(ImplicitOp::subtract));
+  n = primitive(ImplicitOp::torus, {0.0, -0.1, 0.0}, axis_angle({1.0, 0.0, 0.0}, 0.3));
+  n.radius = 0.2;
+  n.minor_radius = 0.05;
+  nodes.push_back(n);
+  nodes.push_back(operation(ImplicitOp::unite));
+  n = primitive(ImplicitOp::capsule, {-0.15, 0.1, 0.1}, axis_angle({0.0, 0.0, 1.0}, 1.0));
+  n.radius = 0.06;
+  n.half_height = 0.15;
+  nodes.push_back(n);
+  n = primitive(ImplicitOp::cylinder, {0.15, -0.05, -0.1}, axis_angle({0.0, 0.6, 0.8}, 0.9));
+  n.radius = 0.1;
+  n.half_height = 0.08;
+  n.rounding = 0.01;
+  nodes.push_back(n);
+  nodes.push_back(operation(ImplicitOp::unite));
+  nodes.push_back(operation(ImplicitOp::unite));
+  nodes.push_back(primitive(ImplicitOp::half_space, {0.0, 0.12, 0.0}, axis_angle({0.8, 0.0, 0.6}, 0.2)));
+  nodes.push_back(operation(ImplicitOp::intersect));
+
+  // The kernel's nodes, field by field (what compile_contacts.cpp writes).
+  std::vector<kernels::ImplicitEntry> entries;
+  for (const ImplicitNode& m : nodes) {
+    kernels::ImplicitEntry e{};
+    e.op = static_cast<std::uint32_t>(m.op);  // ImplicitOp's order is SINEW_IMPLICIT_*'s
+    e.radius = float(m.radius), e.half_height = float(m.half_height), e.rounding = float(m.rounding);
+    e.half_x = float(m.half_extents[0]), e.half_y = float(m.half_extents[1]), e.half_z = float(m.half_extents[2]);
+    e.minor_radius = float(m.minor_radius);
+    e.px = float(m.position[0]), e.py = float(m.position[1]), e.pz = float(m.position[2]);
+    e.qw = float(m.rotation[0]), e.qx = float(m.rotation[1]), e.qy = float(m.rotation[2]), e.qz = float(m.rotation[3]);
+    entries.push_back(e);
+  }
+  static_assert(SINEW_IMPLICIT_SUBTRACT == static_cast<std::uint32_t>(ImplicitOp::subtract));
+
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-0.4f, 0.4f);
+  double worst = 0.0, worst_angle = 0.0;
+  int smooth = 0, inside = 0;
+  constexpr int samples = 20000;
+  for (int i = 0; i < samples; ++i) {
+    const kernels::float4 p{u(rng), u(rng), u(rng), 0.0f};
+    const V3 pd{p.x, p.y, p.z};
+    const kernels::SignedDistance sd = kernels::implicit_distance(entries.data(), std::uint32_t(entries.size()), p);
+    const double d = test::oracle_implicit(nodes, pd);
+    worst = std::max(worst, std::abs(sd.distance - d));
+    inside += d < 0;
+    constexpr double h = 1e-6;
+    V3 g;
+    for (int k = 0; k < 3; ++k) {
+      V3 a = pd, b = pd;
+      a[k] += h, b[k] -= h;
+      g[k] = (test::oracle_implicit(nodes, a) - test::oracle_implicit(nodes, b)) / (2 * h);
+    }
+    const double len = std::hypot(g[0], g[1], g[2]);
+    if (std::abs(len - 1.0) > 1e-4) continue;
+    ++smooth;
+    const double c = (g[0] * sd.normal.x + g[1] * sd.normal.y + g[2] * sd.normal.z) / len;
+    worst_angle = std::max(worst_angle, std::acos(std::clamp(c, -1.0, 1.0)));
+  }
+  std::printf("[ measured ] implicit: largest distance error %.3g m, largest normal error %.3g deg at %d smooth "
+              "points of %d (%d inside)\n", worst, worst_angle * 180 / kPi, smooth, samples, inside);
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_LT(worst_angle * 180 / kPi, 0.5);
+  EXPECT_GT(smooth, samples / 2);
+  EXPECT_GT(inside, samples / 20);
 }
 
 TEST_P(Contact, ParticleDroppedOnEachColliderComesToRestOnIt) {
@@ -687,6 +827,41 @@ TEST_P(Contact, BadArgumentsAreErrorsNamingTheParameter) {
   bad.colliders[0].radius = -1.0;
   EXPECT_TRUE(says(check_scene(bad), "colliders[0].radius"));
   bad.colliders[0].radius = 0.1;
+  EXPECT_TRUE(check_scene(bad).ok());
+  // Implicit shapes: nodes only with that shape, a balanced postfix
+  // expression within 64 nodes and 8 pending values, valid primitives.
+  bad.colliders[0].implicit = bitten_slab().implicit;
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit has nodes but the shape is not"));
+  bad.colliders[0] = bitten_slab();
+  EXPECT_TRUE(check_scene(bad).ok());
+  bad.colliders[0].implicit.clear();
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit is empty"));
+  bad.colliders[0] = bitten_slab();
+  bad.colliders[0].implicit.pop_back();
+  EXPECT_TRUE(says(check_scene(bad), "leaves 2 values"));
+  bad.colliders[0].implicit = {operation(ImplicitOp::unite)};
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit[0] is an operation with 0 value(s)"));
+  bad.colliders[0] = bitten_slab();
+  bad.colliders[0].implicit[1].radius = std::nan("");
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit[1].radius"));
+  bad.colliders[0] = bitten_slab();
+  bad.colliders[0].implicit[0].rotation = {1, 1, 0, 0};
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit[0].rotation"));
+  bad.colliders[0] = ringed_ball();
+  bad.colliders[0].implicit[0].minor_radius = 0.0;
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit[0].minor_radius"));
+  bad.colliders[0] = cut_capsule();
+  bad.colliders[0].implicit[0].rounding = -0.001;
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit[0].rounding"));
+  bad.colliders[0].implicit.assign(9, bitten_slab().implicit[1]);  // nine spheres pending at once
+  EXPECT_TRUE(says(check_scene(bad), "colliders[0].implicit[8] makes 9 values pending"));
+  bad.colliders[0].implicit.clear();
+  for (int k = 0; k < 33; ++k) {
+    bad.colliders[0].implicit.push_back(bitten_slab().implicit[1]);
+    if (k > 0) bad.colliders[0].implicit.push_back(operation(ImplicitOp::unite));
+  }
+  EXPECT_TRUE(says(check_scene(bad), "has 65 nodes, more than the 64"));
+  bad.colliders[0].implicit.resize(63);  // 32 spheres, 31 unions
   EXPECT_TRUE(check_scene(bad).ok());
   // Rejected calls change nothing; good ones still work.
   SINEW_ASSERT_OK(sim.set_collider_pose(0, {0, -0.5, 0}, {std::sqrt(0.5), 0, std::sqrt(0.5), 0}));

@@ -150,8 +150,40 @@ struct TriBodyDesc {
 /// solid below (normal +y); a sphere has `radius`; a capsule is the segment
 /// from (0, -half_height, 0) to (0, +half_height, 0) swollen by `radius`; a
 /// box has `half_extents`; a cylinder has flat caps at y = +-half_height and
-/// `radius` about the y axis.
-enum class ColliderShape { plane, sphere, capsule, box, cylinder };
+/// `radius` about the y axis; an implicit shape is the signed distance
+/// function its `implicit` nodes compute (ImplicitNode).
+enum class ColliderShape { plane, sphere, capsule, box, cylinder, implicit };
+
+/// One node of an implicit shape (ColliderShape::implicit), an analytic
+/// signed distance function written as a CSG expression in postfix order:
+/// a primitive pushes its signed distance, an operation pops two (a, then
+/// b on top) and pushes the result. {box, sphere, subtract} is a box with
+/// a spherical bite; {a, b, unite, c, intersect} is (a u b) n c.
+///
+/// Primitives, in their own frame (`position` [m] and unit quaternion
+/// `rotation` (w, x, y, z) within the collider's frame): half_space (y <= 0,
+/// solid below, like a plane collider), sphere (`radius`), capsule (the
+/// segment +-half_height along y swollen by `radius`), box (`half_extents`),
+/// cylinder (`radius`, caps at +-half_height), torus (a tube of
+/// `minor_radius` around the circle of `radius` in the y = 0 plane). Each
+/// primitive's distance is reduced by `rounding` [m] >= 0 (rounded edges,
+/// grown by that much).
+/// Operations: unite min(a, b), intersect max(a, b), subtract max(a, -b)
+/// (a without b). These are exact distances outside a union and bounds
+/// elsewhere (the sign, the zero set and the normal on it are exact; the
+/// normal is the gradient of the primitive that decides the value).
+/// At most 64 nodes, at most 8 values on the stack at once.
+enum class ImplicitOp { half_space, sphere, capsule, box, cylinder, torus, unite, intersect, subtract };
+struct ImplicitNode {
+  ImplicitOp op = ImplicitOp::sphere;
+  std::array<double, 3> position{0.0, 0.0, 0.0};       ///< primitive's origin in the collider's frame [m]
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
+  double radius = 0.0;                                  ///< sphere, capsule, cylinder, torus (major) [m], > 0
+  double half_height = 0.0;                             ///< capsule [m] >= 0; cylinder [m] > 0
+  std::array<double, 3> half_extents{0.0, 0.0, 0.0};    ///< box [m], > 0
+  double minor_radius = 0.0;                            ///< torus tube [m], > 0
+  double rounding = 0.0;                                ///< [m], >= 0
+};
 
 /// A static or kinematic collider that every body's particles collide with,
 /// as xPBD contact constraints C = signed distance >= 0 with `compliance`
@@ -168,6 +200,7 @@ struct ColliderDesc {
   double static_friction = 0.5;                         ///< >= 0
   double dynamic_friction = 0.4;                        ///< >= 0, <= static_friction
   double compliance = 0.0;                              ///< [m/N], >= 0
+  std::vector<ImplicitNode> implicit;                   ///< implicit shape's nodes (only with ColliderShape::implicit)
 };
 
 /// Which body a vertex belongs to.

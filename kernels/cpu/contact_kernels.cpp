@@ -1,5 +1,6 @@
 // contact_kernels.cpp — CPU reference kernels of attachments and of contacts
-// with analytic colliders (planes, spheres, capsules, boxes, tools).
+// with analytic colliders (planes, spheres, capsules, boxes, cylinders,
+// implicit CSG shapes, tools).
 //
 // Macklin, Müller, Chentanez, "XPBD: Position-Based Simulation of Compliant
 // Constrained Dynamics", MIG 2016: the xPBD update, with the contact's
@@ -43,7 +44,10 @@ Pose collider_pose(const ColliderEntry& e, float t) {
   return {lerp3(p0, p1, t), (1.0f / norm) * q};
 }
 
-SignedDistance collider_distance(const ColliderEntry& e, float4 local) {
+namespace {
+
+// The distance of one of the analytic shapes (SINEW_SHAPE_PLANE..CYLINDER).
+SignedDistance shape_distance(const ColliderEntry& e, float4 local) {
   switch (e.shape) {
     case SINEW_SHAPE_SPHERE: {
       const float r = length3(local);
@@ -96,6 +100,69 @@ SignedDistance collider_distance(const ColliderEntry& e, float4 local) {
   }
 }
 
+// A torus about the y axis: the distance to its core circle (radius R in
+// y = 0) less the tube's radius. On the core circle (no direction) the
+// normal is +y; on the axis the radial direction is +x.
+SignedDistance torus_distance(float major, float minor, float4 local) {
+  const float r = std::sqrt(local.x * local.x + local.z * local.z);
+  const float ux = r > 0.0f ? local.x / r : 1.0f, uz = r > 0.0f ? local.z / r : 0.0f;
+  const float qr = r - major;
+  const float len = std::sqrt(qr * qr + local.y * local.y);
+  if (!(len > 0.0f)) return {-minor, {0.0f, 1.0f, 0.0f, 0.0f}};
+  return {len - minor, {qr * ux / len, local.y / len, qr * uz / len, 0.0f}};
+}
+
+// One primitive node at a point in the collider's frame: moved into the
+// node's frame, measured, the normal rotated back, less the rounding.
+SignedDistance primitive_distance(const ImplicitEntry& n, float4 local) {
+  const float4 q{n.qx, n.qy, n.qz, n.qw};
+  const float4 own = rotate_inverse(q, local - float4{n.px, n.py, n.pz, 0.0f});
+  SignedDistance sd;
+  if (n.op == SINEW_IMPLICIT_TORUS) {
+    sd = torus_distance(n.radius, n.minor_radius, own);
+  } else {
+    ColliderEntry shape{};
+    shape.shape = n.op;  // SINEW_IMPLICIT_HALF_SPACE..CYLINDER are SINEW_SHAPE_PLANE..CYLINDER
+    shape.radius = n.radius;
+    shape.half_height = n.half_height;
+    shape.half_x = n.half_x;
+    shape.half_y = n.half_y;
+    shape.half_z = n.half_z;
+    sd = shape_distance(shape, own);
+  }
+  return {sd.distance - n.rounding, rotate(q, sd.normal)};
+}
+
+}  // namespace
+
+SignedDistance implicit_distance(const ImplicitEntry* nodes, std::uint32_t count, float4 local) {
+  SignedDistance stack[SINEW_IMPLICIT_STACK];
+  int top = 0;  // values on the stack
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const ImplicitEntry& n = nodes[k];
+    if (n.op < SINEW_IMPLICIT_UNITE) {
+      stack[top++] = primitive_distance(n, local);
+      continue;
+    }
+    const SignedDistance b = stack[--top], a = stack[top - 1];
+    SignedDistance r = a;
+    if (n.op == SINEW_IMPLICIT_UNITE) {
+      if (b.distance < a.distance) r = b;
+    } else if (n.op == SINEW_IMPLICIT_INTERSECT) {
+      if (b.distance > a.distance) r = b;
+    } else if (-b.distance > a.distance) {  // subtract: outside b
+      r = {-b.distance, -1.0f * b.normal};
+    }
+    stack[top - 1] = r;
+  }
+  return stack[0];
+}
+
+SignedDistance collider_distance(const ColliderEntry& e, float4 local, const ImplicitEntry* nodes) {
+  if (e.shape == SINEW_SHAPE_IMPLICIT) return implicit_distance(nodes + e.implicit_first, e.implicit_count, local);
+  return shape_distance(e, local);
+}
+
 void xpbd_solve_attachment(const void* params, std::byte* const* bindings, std::uint32_t begin,
                            std::uint32_t end) {
   const auto& p = *static_cast<const SolveParams*>(params);
@@ -140,6 +207,7 @@ void xpbd_solve_contacts(const void* params, std::byte* const* bindings, std::ui
   const auto* prev = reinterpret_cast<const float4*>(bindings[5]);
   const auto& header = *reinterpret_cast<const ColliderHeader*>(bindings[6]);
   const auto* colliders = reinterpret_cast<const ColliderEntry*>(bindings[6] + sizeof(ColliderHeader));
+  const auto* nodes = reinterpret_cast<const ImplicitEntry*>(colliders + header.colliders + header.tools);
   auto* impulses = reinterpret_cast<float4*>(bindings[7]);
 
   const std::uint32_t count = header.colliders + header.tools;
@@ -172,7 +240,7 @@ void xpbd_solve_contacts(const void* params, std::byte* const* bindings, std::ui
       float4 lambda_t = p.reset_lambda ? float4{0, 0, 0, 0} : float4{lk[1], lk[2], lk[3], 0.0f};
 
       const Pose pose = collider_pose(e, t1);
-      const SignedDistance sd = collider_distance(e, rotate_inverse(pose.q, xi - pose.p));
+      const SignedDistance sd = collider_distance(e, rotate_inverse(pose.q, xi - pose.p), nodes);
       const float c = sd.distance - margin[i];
       const float4 n = rotate(pose.q, sd.normal);
       const float alpha_t = e.compliance * p.inv_h2;

@@ -44,6 +44,14 @@ struct SignedDistance {
   float distance;
   float4 normal;
 };
-SignedDistance collider_distance(const ColliderEntry& e, float4 local);
+/// `nodes`: the collider buffer's ImplicitEntry array (after the last
+/// ColliderEntry), read only by implicit colliders.
+SignedDistance collider_distance(const ColliderEntry& e, float4 local, const ImplicitEntry* nodes);
+
+/// The signed distance and normal of an implicit shape's `count` nodes
+/// (postfix CSG, kernels/shared/contact_params.h) at a point in the
+/// collider's frame. The nodes were checked on the host (a well-formed
+/// expression within SINEW_IMPLICIT_STACK).
+SignedDistance implicit_distance(const ImplicitEntry* nodes, std::uint32_t count, float4 local);
 
 }  // namespace sinew::kernels

@@ -37,6 +37,8 @@ SINEW_STRUCT_BEGIN(ContactCollider)
   float half_z;
   float static_friction;
   float dynamic_friction;
+  uint implicit_first;
+  uint implicit_count;
   float3 start_p;
   float4 start_q;  /* (x, y, z, w) */
   float3 end_p;
@@ -70,6 +72,8 @@ ContactCollider contact_collider(const uint4 f[7]) {
   e.half_z = f1.z;
   e.static_friction = f1.w;
   e.dynamic_friction = bits_float(f[2].x);
+  e.implicit_first = f[2].y;
+  e.implicit_count = f[2].z;
   e.start_p = contact_bits_float4(f[3]).xyz;
   e.start_q = contact_bits_float4(f[4]).yzwx;  // stored (w, x, y, z)
   e.end_p = contact_bits_float4(f[5]).xyz;
@@ -135,8 +139,10 @@ ContactPose contact_collider_pose(ContactCollider e, float t) {
 }
 
 /* Signed distance of a point in the collider's frame (negative inside) and
- * the outward unit normal there, in that frame (CPU: collider_distance). */
-ContactDistance contact_collider_distance(ContactCollider e, float3 point) {
+ * the outward unit normal there, in that frame, for the analytic shapes
+ * (plane to cylinder; CPU: shape_distance). Implicit shapes are evaluated
+ * by the kernel, node by node (contact_implicit_node and below). */
+ContactDistance contact_shape_distance(ContactCollider e, float3 point) {
   ContactDistance sd;
   switch (e.shape) {
     case SINEW_SHAPE_SPHERE: {
@@ -222,6 +228,102 @@ ContactDistance contact_collider_distance(ContactCollider e, float3 point) {
       sd.normal = make_float3(0.0f, 1.0f, 0.0f);
       return sd;
   }
+}
+
+/* The collider buffer holds an ImplicitEntry as CONTACT_IMPLICIT_UINT4S uint4. */
+#define CONTACT_IMPLICIT_UINT4S 4u
+
+SINEW_STRUCT_BEGIN(ContactImplicitNode)
+  uint op;
+  float radius;
+  float half_height;
+  float rounding;
+  float half_x;
+  float half_y;
+  float half_z;
+  float minor_radius;
+  float3 p;
+  float4 q;  /* (x, y, z, w) */
+SINEW_STRUCT_END(ContactImplicitNode)
+
+ContactImplicitNode contact_implicit_node(const uint4 f[4]) {
+  ContactImplicitNode n;
+  n.op = f[0].x;
+  n.radius = bits_float(f[0].y);
+  n.half_height = bits_float(f[0].z);
+  n.rounding = bits_float(f[0].w);
+  const float4 f1 = contact_bits_float4(f[1]);
+  n.half_x = f1.x;
+  n.half_y = f1.y;
+  n.half_z = f1.z;
+  n.minor_radius = f1.w;
+  n.p = contact_bits_float4(f[2]).xyz;
+  n.q = contact_bits_float4(f[3]).yzwx;  // stored (w, x, y, z)
+  return n;
+}
+
+/* A torus about the y axis (CPU: torus_distance): the distance to its core
+ * circle less the tube's radius; +y on the core circle, +x radially on the
+ * axis. */
+ContactDistance contact_torus_distance(float major, float minor, float3 point) {
+  ContactDistance sd;
+  PRECISE float r = sqrt(point.x * point.x + point.z * point.z);
+  PRECISE float ux = r > 0.0f ? point.x / r : 1.0f;
+  PRECISE float uz = r > 0.0f ? point.z / r : 0.0f;
+  PRECISE float qr = r - major;
+  PRECISE float len = sqrt(qr * qr + point.y * point.y);
+  if (!(len > 0.0f)) {
+    sd.distance = -minor;
+    sd.normal = make_float3(0.0f, 1.0f, 0.0f);
+    return sd;
+  }
+  PRECISE float d = len - minor;
+  PRECISE float3 nn = make_float3(qr * ux / len, point.y / len, qr * uz / len);
+  sd.distance = d;
+  sd.normal = nn;
+  return sd;
+}
+
+/* One primitive node at a point in the collider's frame (CPU:
+ * primitive_distance): into the node's frame, measured, the normal rotated
+ * back, less the rounding. */
+ContactDistance contact_primitive_distance(ContactImplicitNode n, float3 point) {
+  PRECISE float3 offset = point - n.p;
+  const float3 own = contact_rotate_inverse(n.q, offset);
+  ContactDistance sd;
+  if (n.op == SINEW_IMPLICIT_TORUS) {
+    sd = contact_torus_distance(n.radius, n.minor_radius, own);
+  } else {
+    ContactCollider shape;
+    shape.shape = n.op;  /* SINEW_IMPLICIT_HALF_SPACE..CYLINDER are SINEW_SHAPE_PLANE..CYLINDER */
+    shape.radius = n.radius;
+    shape.half_height = n.half_height;
+    shape.half_x = n.half_x;
+    shape.half_y = n.half_y;
+    shape.half_z = n.half_z;
+    sd = contact_shape_distance(shape, own);
+  }
+  ContactDistance r;
+  PRECISE float d = sd.distance - n.rounding;
+  r.distance = d;
+  r.normal = contact_rotate(n.q, sd.normal);
+  return r;
+}
+
+/* An operation on a (below) and b (top of the stack): the value chosen and
+ * its normal, a on ties (CPU: implicit_distance). */
+ContactDistance contact_implicit_combine(uint op, ContactDistance a, ContactDistance b) {
+  ContactDistance r = a;
+  if (op == SINEW_IMPLICIT_UNITE) {
+    if (b.distance < a.distance) r = b;
+  } else if (op == SINEW_IMPLICIT_INTERSECT) {
+    if (b.distance > a.distance) r = b;
+  } else if (-b.distance > a.distance) {  /* subtract: outside b */
+    r.distance = -b.distance;
+    PRECISE float3 flipped = -1.0f * b.normal;
+    r.normal = flipped;
+  }
+  return r;
 }
 
 #endif /* SINEW_CONTACT_MATH_H */

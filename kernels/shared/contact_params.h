@@ -21,7 +21,18 @@
  *   sphere  centre 0, `radius`;
  *   capsule segment (0, -half_height, 0)..(0, +half_height, 0) swollen by `radius`;
  *   box     |x| <= half_x, |y| <= half_y, |z| <= half_z;
- *   cylinder x^2 + z^2 <= radius^2, |y| <= half_height (flat caps).
+ *   cylinder x^2 + z^2 <= radius^2, |y| <= half_height (flat caps);
+ *   implicit the signed distance of a CSG expression (include/sinew/scene.h,
+ *            ImplicitNode): `implicit_count` ImplicitEntry nodes from
+ *            `implicit_first`, in postfix order, stored after the last
+ *            ColliderEntry. A kernel runs them as a stack machine: a
+ *            primitive (SINEW_IMPLICIT_*: the shapes above in the node's own
+ *            pose, plus a torus; distance minus `rounding`) pushes
+ *            (distance, normal), an operation pops b then a and pushes
+ *            min(a, b) (unite), max(a, b) (intersect) or max(a, -b)
+ *            (subtract, b's normal negated), keeping the normal of the
+ *            value chosen (a on ties). At most SINEW_IMPLICIT_STACK values
+ *            and SINEW_IMPLICIT_MAX_NODES nodes (checked on the host).
  *
  * ------------------------------------------------------------ xpbd_solve_contacts
  * arity 1: one constraint per movable particle, all in one colour (a particle
@@ -88,6 +99,20 @@
 #define SINEW_SHAPE_CAPSULE 2u
 #define SINEW_SHAPE_BOX 3u
 #define SINEW_SHAPE_CYLINDER 4u
+#define SINEW_SHAPE_IMPLICIT 5u
+
+/* ImplicitEntry::op: primitives (their shape in the node's frame), then operations. */
+#define SINEW_IMPLICIT_HALF_SPACE 0u
+#define SINEW_IMPLICIT_SPHERE 1u
+#define SINEW_IMPLICIT_CAPSULE 2u
+#define SINEW_IMPLICIT_BOX 3u
+#define SINEW_IMPLICIT_CYLINDER 4u
+#define SINEW_IMPLICIT_TORUS 5u
+#define SINEW_IMPLICIT_UNITE 6u
+#define SINEW_IMPLICIT_INTERSECT 7u
+#define SINEW_IMPLICIT_SUBTRACT 8u
+#define SINEW_IMPLICIT_STACK 8
+#define SINEW_IMPLICIT_MAX_NODES 64u
 
 #define SINEW_CONTACT_DATA_STRIDE 1
 #define SINEW_CONTACT_LAMBDA_PER_COLLIDER 4
@@ -116,8 +141,8 @@ SINEW_STRUCT_BEGIN(ColliderEntry)
   float half_z;
   float static_friction;   /* mu_s */
   float dynamic_friction;  /* mu_k <= mu_s */
-  float pad0;
-  float pad1;
+  uint implicit_first;     /* implicit: its first node, counted from the first ImplicitEntry */
+  uint implicit_count;     /* implicit: its node count (0 for the other shapes) */
   float pad2;
   float start_px;          /* pose at the start of the frame: position [m] */
   float start_py;
@@ -136,6 +161,27 @@ SINEW_STRUCT_BEGIN(ColliderEntry)
   float end_qy;
   float end_qz;
 SINEW_STRUCT_END(ColliderEntry)
+
+/* One node of an implicit shape (64 bytes): an operation (only `op` used)
+ * or a primitive with its dimensions and its pose in the collider's frame. */
+SINEW_STRUCT_BEGIN(ImplicitEntry)
+  uint op;                 /* SINEW_IMPLICIT_* */
+  float radius;            /* sphere, capsule, cylinder; torus: major [m] */
+  float half_height;       /* capsule, cylinder [m] */
+  float rounding;          /* subtracted from the primitive's distance [m] */
+  float half_x;            /* box half extents [m] */
+  float half_y;
+  float half_z;
+  float minor_radius;      /* torus tube [m] */
+  float px;                /* position in the collider's frame [m] */
+  float py;
+  float pz;
+  float pad0;
+  float qw;                /* rotation in the collider's frame (w, x, y, z) */
+  float qx;
+  float qy;
+  float qz;
+SINEW_STRUCT_END(ImplicitEntry)
 
 /* A kinematic target: its position at the start and at the end of the
  * frame [m]; the attachment kernel interpolates linearly at substep_end. */

@@ -1,6 +1,7 @@
-// compile_contacts.cpp — colliders, tools and attachments: the collider and
-// target buffers (kernels/shared/contact_params.h), one contact constraint
-// per movable particle and one attachment constraint per attached vertex.
+// compile_contacts.cpp — colliders, tools and attachments: the collider
+// buffer (implicit shapes' nodes after the entries) and the target buffer
+// (kernels/shared/contact_params.h), one contact constraint per movable
+// particle and one attachment constraint per attached vertex.
 // Called after every body has been added, so the particle layout is final.
 #include <array>
 #include <limits>
@@ -16,6 +17,7 @@ namespace {
 
 using kernels::ColliderEntry;
 using kernels::ColliderHeader;
+using kernels::ImplicitEntry;
 using kernels::TargetEntry;
 
 ColliderEntry entry(std::uint32_t shape, const std::array<double, 3>& position, const std::array<double, 4>& rotation) {
@@ -38,8 +40,44 @@ std::uint32_t shape_code(ColliderShape shape) {
     case ColliderShape::capsule: return SINEW_SHAPE_CAPSULE;
     case ColliderShape::box: return SINEW_SHAPE_BOX;
     case ColliderShape::cylinder: return SINEW_SHAPE_CYLINDER;
+    case ColliderShape::implicit: return SINEW_SHAPE_IMPLICIT;
   }
   return SINEW_SHAPE_PLANE;
+}
+
+std::uint32_t op_code(ImplicitOp op) {
+  switch (op) {
+    case ImplicitOp::half_space: return SINEW_IMPLICIT_HALF_SPACE;
+    case ImplicitOp::sphere: return SINEW_IMPLICIT_SPHERE;
+    case ImplicitOp::capsule: return SINEW_IMPLICIT_CAPSULE;
+    case ImplicitOp::box: return SINEW_IMPLICIT_BOX;
+    case ImplicitOp::cylinder: return SINEW_IMPLICIT_CYLINDER;
+    case ImplicitOp::torus: return SINEW_IMPLICIT_TORUS;
+    case ImplicitOp::unite: return SINEW_IMPLICIT_UNITE;
+    case ImplicitOp::intersect: return SINEW_IMPLICIT_INTERSECT;
+    case ImplicitOp::subtract: return SINEW_IMPLICIT_SUBTRACT;
+  }
+  return SINEW_IMPLICIT_UNITE;
+}
+
+ImplicitEntry implicit_entry(const ImplicitNode& n) {
+  ImplicitEntry e{};
+  e.op = op_code(n.op);
+  e.radius = static_cast<float>(n.radius);
+  e.half_height = static_cast<float>(n.half_height);
+  e.rounding = static_cast<float>(n.rounding);
+  e.half_x = static_cast<float>(n.half_extents[0]);
+  e.half_y = static_cast<float>(n.half_extents[1]);
+  e.half_z = static_cast<float>(n.half_extents[2]);
+  e.minor_radius = static_cast<float>(n.minor_radius);
+  e.px = static_cast<float>(n.position[0]);
+  e.py = static_cast<float>(n.position[1]);
+  e.pz = static_cast<float>(n.position[2]);
+  e.qw = static_cast<float>(n.rotation[0]);
+  e.qx = static_cast<float>(n.rotation[1]);
+  e.qy = static_cast<float>(n.rotation[2]);
+  e.qz = static_cast<float>(n.rotation[3]);
+  return e;
 }
 
 std::uint32_t first_particle(const CompiledScene& out, const VertexRef& v) {
@@ -65,8 +103,14 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
   header.substep_fraction = static_cast<float>(1.0 / scene.solver.substeps);
   out.colliders.clear();
   append_words(out.colliders, header);
+  std::vector<ImplicitEntry> nodes;  // every implicit collider's nodes, after the entries
   for (const ColliderDesc& c : scene.colliders) {
     ColliderEntry e = entry(shape_code(c.shape), c.position, c.rotation);
+    if (c.shape == ColliderShape::implicit) {
+      e.implicit_first = static_cast<std::uint32_t>(nodes.size());
+      e.implicit_count = static_cast<std::uint32_t>(c.implicit.size());
+      for (const ImplicitNode& n : c.implicit) nodes.push_back(implicit_entry(n));
+    }
     e.radius = static_cast<float>(c.radius);
     e.half_height = static_cast<float>(c.half_height);
     e.half_x = static_cast<float>(c.half_extents[0]);
@@ -86,6 +130,7 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     e.compliance = static_cast<float>(t.compliance);
     append_words(out.colliders, e);
   }
+  for (const ImplicitEntry& n : nodes) append_words(out.colliders, n);
 
   out.targets.clear();
   for (const auto& t : scene.targets) {

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string>
 
+#include "contact_params.h"
 #include "math/vec3.h"
 #include "sinew/scene.h"
 
@@ -165,27 +166,77 @@ Status check_tri_body(const TriBodyDesc& b, const std::string& name) {
   return check_pinned(name, b.pinned, n);
 }
 
+// The dimensions a shape needs, for colliders and implicit nodes alike.
+enum class Dims { none, sphere, capsule, cylinder, box, torus };
+Status check_dims(const std::string& name, Dims kind, double radius, double half_height,
+                  const std::array<double, 3>& half_extents, double minor_radius) {
+  if (kind == Dims::none) return {};
+  if (kind == Dims::box) {
+    for (int a = 0; a < 3; ++a)
+      if (Status s = positive(name + ".half_extents[" + std::to_string(a) + "]", half_extents[a]); !s) return s;
+    return {};
+  }
+  if (Status s = positive(name + ".radius", radius); !s) return s;
+  if (kind == Dims::capsule) return non_negative(name + ".half_height", half_height);
+  if (kind == Dims::cylinder) return positive(name + ".half_height", half_height);
+  if (kind == Dims::torus) return positive(name + ".minor_radius", minor_radius);
+  return {};
+}
+
+// An implicit shape: every node's values, and a postfix expression that
+// never pops an empty stack, never holds more than the kernels' stack, and
+// leaves exactly one value.
+Status check_implicit(const std::vector<ImplicitNode>& nodes, const std::string& name) {
+  if (nodes.empty()) return Error(ErrorCode::bad_parameter, name + " is empty (an implicit collider needs nodes)");
+  if (nodes.size() > SINEW_IMPLICIT_MAX_NODES)
+    return Error(ErrorCode::bad_parameter, name + " has " + std::to_string(nodes.size()) + " nodes, more than the " +
+                                               std::to_string(SINEW_IMPLICIT_MAX_NODES) + " the kernels evaluate");
+  int depth = 0;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const ImplicitNode& n = nodes[k];
+    const std::string at = name + "[" + std::to_string(k) + "]";
+    const bool operation = n.op == ImplicitOp::unite || n.op == ImplicitOp::intersect || n.op == ImplicitOp::subtract;
+    if (operation) {
+      if (depth < 2)
+        return Error(ErrorCode::bad_parameter,
+                     at + " is an operation with " + std::to_string(depth) + " value(s) before it (it needs two; postfix order)");
+      --depth;
+      continue;
+    }
+    if (++depth > SINEW_IMPLICIT_STACK)
+      return Error(ErrorCode::bad_parameter, at + " makes " + std::to_string(depth) + " values pending at once, more than the " +
+                                                 std::to_string(SINEW_IMPLICIT_STACK) + " the kernels hold (combine earlier)");
+    if (Status s = finite3(at + ".position", n.position); !s) return s;
+    if (Status s = unit_quaternion(at + ".rotation", n.rotation); !s) return s;
+    if (Status s = non_negative(at + ".rounding", n.rounding); !s) return s;
+    const Dims dims = n.op == ImplicitOp::sphere     ? Dims::sphere
+                      : n.op == ImplicitOp::capsule  ? Dims::capsule
+                      : n.op == ImplicitOp::cylinder ? Dims::cylinder
+                      : n.op == ImplicitOp::box      ? Dims::box
+                      : n.op == ImplicitOp::torus    ? Dims::torus
+                                                     : Dims::none;  // half_space: the pose only
+    if (Status s = check_dims(at, dims, n.radius, n.half_height, n.half_extents, n.minor_radius); !s) return s;
+  }
+  if (depth != 1)
+    return Error(ErrorCode::bad_parameter, name + " leaves " + std::to_string(depth) +
+                                               " values (a postfix expression leaves one: combine them with unite, "
+                                               "intersect or subtract)");
+  return {};
+}
+
 Status check_collider(const ColliderDesc& c, const std::string& name) {
   if (Status s = finite3(name + ".position", c.position); !s) return s;
   if (Status s = unit_quaternion(name + ".rotation", c.rotation); !s) return s;
-  switch (c.shape) {
-    case ColliderShape::plane: break;
-    case ColliderShape::sphere:
-      if (Status s = positive(name + ".radius", c.radius); !s) return s;
-      break;
-    case ColliderShape::capsule:
-      if (Status s = positive(name + ".radius", c.radius); !s) return s;
-      if (Status s = non_negative(name + ".half_height", c.half_height); !s) return s;
-      break;
-    case ColliderShape::cylinder:
-      if (Status s = positive(name + ".radius", c.radius); !s) return s;
-      if (Status s = positive(name + ".half_height", c.half_height); !s) return s;
-      break;
-    case ColliderShape::box:
-      for (int k = 0; k < 3; ++k)
-        if (Status s = positive(name + ".half_extents[" + std::to_string(k) + "]", c.half_extents[k]); !s) return s;
-      break;
-  }
+  const Dims dims = c.shape == ColliderShape::sphere     ? Dims::sphere
+                    : c.shape == ColliderShape::capsule  ? Dims::capsule
+                    : c.shape == ColliderShape::cylinder ? Dims::cylinder
+                    : c.shape == ColliderShape::box      ? Dims::box
+                                                         : Dims::none;
+  if (Status s = check_dims(name, dims, c.radius, c.half_height, c.half_extents, 0.0); !s) return s;
+  if (c.shape == ColliderShape::implicit) {
+    if (Status s = check_implicit(c.implicit, name + ".implicit"); !s) return s;
+  } else if (!c.implicit.empty())
+    return Error(ErrorCode::bad_parameter, name + ".implicit has nodes but the shape is not ColliderShape::implicit");
   if (Status s = check_friction(name, c.static_friction, c.dynamic_friction); !s) return s;
   return non_negative(name + ".compliance", c.compliance);
 }

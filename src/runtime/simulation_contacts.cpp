@@ -48,11 +48,17 @@ constexpr std::size_t kHeaderFloats = sizeof(ColliderHeader) / sizeof(float);
 constexpr std::size_t kEntryFloats = sizeof(ColliderEntry) / sizeof(float);
 constexpr std::size_t kTargetFloats = sizeof(TargetEntry) / sizeof(float);
 
+std::size_t entry_at(std::size_t k) { return kHeaderFloats + k * kEntryFloats; }
+
+// The header, the entries and the implicit shapes' nodes after them.
 std::size_t device_floats(const std::vector<float>& c) {
   const auto h = load_words<ColliderHeader>(c, 0);
-  return kHeaderFloats + std::size_t{h.colliders + h.tools} * kEntryFloats;
+  const std::size_t entries = std::size_t{h.colliders} + h.tools;
+  std::size_t nodes = 0;
+  for (std::size_t k = 0; k < entries && entry_at(k + 1) <= c.size(); ++k)
+    nodes += load_words<ColliderEntry>(c, entry_at(k)).implicit_count;
+  return entry_at(entries) + nodes * (sizeof(kernels::ImplicitEntry) / sizeof(float));
 }
-std::size_t entry_at(std::size_t k) { return kHeaderFloats + k * kEntryFloats; }
 
 std::string str(double v) {
   std::ostringstream s;
