@@ -16,17 +16,25 @@
 // part 5: kidney against liver), with the reference BVHs refitted, Embree
 // refitted and Embree rebuilt; contacts at twice the inflation, on TBB's
 // threads.
+// BM_DeviceSelfBroadPhase: the same self-collision frame with the BVH on a
+// device (collision/device_bvh.h: Karras's build, the refit and the
+// bvh_self_pairs traversal in kernels) on each backend built: the boxes
+// computed on the host and written, the tree refitted (or rebuilt), the
+// pairs found, read back and sorted.
 //   bench_broad_phase --benchmark_out=broad.csv --benchmark_out_format=csv
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "backends/backend.h"
 #include "collision/bvh.h"
+#include "collision/device_bvh.h"
 #include "collision/narrow_phase.h"
 #include "collision/parallel_pairs.h"
 #if SINEW_HAS_EMBREE
@@ -275,6 +283,108 @@ void BM_KidneyOnLiver(benchmark::State& state) {
   state.counters["contacts"] = double(contacts.size());
 }
 
+// The self broad phase of BM_SelfBroadPhase with the device BVH: range(0)
+// the mesh (0 kidney, 1 liver), range(1) the backend (0 cpu, 1 opencl, 2
+// vulkan), range(2) 1 to rebuild the tree every frame, 0 to refit it.
+void BM_DeviceSelfBroadPhase(benchmark::State& state) {
+  const Surface& s = surface(int(state.range(0)));
+  static const char* backends[] = {"cpu", "opencl", "vulkan"};
+  const char* backend = backends[state.range(1)];
+  const bool rebuild = state.range(2) != 0;
+  if (s.triangles.empty()) {
+    state.SkipWithError("mesh not found");
+    return;
+  }
+  auto made = sinew::create_device({.backend = backend, .quiet = true});
+  if (!made) {
+    state.SkipWithError(made.error().message().c_str());
+    return;
+  }
+  sinew::Device& device = **made;
+  const float inflate = 0.1f * s.mean_edge;
+  std::vector<float> x;
+  std::vector<Aabb> boxes;
+  deform(s, x, 0);
+  (void)primitive_boxes(x, s.triangles, 3, inflate, boxes);
+  const auto n = static_cast<std::uint32_t>(boxes.size());
+  // Build bounds: the rest surface grown by the deformation's reach
+  // (centres outside would only be clamped).
+  std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (std::size_t v = 0; v < s.rest.size(); v += 4)
+    for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], s.rest[v + k]), hi[k] = std::max(hi[k], s.rest[v + k]);
+  for (std::size_t k = 0; k < 3; ++k) lo[k] -= 3.0f * s.mean_edge, hi[k] += 3.0f * s.mean_edge;
+  // Room for four times the pairs of the first frame.
+  Bvh tree;
+  tree.build(boxes);
+  std::vector<Pair> pairs;
+  self_overlapping_pairs(tree, SharesVertex{s.triangles}, pairs);
+  const auto capacity = static_cast<std::uint32_t>(4 * pairs.size() + 1024);
+  auto bvh = make_device_bvh(device, n);
+  auto ids = device.create_buffer(s.triangles.size() * 4, "vertex ids");
+  auto pair_buffer = device.create_buffer(std::size_t{capacity} * 8, "pairs");
+  auto counter = device.create_buffer(4, "pair counter");
+  if (!bvh || !ids || !pair_buffer || !counter) {
+    state.SkipWithError("device buffers");
+    return;
+  }
+  (void)device.write_buffer(*ids, 0, s.triangles.data(), s.triangles.size() * 4);
+  const sinew::DeviceCount count{*counter, 0, capacity};
+  // The first frame builds; the timed frames rebuild or only refit.
+  const auto program_of = [&](bool build) -> sinew::Result<sinew::ProgramHandle> {
+    sinew::FrameProgram program;
+    if (build) {
+      if (sinew::Status st = append_device_bvh_build(program, *bvh, n, lo, hi); !st) return st.error();
+    }
+    if (sinew::Status st = append_device_bvh_refit(program, *bvh, n); !st) return st.error();
+    if (sinew::Status st = append_device_bvh_self_pairs(program, *bvh, n, *ids, *pair_buffer, count); !st)
+      return st.error();
+    return device.create_program(program);
+  };
+  auto first = program_of(true);
+  auto frame_program = program_of(rebuild);
+  if (!first || !frame_program) {
+    state.SkipWithError("device program");
+    return;
+  }
+  const auto f = [](const std::vector<Aabb>& b) {
+    std::vector<float> words;
+    words.reserve(6 * b.size());
+    for (const Aabb& a : b) words.insert(words.end(), {a.lo[0], a.lo[1], a.lo[2], a.hi[0], a.hi[1], a.hi[2]});
+    return words;
+  };
+  std::vector<float> words = f(boxes);
+  (void)device.write_buffer(bvh->boxes, 0, words.data(), words.size() * 4);
+  if (!device.run_program(*first)) {
+    state.SkipWithError("first frame failed");
+    return;
+  }
+  int frame = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    deform(s, x, ++frame);
+    state.ResumeTiming();
+    (void)primitive_boxes(x, s.triangles, 3, inflate, boxes);
+    words = f(boxes);
+    (void)device.write_buffer(bvh->boxes, 0, words.data(), words.size() * 4);
+    if (sinew::Status st = device.run_program(*frame_program); !st) {
+      state.SkipWithError(st.error().message().c_str());
+      break;
+    }
+    auto found = read_device_bvh_pairs(device, *pair_buffer, count);
+    if (!found) {
+      state.SkipWithError(found.error().message().c_str());
+      break;
+    }
+    pairs = std::move(*found);
+    benchmark::DoNotOptimize(pairs.data());
+  }
+  state.SetLabel(std::string(state.range(0) == 0 ? "kidney_57k" : "liver_382k") + " surface, device BVH on " + backend +
+                 (rebuild ? ", rebuild" : ", refit"));
+  state.counters["triangles"] = double(s.triangles.size() / 3);
+  state.counters["pairs"] = double(pairs.size());
+  state.counters["contacts"] = 0.0;  // the same counters as the other rows (CSV)
+}
+
 BENCHMARK(BM_KidneyOnLiver)
     ->ArgsProduct({{kPairsReference, kPairsEmbreeRefit, kPairsEmbreeRebuild}, {0, 1}})
     ->ArgNames({"variant", "narrow"})
@@ -284,6 +394,12 @@ BENCHMARK(BM_KidneyOnLiver)
 BENCHMARK(BM_SelfBroadPhase)
     ->ArgsProduct({{0, 1}, {kReferenceRefit, kReferenceRebuild, kEmbreeRefit, kEmbreeRebuild, kParallelRefit, kParallelRefitNarrow}})
     ->ArgNames({"mesh", "variant"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK(BM_DeviceSelfBroadPhase)
+    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}})
+    ->ArgNames({"mesh", "backend", "rebuild"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

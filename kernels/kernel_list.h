@@ -68,6 +68,8 @@
   /* the device BVH (kernels/shared/bvh_params.h) */                             \
   SINEW_KERNEL(bvh_morton_codes, 3, MortonParams, 0)                             \
   SINEW_KERNEL(bvh_karras_nodes, 3, KarrasParams, 0)                             \
-  SINEW_KERNEL(bvh_refit_pass, 6, RefitParams, 0)
+  SINEW_KERNEL(bvh_refit_pass, 6, RefitParams, 0)                                \
+  SINEW_KERNEL(bvh_self_pairs, 7, SelfPairsParams, 0)                            \
+  SINEW_KERNEL(bvh_tree_pairs, 7, TreePairsParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

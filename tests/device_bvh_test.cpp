@@ -3,21 +3,32 @@
 // codes interleaved bit by bit here, the internal nodes form a valid binary
 // tree over the sorted leaves (every node reached once, each covering a
 // contiguous range split where its keys first differ), with duplicate
-// codes too; every GPU backend gives the CPU reference's bits.
+// codes too; every GPU backend gives the CPU reference's bits. The
+// traversals (bvh_self_pairs, bvh_tree_pairs) find exactly the pairs of the
+// CPU reference BVH and the brute force (collision/bvh.h) on every backend,
+// on the boundary surfaces of the real meshes and on degenerate boxes; a
+// capacity below the pair count is a capacity_exceeded error with the
+// exact count, and nothing is written past the capacity.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <chrono>
+#include <cmath>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <random>
 #include <vector>
 
 #include "agreement_support.h"
 #include "bvh_params.h"
+#include "collision/aabb.h"
+#include "collision/bvh.h"
 #include "collision/device_bvh.h"
 #include "program/primitives.h"
+#include "surface_support.h"
 #include "test_support.h"
 
 namespace sinew::test {
@@ -300,6 +311,379 @@ TEST(DeviceBvh, BuildOnEveryBackendGivesOneValidTree) {
   EXPECT_FALSE(collision::append_device_bvh_build(program, *bvh, 5, {0, 2, 0}, {1, 1, 1}).ok());
   EXPECT_FALSE(collision::make_device_bvh(**device, 1).ok());
   EXPECT_FALSE(collision::append_device_bvh_refit(program, *bvh, 11).ok());
+}
+
+// ---------------------------------------------------------------- the traversals
+
+using collision::Aabb;
+using collision::Pair;
+
+constexpr std::uint32_t kNone = SINEW_BVH_NONE;
+constexpr std::uint32_t kSentinel = 0xDEADBEEFu;  // pairs-buffer words past the capacity must keep it
+constexpr std::uint32_t kSpare = 64;              // pairs of sentinel room past the capacity
+
+std::vector<float> flat(const std::vector<Aabb>& boxes) {
+  std::vector<float> f;
+  f.reserve(6 * boxes.size());
+  for (const Aabb& b : boxes) f.insert(f.end(), {b.lo[0], b.lo[1], b.lo[2], b.hi[0], b.hi[1], b.hi[2]});
+  return f;
+}
+
+// The bounds of the boxes' centres' cells (the build's lo, hi).
+std::pair<std::array<float, 3>, std::array<float, 3>> bounds_of(const std::vector<Aabb>& boxes) {
+  std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (const Aabb& b : boxes)
+    for (int k = 0; k < 3; ++k) {
+      lo[std::size_t(k)] = std::min(lo[std::size_t(k)], b.lo[std::size_t(k)]);
+      hi[std::size_t(k)] = std::max(hi[std::size_t(k)], b.hi[std::size_t(k)]);
+    }
+  return {lo, hi};
+}
+
+// The reference's skip for vertex ids of 3 per primitive, kNone unused.
+struct SharesValidId {
+  const std::vector<std::uint32_t>* ids;
+  bool operator()(std::uint32_t i, std::uint32_t j) const {
+    for (int s = 0; s < 3; ++s)
+      for (int t = 0; t < 3; ++t) {
+        const std::uint32_t a = (*ids)[3 * std::size_t{i} + std::size_t(s)], b = (*ids)[3 * std::size_t{j} + std::size_t(t)];
+        if (a != kNone && a == b) return true;
+      }
+    return false;
+  }
+};
+
+// What one traversal on a device gave.
+struct DevicePairs {
+  Status run;                          // the program's run (capacity_exceeded when over)
+  Result<std::vector<Pair>> pairs{std::vector<Pair>{}};  // read_device_bvh_pairs
+  std::vector<std::uint32_t> words;    // the whole pairs buffer: capacity + kSpare pairs
+  std::uint32_t counter = 0;           // the device counter after the run
+  double ms = 0.0;                     // wall time of the traversal's program [ms]
+};
+
+// Builds and refits a device BVH over `boxes` (one program), then runs the
+// self traversal with `vertex_ids` (or, when `a_boxes` is given, the tree
+// traversal of those boxes against it) in a second program.
+DevicePairs pairs_on(Device& device, const std::vector<Aabb>& boxes, const std::vector<std::uint32_t>& vertex_ids,
+                     std::uint32_t capacity, const std::vector<Aabb>* a_boxes = nullptr) {
+  DevicePairs r;
+  const auto n = std::uint32_t(boxes.size());
+  auto bvh = collision::make_device_bvh(device, n);
+  EXPECT_TRUE(bvh.ok());
+  if (!bvh.ok()) return r;
+  const std::vector<float> f = flat(boxes);
+  EXPECT_TRUE(device.write_buffer(bvh->boxes, 0, f.data(), f.size() * 4).ok());
+  const auto [lo, hi] = bounds_of(boxes);
+  FrameProgram build;
+  EXPECT_TRUE(collision::append_device_bvh_build(build, *bvh, n, lo, hi).ok());
+  EXPECT_TRUE(collision::append_device_bvh_refit(build, *bvh, n).ok());
+  auto built = device.create_program(build);
+  EXPECT_TRUE(built.ok()) << (built.ok() ? "" : built.error().message());
+  if (!built.ok()) return r;
+  EXPECT_TRUE(device.run_program(*built).ok());
+
+  const std::size_t pair_words = 2 * (std::size_t{capacity} + kSpare);
+  auto pairs = device.create_buffer(pair_words * 4, "pairs");
+  auto counter = device.create_buffer(4 * 4, "pair counter");
+  EXPECT_TRUE(pairs.ok() && counter.ok());
+  if (!pairs.ok() || !counter.ok()) return r;
+  const std::vector<std::uint32_t> sentinel(pair_words, kSentinel);
+  EXPECT_TRUE(device.write_buffer(*pairs, 0, sentinel.data(), pair_words * 4).ok());
+  const DeviceCount count{*counter, 2, capacity};  // a word inside the buffer, not the first
+  FrameProgram traverse;
+  if (a_boxes) {
+    const std::vector<float> fa = flat(*a_boxes);
+    auto a = device.create_buffer(std::max<std::size_t>(fa.size(), 1) * 4, "boxes of A");
+    EXPECT_TRUE(a.ok());
+    if (!a.ok()) return r;
+    if (!fa.empty()) {
+      EXPECT_TRUE(device.write_buffer(*a, 0, fa.data(), fa.size() * 4).ok());
+    }
+    EXPECT_TRUE(collision::append_device_bvh_tree_pairs(traverse, *a, std::uint32_t(a_boxes->size()), *bvh, n, *pairs, count).ok());
+  } else {
+    auto ids = device.create_buffer(vertex_ids.size() * 4, "vertex ids");
+    EXPECT_TRUE(ids.ok());
+    if (!ids.ok()) return r;
+    EXPECT_TRUE(device.write_buffer(*ids, 0, vertex_ids.data(), vertex_ids.size() * 4).ok());
+    EXPECT_TRUE(collision::append_device_bvh_self_pairs(traverse, *bvh, n, *ids, *pairs, count).ok());
+  }
+  auto prepared = device.create_program(traverse);
+  EXPECT_TRUE(prepared.ok()) << (prepared.ok() ? "" : prepared.error().message());
+  if (!prepared.ok()) return r;
+  const auto start = std::chrono::steady_clock::now();
+  r.run = device.run_program(*prepared);
+  r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  r.pairs = collision::read_device_bvh_pairs(device, *pairs, count);
+  r.words.resize(pair_words);
+  EXPECT_TRUE(device.read_buffer(*pairs, 0, r.words.data(), pair_words * 4).ok());
+  EXPECT_TRUE(device.read_buffer(*counter, 2 * 4, &r.counter, 4).ok());
+  EXPECT_EQ(device.counters().size(), 1u);
+  if (!device.counters().empty()) {
+    EXPECT_EQ(device.counters()[0], r.counter) << "the declared counter";
+  }
+  return r;
+}
+
+std::unique_ptr<Device> device_for(const std::string& backend) {
+  auto made = create_device({.backend = backend, .quiet = true});
+  EXPECT_TRUE(made.ok()) << (made.ok() ? "" : made.error().message());
+  return made.ok() ? std::move(*made) : nullptr;
+}
+
+std::vector<Aabb> boxes_of(const Surface& s, float inflate) {
+  std::vector<Aabb> boxes;
+  const Status status = collision::primitive_boxes(s.positions, s.triangles, 3, inflate, boxes);
+  EXPECT_TRUE(status.ok()) << (status.ok() ? "" : status.error().message());
+  return boxes;
+}
+
+// A mesh's boundary surface, read once per process (the liver takes a
+// few seconds) and shared by the backends' instances.
+const Surface& cached_surface(const std::string& file) {
+  static std::map<std::string, Surface> surfaces;
+  auto it = surfaces.find(file);
+  if (it == surfaces.end()) it = surfaces.emplace(file, surface_of(file)).first;
+  return it->second;
+}
+
+// Every test body runs on each backend; one with no device here is skipped.
+class DeviceBvhPairs : public BackendTest {};
+
+// bvh_self_pairs on the boundary surfaces of the meshes (triangle
+// boxes inflated as in tests/bvh_test.cpp, triangles sharing a vertex
+// skipped) finds exactly the reference BVH's pairs, which bvh_test.cpp
+// proves equal to the brute force (checked here again on the armadillo).
+TEST_P(DeviceBvhPairs, SelfPairsOnRealSurfacesEqualTheReference) {
+  struct Case {
+    const char* file;
+    float inflate;  // of the mean edge
+  };
+  for (const Case c : {Case{"meshes/tet/armadillo_4k.node", 0.5f}, Case{"meshes/tet/kidney_57k.node", 0.5f},
+                       Case{"meshes/tet/liver_382k.node", 0.25f}}) {
+    SCOPED_TRACE(c.file);
+    const Surface& s = cached_surface(c.file);
+    ASSERT_FALSE(s.triangles.empty());
+    const std::vector<Aabb> boxes = boxes_of(s, c.inflate * s.mean_edge);
+    collision::Bvh tree;
+    tree.build(boxes);
+    std::vector<Pair> want;
+    collision::self_overlapping_pairs(tree, collision::SharesVertex{s.triangles}, want);
+    if (boxes.size() < 10000) {
+      std::vector<Pair> brute;
+      collision::brute_force_self_pairs(boxes, collision::SharesVertex{s.triangles}, brute);
+      ASSERT_EQ(want, brute);
+    }
+    auto device = device_for(GetParam());
+    ASSERT_TRUE(device);
+    const DevicePairs got = pairs_on(*device, boxes, s.triangles, std::uint32_t(want.size()) + 100);
+    ASSERT_TRUE(got.run.ok()) << got.run.error().message();
+    ASSERT_TRUE(got.pairs.ok()) << got.pairs.error().message();
+    EXPECT_EQ(got.counter, want.size());
+    EXPECT_EQ(*got.pairs, want) << got.pairs->size() << " device pairs, " << want.size() << " reference";
+    EXPECT_GT(want.size(), 0u);
+    std::printf("[ device bvh ] %s, %s: %zu triangles, %zu self pairs, traversal %.1f ms\n", GetParam().c_str(),
+                c.file, boxes.size(), want.size(), got.ms);
+  }
+}
+
+// Moves `s` so that its bounding-box centre lies at `centre`.
+void centre_at(Surface& s, const std::array<float, 3>& centre) {
+  std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (std::size_t v = 0; v < s.positions.size() / 4; ++v)
+    for (std::size_t k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], s.positions[4 * v + k]);
+      hi[k] = std::max(hi[k], s.positions[4 * v + k]);
+    }
+  for (std::size_t v = 0; v < s.positions.size() / 4; ++v)
+    for (std::size_t k = 0; k < 3; ++k) s.positions[4 * v + k] += centre[k] - 0.5f * (lo[k] + hi[k]);
+}
+
+// bvh_tree_pairs: the kidney's surface moved onto the liver's (its centre
+// on a vertex of the liver's surface, so the two surfaces cross), kidney
+// triangles against the liver's tree and the liver's against the
+// kidney's, equal the reference BVHs' pairs.
+TEST_P(DeviceBvhPairs, TreePairsKidneyInLiverEqualTheReference) {
+  const Surface& liver = cached_surface("meshes/tet/liver_382k.node");
+  Surface kidney = cached_surface("meshes/tet/kidney_57k.node");
+  ASSERT_FALSE(liver.triangles.empty());
+  ASSERT_FALSE(kidney.triangles.empty());
+  const std::uint32_t v = liver.triangles[0];
+  centre_at(kidney, {liver.positions[4 * v], liver.positions[4 * v + 1], liver.positions[4 * v + 2]});
+  const float inflate = 0.5f * liver.mean_edge;
+  const std::vector<Aabb> a = boxes_of(kidney, inflate), b = boxes_of(liver, inflate);
+  collision::Bvh ta, tb;
+  ta.build(a);
+  tb.build(b);
+  std::vector<Pair> want;
+  collision::overlapping_pairs(ta, tb, want);
+  ASSERT_GT(want.size(), 1000u) << "the surfaces should cross";
+  auto device = device_for(GetParam());
+  ASSERT_TRUE(device);
+  const DevicePairs got = pairs_on(*device, b, {}, std::uint32_t(want.size()), &a);
+  ASSERT_TRUE(got.run.ok()) << got.run.error().message();
+  ASSERT_TRUE(got.pairs.ok()) << got.pairs.error().message();
+  EXPECT_EQ(*got.pairs, want);
+  // The other way round: the liver's triangles against the kidney's tree.
+  const DevicePairs back = pairs_on(*device, a, {}, std::uint32_t(want.size()), &b);
+  ASSERT_TRUE(back.pairs.ok()) << back.pairs.error().message();
+  std::vector<Pair> swapped;
+  for (const auto& [i, j] : want) swapped.push_back({j, i});
+  std::sort(swapped.begin(), swapped.end());
+  EXPECT_EQ(*back.pairs, swapped);
+  std::printf("[ device bvh ] %s, kidney x liver: %zu x %zu triangles, %zu pairs, traversal %.1f ms (kidney items), "
+              "%.1f ms (liver items)\n",
+              GetParam().c_str(), a.size(), b.size(), want.size(), got.ms, back.ms);
+}
+
+// A capacity below the pair count: the run reports capacity_exceeded, the
+// read-back names the exact count and the capacity, exactly `capacity`
+// distinct pairs of the true set were written and not a word past them.
+TEST_P(DeviceBvhPairs, CapacityBelowThePairCountIsAnErrorWithTheExactCount) {
+  const Surface& s = cached_surface("meshes/tet/armadillo_4k.node");
+  ASSERT_FALSE(s.triangles.empty());
+  const std::vector<Aabb> boxes = boxes_of(s, 0.5f * s.mean_edge);
+  std::vector<Pair> want;
+  collision::brute_force_self_pairs(boxes, collision::SharesVertex{s.triangles}, want);
+  ASSERT_GT(want.size(), 100u);
+  auto device = device_for(GetParam());
+  ASSERT_TRUE(device);
+  for (const std::uint32_t capacity : {std::uint32_t(want.size() / 3), std::uint32_t(want.size() - 1), 0u}) {
+    SCOPED_TRACE("capacity " + std::to_string(capacity));
+    const DevicePairs got = pairs_on(*device, boxes, s.triangles, capacity);
+    ASSERT_FALSE(got.run.ok());
+    EXPECT_EQ(got.run.error().code(), ErrorCode::capacity_exceeded) << got.run.error().message();
+    EXPECT_EQ(got.counter, want.size()) << "the counter counts past the capacity";
+    ASSERT_FALSE(got.pairs.ok());
+    EXPECT_EQ(got.pairs.error().code(), ErrorCode::capacity_exceeded);
+    const std::string& message = got.pairs.error().message();
+    EXPECT_NE(message.find(std::to_string(want.size()) + " pairs"), std::string::npos) << message;
+    EXPECT_NE(message.find("capacity of " + std::to_string(capacity)), std::string::npos) << message;
+    std::vector<Pair> kept;
+    for (std::uint32_t k = 0; k < capacity; ++k) kept.push_back({got.words[2 * k], got.words[2 * k + 1]});
+    std::sort(kept.begin(), kept.end());
+    EXPECT_EQ(std::adjacent_find(kept.begin(), kept.end()), kept.end()) << "each pair once";
+    for (const Pair& pair : kept) ASSERT_TRUE(std::binary_search(want.begin(), want.end(), pair));
+    for (std::size_t w = 2 * std::size_t{capacity}; w < got.words.size(); ++w)
+      ASSERT_EQ(got.words[w], kSentinel) << "word " << w << " past the capacity was written";
+  }
+  // The tree traversal too.
+  const std::vector<Aabb> half(boxes.begin(), boxes.begin() + std::ptrdiff_t(boxes.size() / 2));
+  std::vector<Pair> cross;
+  collision::brute_force_pairs(half, boxes, cross);
+  const DevicePairs got = pairs_on(*device, boxes, {}, std::uint32_t(cross.size() / 2), &half);
+  ASSERT_FALSE(got.pairs.ok());
+  EXPECT_EQ(got.pairs.error().code(), ErrorCode::capacity_exceeded);
+  EXPECT_NE(got.pairs.error().message().find(std::to_string(cross.size()) + " pairs"), std::string::npos);
+  EXPECT_EQ(got.counter, cross.size());
+  for (std::size_t w = 2 * (cross.size() / 2); w < got.words.size(); ++w) ASSERT_EQ(got.words[w], kSentinel);
+}
+
+// Degenerate inputs: all boxes equal (every pair, or none where they share
+// a vertex), two boxes (touching: a pair; a float step apart: none),
+// zero-size boxes, duplicates and mixed points, segments and triangles
+// against the brute force; the tree traversal of equal boxes finds every
+// (a, b), and boxes of A missing B's root none.
+TEST_P(DeviceBvhPairs, DegenerateInputsEqualTheBruteForce) {
+  auto device = device_for(GetParam());
+  ASSERT_TRUE(device);
+  const Aabb unit{{0, 0, 0}, {1, 1, 1}};
+  // All equal, no vertex ids: every pair once.
+  for (const std::uint32_t n : {2u, 3u, 100u}) {
+    const std::vector<Aabb> boxes(n, unit);
+    const DevicePairs got = pairs_on(*device, boxes, std::vector<std::uint32_t>(3 * n, kNone), n * (n - 1) / 2);
+    ASSERT_TRUE(got.pairs.ok()) << got.pairs.error().message();
+    ASSERT_EQ(got.pairs->size(), n * (n - 1) / 2) << n << " equal boxes";
+    for (std::size_t k = 1; k < got.pairs->size(); ++k) ASSERT_LT((*got.pairs)[k - 1], (*got.pairs)[k]);
+    for (const auto& [i, j] : *got.pairs) ASSERT_LT(i, j);
+  }
+  // All equal, every primitive a segment sharing vertex 7: no pair.
+  {
+    std::vector<std::uint32_t> ids;
+    for (std::uint32_t i = 0; i < 50; ++i) ids.insert(ids.end(), {7u, 100u + i, kNone});
+    const DevicePairs got = pairs_on(*device, std::vector<Aabb>(50, unit), ids, 10);
+    ASSERT_TRUE(got.pairs.ok());
+    EXPECT_TRUE(got.pairs->empty());
+  }
+  // Two boxes: touching faces overlap (closed intervals), a float step apart not.
+  const Aabb right_touch{{1, 0, 0}, {2, 1, 1}};
+  const Aabb right_apart{{std::nextafter(1.0f, 2.0f), 0, 0}, {2, 1, 1}};
+  const std::vector<std::uint32_t> points = {0u, kNone, kNone, 1u, kNone, kNone};
+  auto touching = pairs_on(*device, {unit, right_touch}, points, 4);
+  ASSERT_TRUE(touching.pairs.ok());
+  EXPECT_EQ(*touching.pairs, (std::vector<Pair>{{0, 1}}));
+  auto apart = pairs_on(*device, {unit, right_apart}, points, 4);
+  ASSERT_TRUE(apart.pairs.ok());
+  EXPECT_TRUE(apart.pairs->empty());
+  auto shared = pairs_on(*device, {unit, right_touch}, {0u, 1u, 2u, 5u, 2u, 6u}, 4);
+  ASSERT_TRUE(shared.pairs.ok());
+  EXPECT_TRUE(shared.pairs->empty()) << "triangles sharing vertex 2";
+  // Random boxes with zero-size, coincident and duplicate ones, and
+  // points, segments and triangles with random vertex ids.
+  std::mt19937 rng(59);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int round = 0; round < 4; ++round) {
+    const std::uint32_t n = 2 + rng() % 900;
+    std::vector<Aabb> boxes(n);
+    std::vector<std::uint32_t> ids(3 * n, kNone);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const int kind = int(rng() % 5);
+      for (std::size_t k = 0; k < 3; ++k) {
+        const float c = kind == 0 ? 0.5f : u(rng), h = kind == 1 ? 0.0f : 0.05f * u(rng);
+        boxes[i].lo[k] = c - h;
+        boxes[i].hi[k] = c + h;
+      }
+      if (kind == 2) boxes[i] = boxes[0];
+      const std::uint32_t arity = 1 + rng() % 3;
+      for (std::uint32_t c = 0; c < arity; ++c) ids[3 * i + c] = std::uint32_t(rng() % (2 * n));
+    }
+    std::vector<Pair> want;
+    collision::brute_force_self_pairs(boxes, SharesValidId{&ids}, want);
+    const DevicePairs got = pairs_on(*device, boxes, ids, std::uint32_t(want.size()));
+    ASSERT_TRUE(got.pairs.ok()) << got.pairs.error().message();
+    ASSERT_EQ(*got.pairs, want) << "round " << round << ", " << n << " boxes";
+    const std::vector<Aabb> a(boxes.begin(), boxes.begin() + std::ptrdiff_t(std::min(n, 300u)));
+    std::vector<Pair> cross;
+    collision::brute_force_pairs(a, boxes, cross);
+    const DevicePairs tree = pairs_on(*device, boxes, {}, std::uint32_t(cross.size()), &a);
+    ASSERT_TRUE(tree.pairs.ok()) << tree.pairs.error().message();
+    ASSERT_EQ(*tree.pairs, cross) << "tree pairs, round " << round;
+  }
+  // Tree pairs: 5 equal boxes against a tree of 2 and of 7 equal ones.
+  for (const std::uint32_t m : {2u, 7u}) {
+    const std::vector<Aabb> a(5, unit);
+    const DevicePairs got = pairs_on(*device, std::vector<Aabb>(m, unit), {}, 5 * m, &a);
+    ASSERT_TRUE(got.pairs.ok());
+    EXPECT_EQ(got.pairs->size(), 5 * m);
+  }
+  const std::vector<Aabb> far(3, Aabb{{5, 5, 5}, {6, 6, 6}});
+  const DevicePairs none = pairs_on(*device, {unit, right_touch}, {}, 4, &far);
+  ASSERT_TRUE(none.pairs.ok());
+  EXPECT_TRUE(none.pairs->empty());
+  const std::vector<Aabb> empty;
+  const DevicePairs no_items = pairs_on(*device, {unit, right_touch}, {}, 4, &empty);
+  ASSERT_TRUE(no_items.pairs.ok());
+  EXPECT_TRUE(no_items.pairs->empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, DeviceBvhPairs, ::testing::ValuesIn(backends()), backend_name);
+
+TEST(DeviceBvh, PairsBadArgumentsAreErrors) {
+  auto device = create_device({.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(device.ok());
+  auto bvh = collision::make_device_bvh(**device, 10);
+  ASSERT_TRUE(bvh.ok());
+  auto buffer = (*device)->create_buffer(64, "words");
+  ASSERT_TRUE(buffer.ok());
+  FrameProgram program;
+  const DeviceCount count{*buffer, 0, 4};
+  EXPECT_FALSE(collision::append_device_bvh_self_pairs(program, *bvh, 11, *buffer, *buffer, count).ok());
+  EXPECT_FALSE(collision::append_device_bvh_self_pairs(program, *bvh, 1, *buffer, *buffer, count).ok());
+  EXPECT_FALSE(collision::append_device_bvh_self_pairs(program, *bvh, 5, BufferHandle{}, *buffer, count).ok());
+  EXPECT_FALSE(collision::append_device_bvh_tree_pairs(program, *buffer, 3, *bvh, 11, *buffer, count).ok());
+  EXPECT_FALSE(collision::append_device_bvh_tree_pairs(program, *buffer, 3, *bvh, 1, *buffer, count).ok());
+  EXPECT_FALSE(collision::append_device_bvh_tree_pairs(program, *buffer, 3, *bvh, 5, *buffer, {}).ok());
+  EXPECT_EQ(program.commands().size(), 0u) << "nothing appended on an error";
 }
 
 }  // namespace

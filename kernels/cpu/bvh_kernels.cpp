@@ -1,11 +1,15 @@
 // bvh_kernels.cpp — CPU references of the kernels that build a BVH on the
-// device (kernels/shared/bvh_params.h): Morton codes of box centres, and
-// Karras's internal nodes from the sorted codes (Karras, HPG 2012,
-// "Maximizing Parallelism in the Construction of BVHs, Octrees, and k-d
-// Trees", section 4 and Figure 4). Written in the GPU twins' operation
-// order (kernels/gpu/bvh_*.gpu): integer work, and float work without
-// fused multiply-add.
+// device and find candidate pairs with it (kernels/shared/bvh_params.h):
+// Morton codes of box centres, Karras's internal nodes from the sorted
+// codes (Karras, HPG 2012, "Maximizing Parallelism in the Construction of
+// BVHs, Octrees, and k-d Trees", section 4 and Figure 4), the node boxes
+// bottom-up, and one stack traversal per primitive appending overlapping
+// pairs through an atomic counter (Karras, "Thinking Parallel, Part II:
+// Tree Traversal on the GPU", NVIDIA blog 2012). Written in the GPU twins'
+// operation order (kernels/gpu/bvh_*.gpu): integer work, float work
+// without fused multiply-add, and comparisons.
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstdint>
 
@@ -119,6 +123,105 @@ void bvh_refit_pass(const void* params, std::byte* const* bindings, std::uint32_
     for (int k = 0; k < 3; ++k) out[k] = ba[k] < bb[k] ? ba[k] : bb[k];
     for (int k = 3; k < 6; ++k) out[k] = ba[k] > bb[k] ? ba[k] : bb[k];
     ready_out[i] = 1u;
+  }
+}
+
+namespace {
+
+// Closed intervals on every axis (touching boxes overlap, NaN never does):
+// collision/aabb.h's overlap() on boxes of 6 floats (lo xyz, hi xyz).
+bool boxes_overlap(const float* a, const float* b) {
+  return a[0] <= b[3] && b[0] <= a[3] && a[1] <= b[4] && b[1] <= a[4] && a[2] <= b[5] && b[2] <= a[5];
+}
+
+// Whether two primitives of 3 vertex ids each (SINEW_BVH_NONE unused)
+// share a valid id.
+bool share_vertex(const std::uint32_t* a, const std::uint32_t* b) {
+  bool shared = false;
+  for (int s = 0; s < 3; ++s)
+    for (int t = 0; t < 3; ++t) shared = shared || (a[s] != SINEW_BVH_NONE && a[s] == b[t]);
+  return shared;
+}
+
+// Appends (first, second): a slot from the counter, written within the
+// capacity; the counter counts on past it (the host reports the overflow).
+// Items run in parallel on the CPU too, hence the atomic.
+void append_pair(std::uint32_t* pairs, std::uint32_t* counts, std::uint32_t count_word, std::uint32_t capacity,
+                 std::uint32_t first, std::uint32_t second) {
+  const std::uint32_t slot = std::atomic_ref<std::uint32_t>(counts[count_word]).fetch_add(1u, std::memory_order_relaxed);
+  if (slot < capacity) {
+    pairs[2 * std::size_t{slot}] = first;
+    pairs[2 * std::size_t{slot} + 1] = second;
+  }
+}
+
+}  // namespace
+
+void bvh_self_pairs(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SelfPairsParams*>(params);
+  const auto* children = reinterpret_cast<const std::uint32_t*>(bindings[0]);
+  const auto* indices = reinterpret_cast<const std::uint32_t*>(bindings[1]);
+  const auto* boxes = reinterpret_cast<const float*>(bindings[2]);
+  const auto* node_boxes = reinterpret_cast<const float*>(bindings[3]);
+  const auto* vertex_ids = reinterpret_cast<const std::uint32_t*>(bindings[4]);
+  auto* pairs = reinterpret_cast<std::uint32_t*>(bindings[5]);
+  auto* counts = reinterpret_cast<std::uint32_t*>(bindings[6]);
+  for (std::uint32_t s = begin; s < end && s < p.count; ++s) {
+    const std::uint32_t i = indices[s];
+    const float* box = boxes + 6 * std::size_t{i};
+    const std::uint32_t* ids = vertex_ids + 3 * std::size_t{i};
+    std::uint32_t stack[SINEW_BVH_STACK];
+    std::uint32_t top = 0;
+    stack[top++] = 0u;  // the root holds every box: no test
+    while (top > 0) {
+      const std::uint32_t node = stack[--top];
+      for (std::uint32_t side = 0; side < 2; ++side) {
+        const std::uint32_t c = children[2 * node + side];
+        const std::uint32_t child = c & ~SINEW_BVH_LEAF;
+        // A left child's leaves end at its index (Karras's numbering): none
+        // after s when child <= s. A right leaf before s is skipped too.
+        if (child <= s && (side == 0u || (c & SINEW_BVH_LEAF) != 0u)) continue;
+        if ((c & SINEW_BVH_LEAF) != 0u) {
+          const std::uint32_t j = indices[child];
+          if (!boxes_overlap(box, boxes + 6 * std::size_t{j})) continue;
+          if (share_vertex(ids, vertex_ids + 3 * std::size_t{j})) continue;
+          append_pair(pairs, counts, p.count_word, p.capacity, i < j ? i : j, i < j ? j : i);
+        } else if (boxes_overlap(box, node_boxes + 6 * std::size_t{child}) && top < SINEW_BVH_STACK) {
+          stack[top++] = child;  // top < 64 always holds for a Karras tree (bvh_params.h)
+        }
+      }
+    }
+  }
+}
+
+void bvh_tree_pairs(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const TreePairsParams*>(params);
+  const auto* boxes_a = reinterpret_cast<const float*>(bindings[0]);
+  const auto* children = reinterpret_cast<const std::uint32_t*>(bindings[1]);
+  const auto* indices = reinterpret_cast<const std::uint32_t*>(bindings[2]);
+  const auto* boxes = reinterpret_cast<const float*>(bindings[3]);
+  const auto* node_boxes = reinterpret_cast<const float*>(bindings[4]);
+  auto* pairs = reinterpret_cast<std::uint32_t*>(bindings[5]);
+  auto* counts = reinterpret_cast<std::uint32_t*>(bindings[6]);
+  for (std::uint32_t a = begin; a < end && a < p.count; ++a) {
+    const float* box = boxes_a + 6 * std::size_t{a};
+    if (!boxes_overlap(box, node_boxes)) continue;  // misses B's root
+    std::uint32_t stack[SINEW_BVH_STACK];
+    std::uint32_t top = 0;
+    stack[top++] = 0u;
+    while (top > 0) {
+      const std::uint32_t node = stack[--top];
+      for (std::uint32_t side = 0; side < 2; ++side) {
+        const std::uint32_t c = children[2 * node + side];
+        const std::uint32_t child = c & ~SINEW_BVH_LEAF;
+        if ((c & SINEW_BVH_LEAF) != 0u) {
+          const std::uint32_t b = indices[child];
+          if (boxes_overlap(box, boxes + 6 * std::size_t{b})) append_pair(pairs, counts, p.count_word, p.capacity, a, b);
+        } else if (boxes_overlap(box, node_boxes + 6 * std::size_t{child}) && top < SINEW_BVH_STACK) {
+          stack[top++] = child;
+        }
+      }
+    }
   }
 }
 

@@ -1,6 +1,7 @@
 // device_bvh.cpp — the device BVH build as a program (see device_bvh.h).
 #include "collision/device_bvh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -87,6 +88,70 @@ Status append_device_bvh_refit(FrameProgram& program, const DeviceBvh& bvh, std:
     std::swap(in, out);
   }
   return {};
+}
+
+Status append_device_bvh_self_pairs(FrameProgram& program, const DeviceBvh& bvh, std::uint32_t n,
+                                    BufferHandle vertex_ids, BufferHandle pairs, const DeviceCount& pair_count,
+                                    const std::string& label) {
+  if (n < 2 || n > bvh.capacity)
+    return Error(ErrorCode::bad_parameter, "device BVH self pairs over " + std::to_string(n) +
+                                               " primitives: needs 2 .. capacity (" + std::to_string(bvh.capacity) + ")");
+  if (!vertex_ids.valid() || !pairs.valid() || !pair_count.buffer.valid())
+    return Error(ErrorCode::bad_parameter, "device BVH self pairs: the vertex ids, pairs and counter buffers must be valid");
+  kernels::SelfPairsParams p{};
+  p.count = n;
+  p.capacity = pair_count.capacity;
+  p.count_word = pair_count.word;
+  program.fill(pair_count.buffer, pair_count.word, 1, 0u);
+  program.barrier();
+  program.dispatch(Kernel::bvh_self_pairs, n,
+                   {bvh.children, bvh.indices, bvh.boxes, bvh.node_boxes, vertex_ids, pairs, pair_count.buffer}, p);
+  program.barrier();
+  program.counter(label, pair_count.buffer, pair_count.word, pair_count.capacity);
+  return {};
+}
+
+Status append_device_bvh_tree_pairs(FrameProgram& program, BufferHandle boxes_a, std::uint32_t n_a,
+                                    const DeviceBvh& tree_b, std::uint32_t n_b, BufferHandle pairs,
+                                    const DeviceCount& pair_count, const std::string& label) {
+  if (n_b < 2 || n_b > tree_b.capacity)
+    return Error(ErrorCode::bad_parameter, "device BVH tree pairs against a tree over " + std::to_string(n_b) +
+                                               " primitives: needs 2 .. capacity (" + std::to_string(tree_b.capacity) +
+                                               ")");
+  if (!boxes_a.valid() || !pairs.valid() || !pair_count.buffer.valid())
+    return Error(ErrorCode::bad_parameter, "device BVH tree pairs: the boxes, pairs and counter buffers must be valid");
+  kernels::TreePairsParams p{};
+  p.count = n_a;
+  p.tree_count = n_b;
+  p.capacity = pair_count.capacity;
+  p.count_word = pair_count.word;
+  program.fill(pair_count.buffer, pair_count.word, 1, 0u);
+  program.barrier();
+  if (n_a > 0)  // no items: the counter stays 0
+    program.dispatch(Kernel::bvh_tree_pairs, n_a,
+                     {boxes_a, tree_b.children, tree_b.indices, tree_b.boxes, tree_b.node_boxes, pairs, pair_count.buffer},
+                     p);
+  program.barrier();
+  program.counter(label, pair_count.buffer, pair_count.word, pair_count.capacity);
+  return {};
+}
+
+Result<std::vector<Pair>> read_device_bvh_pairs(Device& device, BufferHandle pairs, const DeviceCount& pair_count) {
+  std::uint32_t found = 0;
+  if (Status s = device.read_buffer(pair_count.buffer, std::size_t{pair_count.word} * 4, &found, 4); !s) return s.error();
+  if (found > pair_count.capacity)
+    return Error(ErrorCode::capacity_exceeded, "device BVH pairs: " + std::to_string(found) +
+                                                   " pairs found, more than the capacity of " +
+                                                   std::to_string(pair_count.capacity) +
+                                                   " (the first ones were kept; declare a capacity of at least " +
+                                                   std::to_string(found) + ")");
+  std::vector<std::uint32_t> words(2 * std::size_t{found});
+  if (found > 0)
+    if (Status s = device.read_buffer(pairs, 0, words.data(), words.size() * 4); !s) return s.error();
+  std::vector<Pair> result(found);
+  for (std::size_t k = 0; k < found; ++k) result[k] = {words[2 * k], words[2 * k + 1]};
+  std::sort(result.begin(), result.end());
+  return result;
 }
 
 }  // namespace sinew::collision
