@@ -236,7 +236,7 @@ ContactSetup contact_setup(std::mt19937& rng, bool friction, float substep_fract
   }
   append_words(c.colliders, ColliderHeader{s.colliders, s.tools, substep_fraction, 0});
   for (const ColliderEntry& e : s.entries) append_words(c.colliders, e);
-  for (const ImplicitEntry& n : s.nodes) append_words(c.colliders, n);
+  for (const ImplicitEntry& entry : s.nodes) append_words(c.colliders, entry);
   c.impulses.resize(std::size_t{n} * s.tools * SINEW_CONTACT_IMPULSE_FLOAT4S * 4);
   for (float& v : c.impulses) v = uf(rng);
   return c;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "runtime/rigid_tool.h"
+#include "sinew/scene.h"
 
 namespace sinew {
 
@@ -17,6 +18,7 @@ struct ContactState {
   bool colliders_dirty = false;  ///< the collider buffer changed since its last upload
   bool targets_dirty = false;    ///< the target buffer changed since its last upload
   std::vector<ToolBody> tools;
+  std::vector<ColliderDesc> shapes;  ///< the scene's colliders (the tools meet them on the host, tool_contacts.h)
 };
 
 }  // namespace sinew

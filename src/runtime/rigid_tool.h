@@ -76,6 +76,8 @@ struct ToolBody {
   V3 gravity{};  ///< [m/s^2], zero when ToolDesc::gravity is off
   V3 inertia{};  ///< principal moments, body frame [kg m^2]
   double mass = 0.0;  ///< [kg]
+  double radius = 0.0, half_height = 0.0;  ///< its capsule [m] (the segment +-half_height along its y)
+  double dynamic_friction = 0.0;          ///< against colliders and other tools (tool_contacts.h)
 };
 
 /// One semi-implicit Euler step of the tool over dt [s] from the applied

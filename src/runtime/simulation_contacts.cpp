@@ -34,6 +34,7 @@
 #include "contact_params.h"
 #include "math/vec3.h"
 #include "runtime/simulation_impl.h"
+#include "runtime/tool_contacts.h"
 
 namespace sinew {
 namespace {
@@ -141,17 +142,30 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
     if (d.gravity) b.gravity = scene.gravity;
     b.inertia = d.inertia;
     b.mass = d.mass;
+    b.radius = d.radius;
+    b.half_height = d.half_height;
+    b.dynamic_friction = d.dynamic_friction;
   }
+  if (!contacts.tools.empty()) contacts.shapes = scene.colliders;
   return {};
 }
 
 Status Simulation::Impl::before_frame() {
   ContactState& c = contacts;
+  for (ToolBody& b : c.tools) integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);
+  if (!c.tools.empty()) {
+    // The tools against the colliders where those end this frame, and each other.
+    std::vector<PosedShape> shapes;
+    for (std::uint32_t k = 0; k < c.colliders; ++k) {
+      const auto e = load_words<ColliderEntry>(colliders, entry_at(k));
+      shapes.push_back({&c.shapes[k], {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}});
+    }
+    resolve_tool_contacts(c.tools, shapes, time_step);
+  }
   for (std::size_t t = 0; t < c.tools.size(); ++t) {
-    ToolBody& b = c.tools[t];
+    const ToolBody& b = c.tools[t];
     const std::size_t at = entry_at(c.colliders + t);
     auto e = load_words<ColliderEntry>(colliders, at);
-    integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);
     settle(e);  // the frame starts where the last one ended
     set_end_pose(e, b.position, b.rotation);
     store_words(colliders, at, e);

@@ -1,0 +1,161 @@
+// shape_distance.cpp — signed distances of the analytic shapes in double and
+// a capsule's deepest point against them (see shape_distance.h). The
+// primitives follow kernels/cpu/contact_kernels.cpp; a golden-section
+// search minimises the distance along a segment (Kiefer, "Sequential
+// minimax search for a maximum", Proc. AMS 4, 1953).
+#include "collision/shape_distance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace sinew::collision {
+namespace {
+
+using math::Vec3;
+
+ShapeDistance sphere(double radius, const Vec3& l) {
+  const double r = math::norm(l);
+  if (r > 0.0) return {r - radius, math::mul(l, 1.0 / r)};
+  return {-radius, {0.0, 1.0, 0.0}};
+}
+
+ShapeDistance capsule(double radius, double half_height, const Vec3& l) {
+  const Vec3 v{l[0], l[1] - std::clamp(l[1], -half_height, half_height), l[2]};
+  const double r = math::norm(v);
+  if (r > 0.0) return {r - radius, math::mul(v, 1.0 / r)};
+  return {-radius, {1.0, 0.0, 0.0}};
+}
+
+ShapeDistance box(const std::array<double, 3>& half, const Vec3& l) {
+  Vec3 q, out;
+  double outside = 0.0;
+  int nearest = 0;
+  for (int a = 0; a < 3; ++a) {
+    q[a] = std::abs(l[a]) - half[a];
+    out[a] = std::max(q[a], 0.0) * (l[a] < 0.0 ? -1.0 : 1.0);
+    outside += out[a] * out[a];
+    if (q[a] > q[nearest]) nearest = a;
+  }
+  if (outside > 0.0) {
+    const double d = std::sqrt(outside);
+    return {d, math::mul(out, 1.0 / d)};
+  }
+  Vec3 n{0.0, 0.0, 0.0};
+  n[nearest] = l[nearest] < 0.0 ? -1.0 : 1.0;
+  return {q[nearest], n};
+}
+
+ShapeDistance cylinder(double radius, double half_height, const Vec3& l) {
+  const double r = std::hypot(l[0], l[2]);
+  const double dr = r - radius, dy = std::abs(l[1]) - half_height, sy = l[1] < 0.0 ? -1.0 : 1.0;
+  const double ux = r > 0.0 ? l[0] / r : 1.0, uz = r > 0.0 ? l[2] / r : 0.0;
+  if (dr > 0.0 && dy > 0.0) {
+    const double d = std::hypot(dr, dy);
+    return {d, {dr * ux / d, dy * sy / d, dr * uz / d}};
+  }
+  if (dr > dy) return {dr, {ux, 0.0, uz}};
+  return {dy, {0.0, sy, 0.0}};
+}
+
+ShapeDistance torus(double major, double minor, const Vec3& l) {
+  const double r = std::hypot(l[0], l[2]);
+  const double ux = r > 0.0 ? l[0] / r : 1.0, uz = r > 0.0 ? l[2] / r : 0.0;
+  const double qr = r - major, len = std::hypot(qr, l[1]);
+  if (!(len > 0.0)) return {-minor, {0.0, 1.0, 0.0}};
+  return {len - minor, {qr * ux / len, l[1] / len, qr * uz / len}};
+}
+
+// A shape's distance at a point of its own frame, the normal in that frame.
+ShapeDistance local_distance(const ColliderDesc& c, const Vec3& l);
+
+ShapeDistance node_distance(const ImplicitNode& n, const Vec3& p) {
+  const Vec3 l = math::rotate(math::conj(n.rotation), math::sub(p, n.position));
+  ShapeDistance d;
+  switch (n.op) {
+    case ImplicitOp::half_space: d = {l[1], {0.0, 1.0, 0.0}}; break;
+    case ImplicitOp::sphere: d = sphere(n.radius, l); break;
+    case ImplicitOp::capsule: d = capsule(n.radius, n.half_height, l); break;
+    case ImplicitOp::box: d = box(n.half_extents, l); break;
+    case ImplicitOp::cylinder: d = cylinder(n.radius, n.half_height, l); break;
+    case ImplicitOp::torus: d = torus(n.radius, n.minor_radius, l); break;
+    default: break;
+  }
+  return {d.distance - n.rounding, math::rotate(n.rotation, d.normal)};
+}
+
+// The postfix CSG of the nodes (checked by scene_checks.cpp), as the kernels evaluate it.
+ShapeDistance implicit(const std::vector<ImplicitNode>& nodes, const Vec3& p) {
+  std::vector<ShapeDistance> stack;
+  for (const ImplicitNode& n : nodes) {
+    if (n.op != ImplicitOp::unite && n.op != ImplicitOp::intersect && n.op != ImplicitOp::subtract) {
+      stack.push_back(node_distance(n, p));
+      continue;
+    }
+    const ShapeDistance b = stack.back();
+    stack.pop_back();
+    ShapeDistance& a = stack.back();
+    if (n.op == ImplicitOp::unite && b.distance < a.distance) a = b;
+    else if (n.op == ImplicitOp::intersect && b.distance > a.distance) a = b;
+    else if (n.op == ImplicitOp::subtract && -b.distance > a.distance) a = {-b.distance, math::mul(b.normal, -1.0)};
+  }
+  return stack.empty() ? ShapeDistance{} : stack.back();
+}
+
+ShapeDistance local_distance(const ColliderDesc& c, const Vec3& l) {
+  switch (c.shape) {
+    case ColliderShape::plane: return {l[1], {0.0, 1.0, 0.0}};
+    case ColliderShape::sphere: return sphere(c.radius, l);
+    case ColliderShape::capsule: return capsule(c.radius, c.half_height, l);
+    case ColliderShape::box: return box(c.half_extents, l);
+    case ColliderShape::cylinder: return cylinder(c.radius, c.half_height, l);
+    case ColliderShape::implicit: return implicit(c.implicit, l);
+  }
+  return {};
+}
+
+}  // namespace
+
+ShapeDistance shape_distance(const ColliderDesc& shape, const Vec3& position, const math::Quat& rotation,
+                             const Vec3& p) {
+  const ShapeDistance d = local_distance(shape, math::rotate(math::conj(rotation), math::sub(p, position)));
+  return {d.distance, math::rotate(rotation, d.normal)};
+}
+
+CapsuleContact capsule_against(const ColliderDesc& shape, const Vec3& position, const math::Quat& rotation,
+                               const Vec3& a, const Vec3& b, double radius) {
+  const Vec3 ab = math::sub(b, a);
+  auto at = [&](double t) { return math::add(a, math::mul(ab, t)); };
+  auto f = [&](double t) { return shape_distance(shape, position, rotation, at(t)).distance; };
+  double lo = 0.0, hi = 1.0;
+  if (shape.shape == ColliderShape::implicit) {  // not convex: bracket the best of 33 samples
+    constexpr int samples = 32;
+    int best = 0;
+    double best_f = f(0.0);
+    for (int k = 1; k <= samples; ++k)
+      if (const double v = f(double(k) / samples); v < best_f) best_f = v, best = k;
+    lo = std::max(0.0, double(best - 1) / samples);
+    hi = std::min(1.0, double(best + 1) / samples);
+  }
+  // Golden-section search for the least distance on [lo, hi].
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
+  while (hi - lo > 1e-12) {
+    if (f1 <= f2) {
+      hi = x2, x2 = x1, f2 = f1;
+      x1 = hi - g * (hi - lo), f1 = f(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2;
+      x2 = lo + g * (hi - lo), f2 = f(x2);
+    }
+  }
+  // The ends too: the least may sit exactly at one (a segment lying on a face).
+  double t = 0.5 * (lo + hi);
+  for (double end : {0.0, 1.0})
+    if (f(end) < f(t)) t = end;
+  const Vec3 p = at(t);
+  const ShapeDistance d = shape_distance(shape, position, rotation, p);
+  return {radius - d.distance, d.normal, math::sub(p, math::mul(d.normal, radius))};
+}
+
+}  // namespace sinew::collision
