@@ -754,6 +754,54 @@ TEST_P(Contact, ToolDroppedOnEachColliderComesToRestOnIt) {
   }
 }
 
+// A tool's capsule as a collider shape at the tool's pose (for the oracle).
+ColliderDesc tool_capsule(const ToolDesc& t, const Simulation::ToolState& s) {
+  ColliderDesc c;
+  c.shape = ColliderShape::capsule;
+  c.radius = t.radius;
+  c.half_height = t.half_height;
+  c.position = s.position;
+  c.rotation = s.rotation;
+  return c;
+}
+
+// Tool against tool: two tools lie side by side on the floor along z, 3 cm
+// apart; the light one (100 g) is pushed against the heavy one (10 kg) with
+// 0.5 N for a second, then let go. It rolls over and stays against it:
+// their capsules touch within 1e-4 m at the end and never overlap by more
+// than 0.1 mm, and the push passes on (the heavy one rolls away: capsules
+// roll without resistance). Without tool-tool contacts the light one rolls
+// through it.
+TEST_P(Contact, ToolPushedAgainstAnotherStopsAtIt) {
+  SceneDesc scene;
+  scene.solver = {.time_step = 1.0 / 60.0, .substeps = 4, .iterations = 2};
+  scene.colliders.push_back(ColliderDesc{});  // the floor
+  const Q4 along_z = axis_angle({1, 0, 0}, kPi / 2);
+  scene.tools.push_back(falling_tool({0.0, 0.005, 0.0}, along_z));
+  scene.tools[0].mass = 10.0;
+  for (auto& i : scene.tools[0].inertia) i *= 100.0;
+  scene.tools.push_back(falling_tool({0.04, 0.005, 0.0}, along_z));
+  CONTACT_SIMULATION(sim, scene);
+  double deepest = 1.0;
+  Simulation::ToolState heavy, light;
+  for (int f = 0; f < 90; ++f) {
+    if (f < 60) SINEW_ASSERT_OK(sim.apply_tool_force(1, {-0.5, 0.0, 0.0}, {0.0, 0.0, 0.0}));
+    SINEW_ASSERT_OK(sim.step());
+    auto a = sim.tool_state(0), b = sim.tool_state(1);
+    SINEW_ASSERT_OK(a);
+    SINEW_ASSERT_OK(b);
+    heavy = *a, light = *b;
+    deepest = std::min(deepest, clearance(scene.tools[1], light, tool_capsule(scene.tools[0], heavy)));
+  }
+  const double gap = clearance(scene.tools[1], light, tool_capsule(scene.tools[0], heavy));
+  std::printf("[ measured ] tool pushed against a tool: deepest %.3g m, ends %.3g m off it, the heavy one moved %.3g m, "
+              "the light one's x %.4f m\n", deepest, gap, std::abs(heavy.position[0]), light.position[0]);
+  EXPECT_GT(deepest, -1e-4);
+  EXPECT_NEAR(gap, 0.0, 1e-4);
+  EXPECT_GT(light.position[0], heavy.position[0]);  // still on its own side
+  EXPECT_LT(heavy.position[0], -1e-3);              // and the push passed on: the heavy one rolls away
+}
+
 TEST_P(Contact, HeavyToolRestsOnSoftTissue) {
   // Dropped from 1 mm, the tool is held up: its lowest point never goes
   // into the block's bottom layer of cells (no tunnelling), its energy (kinetic +

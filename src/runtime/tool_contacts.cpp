@@ -12,8 +12,6 @@ namespace {
 
 using V3 = math::Vec3;
 
-constexpr bool kToolAgainstTool = false;
-
 // The world inverse inertia applied to v: R diag(1 / I) R^T v.
 V3 inverse_inertia(const ToolBody& b, const V3& v) {
   V3 l = math::rotate(math::conj(b.rotation), v);
@@ -69,13 +67,17 @@ void contacts_against(ToolBody& a, ToolBody* b, const ColliderDesc& shape, const
                       double mu, std::vector<Contact>& out) {
   const V3 axis = math::rotate(a.rotation, V3{0.0, a.half_height, 0.0});
   const V3 p0 = math::sub(a.position, axis), p1 = math::add(a.position, axis);
+  // Speculative: contacts up to a radius apart are kept too, since other
+  // contacts' corrections may move the bodies into each other (a tool
+  // resting on one that the floor pushes up); they act only once touching.
+  const double reach = -a.radius;
   const collision::CapsuleContact deepest = collision::capsule_against(shape, position, rotation, p0, p1, a.radius);
-  if (!(deepest.depth > 0.0)) return;
+  if (!(deepest.depth > reach)) return;
   out.push_back({&a, b, deepest.point, deepest.normal, deepest.depth, mu});
   for (const V3& end : {p0, p1}) {
     const collision::ShapeDistance d = collision::shape_distance(shape, position, rotation, end);
     const V3 segment_point = math::add(deepest.point, math::mul(deepest.normal, a.radius));
-    if (a.radius - d.distance > 0.0 && math::norm(math::sub(end, segment_point)) > 1e-9)  // not the deepest again
+    if (a.radius - d.distance > reach && math::norm(math::sub(end, segment_point)) > 1e-9)  // not the deepest again
       out.push_back({&a, b, math::sub(end, math::mul(d.normal, a.radius)), d.normal, a.radius - d.distance, mu});
   }
 }
@@ -97,13 +99,9 @@ void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<Posed
     ToolBody& a = tools[i];
     for (const PosedShape& s : colliders)
       contacts_against(a, nullptr, *s.shape, s.position, s.rotation, std::min(s.shape->dynamic_friction, a.dynamic_friction), contacts);
-    // Tool against tool goes through the same code (b = the other tool) but
-    // is off: a thin tool resting across a thick one on the floor lost the
-    // contact after ~20 frames and fell into it (not understood yet).
-    if (kToolAgainstTool)
-      for (std::size_t j = i + 1; j < tools.size(); ++j)
-        contacts_against(a, &tools[j], capsule_of(tools[j]), tools[j].position, tools[j].rotation,
-                         std::min(a.dynamic_friction, tools[j].dynamic_friction), contacts);
+    for (std::size_t j = i + 1; j < tools.size(); ++j)
+      contacts_against(a, &tools[j], capsule_of(tools[j]), tools[j].position, tools[j].rotation,
+                       std::min(a.dynamic_friction, tools[j].dynamic_friction), contacts);
   }
   if (contacts.empty()) return;
   // Each contact's points in the bodies' frames at detection, so that its
@@ -156,8 +154,10 @@ void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<Posed
   for (int pass = 0; pass < 8; ++pass) {
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       Contact& c = contacts[k];
-      const V3 ra = math::rotate(c.a->rotation, anchors[k].ra);
-      const V3 rb = c.b ? math::rotate(c.b->rotation, anchors[k].rb) : V3{};
+      const Anchor& an = anchors[k];
+      if (current_depth(c, an.ra, an.rb, an.a_at, an.b_at) < -1e-6) continue;  // apart: no impulse
+      const V3 ra = math::rotate(c.a->rotation, an.ra);
+      const V3 rb = c.b ? math::rotate(c.b->rotation, an.rb) : V3{};
       auto relative = [&] {
         V3 v = point_velocity(*c.a, ra);
         return c.b ? math::sub(v, point_velocity(*c.b, rb)) : v;
