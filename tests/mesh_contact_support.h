@@ -391,3 +391,47 @@ struct KidneyOnLiver {
 };
 
 }  // namespace sinew::test
+
+namespace sinew::test {
+
+/// A thin probe (a capsule collider 4 mm thick, 12 mm long, along z)
+/// pressed 15 mm down over 30 frames into the middle of one 2 cm cell of a
+/// coarse membrane (4 x 4 cells, pinned at its border, no gravity), then
+/// held for 15: no vertex of the membrane touches it, only its triangles.
+struct ThinProbe {
+  static constexpr int frames = 45;
+  static SceneDesc scene() {
+    SceneDesc scene;
+    scene.solver.time_step = 1.0 / 60.0;
+    scene.solver.substeps = 10;
+    scene.solver.iterations = 2;
+    scene.gravity = {0.0, 0.0, 0.0};
+    TriBodyDesc sheet;
+    constexpr int cells = 4;
+    sheet.mesh = membrane(cells, cells, 0.02, 0.0);
+    sheet.distance_compliance = 1e-5;
+    sheet.area_compliance = 1e-5;
+    sheet.velocity_damping = 5.0;
+    for (int i = 0; i <= cells; ++i)
+      for (int k = 0; k <= cells; ++k)
+        if (i == 0 || k == 0 || i == cells || k == cells)
+          sheet.pinned.push_back(static_cast<std::uint32_t>(i * (cells + 1) + k));
+    scene.tri_bodies.push_back(sheet);
+    ColliderDesc probe;
+    probe.shape = ColliderShape::capsule;
+    probe.radius = 0.002;
+    probe.half_height = 0.006;
+    probe.rotation = {std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0};  // its axis along z
+    probe.position = probe_at(-1);
+    scene.colliders.push_back(probe);
+    scene.mesh_collision.enabled = true;
+    scene.mesh_collision.thickness = 1e-3;
+    return scene;
+  }
+  /// The probe's centre at the end of frame f [m] (f = -1: the start).
+  static std::array<double, 3> probe_at(int f) {
+    return {0.03, 0.007 - 0.015 * std::min(1.0, (f + 1) / 30.0), 0.03};  // over the middle of cell (1, 1)
+  }
+};
+
+}  // namespace sinew::test

@@ -210,9 +210,54 @@ TEST_P(MeshContact, CapsulePressesTheKidneyOntoTheLiverWithoutPassingThrough) {
   EXPECT_LE(difference, 1e-5);
 }
 
+// A thin probe (a capsule collider 4 mm thick, 12 mm long) pressed 15 mm
+// down into the middle of one 2 cm cell of a coarse membrane (pinned at its
+// border): no vertex of the membrane ever touches the probe, so only the
+// triangle-shape contacts hold it. The membrane under the probe's centre
+// ends below the probe (within the thickness) and the probe's axis never
+// crosses a triangle. Without them the probe passes through the cell: the
+// membrane there stays at its height, 10 mm above the probe.
+TEST_P(MeshContact, ThinProbePressesACoarseMembraneBetweenItsVertices) {
+  const SceneDesc scene = ThinProbe::scene();
+  const ColliderDesc& probe = scene.colliders[0];
+  auto sim = create_or_skip(scene, GetParam());
+  SINEW_ASSERT_OK(sim);
+  const std::uint32_t first = sim->info().tri_body_first_particle[0];
+  std::vector<float> x;
+  int crossings = 0;
+  std::array<double, 3> at_end = probe.position;
+  for (int f = 0; f < ThinProbe::frames; ++f) {
+    at_end = ThinProbe::probe_at(f);
+    SINEW_ASSERT_OK(sim->set_collider_pose(0, at_end, probe.rotation));
+    SINEW_ASSERT_OK(sim->step());
+    SINEW_ASSERT_OK(sim->read_positions(x));
+    const P3 axis0{at_end[0], at_end[1], at_end[2] - probe.half_height}, axis1{at_end[0], at_end[1], at_end[2] + probe.half_height};
+    for (const auto& t : scene.tri_bodies[0].mesh.triangles)
+      crossings += segment_crosses_triangle(axis0, axis1, at(x, first + t[0]), at(x, first + t[1]), at(x, first + t[2]));
+  }
+  // The membrane's height over the probe's centre: where the vertical line
+  // there meets it.
+  double height = 1e9;
+  for (const auto& t : scene.tri_bodies[0].mesh.triangles) {
+    const P3 a = at(x, first + t[0]), b = at(x, first + t[1]), c = at(x, first + t[2]);
+    const P3 top{at_end[0], 1.0, at_end[2]}, bottom{at_end[0], -1.0, at_end[2]};
+    if (!segment_crosses_triangle(top, bottom, a, b, c)) continue;
+    const P3 n = cross(sub(b, a), sub(c, a));
+    height = a[1] - (n[0] * (at_end[0] - a[0]) + n[2] * (at_end[2] - a[2])) / n[1];
+  }
+  const FrameStats& s = sim->last_frame();
+  std::printf("[%s] membrane over the probe's centre at %.2f mm, probe's bottom at %.2f mm, %d crossings, %u contacts\n",
+              GetParam().c_str(), 1e3 * height, 1e3 * (at_end[1] - probe.radius), crossings, s.mesh_contacts);
+  EXPECT_EQ(crossings, 0);
+  EXPECT_LT(height, at_end[1] - probe.radius + 1e-4);                  // under the probe
+  EXPECT_GT(height, at_end[1] - probe.radius - scene.mesh_collision.thickness - 1e-3);  // and on it
+  EXPECT_GT(s.mesh_contacts, 0u);
+}
+
 // Every backend against the CPU reference after 100 frames: the dropped
-// blocks with either schedule (contacts from the third frame on) and the
-// folded membrane (self-contacts from about the 40th): positions within
+// blocks with either schedule (contacts from the third frame on), the
+// folded membrane (self-contacts from about the 40th) and the thin probe
+// (triangle-shape contacts) with either schedule: positions within
 // 1e-5 m (the kernels follow the CPU's operation order without fused
 // multiply-adds, so they are expected to agree bitwise; the test prints how
 // many coordinates do). The contacts are found on the host from each
@@ -223,11 +268,15 @@ TEST_P(MeshContact, BackendsAgreeWithTheCpuReference) {
   struct Case {
     const char* name;
     SceneDesc scene;
-    bool fold;
+    bool fold, probe;
   };
-  const Case cases[] = {{"blocks, colored", dropped_blocks_scene(ContactSchedule::colored), false},
-                        {"blocks, jacobi", dropped_blocks_scene(ContactSchedule::jacobi), false},
-                        {"fold, colored", FoldedStrip::scene(ContactSchedule::colored), true}};
+  SceneDesc probe_jacobi = ThinProbe::scene();
+  probe_jacobi.mesh_collision.schedule = ContactSchedule::jacobi;
+  const Case cases[] = {{"blocks, colored", dropped_blocks_scene(ContactSchedule::colored), false, false},
+                        {"blocks, jacobi", dropped_blocks_scene(ContactSchedule::jacobi), false, false},
+                        {"fold, colored", FoldedStrip::scene(ContactSchedule::colored), true, false},
+                        {"thin probe, colored", ThinProbe::scene(), false, true},
+                        {"thin probe, jacobi", probe_jacobi, false, true}};
   for (const Case& c : cases) {
     auto reference = create_or_skip(c.scene, "cpu");
     auto sim = create_or_skip(c.scene, GetParam());
@@ -238,6 +287,11 @@ TEST_P(MeshContact, BackendsAgreeWithTheCpuReference) {
       for (int k = 0; c.fold && k <= FoldedStrip::nz; ++k) {
         SINEW_ASSERT_OK(reference->set_target(k, FoldedStrip::target(f, k)));
         SINEW_ASSERT_OK(sim->set_target(k, FoldedStrip::target(f, k)));
+      }
+      if (c.probe) {
+        const auto at = ThinProbe::probe_at(f % ThinProbe::frames);  // pressed, then again from the top
+        SINEW_ASSERT_OK(reference->set_collider_pose(0, at, c.scene.colliders[0].rotation));
+        SINEW_ASSERT_OK(sim->set_collider_pose(0, at, c.scene.colliders[0].rotation));
       }
       SINEW_ASSERT_OK(reference->step());
       SINEW_ASSERT_OK(sim->step());

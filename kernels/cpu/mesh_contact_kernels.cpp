@@ -37,8 +37,8 @@ struct Step {
 // One contact solved once from positions xk (w = inverse mass) and the
 // substep's start positions prev, in the GPU kernels' operation order
 // (kernels/gpu/mesh_contact_math.h).
-Step solve_contact(const float4 (&xk)[4], const float4 (&prev)[4], const float (&c)[4], float4 n, float4 lambda_i,
-                   const MeshContactParams& p) {
+Step solve_contact(const float4 (&xk)[4], const float4 (&prev)[4], const float (&c)[4], float4 n, float offset,
+                   float4 lambda_i, const MeshContactParams& p) {
   Step out{{xk[0], xk[1], xk[2], xk[3]}, {}};
   const float alpha_t = p.compliance * p.inv_h2;
   const float lambda_n = lambda_i.x;
@@ -49,7 +49,7 @@ Step solve_contact(const float4 (&xk)[4], const float4 (&prev)[4], const float (
   gap_vector = gap_vector + c[1] * xk[1];
   gap_vector = gap_vector + c[2] * xk[2];
   gap_vector = gap_vector + c[3] * xk[3];
-  const float constraint = dot3(n, gap_vector) - p.thickness;
+  const float constraint = dot3(n, gap_vector) + offset - p.thickness;
   float lambda_n_new = 0.0f;
   float4 lambda_t_new{0.0f, 0.0f, 0.0f, 0.0f};
   // Touching, or pushed earlier in this substep; nothing movable: nothing to do.
@@ -100,7 +100,7 @@ Step solve_item(std::uint32_t i, const MeshContactParams& p, std::byte* const* b
   const float c[4] = {coefficients[i].x, coefficients[i].y, coefficients[i].z, coefficients[i].w};
   const float4 n{normals[i].x, normals[i].y, normals[i].z, 0.0f};
   const float4 lambda_i = p.reset_lambda ? float4{0.0f, 0.0f, 0.0f, 0.0f} : lambda[i];
-  return solve_contact(xk, before, c, n, lambda_i, p);
+  return solve_contact(xk, before, c, n, normals[i].w, lambda_i, p);
 }
 
 }  // namespace

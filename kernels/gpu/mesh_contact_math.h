@@ -20,8 +20,8 @@ SINEW_STRUCT_BEGIN(MeshContactStep)
 SINEW_STRUCT_END(MeshContactStep)
 
 MeshContactStep mesh_contact_solve(float4 x0, float4 x1, float4 x2, float4 x3, float3 prev0, float3 prev1,
-                                   float3 prev2, float3 prev3, float4 c, float3 n, float4 lambda_i,
-                                   MeshContactParams p) {
+                                   float3 prev2, float3 prev3, float4 c, float3 n, float offset,
+                                   float4 lambda_i, MeshContactParams p) {
   MeshContactStep result;
   result.z0 = x0.xyz;
   result.z1 = x1.xyz;
@@ -35,7 +35,7 @@ MeshContactStep mesh_contact_solve(float4 x0, float4 x1, float4 x2, float4 x3, f
   gap_vector = gap_vector + c.y * x1.xyz;
   gap_vector = gap_vector + c.z * x2.xyz;
   gap_vector = gap_vector + c.w * x3.xyz;
-  PRECISE float constraint = dot3(n, gap_vector) - p.thickness;
+  PRECISE float constraint = dot3(n, gap_vector) + offset - p.thickness;
   float lambda_n_new = 0.0f;
   float3 lambda_t_new = make_float3(0.0f, 0.0f, 0.0f);
   if ((lambda_n > 0.0f || constraint < 0.0f) && weight > 0.0f) {

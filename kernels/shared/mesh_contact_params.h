@@ -12,8 +12,16 @@
  *                    point on the triangle (barycentric wa, wb, wc);
  *   edge-edge        c = (1 - s, s, -(1 - t), -t): the first edge's closest
  *                    point minus the second's;
- * n points from the second primitive to the first. The constraint
- *   C = n . sum_k c_k x_k - thickness >= 0
+ *   triangle-shape   c = (0, wa, wb, wc) on particles (a, a, b, c): the
+ *                    triangle's point deepest in a collider's shape (its
+ *                    first vertex repeated with c = 0: the kernels read all
+ *                    four and write them in order, so the repeat's
+ *                    unchanged value is overwritten by the real one);
+ * n points from the second primitive to the first (from the shape). With
+ * o = normal.w (0 between meshes; thickness - n . s for a shape's surface
+ * point s, so the triangle touches the shape like a vertex does) the
+ * constraint is
+ *   C = n . sum_k c_k x_k + o - thickness >= 0
  * keeps the first primitive on its side of the plane through the second's
  * closest point (a separating plane at the frame's start: conservative),
  * at least `thickness` away. Gradient for particle k: c_k n; with
@@ -41,7 +49,7 @@
  *   2 table uint [in]: colors counts, then colors firsts
  *   3 particles uint4 per contact [in]
  *   4 coefficients float4 per contact (c_0..c_3) [in]
- *   5 normal float4 per contact (xyz unit, w unused) [in]
+ *   5 normal float4 per contact (xyz unit, w the offset o) [in]
  *   6 lambda float4 per contact [in/out]: (lambda_n, lambda_t xyz), [kg m],
  *     reset to 0 in a substep's first sweep (reset_lambda) */
 #ifndef SINEW_MESH_CONTACT_PARAMS_H

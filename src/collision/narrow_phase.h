@@ -27,15 +27,18 @@
 namespace sinew::collision {
 
 struct Contact {
-  enum class Kind : std::uint8_t { vertex_triangle, edge_edge, capsule_triangle };
+  enum class Kind : std::uint8_t { vertex_triangle, edge_edge, capsule_triangle, shape_face };
   Kind kind = Kind::vertex_triangle;
   /// vertex_triangle: the vertex, then the triangle's three; edge_edge: the
   /// first edge's two vertices, then the second's; capsule_triangle: the
-  /// capsule's index (0 for a single one), then the triangle's three.
+  /// capsule's index (0 for a single one), then the triangle's three;
+  /// shape_face (a triangle against a collider's shape, whose surface point
+  /// is no particle): the triangle's first vertex twice, then the other two.
   std::array<std::uint32_t, 4> v{};
   /// The weights that place the two closest points on the primitives:
   /// vertex_triangle (1, wa, wb, wc); edge_edge (1 - s, s, 1 - t, t);
-  /// capsule_triangle (s along the capsule's axis, wa, wb, wc).
+  /// capsule_triangle (s along the capsule's axis, wa, wb, wc); shape_face
+  /// (0, wa, wb, wc).
   std::array<float, 4> w{};
   /// Unit, from the second primitive towards the first; capsule_triangle:
   /// from the capsule's axis towards the triangle (the way the tissue is
@@ -45,6 +48,9 @@ struct Contact {
   /// between the capsule's surface and the triangle, negative when the
   /// triangle reaches inside the capsule.
   float distance = 0.0f;
+  /// shape_face: thickness - n . (the shape's surface point) [m], the
+  /// constant of its constraint (mesh_contact_params.h); 0 otherwise.
+  float offset = 0.0f;
 };
 
 /// Contacts of the candidate triangle pairs `pairs` (indices into

@@ -158,4 +158,72 @@ CapsuleContact capsule_against(const ColliderDesc& shape, const Vec3& position, 
   return {radius - d.distance, d.normal, math::sub(p, math::mul(d.normal, radius))};
 }
 
+bool triangle_against(const ColliderDesc& shape, const Vec3& position, const math::Quat& rotation, const Vec3& a,
+                      const Vec3& b, const Vec3& c, double reach, TriangleContact& out) {
+  const Vec3 corner[3] = {a, b, c};
+  const Vec3 centroid = math::mul(math::add(math::add(a, b), c), 1.0 / 3.0);
+  double circumradius = 0.0;
+  for (const Vec3& v : corner) circumradius = std::max(circumradius, math::norm(math::sub(v, centroid)));
+  const auto at = [&](const std::array<double, 3>& w) {
+    return math::add(math::add(math::mul(a, w[0]), math::mul(b, w[1])), math::mul(c, w[2]));
+  };
+  const auto f = [&](const std::array<double, 3>& w) { return shape_distance(shape, position, rotation, at(w)).distance; };
+  if (f({1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0}) > reach + circumradius) return false;
+  // Start from the best of seven points.
+  const std::array<double, 3> starts[7] = {{1, 0, 0},     {0, 1, 0},     {0, 0, 1},
+                                           {0.5, 0.5, 0}, {0, 0.5, 0.5}, {0.5, 0, 0.5},
+                                           {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0}};
+  std::array<double, 3> w = starts[0];
+  double best = f(w);
+  int best_start = 0;
+  for (int k = 1; k < 7; ++k)
+    if (const double v = f(starts[k]); v < best) best = v, w = starts[k], best_start = k;
+  if (best > reach) return false;
+  // A corner where the distance grows along both edges is the minimum of
+  // a convex distance over the triangle (first-order optimality): most
+  // triangles against a shape smoother than they are end here.
+  if (best_start < 3) {
+    const Vec3 gradient = shape_distance(shape, position, rotation, corner[best_start]).normal;
+    bool rises = true;
+    for (int k = 0; k < 3; ++k)
+      if (k != best_start) rises &= math::dot(gradient, math::sub(corner[k], corner[best_start])) >= 0.0;
+    if (rises) {
+      out.weights = starts[best_start];
+      return true;
+    }
+  }
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int iteration = 0; iteration < 16; ++iteration) {
+    const Vec3 q = at(w);
+    const Vec3 gradient = shape_distance(shape, position, rotation, q).normal;
+    int s = 0;  // the corner the gradient descends to most
+    for (int k = 1; k < 3; ++k)
+      if (math::dot(gradient, corner[k]) < math::dot(gradient, corner[s])) s = k;
+    if (!(math::dot(gradient, math::sub(corner[s], q)) < -1e-12 * circumradius)) break;  // no descent left
+    std::array<double, 3> target{0, 0, 0};
+    target[s] = 1.0;
+    const auto blend = [&](double t) {
+      return std::array<double, 3>{w[0] + t * (target[0] - w[0]), w[1] + t * (target[1] - w[1]),
+                                   w[2] + t * (target[2] - w[2])};
+    };
+    double lo = 0.0, hi = 1.0, x1 = hi - g, x2 = lo + g, f1 = f(blend(x1)), f2 = f(blend(x2));
+    for (int k = 0; k < 24; ++k) {
+      if (f1 <= f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(blend(x1));
+      else lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(blend(x2));
+    }
+    const std::array<double, 3> next = blend(0.5 * (lo + hi));
+    const double v = f(next);
+    if (!(v < best)) break;
+    best = v, w = next;
+  }
+  if (best > reach) return false;
+  const Vec3 q = at(w);
+  const ShapeDistance d = shape_distance(shape, position, rotation, q);
+  out.weights = w;
+  out.distance = d.distance;
+  out.normal = d.normal;
+  out.surface = math::sub(q, math::mul(d.normal, d.distance));
+  return true;
+}
+
 }  // namespace sinew::collision

@@ -12,6 +12,8 @@
 // their CSG by min and max).
 #pragma once
 
+#include <array>
+
 #include "math/vec3.h"
 #include "sinew/scene.h"
 
@@ -47,5 +49,29 @@ struct CapsuleContact {
 };
 CapsuleContact capsule_against(const ColliderDesc& shape, const math::Vec3& position, const math::Quat& rotation,
                                const math::Vec3& a, const math::Vec3& b, double radius);
+
+/// The point of a triangle (a, b, c [m]) deepest in a shape, when it is
+/// closer than `reach` [m] to it: its barycentric weights, the signed
+/// distance there (negative inside), the shape's normal there and its
+/// surface point under it. Frank-Wolfe iterations (Frank and Wolfe, Naval
+/// Research Logistics Quarterly 3, 1956) with a golden-section line search,
+/// from the best of the corners, edge midpoints and centroid: the global
+/// minimum for the convex shapes (the distance is convex over the
+/// triangle), a local one for implicit shapes. A triangle whose centroid
+/// is farther than reach + its circumradius is skipped after one
+/// evaluation (signed distances are 1-Lipschitz); one whose deepest point
+/// is a corner (the distance rising from it along both edges) returns just
+/// that corner's weights (1 at the corner), the other fields unset: a
+/// corner is a vertex, which meets the shape on its own. Returns false when
+/// the triangle stays beyond reach.
+struct TriangleContact {
+  std::array<double, 3> weights{};
+  double distance = 0.0;
+  math::Vec3 normal{0.0, 1.0, 0.0};
+  math::Vec3 surface{0.0, 0.0, 0.0};
+};
+bool triangle_against(const ColliderDesc& shape, const math::Vec3& position, const math::Quat& rotation,
+                      const math::Vec3& a, const math::Vec3& b, const math::Vec3& c, double reach,
+                      TriangleContact& out);
 
 }  // namespace sinew::collision

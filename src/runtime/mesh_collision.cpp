@@ -5,13 +5,19 @@
 // them (greedy, coloring/greedy_coloring.h) and upload them colour-sorted.
 #include "runtime/mesh_collision.h"
 
+#include "collision/shape_distance.h"
+
 #include <algorithm>
 #include <cmath>
 #include <span>
 #include <string>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "coloring/greedy_coloring.h"
 #include "collision/parallel_pairs.h"
+#include "collision/shape_distance.h"
 #include "sinew/mesh.h"
 
 namespace sinew {
@@ -255,13 +261,55 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
                  positions_[4 * std::size_t{upload_particles_[4 * std::size_t{k} + j]} + a];
       gap += along * upload_normals_[4 * std::size_t{k} + a];
     }
+    gap += upload_normals_[4 * std::size_t{k} + 3];  // the offset (shape contacts)
     worst = std::max(worst, desc_.thickness - gap);
   }
   violation_ = worst;
   return {};
 }
 
-Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buffers, bool& grew) {
+Status MeshCollision::shape_faces(std::span<const PosedShape> colliders, double common) {
+  const double dt = time_step_;
+  const std::size_t triangles = triangle_body_.size();
+  for (const PosedShape& shape : colliders) {
+    if (shape.shape->shape == ColliderShape::plane) continue;
+    // Triangles in parallel (one evaluation each for most), joined in
+    // triangle order so the contacts do not depend on the threads.
+    found_.assign(triangles, Contact{});
+    face_hit_.assign(triangles, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t t = r.begin(); t < r.end(); ++t) {
+        const std::uint32_t* v = &triangles_[3 * t];
+        if (!movable_[v[0]] && !movable_[v[1]] && !movable_[v[2]]) continue;
+        math::Vec3 corner[3];
+        float speed = 0.0f;
+        for (int k = 0; k < 3; ++k) {
+          for (int a = 0; a < 3; ++a) corner[k][a] = positions_[4 * std::size_t{v[k]} + a];
+          speed = std::max(speed, speed_[v[k]]);
+        }
+        collision::TriangleContact hit;
+        if (!collision::triangle_against(*shape.shape, shape.position, shape.rotation, corner[0], corner[1],
+                                         corner[2], common + 2.0 * dt * speed, hit))
+          continue;
+        if (std::max({hit.weights[0], hit.weights[1], hit.weights[2]}) > 1.0 - 1e-6) continue;  // a corner
+        Contact& c = found_[t];
+        c.kind = Contact::Kind::shape_face;
+        c.v = {v[0], v[0], v[1], v[2]};
+        c.w = {0.0f, float(hit.weights[0]), float(hit.weights[1]), float(hit.weights[2])};
+        c.normal = {float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2])};
+        c.distance = float(hit.distance);
+        c.offset = float(desc_.thickness - math::dot(hit.normal, hit.surface));
+        face_hit_[t] = 1;
+      }
+    });
+    for (std::size_t t = 0; t < triangles; ++t)
+      if (face_hit_[t]) all_.push_back(found_[t]);
+  }
+  return {};
+}
+
+Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buffers,
+                                   std::span<const PosedShape> colliders, bool& grew) {
   grew = false;
   const std::size_t particles = movable_.size();
   // The positions and velocities the last frame ended with (after_frame);
@@ -378,6 +426,8 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   }
 
   prune();
+  if (!triangles_.empty())
+    if (Status s = shape_faces(colliders, common); !s) return s;
 
   // Coefficients c_k (mesh_contact_params.h); contacts of immovable
   // particles only are dropped (nothing to solve).
@@ -436,7 +486,8 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     const Contact& c = all_[kept_[k]];
     const std::size_t at = std::size_t{slot_of[k]} * 4;
     const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
-    const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], -c.w[2], -c.w[3]};
+    const float sign = c.kind == Contact::Kind::shape_face ? 1.0f : -1.0f;  // both weights on the triangle's side
+    const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], sign * c.w[2], sign * c.w[3]};
     for (int j = 0; j < 4; ++j) {
       upload_particles_[at + j] = c.v[j];
       upload_coefficients_[at + j] = coefficient[j];
@@ -444,15 +495,20 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     upload_normals_[at] = c.normal[0];
     upload_normals_[at + 1] = c.normal[1];
     upload_normals_[at + 2] = c.normal[2];
-    upload_normals_[at + 3] = 0.0f;
+    upload_normals_[at + 3] = c.offset;
   }
   if (b.jacobi) {
     // Per touched (movable) particle, its correction slots 4 i + k in
     // increasing order: a counting sort by particle, so the gather sums
     // them in a fixed order.
     upload_offsets_.assign(particles + 1, 0);
+    // A triangle-shape contact's repeated first vertex (slot 4 i, c = 0)
+    // has no correction of its own: not counted in its particle's mean.
+    const auto counted = [&](std::size_t s) {
+      return movable_[upload_particles_[s]] && !(s % 4 == 0 && upload_particles_[s] == upload_particles_[s + 1]);
+    };
     for (std::size_t s = 0; s < upload_particles_.size(); ++s)
-      if (movable_[upload_particles_[s]]) ++upload_offsets_[upload_particles_[s] + 1];
+      if (counted(s)) ++upload_offsets_[upload_particles_[s] + 1];
     upload_touched_.clear();
     for (std::size_t p = 0; p < particles; ++p) {
       if (upload_offsets_[p + 1] > 0) upload_touched_.push_back(static_cast<std::uint32_t>(p));
@@ -461,7 +517,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     upload_slots_.resize(upload_offsets_[particles]);
     std::vector<std::uint32_t> next(upload_offsets_.begin(), upload_offsets_.end() - 1);
     for (std::size_t s = 0; s < upload_particles_.size(); ++s)
-      if (movable_[upload_particles_[s]]) upload_slots_[next[upload_particles_[s]]++] = static_cast<std::uint32_t>(s);
+      if (counted(s)) upload_slots_[next[upload_particles_[s]]++] = static_cast<std::uint32_t>(s);
     // Offsets of the touched particles only (the gather's CSR rows).
     compact_offsets_.clear();
     for (std::uint32_t p : upload_touched_) compact_offsets_.push_back(upload_offsets_[p]);

@@ -24,6 +24,7 @@
 #include "collision/narrow_phase.h"
 #include "compiler/scene_compiler.h"
 #include "program/xpbd_program.h"
+#include "runtime/tool_contacts.h"
 #include "sinew/scene.h"
 
 namespace sinew {
@@ -39,7 +40,10 @@ class MeshCollision {
   /// the device and uploads them. [out] grew: the buffers or the colours
   /// outgrew the frame program, which must be rebuilt with buffers().
   /// Errors: a non-finite position or a collapsed triangle, named.
-  Status before_frame(Device& device, const XpbdBuffers& scene_buffers, bool& grew);
+  /// [in] colliders: the scene's colliders at their poses at the end of
+  /// the frame; the triangles meet them face-on (shape_faces()).
+  Status before_frame(Device& device, const XpbdBuffers& scene_buffers, std::span<const PosedShape> colliders,
+                      bool& grew);
 
   /// Reads the positions and velocities the frame ended with (the next
   /// frame's detection starts from them) and measures violation().
@@ -89,6 +93,13 @@ class MeshCollision {
   std::vector<TriangleKey> triangle_keys_;
   std::vector<std::uint8_t> chosen_;
   void prune();
+  // Contacts of the triangles against the colliders' shapes, where a
+  // triangle's deepest point is inside its face or on an edge (a corner is
+  // the vertex's own collider contact): a sharp or thin shape pressed
+  // between a coarse mesh's vertices. Not for planes (a triangle's deepest
+  // point against a plane is always a corner) nor tools (their reaction
+  // comes from the particle contacts only).
+  Status shape_faces(std::span<const PosedShape> colliders, double common);
   static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
   template <int Arity>
   void candidate_pairs(const std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
@@ -105,6 +116,7 @@ class MeshCollision {
   std::vector<collision::Pair> pairs_;
   std::vector<collision::Contact> found_, all_;
   std::vector<std::uint8_t> movable_;  // per particle (device order): inverse mass > 0
+  std::vector<std::uint8_t> face_hit_;  // per triangle: a triangle-shape contact in found_
   std::vector<std::uint32_t> kept_, contact_particles_, table_, upload_particles_;
   std::vector<float> upload_coefficients_, upload_normals_;
   std::vector<std::uint32_t> upload_offsets_, upload_touched_, upload_slots_, compact_offsets_;  // Jacobi

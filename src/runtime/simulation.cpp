@@ -132,7 +132,9 @@ Status Simulation::step() {
   if (Status s = impl_->before_frame(); !s) return s;
   if (impl_->mesh_collision) {
     bool grew = false;
-    if (Status s = impl_->mesh_collision->before_frame(*impl_->device, impl_->buffers, grew); !s) return s;
+    if (Status s = impl_->mesh_collision->before_frame(*impl_->device, impl_->buffers, impl_->collider_shapes(), grew);
+        !s)
+      return s;
     if (grew)
       if (Status s = impl_->prepare_program(impl_->program_shape); !s) return s;
     impl_->stats.mesh_contacts = impl_->mesh_collision->contacts();

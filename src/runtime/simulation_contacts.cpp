@@ -146,22 +146,24 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
     b.half_height = d.half_height;
     b.dynamic_friction = d.dynamic_friction;
   }
-  if (!contacts.tools.empty()) contacts.shapes = scene.colliders;
+  contacts.shapes = scene.colliders;
   return {};
+}
+
+std::vector<PosedShape> Simulation::Impl::collider_shapes() const {
+  std::vector<PosedShape> shapes;
+  for (std::uint32_t k = 0; k < contacts.colliders; ++k) {
+    const auto e = load_words<ColliderEntry>(colliders, entry_at(k));
+    shapes.push_back({&contacts.shapes[k], {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}});
+  }
+  return shapes;
 }
 
 Status Simulation::Impl::before_frame() {
   ContactState& c = contacts;
   for (ToolBody& b : c.tools) integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);
-  if (!c.tools.empty()) {
-    // The tools against the colliders where those end this frame, and each other.
-    std::vector<PosedShape> shapes;
-    for (std::uint32_t k = 0; k < c.colliders; ++k) {
-      const auto e = load_words<ColliderEntry>(colliders, entry_at(k));
-      shapes.push_back({&c.shapes[k], {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}});
-    }
-    resolve_tool_contacts(c.tools, shapes, time_step);
-  }
+  // The tools against the colliders where those end this frame, and each other.
+  if (!c.tools.empty()) resolve_tool_contacts(c.tools, collider_shapes(), time_step);
   for (std::size_t t = 0; t < c.tools.size(); ++t) {
     const ToolBody& b = c.tools[t];
     const std::size_t at = entry_at(c.colliders + t);

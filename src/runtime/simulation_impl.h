@@ -11,6 +11,7 @@
 #include "program/stats_program.h"
 #include "program/xpbd_program.h"
 #include "runtime/contact_state.h"
+#include "runtime/tool_contacts.h"
 #include "runtime/mesh_collision.h"
 #include "runtime/solve_stepper.h"
 #include "sinew/simulation.h"
@@ -60,6 +61,8 @@ struct Simulation::Impl {
   ContactState contacts;
   Status init_contacts(const SceneDesc& scene, const CompiledScene& compiled);
   Status before_frame();  ///< integrates the tools (rigid_tool.h), uploads what moved
+  /// The scene's colliders at their poses at the end of the coming frame.
+  [[nodiscard]] std::vector<PosedShape> collider_shapes() const;
   Status after_frame();   ///< settles what moved, takes each tool's reaction from device_stats
 };
 
