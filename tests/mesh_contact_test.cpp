@@ -254,6 +254,61 @@ TEST_P(MeshContact, ThinProbePressesACoarseMembraneBetweenItsVertices) {
   EXPECT_GT(s.mesh_contacts, 0u);
 }
 
+// The thread's twin: a thread of four 2 cm segments pinned at both ends,
+// the thin probe (upright) pressed 15 mm down onto the middle of a segment
+// (no vertex under it): the segment-shape contact holds the thread on the
+// probe's tip (never into it, at most the thickness off) and pressed down
+// with it. Without it the probe passes through: the thread stays straight
+// at its height, 2 mm into the probe.
+TEST_P(MeshContact, ThinProbePressesACoarseThreadBetweenItsVertices) {
+  SceneDesc scene = ThinProbe::scene();
+  scene.tri_bodies.clear();
+  LineBodyDesc thread;
+  for (int i = 0; i <= 4; ++i) {
+    thread.vertices.push_back({0.02 + 0.02 * i, 0.0, 0.03});
+    thread.masses.push_back(1e-4);
+  }
+  thread.pinned = {0, 4};
+  for (std::uint32_t i = 0; i < 4; ++i) thread.segments.push_back({i, i + 1});
+  thread.velocity_damping = 5.0;
+  scene.line_bodies.push_back(thread);
+  scene.colliders[0].rotation = {1.0, 0.0, 0.0, 0.0};  // the probe upright: across the thread, its tip down
+  auto sim = create_or_skip(scene, GetParam());
+  SINEW_ASSERT_OK(sim);
+  const std::uint32_t first = sim->info().line_body_first_particle[0];
+  std::array<double, 3> at_end{};
+  double lowest_tip = 1e9;  // the probe's tip [m]
+  for (int f = 0; f < ThinProbe::frames; ++f) {
+    at_end = ThinProbe::probe_at(f);
+    at_end[0] = 0.05;  // over the middle of the thread's third segment (4 to 6 cm)
+    at_end[1] += scene.colliders[0].half_height;
+    SINEW_ASSERT_OK(sim->set_collider_pose(0, at_end, scene.colliders[0].rotation));
+    SINEW_ASSERT_OK(sim->step());
+    lowest_tip = std::min(lowest_tip, at_end[1] - scene.colliders[0].half_height - scene.colliders[0].radius);
+  }
+  std::vector<float> x;
+  SINEW_ASSERT_OK(sim->read_positions(x));
+  // The thread's clearance from the probe (sampled along its segments, in
+  // double) and its lowest point.
+  double clearance = 1e9, lowest = 1e9;
+  for (int i = 0; i < 4; ++i) {
+    const P3 a = at(x, first + i), b = at(x, first + i + 1);
+    for (int k = 0; k <= 200; ++k) {
+      const double u = k / 200.0;
+      const P3 p{a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]), a[2] + u * (b[2] - a[2])};
+      const double hh = scene.colliders[0].half_height;
+      const double y = std::clamp(p[1], at_end[1] - hh, at_end[1] + hh);
+      clearance = std::min(clearance, std::hypot(p[0] - at_end[0], p[1] - y, p[2] - at_end[2]) - scene.colliders[0].radius);
+      lowest = std::min(lowest, p[1]);
+    }
+  }
+  std::printf("[%s] thread %.2f mm clear of the probe, its lowest point at %.2f mm, probe's tip at %.2f mm, %u contacts\n",
+              GetParam().c_str(), 1e3 * clearance, 1e3 * lowest, 1e3 * lowest_tip, sim->last_frame().mesh_contacts);
+  EXPECT_GT(clearance, -1e-4);                                   // never into the probe
+  EXPECT_LT(clearance, scene.mesh_collision.thickness + 1e-3);   // but on it
+  EXPECT_LT(lowest, lowest_tip + 1e-3);                          // pressed down with it
+}
+
 // Every backend against the CPU reference after 100 frames: the dropped
 // blocks with either schedule (contacts from the third frame on), the
 // folded membrane (self-contacts from about the 40th) and the thin probe

@@ -17,6 +17,7 @@
  *                    first vertex repeated with c = 0: the kernels read all
  *                    four and write them in order, so the repeat's
  *                    unchanged value is overwritten by the real one);
+ *   segment-shape    c = (0, 1 - s, 0, s) on particles (a, a, b, b) alike;
  * n points from the second primitive to the first (from the shape). With
  * o = normal.w (0 between meshes; thickness - n . s for a shape's surface
  * point s, so the triangle touches the shape like a vertex does) the

@@ -32,13 +32,14 @@ struct Contact {
   /// vertex_triangle: the vertex, then the triangle's three; edge_edge: the
   /// first edge's two vertices, then the second's; capsule_triangle: the
   /// capsule's index (0 for a single one), then the triangle's three;
-  /// shape_face (a triangle against a collider's shape, whose surface point
-  /// is no particle): the triangle's first vertex twice, then the other two.
+  /// shape_face (a triangle or segment against a collider's shape, whose
+  /// surface point is no particle): a triangle's first vertex twice, then
+  /// the other two; a segment's vertices twice each.
   std::array<std::uint32_t, 4> v{};
   /// The weights that place the two closest points on the primitives:
   /// vertex_triangle (1, wa, wb, wc); edge_edge (1 - s, s, 1 - t, t);
   /// capsule_triangle (s along the capsule's axis, wa, wb, wc); shape_face
-  /// (0, wa, wb, wc).
+  /// (0, wa, wb, wc) or (0, 1 - s, 0, s).
   std::array<float, 4> w{};
   /// Unit, from the second primitive towards the first; capsule_triangle:
   /// from the capsule's axis towards the triangle (the way the tissue is

@@ -304,6 +304,33 @@ Status MeshCollision::shape_faces(std::span<const PosedShape> colliders, double 
     });
     for (std::size_t t = 0; t < triangles; ++t)
       if (face_hit_[t]) all_.push_back(found_[t]);
+    // Segments (threads): the point deepest in the shape along each, by
+    // golden-section search (collision::capsule_against, radius 0), kept
+    // between its ends, on particles (a, a, b, b) with c = (0, 1 - s, 0, s).
+    for (std::size_t e = 0; e < segment_body_.size(); ++e) {
+      const std::uint32_t* v = &segments_[2 * e];
+      if (!movable_[v[0]] && !movable_[v[1]]) continue;
+      math::Vec3 end[2];
+      for (int k = 0; k < 2; ++k)
+        for (int a = 0; a < 3; ++a) end[k][a] = positions_[4 * std::size_t{v[k]} + a];
+      const double reach = common + 2.0 * dt * std::max(speed_[v[0]], speed_[v[1]]);
+      const math::Vec3 ab = math::sub(end[1], end[0]);
+      const double length2 = math::dot(ab, ab);
+      if (!(length2 > 0.0)) continue;
+      const collision::CapsuleContact hit = collision::capsule_against(*shape.shape, shape.position, shape.rotation,
+                                                                      end[0], end[1], 0.0);
+      if (-hit.depth > reach) continue;
+      const double along = math::dot(math::sub(hit.point, end[0]), ab) / length2;
+      if (along < 1e-6 || along > 1.0 - 1e-6) continue;  // an end: the vertex's own contact
+      Contact c;
+      c.kind = Contact::Kind::shape_face;
+      c.v = {v[0], v[0], v[1], v[1]};
+      c.w = {0.0f, float(1.0 - along), 0.0f, float(along)};
+      c.normal = {float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2])};
+      c.distance = float(-hit.depth);
+      c.offset = float(desc_.thickness - math::dot(hit.normal, hit.point) - hit.depth);
+      all_.push_back(c);
+    }
   }
   return {};
 }
@@ -426,8 +453,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   }
 
   prune();
-  if (!triangles_.empty())
-    if (Status s = shape_faces(colliders, common); !s) return s;
+  if (Status s = shape_faces(colliders, common); !s) return s;
 
   // Coefficients c_k (mesh_contact_params.h); contacts of immovable
   // particles only are dropped (nothing to solve).
@@ -502,10 +528,12 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     // increasing order: a counting sort by particle, so the gather sums
     // them in a fixed order.
     upload_offsets_.assign(particles + 1, 0);
-    // A triangle-shape contact's repeated first vertex (slot 4 i, c = 0)
-    // has no correction of its own: not counted in its particle's mean.
+    // A shape contact's repeated particle (a slot with c = 0 followed by
+    // the same particle) has no correction of its own: not counted in its
+    // particle's mean.
     const auto counted = [&](std::size_t s) {
-      return movable_[upload_particles_[s]] && !(s % 4 == 0 && upload_particles_[s] == upload_particles_[s + 1]);
+      const bool repeat = s % 4 != 3 && upload_coefficients_[s] == 0.0f && upload_particles_[s] == upload_particles_[s + 1];
+      return movable_[upload_particles_[s]] && !repeat;
     };
     for (std::size_t s = 0; s < upload_particles_.size(); ++s)
       if (counted(s)) ++upload_offsets_[upload_particles_[s] + 1];

@@ -93,12 +93,12 @@ class MeshCollision {
   std::vector<TriangleKey> triangle_keys_;
   std::vector<std::uint8_t> chosen_;
   void prune();
-  // Contacts of the triangles against the colliders' shapes, where a
-  // triangle's deepest point is inside its face or on an edge (a corner is
-  // the vertex's own collider contact): a sharp or thin shape pressed
-  // between a coarse mesh's vertices. Not for planes (a triangle's deepest
-  // point against a plane is always a corner) nor tools (their reaction
-  // comes from the particle contacts only).
+  // Contacts of the triangles and segments against the colliders' shapes,
+  // where a primitive's deepest point is inside it or on an edge (a corner
+  // is the vertex's own collider contact): a sharp or thin shape pressed
+  // between a coarse mesh's or thread's vertices. Not for planes (a
+  // primitive's deepest point against a plane is always a corner) nor
+  // tools (their reaction comes from the particle contacts only).
   Status shape_faces(std::span<const PosedShape> colliders, double common);
   static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
   template <int Arity>
