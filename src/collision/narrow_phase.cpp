@@ -162,7 +162,11 @@ void sort_unique(std::vector<Contact>& contacts) {
       contacts.end());
 }
 
-bool contains(const std::uint32_t* v, int n, std::uint32_t x) { return std::find(v, v + n, x) != v + n; }
+bool contains(const std::uint32_t* v, int n, std::uint32_t x) {
+  for (int k = 0; k < n; ++k)
+    if (v[k] == x) return true;
+  return false;
+}
 
 // The pairs in chunks of kChunk on TBB's threads, each chunk's contacts in
 // its own list; joined and deduplicated, so the result is the same on any
@@ -194,25 +198,102 @@ Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, PerPair per_
 
 }  // namespace
 
+TriangleOwnership triangle_ownership(std::span<const std::uint32_t> triangles) {
+  const std::size_t n = triangles.size() / 3;
+  TriangleOwnership o;
+  o.owner.resize(n);
+  std::uint32_t vertices = 0;
+  for (std::uint32_t v : triangles) vertices = std::max(vertices, v + 1);
+  std::vector<std::uint32_t> first(vertices, UINT32_MAX);
+  struct Edge {
+    std::uint32_t lo, hi, triangle, corner;
+  };
+  std::vector<Edge> edges;
+  edges.reserve(3 * n);
+  for (std::uint32_t t = 0; t < n; ++t)
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      const std::uint32_t v = triangles[3 * t + c], w = triangles[3 * t + (c + 1) % 3];
+      if (first[v] == UINT32_MAX) first[v] = t;
+      o.owner[t][c] = first[v];
+      edges.push_back({std::min(v, w), std::max(v, w), t, c});
+    }
+  std::sort(edges.begin(), edges.end(), [](const Edge& a, const Edge& b) {
+    return std::tie(a.lo, a.hi, a.triangle) < std::tie(b.lo, b.hi, b.triangle);
+  });
+  std::uint32_t owner = 0;
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    if (k == 0 || edges[k].lo != edges[k - 1].lo || edges[k].hi != edges[k - 1].hi) owner = edges[k].triangle;
+    o.owner[edges[k].triangle][3 + edges[k].corner] = owner;
+  }
+  return o;
+}
+
 Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
                          std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
+  return triangle_contacts(positions, triangles, triangle_ownership(triangles), pairs, thickness, contacts);
+}
+
+Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
+                         const TriangleOwnership& ownership, std::span<const Pair> pairs, float thickness,
+                         std::vector<Contact>& contacts) {
   contacts.clear();
   if (Status s = check_thickness(thickness); !s) return s;
+  if (ownership.owner.size() != triangles.size() / 3)
+    return Error(ErrorCode::bad_parameter, "triangle_contacts: the ownership is of another triangle list");
+  const std::size_t count = triangles.size() / 3;
   return in_chunks(pairs.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
     const auto [ti, tj] = pairs[k];
-    std::uint32_t vi[3], vj[3];
-    float4 pi[3], pj[3];
-    if (Status s = corners(positions, triangles, 3, "triangle", ti, vi, pi); !s) return s;
-    if (Status s = corners(positions, triangles, 3, "triangle", tj, vj, pj); !s) return s;
-    for (int c = 0; c < 3; ++c) {
-      if (!contains(vj, 3, vi[c])) vertex_triangle(vi[c], pi[c], vj, pj, thickness, out);
-      if (!contains(vi, 3, vj[c])) vertex_triangle(vj[c], pj[c], vi, pi, thickness, out);
+    if (ti >= count || tj >= count) {  // corners() names the bad index
+      std::uint32_t v[3];
+      float4 p[3];
+      return corners(positions, triangles, 3, "triangle", std::max(ti, tj), v, p);
     }
+    const std::uint32_t* vi = &triangles[3 * std::size_t{ti}];
+    const std::uint32_t* vj = &triangles[3 * std::size_t{tj}];
+    const auto& oi = ownership.owner[ti];
+    const auto& oj = ownership.owner[tj];
+    // Whether this pair tests a feature of ti (owned by `owner`) against tj
+    // (or the other way round): yes if it is its owner, or if its owner
+    // shares a vertex with the other triangle (that pair is never a
+    // candidate, so every pair around the feature tests it).
+    const auto shares = [&](std::uint32_t t, const std::uint32_t* v) {
+      for (int c = 0; c < 3; ++c)
+        if (contains(v, 3, triangles[3 * std::size_t{t} + c])) return true;
+      return false;
+    };
+    const auto tests = [&](std::uint32_t owner, std::uint32_t self, const std::uint32_t* other) {
+      return owner == self || shares(owner, other);
+    };
+    // Decide from the indices alone; most pairs test nothing of their own.
+    bool vertex_i[3], vertex_j[3], edges[3][3], any = false, any_edge = false;
+    for (int c = 0; c < 3; ++c) {
+      vertex_i[c] = !contains(vj, 3, vi[c]) && tests(oi[c], ti, vj);
+      vertex_j[c] = !contains(vi, 3, vj[c]) && tests(oj[c], tj, vi);
+      any |= vertex_i[c] || vertex_j[c];
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        // The pair of the two edges' owners, unless those share a vertex.
+        const std::uint32_t ea = oi[3 + a], eb = oj[3 + b];
+        edges[a][b] = (ea == ti && eb == tj) || ea == eb || shares(ea, &triangles[3 * std::size_t{eb}]);
+        any_edge |= edges[a][b];
+      }
+    if (!any && !any_edge) return {};
+    std::uint32_t ui[3], uj[3];
+    float4 pi[3], pj[3];
+    if (Status s = corners(positions, triangles, 3, "triangle", ti, ui, pi); !s) return s;
+    if (Status s = corners(positions, triangles, 3, "triangle", tj, uj, pj); !s) return s;
+    for (int c = 0; c < 3; ++c) {
+      if (vertex_i[c]) vertex_triangle(ui[c], pi[c], uj, pj, thickness, out);
+      if (vertex_j[c]) vertex_triangle(uj[c], pj[c], ui, pi, thickness, out);
+    }
+    if (!any_edge) return {};
     const float4 ni = face_normal(pi[0], pi[1], pi[2]), nj = face_normal(pj[0], pj[1], pj[2]);
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b)
-        edge_edge_within_one_set(vi[a], vi[(a + 1) % 3], pi[a], pi[(a + 1) % 3], ni, vj[b], vj[(b + 1) % 3], pj[b],
-                                 pj[(b + 1) % 3], nj, thickness, out);
+        if (edges[a][b])
+          edge_edge_within_one_set(ui[a], ui[(a + 1) % 3], pi[a], pi[(a + 1) % 3], ni, uj[b], uj[(b + 1) % 3], pj[b],
+                                   pj[(b + 1) % 3], nj, thickness, out);
     return {};
   });
 }

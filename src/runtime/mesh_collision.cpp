@@ -89,6 +89,7 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
     for (int k = 0; k < 3; ++k) mc->body_of_[mc->triangles_[3 * t + k]] = mc->triangle_body_[t];
   for (std::size_t t = 0; t < mc->segment_body_.size(); ++t)
     for (int k = 0; k < 2; ++k) mc->body_of_[mc->segments_[2 * t + k]] = mc->segment_body_[t];
+  mc->ownership_ = collision::triangle_ownership(mc->triangles_);
   mc->collidable_ = mc->triangles_;
   mc->collidable_.insert(mc->collidable_.end(), mc->segments_.begin(), mc->segments_.end());
   std::sort(mc->collidable_.begin(), mc->collidable_.end());
@@ -431,7 +432,8 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     refit(triangle_trees_, boxes_);
     candidate_pairs<3>(triangle_trees_, triangles_, triangle_trees_, pairs_);
     if (Status s = check_pairs(); !s) return s;
-    if (Status s = collision::triangle_contacts(positions_, triangles_, pairs_, reach, found_); !s) return s;
+    if (Status s = collision::triangle_contacts(positions_, triangles_, ownership_, pairs_, reach, found_); !s)
+      return s;
     keep();
   }
   if (!segments_.empty()) {

@@ -63,6 +63,7 @@ class MeshCollision {
   double time_step_ = 0.0;
   double gravity_ = 0.0;  // |g| [m/s^2]
   std::vector<std::uint32_t> triangles_, triangle_body_;  // device particles, 3 per triangle; body per triangle
+  collision::TriangleOwnership ownership_;                // of triangles_: each vertex and edge tested once
   std::vector<std::uint32_t> segments_, segment_body_;    // 2 per segment
   std::vector<std::uint32_t> collidable_;                 // particles of any primitive
   // A BVH per body over its primitives [first, first + count).
