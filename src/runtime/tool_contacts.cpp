@@ -61,8 +61,9 @@ struct Contact {
   double normal_impulse = 0.0;  // accumulated positional corrections / dt [N s]
 };
 
-// The contacts of tool a's capsule against a shape: its segment's two ends
-// and its deepest point, where they are inside.
+// The contacts of tool a's capsule against a shape: its segment's deepest
+// point and its two ends, where they are inside it or less than a's radius
+// outside (speculative, see below).
 void contacts_against(ToolBody& a, ToolBody* b, const ColliderDesc& shape, const V3& position, const math::Quat& rotation,
                       double mu, std::vector<Contact>& out) {
   const V3 axis = math::rotate(a.rotation, V3{0.0, a.half_height, 0.0});
