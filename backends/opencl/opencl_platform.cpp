@@ -20,7 +20,22 @@ namespace sinew {
 namespace opencl {
 namespace {
 
-constexpr const char* kBuildOptions = "-cl-std=CL1.2";
+// OpenCL 1.2 lets float division and sqrt be off by up to 2.5 and 3 ulp
+// unless -cl-fp32-correctly-rounded-divide-sqrt is given, which a device
+// offers through CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT. The kernels follow
+// the CPU reference's operation order to agree with it bitwise; without
+// the flag an H100 (NVIDIA's OpenCL) drifted by 1e-4 m on the mesh-contact
+// scenes, and since contacts are found from the positions, a drift changes
+// them and grows (1 cm on the folded membrane). CPU devices (PoCL) round
+// correctly either way.
+std::string build_options(cl_device_id device) {
+  std::string options = "-cl-std=CL1.2";
+  cl_device_fp_config fp = 0;
+  if (clGetDeviceInfo(device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof fp, &fp, nullptr) == CL_SUCCESS &&
+      (fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT) != 0)
+    options += " -cl-fp32-correctly-rounded-divide-sqrt";
+  return options;
+}
 
 // A string property through one of OpenCL's two-call getters
 // (clGetDeviceInfo, clGetPlatformInfo): ask the size, then the bytes.
@@ -58,7 +73,7 @@ std::uint64_t fnv1a(std::uint64_t h, const std::string& s) {
 
 std::filesystem::path cache_file(const Found& f, const std::string& source) {
   std::uint64_t h = 14695981039346656037ull;
-  for (const std::string& part : {f.info.platform, f.info.name, f.info.driver_version, std::string(kBuildOptions), source})
+  for (const std::string& part : {f.info.platform, f.info.name, f.info.driver_version, build_options(f.device), source})
     h = fnv1a(h, part + '\n');
   std::filesystem::path dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) dir = xdg;
@@ -165,7 +180,7 @@ Result<cl_program> build_from_source(cl_context ctx, const Found& f, const std::
   cl_int err = CL_SUCCESS;
   cl_program program = clCreateProgramWithSource(ctx, 1, &text, nullptr, &err);
   if (err != CL_SUCCESS) return cl_error(err, "clCreateProgramWithSource");
-  err = clBuildProgram(program, 1, &f.device, kBuildOptions, nullptr, nullptr);
+  err = clBuildProgram(program, 1, &f.device, build_options(f.device).c_str(), nullptr, nullptr);
   if (err != CL_SUCCESS) {
     const std::string log = build_log(program, f.device);
     clReleaseProgram(program);
@@ -185,7 +200,7 @@ Result<cl_program> build_cached(cl_context ctx, const Found& f, const std::strin
       cl_int status = CL_SUCCESS, err = CL_SUCCESS;
       cl_program program = clCreateProgramWithBinary(ctx, 1, &f.device, &size, &data, &status, &err);
       if (err == CL_SUCCESS && status == CL_SUCCESS &&
-          clBuildProgram(program, 1, &f.device, kBuildOptions, nullptr, nullptr) == CL_SUCCESS)
+          clBuildProgram(program, 1, &f.device, build_options(f.device).c_str(), nullptr, nullptr) == CL_SUCCESS)
         return program;
       if (program) clReleaseProgram(program);  // stale or foreign binary: rebuild below
     }
