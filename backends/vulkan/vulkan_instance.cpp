@@ -75,6 +75,28 @@ Instance::~Instance() {
   if (instance) vkDestroyInstance(instance, nullptr);
 }
 
+// NVIDIA's driver (580, on an H100) answers vkCreateInstance with
+// VK_ERROR_INCOMPATIBLE_DRIVER once about 28 instances have been created and
+// destroyed in one process: the loader unloads the driver with the last
+// instance and loads it again with the next, and that reload stops working.
+// One extra instance, without layers, held for the process's life keeps the
+// drivers loaded (measured there: 60 simulations created and destroyed in a
+// row all pass; without it the 29th fails). It is destroyed at exit.
+void keep_drivers_loaded(const VkApplicationInfo& app) {
+  static struct Keeper {
+    VkInstance instance = VK_NULL_HANDLE;
+    ~Keeper() {
+      if (instance) vkDestroyInstance(instance, nullptr);
+    }
+  } keeper;
+  static std::once_flag once;
+  std::call_once(once, [&] {
+    auto info = vk_struct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
+    info.pApplicationInfo = &app;
+    if (vkCreateInstance(&info, nullptr, &keeper.instance) != VK_SUCCESS) keeper.instance = VK_NULL_HANDLE;
+  });
+}
+
 Result<std::unique_ptr<Instance>> make_instance() {
   std::uint32_t loader = 0;
   if (vkEnumerateInstanceVersion(&loader) != VK_SUCCESS || loader < VK_API_VERSION_1_2)
@@ -113,6 +135,7 @@ Result<std::unique_ptr<Instance>> make_instance() {
     inst->instance = VK_NULL_HANDLE;
     return vk_error("vkCreateInstance", r, ErrorCode::backend_unavailable);
   }
+  keep_drivers_loaded(app);
   if (inst->validation) {
     auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(inst->instance, "vkCreateDebugUtilsMessengerEXT"));
