@@ -273,7 +273,7 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
   return {};
 }
 
-Status MeshCollision::shape_faces(std::span<const PosedShape> colliders, double common) {
+void MeshCollision::shape_faces(std::span<const PosedShape> colliders, double common) {
   const double dt = time_step_;
   const std::size_t triangles = triangle_body_.size();
   for (const PosedShape& shape : colliders) {
@@ -337,7 +337,6 @@ Status MeshCollision::shape_faces(std::span<const PosedShape> colliders, double 
       all_.push_back(c);
     }
   }
-  return {};
 }
 
 Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buffers,
@@ -477,7 +476,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   }
 
   prune();
-  if (Status s = shape_faces(colliders, common); !s) return s;
+  shape_faces(colliders, common);
 
   // Coefficients c_k (mesh_contact_params.h); contacts of immovable
   // particles only are dropped (nothing to solve).

@@ -100,7 +100,7 @@ class MeshCollision {
   // between a coarse mesh's or thread's vertices. Not for planes (a
   // primitive's deepest point against a plane is always a corner) nor
   // tools (their reaction comes from the particle contacts only).
-  Status shape_faces(std::span<const PosedShape> colliders, double common);
+  void shape_faces(std::span<const PosedShape> colliders, double common);
   static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
   template <int Arity>
   void candidate_pairs(const std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,

@@ -59,6 +59,10 @@ struct Contact {
   double depth;
   double mu;
   double normal_impulse = 0.0;  // accumulated positional corrections / dt [N s]
+  // The contact's points in the bodies' frames at detection (a's at
+  // `point`, b's at `surface`, on the other's surface), so that its depth
+  // follows the corrections of the others.
+  V3 ra{}, rb{}, surface{};
 };
 
 // The contacts of tool a's capsule against a shape: its segment's deepest
@@ -83,12 +87,19 @@ void contacts_against(ToolBody& a, ToolBody* b, const ColliderDesc& shape, const
   }
 }
 
+// Anchors a new contact in its bodies' frames.
+void anchor(Contact& c) {
+  c.ra = math::rotate(math::conj(c.a->rotation), math::sub(c.point, c.a->position));
+  c.surface = math::add(c.point, math::mul(c.normal, c.depth));
+  if (c.b) c.rb = math::rotate(math::conj(c.b->rotation), math::sub(c.surface, c.b->position));
+}
+
 // The depth of a contact now (after earlier corrections moved the bodies):
 // the contact point moves with a, the other surface with b.
-double current_depth(const Contact& c, const V3& ra0, const V3& rb0, const V3& a_at, const V3& b_at) {
-  const V3 ra = math::rotate(c.a->rotation, ra0);
-  double depth = c.depth - math::dot(math::sub(math::add(c.a->position, ra), a_at), c.normal);
-  if (c.b) depth += math::dot(math::sub(math::add(c.b->position, math::rotate(c.b->rotation, rb0)), b_at), c.normal);
+double current_depth(const Contact& c) {
+  const V3 ra = math::rotate(c.a->rotation, c.ra);
+  double depth = c.depth - math::dot(math::sub(math::add(c.a->position, ra), c.point), c.normal);
+  if (c.b) depth += math::dot(math::sub(math::add(c.b->position, math::rotate(c.b->rotation, c.rb)), c.surface), c.normal);
   return depth;
 }
 
@@ -105,21 +116,7 @@ void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<Posed
                        std::min(a.dynamic_friction, tools[j].dynamic_friction), contacts);
   }
   if (contacts.empty()) return;
-  // Each contact's points in the bodies' frames at detection, so that its
-  // depth follows the corrections of the others.
-  struct Anchor {
-    V3 ra, rb, a_at, b_at;
-  };
-  std::vector<Anchor> anchors;
-  for (const Contact& c : contacts) {
-    Anchor an;
-    an.ra = math::rotate(math::conj(c.a->rotation), math::sub(c.point, c.a->position));
-    an.a_at = c.point;
-    const V3 other = math::add(c.point, math::mul(c.normal, c.depth));  // on the other's surface
-    an.b_at = other;
-    an.rb = c.b ? math::rotate(math::conj(c.b->rotation), math::sub(other, c.b->position)) : V3{};
-    anchors.push_back(an);
-  }
+  for (Contact& c : contacts) anchor(c);
   // Positions: Gauss-Seidel over the contacts, forwards and backwards
   // (stacked tools pass corrections both ways), until nothing is deeper
   // than a micrometre or 32 passes.
@@ -128,15 +125,14 @@ void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<Posed
     for (std::size_t i = 0; i < contacts.size(); ++i) {
       const std::size_t k = pass % 2 == 0 ? i : contacts.size() - 1 - i;
       Contact& c = contacts[k];
-      const Anchor& an = anchors[k];
-      const double depth = current_depth(c, an.ra, an.rb, an.a_at, an.b_at);
+      const double depth = current_depth(c);
       if (!(depth > 0.0)) continue;
       worst = std::max(worst, depth);
-      const V3 ra = math::rotate(c.a->rotation, an.ra);
+      const V3 ra = math::rotate(c.a->rotation, c.ra);
       double w = inverse_mass(*c.a, ra, c.normal);
       V3 rb{};
       if (c.b) {
-        rb = math::rotate(c.b->rotation, an.rb);
+        rb = math::rotate(c.b->rotation, c.rb);
         w += inverse_mass(*c.b, rb, c.normal);
       }
       const double lambda = depth / w;
@@ -155,10 +151,9 @@ void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<Posed
   for (int pass = 0; pass < 8; ++pass) {
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       Contact& c = contacts[k];
-      const Anchor& an = anchors[k];
-      if (current_depth(c, an.ra, an.rb, an.a_at, an.b_at) < -1e-6) continue;  // apart: no impulse
-      const V3 ra = math::rotate(c.a->rotation, an.ra);
-      const V3 rb = c.b ? math::rotate(c.b->rotation, an.rb) : V3{};
+      if (current_depth(c) < -1e-6) continue;  // apart: no impulse
+      const V3 ra = math::rotate(c.a->rotation, c.ra);
+      const V3 rb = c.b ? math::rotate(c.b->rotation, c.rb) : V3{};
       auto relative = [&] {
         V3 v = point_velocity(*c.a, ra);
         return c.b ? math::sub(v, point_velocity(*c.b, rb)) : v;
