@@ -11,6 +11,8 @@
 // the thickness the surfaces have not passed through each other.
 //
 //   organ_contact [--backend auto|cpu|opencl|vulkan] [--frames N] [--out DIR]
+//                 [--thickness MM] [--self-collision on|off] [--self-culling on|off]
+//                 [--every N]   (report and write every N frames; 10)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -52,12 +54,31 @@ int fail(const sinew::Error& e) {
 int main(int argc, char** argv) {
   std::string backend = "auto", out = "organ_contact_out";
   int frames = 60;
+  bool self_collision = false, self_culling = true;
+  double thickness_mm = 1.0;
+  int every = 10;
+  const auto on_off = [](const std::string& option, const std::string& value, bool& flag) {
+    if (value != "on" && value != "off") {
+      std::fprintf(stderr, "%s takes on or off (got %s)\n", option.c_str(), value.c_str());
+      return false;
+    }
+    flag = value == "on";
+    return true;
+  };
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--backend") backend = argv[i + 1];
     else if (a == "--frames") frames = std::atoi(argv[i + 1]);
     else if (a == "--out") out = argv[i + 1];
+    else if (a == "--thickness") thickness_mm = std::atof(argv[i + 1]);
+    else if (a == "--every") every = std::atoi(argv[i + 1]);
+    else if (a == "--self-collision") { if (!on_off(a, argv[i + 1], self_collision)) return 1; }
+    else if (a == "--self-culling") { if (!on_off(a, argv[i + 1], self_culling)) return 1; }
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 1; }
+  }
+  if (every < 1 || frames < 1) {
+    std::fprintf(stderr, "--every and --frames take a whole number >= 1\n");
+    return 1;
   }
   auto liver = organ("liver_382k");
   if (!liver) return fail(liver.error());
@@ -97,8 +118,12 @@ int main(int argc, char** argv) {
   for (std::uint32_t v = 0; v < liver->vertices.size(); ++v)
     if (liver->vertices[v][1] < lb.lo[1] + 0.2 * (lb.hi[1] - lb.lo[1])) scene.tet_bodies[0].pinned.push_back(v);
   scene.mesh_collision.enabled = true;
-  scene.mesh_collision.thickness = 1e-3;
-  scene.mesh_collision.self_collision = false;  // organ against organ only
+  scene.mesh_collision.thickness = 1e-3 * thickness_mm;  // check_scene rejects a bad one
+  // Organ against organ only by default; with --self-collision on each
+  // organ's surface also against itself (--self-culling off: without the
+  // normal cones, to measure what they save).
+  scene.mesh_collision.self_collision = self_collision;
+  scene.mesh_collision.self_culling = self_culling;
   // The probe: a capsule of radius 8 mm lying along x, starting 1 cm above the kidney.
   sinew::ColliderDesc probe;
   probe.shape = sinew::ColliderShape::capsule;
@@ -137,7 +162,7 @@ int main(int argc, char** argv) {
     collision_ms += st.collision_ms;
     worst = std::max(worst, st.contact_violation);
 
-    if ((f + 1) % 10 != 0 && f + 1 != frames) continue;
+    if ((f + 1) % every != 0 && f + 1 != frames) continue;
     if (auto r = sim->read_positions(x); !r) return fail(r.error());
     const std::span<const float> all(x);
     kidney_files.push_back(out + "/kidney_" + std::to_string(f + 1) + ".vtu");
@@ -148,8 +173,9 @@ int main(int argc, char** argv) {
     if (auto w = sinew::write_vtu(kidney_files.back(), all.subspan(std::size_t{kidney_first} * 4), 4, kidney->tets); !w)
       return fail(w.error());
     std::printf("frame %4d  %.1f ms (collision %.1f)  %u contacts in %u colours  contact violation %.3f mm "
-                "(thickness 1 mm)\n",
-                f + 1, st.wall_ms, st.collision_ms, st.mesh_contacts, st.mesh_contact_colors, 1e3 * st.contact_violation);
+                "(thickness %g mm)\n",
+                f + 1, st.wall_ms, st.collision_ms, st.mesh_contacts, st.mesh_contact_colors, 1e3 * st.contact_violation,
+                thickness_mm);
   }
   if (auto w = sinew::write_pvd(out + "/kidney.pvd", kidney_files, times); !w) return fail(w.error());
   if (auto w = sinew::write_pvd(out + "/liver.pvd", liver_files, times); !w) return fail(w.error());

@@ -371,9 +371,19 @@ struct MeshCollisionDesc {
   /// every frame (2 |v|max dt + |g| dt^2 over the collidable particles).
   double margin = 0.0;
   /// A body's contacts with itself (its surface folding onto itself),
-  /// skipping primitives that share a vertex. Off: bodies collide only with
-  /// other bodies.
+  /// skipping primitives that share a vertex and pairs of triangles already
+  /// closer than the thickness in the shape the scene starts from (a
+  /// mesh's fissures and creases: pushed apart to the thickness they would
+  /// jump at the first frame; SceneInfo::rest_close_triangle_pairs counts
+  /// them). Off: bodies collide only with other bodies.
   bool self_collision = true;
+  /// Self-collision skips the patches of a surface too flat to touch
+  /// themselves: edge-connected, every triangle normal (at the frame's start
+  /// and where its velocities take it) within 30 degrees of one axis
+  /// (normal cones, Volino and Magnenat-Thalmann 1994). It assumes no
+  /// patch winds over itself like a ramp (a slit, twisted membrane); turn it
+  /// off for such scenes (README, mesh collision).
+  bool self_culling = true;
   double compliance = 0.0;        ///< of each contact [m/N], >= 0
   double static_friction = 0.3;   ///< >= 0
   double dynamic_friction = 0.2;  ///< >= 0, <= static_friction

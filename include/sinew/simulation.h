@@ -34,6 +34,10 @@ struct SceneInfo {
   std::vector<std::uint32_t> tet_body_first_particle;   ///< body i's vertex 0 is this particle
   std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;
+  /// Mesh self-collision: pairs of a body's triangles closer than the
+  /// thickness in the starting shape, which never make contacts with each
+  /// other (MeshCollisionDesc::self_collision).
+  std::uint32_t rest_close_triangle_pairs = 0;
   [[nodiscard]] std::uint32_t constraints() const {
     return distance_constraints + volume_constraints + other_constraints;
   }

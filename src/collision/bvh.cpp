@@ -2,6 +2,7 @@
 #include "collision/bvh.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -43,6 +44,8 @@ Status primitive_boxes(std::span<const float> positions, std::span<const std::ui
 }
 
 void Bvh::build(std::span<const Aabb> boxes) {
+  static std::atomic<std::uint64_t> builds{0};
+  build_id_ = ++builds;
   nodes_.clear();
   order_.resize(boxes.size());
   for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;

@@ -66,6 +66,9 @@ class Bvh {
   /// with it).
   [[nodiscard]] const std::vector<Aabb>& leaf_boxes() const { return leaf_boxes_; }
   [[nodiscard]] bool empty() const { return nodes_.empty(); }
+  /// A number no other build() in the process has had: what is derived
+  /// from the tree's shape (normal_cones.h) is recomputed when it changes.
+  [[nodiscard]] std::uint64_t build_id() const { return build_id_; }
 
  private:
   void build_node(std::span<const Aabb> boxes, const std::vector<float>& centroids, std::uint32_t index,
@@ -74,6 +77,16 @@ class Bvh {
   std::vector<std::uint32_t> order_;
   std::vector<Aabb> leaf_boxes_;
   double built_cost_ = 0.0;
+  std::uint64_t build_id_ = 0;
+};
+
+/// The traversals' default: nothing is culled. A culling policy (e.g.
+/// NormalCones, normal_cones.h) says which nodes cannot touch themselves
+/// (self) and which pairs of disjoint nodes of one tree cannot touch each
+/// other (pair); the self traversal skips their primitive pairs.
+struct NoCulling {
+  [[nodiscard]] bool self(std::uint32_t) const { return false; }
+  [[nodiscard]] bool pair(std::uint32_t, std::uint32_t) const { return false; }
 };
 
 /// Every (i, j) with primitive i of `a` overlapping primitive j of `b`, for
@@ -83,9 +96,10 @@ void overlapping_pairs(const Bvh& a, const Bvh& b, std::vector<Pair>& pairs);
 
 /// Every (i, j), i < j, of one tree's primitives with overlapping boxes (as
 /// of its last build or refit), skipping pairs for which skip(i, j) is true
-/// (e.g. triangles sharing a vertex). [out] pairs, sorted.
-template <class Skip>
-void self_overlapping_pairs(const Bvh& tree, Skip skip, std::vector<Pair>& pairs);
+/// (e.g. triangles sharing a vertex) and the pairs `cull` rules out (see
+/// NoCulling). [out] pairs, sorted.
+template <class Skip, class Cull = NoCulling>
+void self_overlapping_pairs(const Bvh& tree, Skip skip, std::vector<Pair>& pairs, const Cull& cull = {});
 
 /// The oracles: every pair tested, O(n m) and O(n^2 / 2). [out] pairs, sorted.
 void brute_force_pairs(std::span<const Aabb> boxes_a, std::span<const Aabb> boxes_b, std::vector<Pair>& pairs);
@@ -117,9 +131,11 @@ namespace detail {
 // Visits every pair of leaves whose boxes overlap, from the node pair
 // (i, j): within one tree (self = true, a == b: node i with itself visits
 // each unordered pair of its distinct leaves once and every leaf with
-// itself) or across two.
-template <class Visit>
-void traverse_from(const Bvh& a, const Bvh& b, bool self, std::uint32_t i0, std::uint32_t j0, Visit visit) {
+// itself) or across two. `cull` (self only): the nodes and node pairs
+// never visited.
+template <class Visit, class Cull = NoCulling>
+void traverse_from(const Bvh& a, const Bvh& b, bool self, std::uint32_t i0, std::uint32_t j0, Visit visit,
+                   const Cull& cull = {}) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{i0, j0}};
   const auto& na = a.nodes();
   const auto& nb = b.nodes();
@@ -129,6 +145,7 @@ void traverse_from(const Bvh& a, const Bvh& b, bool self, std::uint32_t i0, std:
     const Bvh::Node& x = na[i];
     const Bvh::Node& y = nb[j];
     if (self && i == j) {  // a node against itself: its children against themselves and each other
+      if (cull.self(i)) continue;
       if (x.count > 0) {
         visit(x, x);
         continue;
@@ -139,6 +156,7 @@ void traverse_from(const Bvh& a, const Bvh& b, bool self, std::uint32_t i0, std:
       continue;
     }
     if (!overlap(x.box, y.box)) continue;
+    if (self && cull.pair(i, j)) continue;
     if (x.count > 0 && y.count > 0) {
       visit(x, y);
     } else if (y.count > 0 || (x.count == 0 && half_area(x.box) >= half_area(y.box))) {
@@ -161,12 +179,13 @@ void traverse(const Bvh& a, const Bvh& b, bool self, Visit visit) {
 void sort_unique(std::vector<Pair>& pairs);
 }  // namespace detail
 
-template <class Skip>
-void self_overlapping_pairs(const Bvh& tree, Skip skip, std::vector<Pair>& pairs) {
+template <class Skip, class Cull>
+void self_overlapping_pairs(const Bvh& tree, Skip skip, std::vector<Pair>& pairs, const Cull& cull) {
   pairs.clear();
+  if (tree.empty()) return;
   const auto& order = tree.order();
   const auto& leaf = tree.leaf_boxes();
-  detail::traverse(tree, tree, true, [&](const Bvh::Node& x, const Bvh::Node& y) {
+  detail::traverse_from(tree, tree, true, 0, 0, [&](const Bvh::Node& x, const Bvh::Node& y) {
     const bool same = &x == &y;
     for (std::uint32_t s = 0; s < x.count; ++s)
       for (std::uint32_t t = same ? s + 1 : 0; t < y.count; ++t) {
@@ -175,7 +194,7 @@ void self_overlapping_pairs(const Bvh& tree, Skip skip, std::vector<Pair>& pairs
         if (i > j) std::swap(i, j);
         if (!skip(i, j)) pairs.push_back({i, j});
       }
-  });
+  }, cull);
   detail::sort_unique(pairs);
 }
 

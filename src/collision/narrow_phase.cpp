@@ -198,6 +198,37 @@ Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, PerPair per_
 
 }  // namespace
 
+float triangle_distance(std::span<const float> positions, const std::uint32_t* a, const std::uint32_t* b) {
+  float4 pa[3], pb[3];
+  for (int k = 0; k < 3; ++k) pa[k] = vertex(positions, a[k]), pb[k] = vertex(positions, b[k]);
+  // The nearest points of two triangles lie on an edge of one of them (or
+  // the triangles cross, and an edge of one crosses the other): every edge
+  // against the other triangle covers both.
+  float best = INFINITY;
+  for (int side = 0; side < 2; ++side) {
+    const float4* e = side == 0 ? pa : pb;
+    const float4* t = side == 0 ? pb : pa;
+    for (int k = 0; k < 3; ++k) {
+      const auto c = px::closest_segment_triangle(e[k], e[(k + 1) % 3], t[0], t[1], t[2]);
+      best = std::min(best, length3(px::lerp3(e[k], e[(k + 1) % 3], c.s) - px::at(c.w, t[0], t[1], t[2])));
+    }
+  }
+  return best;
+}
+
+bool facing(const Contact& c, std::span<const float> positions) {
+  const auto point = [&](std::uint32_t v) {
+    return kernels::float4{positions[4 * std::size_t{v}], positions[4 * std::size_t{v} + 1],
+                           positions[4 * std::size_t{v} + 2], 0.0f};
+  };
+  const kernels::float4 axis = c.kind == Contact::Kind::vertex_triangle
+                                   ? kernels::cross3(point(c.v[2]) - point(c.v[1]), point(c.v[3]) - point(c.v[1]))
+                                   : kernels::cross3(point(c.v[1]) - point(c.v[0]), point(c.v[3]) - point(c.v[2]));
+  const float along = axis.x * c.normal[0] + axis.y * c.normal[1] + axis.z * c.normal[2];
+  const float squared = kernels::dot3(axis, axis);
+  return squared > 0.0f && along * along >= kFacingCos * kFacingCos * squared;
+}
+
 TriangleOwnership triangle_ownership(std::span<const std::uint32_t> triangles) {
   const std::size_t n = triangles.size() / 3;
   TriangleOwnership o;

@@ -54,6 +54,24 @@ struct Contact {
   float offset = 0.0f;
 };
 
+/// cos 25.8 degrees: how far a contact's normal may turn from the direction
+/// its primitives face for facing() to hold.
+inline constexpr float kFacingCos = 0.9f;
+
+/// Whether a vertex-triangle or edge-edge contact's normal is the direction
+/// its primitives face each other across, at `positions` (xyzw per vertex):
+/// within kFacingCos of the triangle's normal (vertex-triangle) or of the
+/// two edges' common perpendicular (edge-edge), either sign. The others are
+/// a vertex beside a triangle or two edges that meet end-on, whose normal
+/// from the closest points is the way round the corner. False for parallel
+/// edges and zero-area triangles (no direction to face).
+bool facing(const Contact& contact, std::span<const float> positions);
+
+/// The distance between triangles a and b (three vertex indices each into
+/// `positions`, xyzw per vertex, finite) [m]: every edge of each against
+/// the other (proximity::closest_segment_triangle), so 0 where they cross.
+float triangle_distance(std::span<const float> positions, const std::uint32_t* a, const std::uint32_t* b);
+
 /// Which triangle owns each vertex and edge of a triangle list: the first
 /// (lowest index) that has it. triangle_contacts tests a vertex against a
 /// triangle B only from the candidate pair (owner, B), and an edge against

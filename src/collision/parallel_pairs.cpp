@@ -6,7 +6,8 @@
 
 namespace sinew::collision::detail {
 
-std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree, std::size_t wanted) {
+std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree, std::size_t wanted,
+                                                                const NormalCones* cones) {
   // Expand the self traversal breadth-first until there are enough tasks:
   // (n, n) becomes its children with themselves and with each other; a
   // cross pair becomes its children against the other side (after the
@@ -20,6 +21,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree,
     for (const auto& [a, b] : tasks) {
       const Bvh::Node& x = nodes[a];
       const Bvh::Node& y = nodes[b];
+      if (cones && (a == b ? cones->self(a) : cones->pair(a, b))) continue;  // nothing of it is visited
       if (a == b && x.count == 0) {
         next.push_back({x.left, x.left});
         next.push_back({x.left + 1, x.left + 1});

@@ -14,43 +14,49 @@
 #include <vector>
 
 #include "collision/bvh.h"
+#include "collision/normal_cones.h"
 
 namespace sinew::collision {
 
-/// The pairs of self_overlapping_pairs, in a fixed order that does not
-/// depend on the thread count (not sorted). `skip` is called from several
-/// threads at once.
+/// The pairs of self_overlapping_pairs (culled by `cones` when given, for
+/// the same tree), in a fixed order that does not depend on the thread
+/// count (not sorted). `skip` is called from several threads at once.
 template <class Skip>
-void self_overlapping_pairs_parallel(const Bvh& tree, Skip skip, std::vector<Pair>& pairs);
+void self_overlapping_pairs_parallel(const Bvh& tree, Skip skip, std::vector<Pair>& pairs,
+                                     const NormalCones* cones = nullptr);
 
 namespace detail {
 // The tasks: node pairs (self pairs are (n, n)) whose traversals together
-// are the whole self traversal; at most ~`wanted` of them.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree, std::size_t wanted);
+// are the whole self traversal (without what `cones` culls, when given);
+// at most ~`wanted` of them.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree, std::size_t wanted,
+                                                                const NormalCones* cones);
 // Runs work(k) for k in [0, count) on TBB's threads.
 void run_tasks(std::size_t count, void (*work)(void*, std::size_t), void* context);
 
 }  // namespace detail
 
 template <class Skip>
-void self_overlapping_pairs_parallel(const Bvh& tree, Skip skip, std::vector<Pair>& pairs) {
+void self_overlapping_pairs_parallel(const Bvh& tree, Skip skip, std::vector<Pair>& pairs,
+                                     const NormalCones* cones) {
   pairs.clear();
   if (tree.empty()) return;
-  const auto tasks = detail::self_tasks(tree, 64);
+  const auto tasks = detail::self_tasks(tree, 64, cones);
   std::vector<std::vector<Pair>> found(tasks.size());
   struct Context {
     const Bvh* tree;
     const Skip* skip;
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>* tasks;
     std::vector<std::vector<Pair>>* found;
-  } context{&tree, &skip, &tasks, &found};
+    const NormalCones* cones;
+  } context{&tree, &skip, &tasks, &found, cones};
   detail::run_tasks(tasks.size(), [](void* c, std::size_t k) {
     auto& ctx = *static_cast<Context*>(c);
     const auto& order = ctx.tree->order();
     const auto& leaf = ctx.tree->leaf_boxes();
     std::vector<Pair>& out = (*ctx.found)[k];
     const auto [i, j] = (*ctx.tasks)[k];
-    detail::traverse_from(*ctx.tree, *ctx.tree, true, i, j, [&](const Bvh::Node& x, const Bvh::Node& y) {
+    const auto visit = [&](const Bvh::Node& x, const Bvh::Node& y) {
       const bool same = &x == &y;
       for (std::uint32_t s = 0; s < x.count; ++s)
         for (std::uint32_t t = same ? s + 1 : 0; t < y.count; ++t) {
@@ -59,7 +65,9 @@ void self_overlapping_pairs_parallel(const Bvh& tree, Skip skip, std::vector<Pai
           if (a > b) std::swap(a, b);
           if (!(*ctx.skip)(a, b)) out.push_back({a, b});
         }
-    });
+    };
+    if (ctx.cones) detail::traverse_from(*ctx.tree, *ctx.tree, true, i, j, visit, *ctx.cones);
+    else detail::traverse_from(*ctx.tree, *ctx.tree, true, i, j, visit);
   }, &context);
   std::size_t total = 0;
   for (const auto& f : found) total += f.size();

@@ -26,9 +26,6 @@ namespace {
 using collision::Contact;
 
 constexpr std::uint32_t kFirstColors = 16;
-// cos 25 degrees: how far a contact's normal may turn from the direction
-// its primitives face (see `facing` in before_frame).
-constexpr float kFacing = 0.9f;
 // Vertex-triangle contacts kept per triangle and other body (see prune).
 constexpr std::size_t kPerTriangle = 3;
 // Edge-edge contacts kept per edge and other body (see prune).
@@ -81,7 +78,7 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   // One tree per body: contiguous runs of triangle_body_ / segment_body_.
   const auto ranges = [](const std::vector<std::uint32_t>& body_of, std::vector<BodyTree>& trees) {
     for (std::uint32_t k = 0; k < body_of.size(); ++k)
-      if (k == 0 || body_of[k] != body_of[k - 1]) trees.push_back({k, 0, {}});
+      if (k == 0 || body_of[k] != body_of[k - 1]) trees.push_back({k, 0, {}, {}, {}});
     for (std::size_t t = 0; t < trees.size(); ++t)
       trees[t].count = (t + 1 < trees.size() ? trees[t + 1].first : static_cast<std::uint32_t>(body_of.size())) -
                        trees[t].first;
@@ -94,6 +91,14 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   for (std::size_t t = 0; t < mc->segment_body_.size(); ++t)
     for (int k = 0; k < 2; ++k) mc->body_of_[mc->segments_[2 * t + k]] = mc->segment_body_[t];
   mc->ownership_ = collision::triangle_ownership(mc->triangles_);
+  if (mc->desc_.self_collision) {
+    std::vector<float> start(4 * compiled.positions.size());
+    for (std::size_t p = 0; p < compiled.positions.size(); ++p) {
+      const auto& x = compiled.positions[p];
+      start[4 * p] = x.x, start[4 * p + 1] = x.y, start[4 * p + 2] = x.z, start[4 * p + 3] = 0.0f;
+    }
+    if (Status s = mc->find_rest_close(start); !s) return s.error();
+  }
   mc->collidable_ = mc->triangles_;
   mc->collidable_.insert(mc->collidable_.end(), mc->segments_.begin(), mc->segments_.end());
   std::sort(mc->collidable_.begin(), mc->collidable_.end());
@@ -129,6 +134,40 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   return mc;
 }
 
+// The broad phase at the start (boxes grown by half the thickness: every
+// pair closer than it overlaps), then the exact distance of each candidate.
+// A mesh's fissures and sharp creases, closer than the thickness before
+// anything moves, would otherwise be pushed apart to it in the first frame:
+// the liver_382k surface at 1 mm has 683 facing vertex-triangle contacts at
+// rest, the nearest 0.03 mm, and with self-collision on the organ example
+// blew up (28 m/s by frame 20, then the pair capacity error).
+Status MeshCollision::find_rest_close(std::span<const float> start) {
+  std::vector<collision::Aabb> boxes;
+  std::vector<collision::Pair> pairs;
+  collision::Bvh tree;
+  for (BodyTree& body : triangle_trees_) {
+    const auto mine = std::span<const std::uint32_t>(triangles_).subspan(std::size_t{body.first} * 3,
+                                                                         std::size_t{body.count} * 3);
+    if (Status s = collision::primitive_boxes(start, mine, 3, static_cast<float>(0.5 * desc_.thickness), boxes); !s)
+      return s;
+    tree.build(boxes);
+    collision::self_overlapping_pairs_parallel(tree, collision::SharesVertex{mine}, pairs);
+    body.rest_close.clear();
+    for (const auto& [i, j] : pairs)
+      if (collision::triangle_distance(start, &mine[3 * std::size_t{i}], &mine[3 * std::size_t{j}]) <
+          static_cast<float>(desc_.thickness))
+        body.rest_close.push_back({i, j});
+    std::sort(body.rest_close.begin(), body.rest_close.end());
+  }
+  return {};
+}
+
+std::uint32_t MeshCollision::rest_close_pairs() const {
+  std::size_t sum = 0;
+  for (const BodyTree& body : triangle_trees_) sum += body.rest_close.size();
+  return static_cast<std::uint32_t>(sum);
+}
+
 void MeshCollision::refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes) {
   for (BodyTree& t : trees) {
     const auto mine = boxes.subspan(t.first, t.count);
@@ -144,16 +183,27 @@ void MeshCollision::refit(std::vector<BodyTree>& trees, std::span<const collisio
 // a vertex); otherwise every body of a against every body of b. A body's
 // own pairs are never visited when self-collision is off, so a scene pays
 // nothing for the self-pairs it does not want.
+// Triangle surfaces skip their flat patches' self-pairs (normal_cones.h)
+// unless desc_.self_culling is off.
 template <int Arity>
-void MeshCollision::candidate_pairs(const std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
+void MeshCollision::candidate_pairs(std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
                                     const std::vector<BodyTree>& b, std::vector<collision::Pair>& pairs) {
   pairs.clear();
   const bool same = &a == &b;
   for (std::size_t i = 0; i < a.size(); ++i) {
     if (same && desc_.self_collision) {
-      const collision::SharesVertexOf<Arity> shares{indices.subspan(std::size_t{a[i].first} * Arity)};
-      collision::self_overlapping_pairs_parallel(a[i].tree, shares, local_);
-      for (const auto& [p, q] : local_) pairs.push_back({a[i].first + p, a[i].first + q});
+      const auto mine = indices.subspan(std::size_t{a[i].first} * Arity, std::size_t{a[i].count} * Arity);
+      const collision::SharesVertexOf<Arity> shares{mine};
+      const collision::NormalCones* cones = nullptr;
+      if (Arity == 3 && desc_.self_culling) {
+        a[i].cones.update(a[i].tree, mine, positions_, later_);
+        cones = &a[i].cones;
+      }
+      collision::self_overlapping_pairs_parallel(a[i].tree, shares, local_, cones);
+      const auto& close = a[i].rest_close;
+      for (const auto& [p, q] : local_)
+        if (close.empty() || !std::binary_search(close.begin(), close.end(), collision::Pair{p, q}))
+          pairs.push_back({a[i].first + p, a[i].first + q});
     }
     for (std::size_t j = same ? i + 1 : 0; j < b.size(); ++j) {
       collision::overlapping_pairs(a[i].tree, b[j].tree, local_);
@@ -399,31 +449,17 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
       }
     }
   };
-  // Whether a contact's normal is the direction its primitives face each
-  // other across: within kFacing of the triangle's normal (vertex-triangle)
-  // or of the two edges' common perpendicular (edge-edge). The others are a
+  // Only facing contacts (collision::facing) are kept. The others are a
   // vertex beside a triangle or two edges that meet end-on, whose normal
   // from the closest points is the way round the corner: a plane along it,
   // fixed for the frame, would push a vertex that falls past a convex edge
   // sideways off it (measured: a block resting across another's edge slid
   // off at 0.15 m/s). Those meetings are covered by the facing contacts of
   // the neighbouring primitives.
-  const auto facing = [&](const Contact& c) {
-    const auto point = [&](std::uint32_t v) {
-      return kernels::float4{positions_[4 * std::size_t{v}], positions_[4 * std::size_t{v} + 1],
-                             positions_[4 * std::size_t{v} + 2], 0.0f};
-    };
-    const kernels::float4 axis =
-        c.kind == Contact::Kind::vertex_triangle
-            ? kernels::cross3(point(c.v[2]) - point(c.v[1]), point(c.v[3]) - point(c.v[1]))
-            : kernels::cross3(point(c.v[1]) - point(c.v[0]), point(c.v[3]) - point(c.v[2]));
-    const float along = axis.x * c.normal[0] + axis.y * c.normal[1] + axis.z * c.normal[2];
-    return along * along >= kFacing * kFacing * kernels::dot3(axis, axis) && kernels::dot3(axis, axis) > 0.0f;
-  };
   // Keeps the facing contacts of found_ within their pair's reach.
   const auto keep = [&] {
     for (const Contact& c : found_) {
-      if (!facing(c)) continue;
+      if (!collision::facing(c, positions_)) continue;
       const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
       const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], -c.w[2], -c.w[3]};
       double rel[3] = {0.0, 0.0, 0.0};
@@ -447,6 +483,11 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   };
   all_.clear();
   const auto half = static_cast<float>(0.5 * common);
+  if (desc_.self_collision && desc_.self_culling && !triangles_.empty()) {
+    later_.resize(positions_.size());
+    for (std::size_t k = 0; k < positions_.size(); ++k)
+      later_[k] = static_cast<float>(positions_[k] + 2.0 * dt * velocities_[k]);
+  }
   if (!triangles_.empty()) {
     if (Status s = collision::primitive_boxes(positions_, triangles_, 3, half, boxes_); !s) return s;
     swell(triangles_, 3);

@@ -22,6 +22,7 @@
 
 #include "collision/bvh.h"
 #include "collision/narrow_phase.h"
+#include "collision/normal_cones.h"
 #include "compiler/scene_compiler.h"
 #include "program/xpbd_program.h"
 #include "runtime/tool_contacts.h"
@@ -57,6 +58,9 @@ class MeshCollision {
   [[nodiscard]] std::uint32_t colors() const { return color_count_; }      ///< this frame's
   /// This frame's largest motion margin [m]: the reach of the fastest pair beyond the thickness.
   [[nodiscard]] double margin() const { return margin_; }
+  /// Pairs of triangles closer than the thickness at the scene's start,
+  /// summed over the bodies (SceneInfo::rest_close_triangle_pairs).
+  [[nodiscard]] std::uint32_t rest_close_pairs() const;
 
  private:
   MeshCollisionDesc desc_;
@@ -70,6 +74,10 @@ class MeshCollision {
   struct BodyTree {
     std::uint32_t first = 0, count = 0;
     collision::Bvh tree;
+    collision::NormalCones cones;  // triangle trees with self-culling only
+    // Triangle trees with self-collision: the pairs (local indices, sorted)
+    // closer than the thickness in the starting shape, never in contact.
+    std::vector<collision::Pair> rest_close;
   };
   std::vector<BodyTree> triangle_trees_, segment_trees_;
   std::vector<collision::Pair> local_;
@@ -102,8 +110,11 @@ class MeshCollision {
   // tools (their reaction comes from the particle contacts only).
   void shape_faces(std::span<const PosedShape> colliders, double common);
   static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
+  // Fills each triangle tree's rest_close from the starting positions
+  // (device order, xyzw).
+  Status find_rest_close(std::span<const float> start);
   template <int Arity>
-  void candidate_pairs(const std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
+  void candidate_pairs(std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
                        const std::vector<BodyTree>& b, std::vector<collision::Pair>& pairs);
   MeshContactBuffers buffers_;
   std::uint32_t contact_count_ = 0, color_count_ = 0;
@@ -113,6 +124,7 @@ class MeshCollision {
   Status read_back(Device& device, const XpbdBuffers& scene_buffers);
   // Per-frame scratch, kept to avoid reallocating.
   std::vector<float> positions_, start_positions_, velocities_, speed_;
+  std::vector<float> later_;  // positions_ + 2 dt velocities_: the second configuration of the normal cones
   std::vector<collision::Aabb> boxes_;
   std::vector<collision::Pair> pairs_;
   std::vector<collision::Contact> found_, all_;

@@ -110,6 +110,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   info.tet_body_first_particle = compiled->tet_body_first_particle;
   info.tri_body_first_particle = compiled->tri_body_first_particle;
   info.line_body_first_particle = compiled->line_body_first_particle;
+  if (impl->mesh_collision) info.rest_close_triangle_pairs = impl->mesh_collision->rest_close_pairs();
   return Simulation(std::move(impl));
 }
 
