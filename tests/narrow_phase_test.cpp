@@ -265,6 +265,36 @@ std::vector<float> random_thread(std::mt19937& rng, int n, std::array<float, 3> 
 
 // A thread against itself: segment boxes inflated by thickness / 2,
 // neighbours (sharing a vertex) skipped, equal to every pair's contacts.
+// A filter given to the narrow phase keeps exactly the contacts it would
+// keep afterwards (the solver passes its own: facing, within each pair's
+// reach), on the armadillo's surface.
+TEST(NarrowPhase, AFilterKeepsWhatFilteringAfterwardsKeeps) {
+  const test::Surface s = test::surface_of("meshes/tet/armadillo_4k.node");
+  ASSERT_FALSE(s.triangles.empty());
+  const float thickness = 0.2f * s.mean_edge;
+  std::vector<Aabb> boxes;
+  ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, 0.5f * thickness, boxes).ok());
+  Bvh tree;
+  tree.build(boxes);
+  std::vector<Pair> candidates;
+  self_overlapping_pairs(tree, SharesVertex{s.triangles}, candidates);
+  const TriangleOwnership owners = triangle_ownership(s.triangles);
+  const ContactFilter keep = [&](const Contact& c) { return facing(c, s.positions); };
+  std::vector<Contact> all, filtered;
+  ASSERT_TRUE(triangle_contacts(s.positions, s.triangles, owners, candidates, thickness, all).ok());
+  ASSERT_TRUE(triangle_contacts(s.positions, s.triangles, owners, candidates, thickness, filtered, keep).ok());
+  std::vector<Contact> want;
+  for (const Contact& c : all)
+    if (keep(c)) want.push_back(c);
+  ASSERT_EQ(filtered.size(), want.size());
+  for (std::size_t k = 0; k < want.size(); ++k) {
+    EXPECT_EQ(filtered[k].v, want[k].v);
+    EXPECT_EQ(filtered[k].distance, want[k].distance);
+  }
+  EXPECT_GT(want.size(), 0u);
+  EXPECT_LT(want.size(), all.size());  // the filter dropped some: the comparison is not vacuous
+}
+
 TEST(NarrowPhase, ThreadAgainstItselfEqualsEveryPair) {
   std::mt19937 rng(17);
   std::vector<std::uint32_t> segs;

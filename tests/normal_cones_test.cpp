@@ -64,7 +64,7 @@ std::array<double, 3> normal_of(std::span<const float> x, const std::uint32_t* t
   return n;
 }
 
-TEST(NormalCones, EveryNodesConeHoldsItsTrianglesNormalsAtBothConfigurations) {
+TEST(NormalCones, EveryNodesConeHoldsItsTrianglesNormals) {
   for (const char* file : {"meshes/tet/kidney_57k.node", "meshes/tet/armadillo_4k.node"}) {
     const Surface s = surface_of(file);
     ASSERT_FALSE(s.triangles.empty()) << file;
@@ -72,9 +72,9 @@ TEST(NormalCones, EveryNodesConeHoldsItsTrianglesNormalsAtBothConfigurations) {
     ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, 0.1f * s.mean_edge, boxes).ok());
     Bvh tree;
     tree.build(boxes);
-    const auto now = bent(s, 2.0f * s.mean_edge, 1), later = bent(s, 2.0f * s.mean_edge, 3);
+    const auto now = bent(s, 2.0f * s.mean_edge, 1);
     NormalCones cones;
-    cones.update(tree, s.triangles, now, later);
+    cones.update(tree, s.triangles, now);
     const auto r = ranges(tree);
     const float flat_cos = std::cos(NormalCones::kFlatDegrees * 3.14159265f / 180.0f);
     std::size_t tracked = 0, flat = 0;
@@ -90,12 +90,11 @@ TEST(NormalCones, EveryNodesConeHoldsItsTrianglesNormalsAtBothConfigurations) {
         continue;
       }
       ++tracked;
-      for (std::uint32_t slot = r[i].first; slot < r[i].first + r[i].second; ++slot)
-        for (const auto* x : {&now, &later}) {
-          const auto n = normal_of(*x, &s.triangles[3 * std::size_t{tree.order()[slot]}]);
-          const double along = cone.axis[0] * n[0] + cone.axis[1] * n[1] + cone.axis[2] * n[2];
-          ASSERT_GE(along, double(cone.cos) - 1e-5) << file << " node " << i << " triangle " << tree.order()[slot];
-        }
+      for (std::uint32_t slot = r[i].first; slot < r[i].first + r[i].second; ++slot) {
+        const auto n = normal_of(now, &s.triangles[3 * std::size_t{tree.order()[slot]}]);
+        const double along = cone.axis[0] * n[0] + cone.axis[1] * n[1] + cone.axis[2] * n[2];
+        ASSERT_GE(along, double(cone.cos) - 1e-5) << file << " node " << i << " triangle " << tree.order()[slot];
+      }
     }
     // Cannot pass vacuously: many nodes are narrow (most on the smooth
     // kidney, a fifth on the coarse armadillo).
@@ -192,6 +191,60 @@ TEST(NormalCones, TwoLayersFacingTheSameWayAreNeverCulled) {
   EXPECT_LT(culled.size(), all.size());  // pairs within one layer are culled
 }
 
+// A sheet with a slit along x < 1.2, one lip raised on a 20-degree ramp
+// that comes back to the sheet at the slit's end (found in review): the
+// sheet is connected around the slit's end and every normal is within 20
+// degrees of y, yet the raised lip faces the other across the slit. Its
+// triangles have open edges, so nothing with them is culled: every facing
+// vertex-triangle contact of the unculled query is found.
+TEST(NormalCones, ASlitWhoseLipsShearApartIsNeverCulled) {
+  const int nx = 20, half = 5;
+  const float step = 0.1f, gap = 0.01f, slope = std::tan(20.0f * 3.14159265f / 180.0f), end = 1.2f;
+  Surface s;
+  const auto add = [&](float x, float y, float z) {
+    s.positions.insert(s.positions.end(), {x, y, z, 0.0f});
+    return static_cast<std::uint32_t>(s.positions.size() / 4 - 1);
+  };
+  std::vector<std::vector<std::uint32_t>> lower(nx + 1, std::vector<std::uint32_t>(half + 1)), upper = lower;
+  for (int i = 0; i <= nx; ++i) {
+    const float x = float(i) * step;
+    for (int j = 0; j <= half; ++j) lower[i][j] = add(x, 0.0f, float(j) * step);
+    for (int j = 0; j <= half; ++j)
+      upper[i][j] = j == 0 && x >= end - 1e-6f ? lower[i][half]
+                                               : add(x, slope * std::max(0.0f, end - x), 0.5f + gap + float(j) * step);
+  }
+  for (const auto* g : {&lower, &upper})
+    for (int i = 0; i < nx; ++i)
+      for (int j = 0; j < half; ++j) {
+        const std::uint32_t p = (*g)[i][j], q = (*g)[i + 1][j], r = (*g)[i][j + 1], t = (*g)[i + 1][j + 1];
+        s.triangles.insert(s.triangles.end(), {p, r, q, q, r, t});
+      }
+  const float thickness = 0.05f;
+  std::vector<Aabb> boxes;
+  ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, 0.5f * thickness, boxes).ok());
+  Bvh tree;
+  tree.build(boxes);
+  NormalCones cones;
+  cones.update(tree, s.triangles, s.positions);
+  std::vector<Pair> all, culled;
+  self_overlapping_pairs_parallel(tree, SharesVertex{s.triangles}, all);
+  self_overlapping_pairs_parallel(tree, SharesVertex{s.triangles}, culled, &cones);
+  EXPECT_LT(culled.size(), all.size());  // the sheet away from the slit is culled
+  const TriangleOwnership owners = triangle_ownership(s.triangles);
+  std::vector<Contact> from_all, from_culled;
+  ASSERT_TRUE(triangle_contacts(s.positions, s.triangles, owners, all, thickness, from_all).ok());
+  ASSERT_TRUE(triangle_contacts(s.positions, s.triangles, owners, culled, thickness, from_culled).ok());
+  std::size_t facing_vertex_triangle = 0;
+  for (const Contact& c : from_all) {
+    if (c.kind != Contact::Kind::vertex_triangle || !facing(c, s.positions)) continue;
+    ++facing_vertex_triangle;
+    const bool kept = std::any_of(from_culled.begin(), from_culled.end(),
+                                  [&](const Contact& d) { return d.kind == c.kind && d.v == c.v; });
+    EXPECT_TRUE(kept) << "vertex " << c.v[0] << " against triangle " << c.v[1] << " " << c.v[2] << " " << c.v[3];
+  }
+  EXPECT_GT(facing_vertex_triangle, 0u);  // the lips do face each other
+}
+
 // The bending organs: the culled pairs are a subset of the unculled, the
 // facing vertex-triangle contacts of both are the same, and every facing
 // edge-edge contact lost lies inside a flat patch: its normal is >= 30
@@ -208,14 +261,14 @@ TEST(NormalCones, CullingKeepsEveryFacingVertexTriangleContactOnBendingOrgans) {
     std::vector<Aabb> boxes;
     std::size_t facing_seen = 0, lost_edge_edge = 0, culled_away = 0;
     for (int frame = 0; frame < 3; ++frame) {
-      const auto x = bent(s, 2.0f * s.mean_edge, 2 * frame), later = bent(s, 2.0f * s.mean_edge, 2 * frame + 1);
+      const auto x = bent(s, 2.0f * s.mean_edge, 2 * frame);
       ASSERT_TRUE(primitive_boxes(x, s.triangles, 3, inflate, boxes).ok());
       if (frame == 0) {
         tree.build(boxes);
       } else {
         tree.refit(boxes);
       }
-      cones.update(tree, s.triangles, x, later);
+      cones.update(tree, s.triangles, x);
       std::vector<Pair> all, culled;
       self_overlapping_pairs_parallel(tree, SharesVertex{s.triangles}, all);
       self_overlapping_pairs_parallel(tree, SharesVertex{s.triangles}, culled, &cones);

@@ -378,11 +378,11 @@ struct MeshCollisionDesc {
   /// them). Off: bodies collide only with other bodies.
   bool self_collision = true;
   /// Self-collision skips the patches of a surface too flat to touch
-  /// themselves: edge-connected, every triangle normal (at the frame's start
-  /// and where its velocities take it) within 30 degrees of one axis
-  /// (normal cones, Volino and Magnenat-Thalmann 1994). It assumes no
-  /// patch winds over itself like a ramp (a slit, twisted membrane); turn it
-  /// off for such scenes (README, mesh collision).
+  /// themselves: connected through shared vertices, without open edges,
+  /// every triangle normal at the frame's start within 30 degrees of one
+  /// axis (normal cones, Volino and Magnenat-Thalmann 1994). It assumes no
+  /// patch winds over itself like a helical ramp; turn it off for scenes
+  /// that may form one (README, mesh collision).
   bool self_culling = true;
   double compliance = 0.0;        ///< of each contact [m/N], >= 0
   double static_friction = 0.3;   ///< >= 0

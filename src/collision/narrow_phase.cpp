@@ -174,17 +174,25 @@ bool contains(const std::uint32_t* v, int n, std::uint32_t x) {
 // surface's 105,000 candidate pairs: ~85 ms on one thread.)
 constexpr std::size_t kChunk = 1024;
 
+// `keep` (when set) drops a pair's contacts as they are made, before the
+// join and the sort.
 template <class PerPair>
-Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, PerPair per_pair) {
+Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, const ContactFilter& keep, PerPair per_pair) {
   const std::size_t chunks = (pairs + kChunk - 1) / kChunk;
   std::vector<std::vector<Contact>> found(chunks);
   std::vector<Status> errors(chunks);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-    for (std::size_t k = c * kChunk; k < std::min(pairs, (c + 1) * kChunk); ++k)
+    for (std::size_t k = c * kChunk; k < std::min(pairs, (c + 1) * kChunk); ++k) {
+      const std::size_t before = found[c].size();
       if (Status s = per_pair(k, found[c]); !s) {
         errors[c] = s;
         return;
       }
+      if (keep)
+        found[c].erase(std::remove_if(found[c].begin() + std::ptrdiff_t(before), found[c].end(),
+                                      [&](const Contact& x) { return !keep(x); }),
+                       found[c].end());
+    }
   });
   for (const Status& e : errors)
     if (!e) return e;
@@ -266,13 +274,13 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
 
 Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
                          const TriangleOwnership& ownership, std::span<const Pair> pairs, float thickness,
-                         std::vector<Contact>& contacts) {
+                         std::vector<Contact>& contacts, const ContactFilter& keep) {
   contacts.clear();
   if (Status s = check_thickness(thickness); !s) return s;
   if (ownership.owner.size() != triangles.size() / 3)
     return Error(ErrorCode::bad_parameter, "triangle_contacts: the ownership is of another triangle list");
   const std::size_t count = triangles.size() / 3;
-  return in_chunks(pairs.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+  return in_chunks(pairs.size(), contacts, keep, [&](std::size_t k, std::vector<Contact>& out) -> Status {
     const auto [ti, tj] = pairs[k];
     if (ti >= count || tj >= count) {  // corners() names the bad index
       std::uint32_t v[3];
@@ -330,10 +338,11 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
 }
 
 Status segment_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
-                        std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts) {
+                        std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts,
+                        const ContactFilter& keep) {
   contacts.clear();
   if (Status s = check_thickness(thickness); !s) return s;
-  return in_chunks(pairs.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+  return in_chunks(pairs.size(), contacts, keep, [&](std::size_t k, std::vector<Contact>& out) -> Status {
     const auto [si, sj] = pairs[k];
     std::uint32_t vi[3], vj[3];
     float4 pi[3], pj[3];
@@ -347,10 +356,10 @@ Status segment_contacts(std::span<const float> positions, std::span<const std::u
 
 Status segment_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
                                  std::span<const std::uint32_t> triangles, std::span<const Pair> pairs,
-                                 float thickness, std::vector<Contact>& contacts) {
+                                 float thickness, std::vector<Contact>& contacts, const ContactFilter& keep) {
   contacts.clear();
   if (Status s = check_thickness(thickness); !s) return s;
-  return in_chunks(pairs.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+  return in_chunks(pairs.size(), contacts, keep, [&](std::size_t k, std::vector<Contact>& out) -> Status {
     const auto [si, tj] = pairs[k];
     std::uint32_t vs[3], vt[3];
     float4 ps[3], pt[3];
@@ -377,7 +386,7 @@ Status capsule_triangle_contacts(std::span<const float> positions, std::span<con
     if (!std::isfinite(p0[std::size_t(k)]) || !std::isfinite(p1[std::size_t(k)]))
       return Error(ErrorCode::bad_parameter, "the capsule's axis has a non-finite coordinate");
   const float4 a{p0[0], p0[1], p0[2], 0.0f}, b{p1[0], p1[1], p1[2], 0.0f};
-  return in_chunks(candidates.size(), contacts, [&](std::size_t k, std::vector<Contact>& out) -> Status {
+  return in_chunks(candidates.size(), contacts, {}, [&](std::size_t k, std::vector<Contact>& out) -> Status {
     const std::uint32_t t = candidates[k];
     std::uint32_t v[3];
     float4 p[3];

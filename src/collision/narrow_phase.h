@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -100,11 +101,18 @@ TriangleOwnership triangle_ownership(std::span<const std::uint32_t> triangles);
 /// push along), each named.
 Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
                          std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts);
+/// Which contacts a caller keeps (called from several threads at once):
+/// those it drops are never stored or sorted. The solver keeps few of the
+/// contacts within a reach swollen by fast motion, and sorting the rest
+/// took most of a frame's detection when a pressed organ jittered.
+using ContactFilter = std::function<bool(const Contact&)>;
+
 /// The same with the triangles' ownership computed once (triangle_ownership
-/// of the same `triangles`), for callers that run it every frame.
+/// of the same `triangles`), for callers that run it every frame, and only
+/// the contacts `keep` accepts (all when empty).
 Status triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> triangles,
                          const TriangleOwnership& ownership, std::span<const Pair> pairs, float thickness,
-                         std::vector<Contact>& contacts);
+                         std::vector<Contact>& contacts, const ContactFilter& keep = {});
 
 /// Contacts of candidate segment pairs (indices into `segments`, two vertex
 /// indices each) closer than `thickness` [m]: edge-edge contacts between
@@ -113,7 +121,8 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
 /// (no direction to push along) make none. [out] contacts, sorted. Errors:
 /// a bad thickness, a non-finite position or a bad index, named.
 Status segment_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
-                        std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts);
+                        std::span<const Pair> pairs, float thickness, std::vector<Contact>& contacts,
+                        const ContactFilter& keep = {});
 
 /// Contacts of candidate (segment, triangle) pairs closer than `thickness`:
 /// each segment end against the triangle (vertex_triangle, the segment's
@@ -122,7 +131,7 @@ Status segment_contacts(std::span<const float> positions, std::span<const std::u
 /// surface at a vertex). [out] contacts, sorted. Errors as triangle_contacts.
 Status segment_triangle_contacts(std::span<const float> positions, std::span<const std::uint32_t> segments,
                                  std::span<const std::uint32_t> triangles, std::span<const Pair> pairs,
-                                 float thickness, std::vector<Contact>& contacts);
+                                 float thickness, std::vector<Contact>& contacts, const ContactFilter& keep = {});
 
 /// A capsule (axis from `p0` to `p1`, xyzw, and `radius` [m] > 0) against
 /// the candidate triangles `candidates` (indices into `triangles`): one

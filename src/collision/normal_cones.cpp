@@ -92,6 +92,32 @@ void NormalCones::connect(const Bvh& tree, std::span<const std::uint32_t> triang
     connected_[i] = components[i] == 1;
   }
 
+  // Open edges (one triangle only: a membrane's border, a slit's lips): a
+  // node with a triangle on one is never flat, nor culled against another.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> edge_keys;
+  edge_keys.reserve(3 * order.size());
+  for (std::uint32_t slot = 0; slot < order.size(); ++slot)
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t a = triangles[3 * std::size_t{order[slot]} + std::size_t(c)];
+      const std::uint32_t b = triangles[3 * std::size_t{order[slot]} + std::size_t((c + 1) % 3)];
+      edge_keys.push_back({(std::uint64_t{std::min(a, b)} << 32) | std::max(a, b), slot});
+    }
+  std::sort(edge_keys.begin(), edge_keys.end());
+  std::vector<std::uint8_t> open_slot(order.size(), 0);
+  for (std::size_t k = 0; k < edge_keys.size(); ++k) {
+    const bool alone = (k == 0 || edge_keys[k - 1].first != edge_keys[k].first) &&
+                       (k + 1 == edge_keys.size() || edge_keys[k + 1].first != edge_keys[k].first);
+    if (alone) open_slot[edge_keys[k].second] = 1;
+  }
+  open_.assign(n, 0);
+  for (std::size_t i = n; i-- > 0;) {
+    if (nodes[i].count > 0) {
+      for (std::uint32_t slot = first[i]; slot < first[i] + count[i]; ++slot) open_[i] |= open_slot[slot];
+    } else {
+      open_[i] = open_[nodes[i].left] | open_[nodes[i].left + 1];
+    }
+  }
+
   // Boundary vertices: a vertex is inside a node when every triangle
   // around it is (its slots, the first and last of its run in `around`,
   // lie in the node's range).
@@ -134,7 +160,9 @@ void NormalCones::connect(const Bvh& tree, std::span<const std::uint32_t> triang
 }
 
 bool NormalCones::pair(std::uint32_t a, std::uint32_t b) const {
-  if (!connected_[a] || !connected_[b] || cones_[a].cos < flat_cos_ || cones_[b].cos < flat_cos_) return false;
+  if (!connected_[a] || !connected_[b] || open_[a] || open_[b] || cones_[a].cos < flat_cos_ ||
+      cones_[b].cos < flat_cos_)
+    return false;
   float axis[3] = {sum_[3 * a] + sum_[3 * b], sum_[3 * a + 1] + sum_[3 * b + 1], sum_[3 * a + 2] + sum_[3 * b + 2]};
   const float length = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
   if (!(length > 0.0f)) return false;
@@ -158,8 +186,7 @@ bool NormalCones::pair(std::uint32_t a, std::uint32_t b) const {
   return false;
 }
 
-void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangles, std::span<const float> positions,
-                         std::span<const float> later) {
+void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangles, std::span<const float> positions) {
   const auto& nodes = tree.nodes();
   if (build_id_ != tree.build_id() || connected_.size() != nodes.size()) connect(tree, triangles);
   const std::size_t n = nodes.size();
@@ -177,7 +204,7 @@ void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangl
   const auto finish = [&](std::size_t i) {
     if (cones_[i].cos < flat_cos) return wide(i);
     sin_[i] = std::sqrt(std::max(0.0f, 1.0f - cones_[i].cos * cones_[i].cos));
-    flat_[i] = connected_[i];
+    flat_[i] = connected_[i] && !open_[i];
   };
   // The axis: the node's summed normals, normalised; false if they cancel.
   const auto axis = [&](std::size_t i) {
@@ -187,20 +214,17 @@ void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangl
     for (int a = 0; a < 3; ++a) cones_[i].axis[a] = sum[a] / length;
     return true;
   };
-  // Leaves: the normals themselves, at both configurations. (On TBB's
+  // Leaves: the normals themselves. (On TBB's
   // threads this took as long on 2 cores, 2.0 ms for the liver's surface:
   // the vertex reads bound it, and the solver's own threads then waited on
   // TBB's, so it stays serial.)
   for (const std::uint32_t i : leaves_) {
     const Bvh::Node& node = nodes[i];
-    float normals[2 * Bvh::kLeafSize][3];
+    float normals[Bvh::kLeafSize][3];
     std::uint32_t m = 0;
     bool ok = true;
-    for (std::uint32_t s = 0; s < node.count; ++s) {
-      const std::uint32_t* corners = &corners_[3 * (std::size_t{node.first} + s)];
-      ok = ok && unit_normal(positions, corners, normals[m++]);
-      if (!later.empty()) ok = ok && unit_normal(later, corners, normals[m++]);
-    }
+    for (std::uint32_t s = 0; s < node.count; ++s)
+      ok = ok && unit_normal(positions, &corners_[3 * (std::size_t{node.first} + s)], normals[m++]);
     float* sum = &sum_[3 * i];
     sum[0] = sum[1] = sum[2] = 0.0f;
     for (std::uint32_t q = 0; ok && q < m; ++q)

@@ -25,19 +25,24 @@
 // parallel edges side by side, pushed apart across the surface, not through
 // it): those are dropped with the patch (measured in tests/normal_cones_test.cpp).
 //
-// Assumptions, stated rather than checked: the outline test of the papers
-// is replaced by two cheaper conditions, (1) the patch is one
-// connected (through shared vertices) piece (checked: a BVH node holding two layers of a rolled
-// membrane, whose normals point the same way, is never culled) and (2) it
-// is not a ramp that winds over itself (a helicoid with a gentle pitch,
-// which a connected patch of tissue forms only when cut along a slit and
-// twisted). Scenes that may form such ramps turn the culling off
+// Assumptions: the papers' outline test (the patch's border, projected
+// along the axis, does not overlap itself) is replaced by three cheaper
+// conditions, two checked and one assumed. Checked: (1) the patch is one
+// piece connected through shared vertices (a BVH node holding two layers of
+// a rolled membrane, whose normals point the same way, is never culled) and
+// (2) it has no open edge, an edge of one triangle only (a slit whose lips
+// shear apart along the axis is flat and connected around the slit's end,
+// yet its lips can face each other: found in review, tested in
+// tests/normal_cones_test.cpp; a membrane's own border is open too, so the
+// nodes along it are always traversed). Assumed: (3) the patch is not a
+// ramp that winds over itself (a helicoid of gentle pitch), which a
+// connected patch without open edges forms only when the tissue around it
+// does. Scenes that may form such ramps turn the culling off
 // (MeshCollisionDesc::self_culling).
 //
-// Motion: the solver passes the positions at the frame's start and where
-// the frame's velocities take them (`later`); a node is flat only if both
-// sets of normals fit in its cone, so a patch that starts to fold within
-// the frame is traversed.
+// Contacts are found at the frame's start only (mesh_collision.h), and the
+// argument above is about that configuration: the cones are computed from
+// the same positions.
 #pragma once
 
 #include <cstdint>
@@ -55,21 +60,20 @@ class NormalCones {
 
   /// Recomputes every node's cone of `tree` (built over the triangles
   /// `triangles`, three vertex indices per primitive, into `positions`,
-  /// xyzw per vertex) and whether it is flat. `later` (same layout as
-  /// positions, or empty) adds the normals at a second configuration. The
-  /// node's connectivity is recomputed when the tree was rebuilt since the
-  /// last call (Bvh::build_id), from the triangles' shared edges. A zero-area
-  /// triangle has no normal: the nodes above it are never flat.
-  void update(const Bvh& tree, std::span<const std::uint32_t> triangles, std::span<const float> positions,
-              std::span<const float> later = {});
+  /// xyzw per vertex) and whether it is flat. The nodes' connectivity and
+  /// open edges are recomputed when the tree was rebuilt since the last
+  /// call (Bvh::build_id), from the triangles' shared vertices and edges. A
+  /// zero-area triangle has no normal: the nodes above it are never flat.
+  void update(const Bvh& tree, std::span<const std::uint32_t> triangles, std::span<const float> positions);
 
   /// Per node of the tree: 1 where its triangles cannot touch themselves.
   [[nodiscard]] std::span<const std::uint8_t> flat() const { return flat_; }
   /// The culling policy of the self traversal (bvh.h, NoCulling): node n
   /// is flat.
   [[nodiscard]] bool self(std::uint32_t n) const { return flat_[n] != 0; }
-  /// Nodes a and b (disjoint) cannot touch each other: each is connected,
-  /// they share a vertex (so their union is connected) and one cone of
+  /// Nodes a and b (disjoint) cannot touch each other: each is connected
+  /// and without open edges, they share a vertex (so their union is
+  /// connected) and one cone of
   /// half-angle kFlatDegrees holds both their cones. What cuts the seams:
   /// two flat patches side by side under a curved parent.
   [[nodiscard]] bool pair(std::uint32_t a, std::uint32_t b) const;
@@ -88,7 +92,7 @@ class NormalCones {
  private:
   void connect(const Bvh& tree, std::span<const std::uint32_t> triangles);
   std::uint64_t build_id_ = 0;
-  std::vector<std::uint8_t> flat_, connected_;
+  std::vector<std::uint8_t> flat_, connected_, open_;  // open_: a triangle of the node has an open edge
   std::vector<Cone> cones_;
   std::vector<float> sum_, sin_;  // per node: the unnormalised sum of its unit normals (xyz); sin of the half-angle
   float flat_cos_ = 0.0f;

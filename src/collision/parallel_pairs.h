@@ -18,9 +18,11 @@
 
 namespace sinew::collision {
 
-/// The pairs of self_overlapping_pairs (culled by `cones` when given, for
-/// the same tree), in a fixed order that does not depend on the thread
-/// count (not sorted). `skip` is called from several threads at once.
+/// The pairs of self_overlapping_pairs, in a fixed order that does not
+/// depend on the thread count (not sorted). With `cones` (for the same
+/// tree) culled like self_overlapping_pairs with that policy, though the
+/// task split offers it other node pairs, so the two may keep different
+/// (equally safe) subsets. `skip` is called from several threads at once.
 template <class Skip>
 void self_overlapping_pairs_parallel(const Bvh& tree, Skip skip, std::vector<Pair>& pairs,
                                      const NormalCones* cones = nullptr);

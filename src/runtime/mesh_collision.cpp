@@ -51,9 +51,11 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   auto mc = std::unique_ptr<MeshCollision>(new MeshCollision());
   mc->desc_ = scene.mesh_collision;
   mc->time_step_ = scene.solver.time_step;
+  mc->solid_bodies_ = static_cast<std::uint32_t>(scene.tet_bodies.size());
   mc->gravity_ = std::hypot(scene.gravity[0], scene.gravity[1], scene.gravity[2]);
   const auto& device_of = compiled.order.device_of;
   std::uint32_t body = 0;
+  mc->body_count_ = static_cast<std::uint32_t>(scene.tet_bodies.size() + scene.tri_bodies.size() + scene.line_bodies.size());
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b, ++body) {
     const std::uint32_t first = compiled.tet_body_first_particle[b];
     for (const auto& f : extract_boundary_surface(scene.tet_bodies[b].mesh).triangles) {
@@ -78,7 +80,7 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   // One tree per body: contiguous runs of triangle_body_ / segment_body_.
   const auto ranges = [](const std::vector<std::uint32_t>& body_of, std::vector<BodyTree>& trees) {
     for (std::uint32_t k = 0; k < body_of.size(); ++k)
-      if (k == 0 || body_of[k] != body_of[k - 1]) trees.push_back({k, 0, {}, {}, {}});
+      if (k == 0 || body_of[k] != body_of[k - 1]) trees.push_back({k, 0, {}, {}, {}, {}});
     for (std::size_t t = 0; t < trees.size(); ++t)
       trees[t].count = (t + 1 < trees.size() ? trees[t + 1].first : static_cast<std::uint32_t>(body_of.size())) -
                        trees[t].first;
@@ -91,6 +93,10 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   for (std::size_t t = 0; t < mc->segment_body_.size(); ++t)
     for (int k = 0; k < 2; ++k) mc->body_of_[mc->segments_[2 * t + k]] = mc->segment_body_[t];
   mc->ownership_ = collision::triangle_ownership(mc->triangles_);
+  mc->solid_triangles_ = 0;
+  while (mc->solid_triangles_ < mc->triangle_body_.size() && mc->triangle_body_[mc->solid_triangles_] < mc->solid_bodies_)
+    ++mc->solid_triangles_;
+  mc->index_solid_edges();
   if (mc->desc_.self_collision) {
     std::vector<float> start(4 * compiled.positions.size());
     for (std::size_t p = 0; p < compiled.positions.size(); ++p) {
@@ -162,17 +168,57 @@ Status MeshCollision::find_rest_close(std::span<const float> start) {
   return {};
 }
 
+// The solids' surface edges and their two faces, sorted by edge (create).
+void MeshCollision::index_solid_edges() {
+  solid_edges_.clear();
+  for (std::uint32_t t = 0; t < solid_triangles_; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = triangles_[3 * std::size_t{t} + k], b = triangles_[3 * std::size_t{t} + (k + 1) % 3];
+      solid_edges_.push_back({(std::uint64_t{std::min(a, b)} << 32) | std::max(a, b), t});
+    }
+  std::sort(solid_edges_.begin(), solid_edges_.end());
+}
+
+// The faces on edge (a, b) of a solid's surface: [first, last) in solid_edges_.
+std::pair<std::size_t, std::size_t> MeshCollision::faces_on(std::uint32_t a, std::uint32_t b) const {
+  const std::uint64_t key = (std::uint64_t{std::min(a, b)} << 32) | std::max(a, b);
+  const auto lo = std::lower_bound(solid_edges_.begin(), solid_edges_.end(), std::pair{key, std::uint32_t{0}});
+  auto hi = lo;
+  while (hi != solid_edges_.end() && hi->first == key) ++hi;
+  return {std::size_t(lo - solid_edges_.begin()), std::size_t(hi - solid_edges_.begin())};
+}
+
+std::uint32_t MeshCollision::solid_face(std::uint32_t a, std::uint32_t b, std::uint32_t c) const {
+  const auto [first, last] = faces_on(a, b);
+  for (std::size_t k = first; k < last; ++k) {
+    const std::uint32_t* v = &triangles_[3 * std::size_t{solid_edges_[k].second}];
+    if (v[0] == c || v[1] == c || v[2] == c) return solid_edges_[k].second;
+  }
+  return UINT32_MAX;
+}
+
+bool MeshCollision::solid_edge(std::uint32_t a, std::uint32_t b, float out[3]) const {
+  const auto [first, last] = faces_on(a, b);
+  if (first == last) return false;
+  out[0] = out[1] = out[2] = 0.0f;
+  for (std::size_t k = first; k < last; ++k)
+    for (int d = 0; d < 3; ++d) out[d] += face_out_[3 * std::size_t{solid_edges_[k].second} + d];
+  return true;
+}
+
 std::uint32_t MeshCollision::rest_close_pairs() const {
   std::size_t sum = 0;
   for (const BodyTree& body : triangle_trees_) sum += body.rest_close.size();
   return static_cast<std::uint32_t>(sum);
 }
 
-void MeshCollision::refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes) {
+void MeshCollision::refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes,
+                          collision::Bvh BodyTree::*which) {
   for (BodyTree& t : trees) {
     const auto mine = boxes.subspan(t.first, t.count);
-    if (t.tree.empty()) t.tree.build(mine);
-    else t.tree.update(mine);
+    collision::Bvh& tree = t.*which;
+    if (tree.empty()) tree.build(mine);
+    else tree.update(mine);
   }
 }
 
@@ -196,10 +242,10 @@ void MeshCollision::candidate_pairs(std::vector<BodyTree>& a, std::span<const st
       const collision::SharesVertexOf<Arity> shares{mine};
       const collision::NormalCones* cones = nullptr;
       if (Arity == 3 && desc_.self_culling) {
-        a[i].cones.update(a[i].tree, mine, positions_, later_);
+        a[i].cones.update(a[i].self_tree, mine, positions_);
         cones = &a[i].cones;
       }
-      collision::self_overlapping_pairs_parallel(a[i].tree, shares, local_, cones);
+      collision::self_overlapping_pairs_parallel(a[i].self_tree, shares, local_, cones);
       const auto& close = a[i].rest_close;
       for (const auto& [p, q] : local_)
         if (close.empty() || !std::binary_search(close.begin(), close.end(), collision::Pair{p, q}))
@@ -431,24 +477,51 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   // path. Measured on the kidney dropped onto the liver's patch (it slides
   // off at 0.4 m/s): detection 0.1-0.3 s per frame instead of 1.5-14 s with
   // a swelling by 2 dt |v| in every direction, the same contacts held.
-  const auto swell = [&](std::span<const std::uint32_t> indices, int arity) {
-    std::vector<float> turn(boxes_.size());
-    for (std::size_t i = 0; i < boxes_.size(); ++i) {
-      float v = 0.0f;
-      for (int k = 0; k < arity; ++k) v = std::max(v, speed_[indices[i * arity + k]]);
-      turn[i] = static_cast<float>(kTurn * dt * v);
-    }
-    for (std::size_t i = 0; i < boxes_.size(); ++i) {
+  // Self-pairs are found in each body's own frame of motion: with `drift`
+  // the boxes are swept by each vertex's velocity less its body's mean
+  // surface velocity (distances within one body do not change under a
+  // common motion), so a body carried along as a whole pairs only what moves
+  // relative to the rest of it (measured: the kidney pushed down by the
+  // organ example's probe, ...).
+  const auto swell = [&](std::span<const std::uint32_t> indices, int arity, std::span<const std::uint32_t> body_of,
+                         bool drift, std::vector<collision::Aabb>& boxes) {
+    const auto velocity = [&](std::size_t i, int k, int a) {
+      const double v = velocities_[4 * std::size_t{indices[i * arity + k]} + a];
+      return drift ? v - mean_velocity_[3 * std::size_t{body_of[i]} + a] : v;
+    };
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      double speed = 0.0;
+      for (int k = 0; k < arity; ++k)
+        speed = std::max(speed, std::sqrt(velocity(i, k, 0) * velocity(i, k, 0) + velocity(i, k, 1) * velocity(i, k, 1) +
+                                          velocity(i, k, 2) * velocity(i, k, 2)));
+      const auto turn = static_cast<float>(kTurn * dt * speed);
       for (int a = 0; a < 3; ++a) {
         float lo = 0.0f, hi = 0.0f;
         for (int k = 0; k < arity; ++k) {
-          const auto d = static_cast<float>(2.0 * dt * velocities_[4 * std::size_t{indices[i * arity + k]} + a]);
+          const auto d = static_cast<float>(2.0 * dt * velocity(i, k, a));
           lo = std::min(lo, d), hi = std::max(hi, d);
         }
-        boxes_[i].lo[a] += lo - turn[i], boxes_[i].hi[a] += hi + turn[i];
+        boxes[i].lo[a] += lo - turn, boxes[i].hi[a] += hi + turn;
       }
     }
   };
+  // Each body's mean surface velocity (over its primitives' corners).
+  mean_velocity_.assign(3 * std::size_t{body_count_}, 0.0);
+  {
+    std::vector<double> weight(body_count_, 0.0);
+    const auto add = [&](std::span<const std::uint32_t> indices, int arity, std::span<const std::uint32_t> body_of) {
+      for (std::size_t i = 0; i < body_of.size(); ++i)
+        for (int k = 0; k < arity; ++k) {
+          weight[body_of[i]] += 1.0;
+          for (int a = 0; a < 3; ++a)
+            mean_velocity_[3 * std::size_t{body_of[i]} + a] += velocities_[4 * std::size_t{indices[i * arity + k]} + a];
+        }
+    };
+    add(triangles_, 3, triangle_body_);
+    add(segments_, 2, segment_body_);
+    for (std::uint32_t b = 0; b < body_count_; ++b)
+      for (int a = 0; a < 3; ++a) mean_velocity_[3 * std::size_t{b} + a] /= std::max(weight[b], 1.0);
+  }
   // Only facing contacts (collision::facing) are kept. The others are a
   // vertex beside a triangle or two edges that meet end-on, whose normal
   // from the closest points is the way round the corner: a plane along it,
@@ -456,19 +529,60 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   // sideways off it (measured: a block resting across another's edge slid
   // off at 0.15 m/s). Those meetings are covered by the facing contacts of
   // the neighbouring primitives.
-  // Keeps the facing contacts of found_ within their pair's reach.
-  const auto keep = [&] {
-    for (const Contact& c : found_) {
-      if (!collision::facing(c, positions_)) continue;
-      const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
-      const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], -c.w[2], -c.w[3]};
-      double rel[3] = {0.0, 0.0, 0.0};
-      for (int k = 0; k < 4; ++k)
-        for (int a = 0; a < 3; ++a) rel[a] += double(coefficient[k]) * velocities_[std::size_t{c.v[k]} * 4 + a];
-      const double closing = 2.0 * dt * std::sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
-      if (double(c.distance) < common + closing) all_.push_back(c);
+  // A solid's surface against itself: the two sides must face each other
+  // across air (each one's outward normal towards the other), not across the
+  // body's material (a thin part's two sides; a fold under a probe). A
+  // vertex's outward direction is its faces' area-weighted normal, an
+  // edge's the sum of its two faces' unit normals, a triangle's its own.
+  const auto across_air = [&](const Contact& c) {
+    const std::uint32_t body = body_of_[c.v[0]];
+    if (body >= solid_bodies_ || body_of_[c.v[3]] != body) return true;
+    const auto along = [&](const float* d) { return c.normal[0] * d[0] + c.normal[1] * d[1] + c.normal[2] * d[2]; };
+    float first = 0.0f, second = 0.0f;  // the outward directions along the normal (second towards first)
+    if (c.kind == Contact::Kind::vertex_triangle) {
+      const std::uint32_t face = solid_face(c.v[1], c.v[2], c.v[3]);
+      if (face == UINT32_MAX) return true;
+      first = along(&vertex_out_[3 * std::size_t{c.v[0]}]);
+      second = along(&face_out_[3 * std::size_t{face}]);
+    } else {
+      float e[2][3];
+      for (int side = 0; side < 2; ++side) {
+        if (!solid_edge(c.v[2 * side], c.v[2 * side + 1], e[side])) return true;
+      }
+      first = along(e[0]);
+      second = along(e[1]);
     }
+    return first < 0.0f && second > 0.0f;
   };
+  if (desc_.self_collision && solid_bodies_ > 0) {
+    vertex_out_.assign(3 * positions_.size() / 4, 0.0f);
+    face_out_.assign(3 * solid_triangles_, 0.0f);
+    for (std::size_t t = 0; t < solid_triangles_; ++t) {
+      const std::uint32_t* v = &triangles_[3 * t];
+      const auto x = [&](int k, int a) { return positions_[4 * std::size_t{v[k]} + a]; };
+      const float u[3] = {x(1, 0) - x(0, 0), x(1, 1) - x(0, 1), x(1, 2) - x(0, 2)};
+      const float w[3] = {x(2, 0) - x(0, 0), x(2, 1) - x(0, 1), x(2, 2) - x(0, 2)};
+      const float n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      const float length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (int a = 0; a < 3; ++a) {
+        face_out_[3 * t + a] = length > 0.0f ? n[a] / length : 0.0f;
+        for (int k = 0; k < 3; ++k) vertex_out_[3 * std::size_t{v[k]} + a] += n[a];
+      }
+    }
+  }
+  // The contacts kept: facing, across air, within their pair's own reach
+  // (given to the narrow phase, which drops the rest as it finds them).
+  const collision::ContactFilter wanted = [&](const Contact& c) {
+    if (!collision::facing(c, positions_) || !across_air(c)) return false;
+    const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
+    const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], -c.w[2], -c.w[3]};
+    double rel[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 4; ++k)
+      for (int a = 0; a < 3; ++a) rel[a] += double(coefficient[k]) * velocities_[std::size_t{c.v[k]} * 4 + a];
+    const double closing = 2.0 * dt * std::sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
+    return double(c.distance) < common + closing;
+  };
+  const auto keep = [&] { all_.insert(all_.end(), found_.begin(), found_.end()); };
 
   // Boxes swollen by fast motion can pair most of two surfaces, and every
   // pair may make up to 15 contacts: past kMaxPairs the frame stops with an
@@ -483,33 +597,41 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   };
   all_.clear();
   const auto half = static_cast<float>(0.5 * common);
-  if (desc_.self_collision && desc_.self_culling && !triangles_.empty()) {
-    later_.resize(positions_.size());
-    for (std::size_t k = 0; k < positions_.size(); ++k)
-      later_[k] = static_cast<float>(positions_[k] + 2.0 * dt * velocities_[k]);
-  }
   if (!triangles_.empty()) {
     if (Status s = collision::primitive_boxes(positions_, triangles_, 3, half, boxes_); !s) return s;
-    swell(triangles_, 3);
-    refit(triangle_trees_, boxes_);
+    if (desc_.self_collision) {
+      self_boxes_ = boxes_;
+      swell(triangles_, 3, triangle_body_, true, self_boxes_);
+      refit(triangle_trees_, self_boxes_, &BodyTree::self_tree);
+    }
+    swell(triangles_, 3, triangle_body_, false, boxes_);
+    refit(triangle_trees_, boxes_, &BodyTree::tree);
     candidate_pairs<3>(triangle_trees_, triangles_, triangle_trees_, pairs_);
     if (Status s = check_pairs(); !s) return s;
-    if (Status s = collision::triangle_contacts(positions_, triangles_, ownership_, pairs_, reach, found_); !s)
+    if (Status s = collision::triangle_contacts(positions_, triangles_, ownership_, pairs_, reach, found_, wanted);
+        !s)
       return s;
     keep();
   }
   if (!segments_.empty()) {
     if (Status s = collision::primitive_boxes(positions_, segments_, 2, half, boxes_); !s) return s;
-    swell(segments_, 2);
-    refit(segment_trees_, boxes_);
+    if (desc_.self_collision) {
+      self_boxes_ = boxes_;
+      swell(segments_, 2, segment_body_, true, self_boxes_);
+      refit(segment_trees_, self_boxes_, &BodyTree::self_tree);
+    }
+    swell(segments_, 2, segment_body_, false, boxes_);
+    refit(segment_trees_, boxes_, &BodyTree::tree);
     candidate_pairs<2>(segment_trees_, segments_, segment_trees_, pairs_);
     if (Status s = check_pairs(); !s) return s;
-    if (Status s = collision::segment_contacts(positions_, segments_, pairs_, reach, found_); !s) return s;
+    if (Status s = collision::segment_contacts(positions_, segments_, pairs_, reach, found_, wanted); !s)
+      return s;
     keep();
     if (!triangles_.empty()) {
       candidate_pairs<2>(segment_trees_, segments_, triangle_trees_, pairs_);
       if (Status s = check_pairs(); !s) return s;
-      if (Status s = collision::segment_triangle_contacts(positions_, segments_, triangles_, pairs_, reach, found_);
+      if (Status s = collision::segment_triangle_contacts(positions_, segments_, triangles_, pairs_, reach, found_,
+                                                              wanted);
           !s)
         return s;
       keep();

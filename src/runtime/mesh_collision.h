@@ -73,8 +73,9 @@ class MeshCollision {
   // A BVH per body over its primitives [first, first + count).
   struct BodyTree {
     std::uint32_t first = 0, count = 0;
-    collision::Bvh tree;
-    collision::NormalCones cones;  // triangle trees with self-culling only
+    collision::Bvh tree;       // boxes swept by the vertices' velocities: against other bodies
+    collision::Bvh self_tree;  // swept relative to the body's mean velocity: against itself (self-collision only)
+    collision::NormalCones cones;  // of self_tree; triangle trees with self-culling only
     // Triangle trees with self-collision: the pairs (local indices, sorted)
     // closer than the thickness in the starting shape, never in contact.
     std::vector<collision::Pair> rest_close;
@@ -109,7 +110,8 @@ class MeshCollision {
   // primitive's deepest point against a plane is always a corner) nor
   // tools (their reaction comes from the particle contacts only).
   void shape_faces(std::span<const PosedShape> colliders, double common);
-  static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
+  static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes,
+                    collision::Bvh BodyTree::*which);
   // Fills each triangle tree's rest_close from the starting positions
   // (device order, xyzw).
   Status find_rest_close(std::span<const float> start);
@@ -124,7 +126,21 @@ class MeshCollision {
   Status read_back(Device& device, const XpbdBuffers& scene_buffers);
   // Per-frame scratch, kept to avoid reallocating.
   std::vector<float> positions_, start_positions_, velocities_, speed_;
-  std::vector<float> later_;  // positions_ + 2 dt velocities_: the second configuration of the normal cones
+  std::uint32_t solid_bodies_ = 0;  // bodies 0 .. solid_bodies_ - 1 are tet bodies (closed, outward surfaces)
+  std::uint32_t body_count_ = 0;      // collidable bodies: tet, then tri, then line bodies
+  std::vector<double> mean_velocity_;  // per body: its surface vertices' mean velocity (xyz) [m/s]
+  std::vector<collision::Aabb> self_boxes_;
+  std::size_t solid_triangles_ = 0;  // triangles_ [0, solid_triangles_) are the solids' surfaces
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> solid_edges_;  // (edge key, face), sorted
+  std::vector<float> vertex_out_;  // per particle of a solid's surface: its area-weighted normal (xyz)
+  std::vector<float> face_out_;    // per solid surface triangle: its unit normal (xyz)
+  void index_solid_edges();
+  std::pair<std::size_t, std::size_t> faces_on(std::uint32_t a, std::uint32_t b) const;
+  // The solid surface triangle (a, b, c), or UINT32_MAX.
+  std::uint32_t solid_face(std::uint32_t a, std::uint32_t b, std::uint32_t c) const;
+  // [out] out: the sum of the unit normals of the faces on edge (a, b);
+  // false if it is no solid's surface edge.
+  bool solid_edge(std::uint32_t a, std::uint32_t b, float out[3]) const;
   std::vector<collision::Aabb> boxes_;
   std::vector<collision::Pair> pairs_;
   std::vector<collision::Contact> found_, all_;
