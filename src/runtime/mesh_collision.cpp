@@ -481,8 +481,10 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   // the boxes are swept by each vertex's velocity less its body's mean
   // surface velocity (distances within one body do not change under a
   // common motion), so a body carried along as a whole pairs only what moves
-  // relative to the rest of it (measured: the kidney pushed down by the
-  // organ example's probe, ...).
+  // relative to the rest of it (measured: the organ example with
+  // self-collision, the kidney pushed down by the probe, detection at frame
+  // 6 took 2.2 s instead of 4.7, before the narrow phase's filter).
+  // Against other bodies the velocities themselves sweep the boxes.
   const auto swell = [&](std::span<const std::uint32_t> indices, int arity, std::span<const std::uint32_t> body_of,
                          bool drift, std::vector<collision::Aabb>& boxes) {
     const auto velocity = [&](std::size_t i, int k, int a) {
