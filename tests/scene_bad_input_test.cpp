@@ -59,7 +59,6 @@ TEST(SceneBadInput, MeshCollision) {
   expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.margin = -1e-3; }, "mesh_collision.margin");
   expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.compliance = kInf; }, "mesh_collision.compliance");
   expect_error([&](SceneDesc& s) { on(s); s.mesh_collision.dynamic_friction = 0.9; }, "mesh_collision.dynamic_friction");
-  expect_error([&](SceneDesc& s) { on(s); s.solver.residual_tolerance = 1e-3; }, "solver.residual_tolerance");
   expect_error([&](SceneDesc& s) { on(s); s.solver.chebyshev_rho = 0.5; }, "solver.chebyshev_rho");
 }
 

@@ -292,13 +292,12 @@ Status check_mesh_collision(const SceneDesc& scene) {
   if (Status s = non_negative("mesh_collision.margin", c.margin); !s) return s;
   if (Status s = non_negative("mesh_collision.compliance", c.compliance); !s) return s;
   if (Status s = check_friction("mesh_collision", c.static_friction, c.dynamic_friction); !s) return s;
-  if (scene.solver.residual_tolerance > 0.0)
-    return Error(ErrorCode::bad_parameter,
-                 "mesh_collision.enabled is not supported with solver.residual_tolerance > 0 yet (got " +
-                     str(scene.solver.residual_tolerance) + "): use the fixed mode");
+  // The accelerator extrapolates positions and the blocks' multipliers;
+  // the contacts' multipliers are not part of its state, and an
+  // extrapolation could push a contact through.
   if (scene.solver.chebyshev_rho > 0.0)
     return Error(ErrorCode::bad_parameter,
-                 "mesh_collision.enabled is not supported with solver.chebyshev_rho > 0 yet (got " +
+                 "mesh_collision.enabled is not supported with solver.chebyshev_rho > 0 (got " +
                      str(scene.solver.chebyshev_rho) + ")");
   return {};
 }

@@ -31,7 +31,11 @@
 namespace sinew {
 namespace {
 
-bool is_solve(const Dispatch& d) { return kernel_name(d.kernel).starts_with("xpbd_solve_"); }
+// A block's sweep or measuring dispatch (SolveParams); the mesh contacts'
+// dispatches (MeshContactParams) ride along with the sweep they follow.
+bool is_solve(const Dispatch& d) {
+  return kernel_name(d.kernel).starts_with("xpbd_solve_") && d.kernel != Kernel::xpbd_solve_mesh_contacts;
+}
 
 kernels::SolveParams solve_params(const Dispatch& d) {
   kernels::SolveParams p{};
@@ -80,14 +84,16 @@ void append_commands(FrameProgram& program, const Commands& commands) {
 }
 
 SolvePrograms::SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
-                             const std::array<double, 3>& gravity, ChebyshevBuffers chebyshev)
+                             const std::array<double, 3>& gravity, ChebyshevBuffers chebyshev,
+                             const MeshContactBuffers* mesh_contacts)
     : scene_(scene), buffers_(buffers), solver_(solver), chebyshev_(std::move(chebyshev)) {
   // Two iterations give one sweep of each kind; measuring on gives the
   // measuring pass (emitted once, in the last substep).
   SolverSettings cut = solver;
   cut.iterations = 2;
   cut.measure_errors = true;
-  const FrameProgram whole = build_xpbd_program(scene, buffers, cut, gravity);
+  const FrameProgram whole = build_xpbd_program(scene, buffers, cut, gravity, mesh_contacts);
+  counters_ = whole.counters();
   enum class Phase { predict, first_sweep, sweep, measure, update } phase = Phase::predict;
   for (const auto& command : whole.commands()) {
     if (const auto* d = std::get_if<Dispatch>(&command)) {
@@ -175,6 +181,10 @@ void SolvePrograms::append_chebyshev(FrameProgram& program, const ChebyshevStep&
 }
 
 void SolvePrograms::append_predict(FrameProgram& program, int s) const { append_commands(program, parts_[s].predict); }
+
+void SolvePrograms::declare_counters(FrameProgram& program) const {
+  for (const Counter& c : counters_) program.counter(c.label, c.buffer, c.word, c.capacity);
+}
 
 void SolvePrograms::append_warm_start(FrameProgram& program) const {
   for (std::size_t k = 0; k < scene_.blocks.size(); ++k) {

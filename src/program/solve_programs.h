@@ -54,9 +54,18 @@ struct CheckedResidual {
 class SolvePrograms {
  public:
   /// [in] solver: the scene's settings; chebyshev: its buffers when
-  /// solver.chebyshev_rho > 0 (else unused).
+  /// solver.chebyshev_rho > 0 (else unused); mesh_contacts: the mesh
+  /// contacts' buffers (or none), whose colours ride in every sweep after
+  /// the bodies' constraints, as in build_xpbd_program.
   SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
-                const std::array<double, 3>& gravity, ChebyshevBuffers chebyshev);
+                const std::array<double, 3>& gravity, ChebyshevBuffers chebyshev,
+                const MeshContactBuffers* mesh_contacts = nullptr);
+
+  /// Declares on `program` the counters of the whole frame's indirect
+  /// dispatches (the mesh contacts' colours), so their capacity is checked
+  /// after the program runs: the commands cut from the whole frame keep
+  /// their counters' buffer and word, not the declarations.
+  void declare_counters(FrameProgram& program) const;
 
   [[nodiscard]] int substeps() const { return static_cast<int>(parts_.size()); }
   /// Predict of substep s (and whatever precedes its first sweep).
@@ -87,6 +96,7 @@ class SolvePrograms {
   void append_warm_start(FrameProgram& program) const;
 
   std::vector<Parts> parts_;
+  std::vector<Counter> counters_;  ///< of the whole frame (declare_counters)
   const CompiledScene& scene_;
   const XpbdBuffers& buffers_;
   SolverSettings solver_;

@@ -83,7 +83,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
     append_stats(impl->program, impl->stats_plan, impl->buffers);
     auto stepper = SolveStepper::create(*impl->device, *compiled, impl->buffers, scene.solver, scene.gravity,
-                                        impl->stats_plan);
+                                        impl->stats_plan,
+                                        impl->mesh_collision ? &impl->mesh_collision->buffers() : nullptr);
     if (!stepper) return stepper.error();
     impl->stepper = std::move(*stepper);
     impl->program = impl->stepper->frame_program();
@@ -136,8 +137,17 @@ Status Simulation::step() {
     if (Status s = impl_->mesh_collision->before_frame(*impl_->device, impl_->buffers, impl_->collider_shapes(), grew);
         !s)
       return s;
-    if (grew)
-      if (Status s = impl_->prepare_program(impl_->program_shape); !s) return s;
+    if (grew) {
+      if (impl_->stepper) {
+        if (Status s = impl_->stepper->rebuild(*impl_->device, impl_->program_shape, impl_->buffers, impl_->gravity,
+                                               impl_->stats_plan, &impl_->mesh_collision->buffers());
+            !s)
+          return s;
+        impl_->program = impl_->stepper->frame_program();
+      } else if (Status s = impl_->prepare_program(impl_->program_shape); !s) {
+        return s;
+      }
+    }
     impl_->stats.mesh_contacts = impl_->mesh_collision->contacts();
     impl_->stats.mesh_contact_colors = impl_->mesh_collision->colors();
     impl_->stats.collision_margin = impl_->mesh_collision->margin();

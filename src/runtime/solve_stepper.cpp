@@ -44,7 +44,8 @@ constexpr int kMostChunkPrograms = 512;
 Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const CompiledScene& scene,
                                                            const XpbdBuffers& buffers, const SolverSettings& solver,
                                                            const std::array<double, 3>& gravity,
-                                                           const StatsPlan& stats) {
+                                                           const StatsPlan& stats,
+                                                           const MeshContactBuffers* mesh_contacts) {
   if (solver.warm_start)
     for (const ConstraintBlock& block : scene.blocks)
       if (block.kernel != Kernel::xpbd_solve_distance && block.kernel != Kernel::xpbd_solve_volume)
@@ -59,10 +60,48 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
     if (!made) return made.error();
     st->chebyshev_ = std::move(*made);
   }
-  SolvePrograms parts(scene, buffers, solver, gravity, st->chebyshev_);
+  if (st->residual_mode_) {
+    auto check = make_residual_check(device, scene);
+    if (!check) return check.error();
+    st->check_ = std::move(*check);
+  }
+  if (Status s = st->build(device, scene, buffers, gravity, stats, mesh_contacts); !s) return s.error();
+  return st;
+}
+
+Status SolveStepper::rebuild(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
+                             const std::array<double, 3>& gravity, const StatsPlan& stats,
+                             const MeshContactBuffers* mesh_contacts) {
+  std::vector<ProgramHandle> all{whole_, end_};
+  all.insert(all.end(), begin_.begin(), begin_.end());
+  all.insert(all.end(), begin_cold_.begin(), begin_cold_.end());
+  for (const auto& chunks : chunks_) all.insert(all.end(), chunks.begin(), chunks.end());
+  for (const ProgramHandle p : all)
+    if (p.id != UINT32_MAX)
+      if (Status s = device.destroy_program(p); !s) return s;
+  whole_ = end_ = ProgramHandle{};
+  begin_.clear();
+  begin_cold_.clear();
+  chunks_.clear();
+  shortest_frame_ = FrameProgram{};
+  return build(device, scene, buffers, gravity, stats, mesh_contacts);
+}
+
+// The programs (the buffers exist): fixed mode one, residual mode the
+// begin, chunk and end programs of every substep.
+Status SolveStepper::build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
+                           const std::array<double, 3>& gravity, const StatsPlan& stats,
+                           const MeshContactBuffers* mesh_contacts) {
+  SolveStepper* st = this;
+  const SolverSettings& solver = solver_;
+  SolvePrograms parts(scene, buffers, solver, gravity, st->chebyshev_, mesh_contacts);
   const int substeps = parts.substeps();
   const int iterations = solver.iterations;
-  const auto prepare = [&](const FrameProgram& program) { return device.create_program(program); };
+  const auto prepare = [&](const FrameProgram& program) {
+    FrameProgram counted = program;
+    parts.declare_counters(counted);
+    return device.create_program(counted);
+  };
 
   if (!st->residual_mode_) {
     FrameProgram& p = st->shortest_frame_;
@@ -76,12 +115,9 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
     auto made = prepare(p);
     if (!made) return made.error();
     st->whole_ = *made;
-    return st;
+    return {};
   }
 
-  auto check = make_residual_check(device, scene);
-  if (!check) return check.error();
-  st->check_ = std::move(*check);
   const int c = solver.check_interval;
   const int chunks_to_cap = (std::max(0, solver.max_iterations - iterations) + c - 1) / c;
   int distinct = std::min(chunks_to_cap, 1);
@@ -129,7 +165,7 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
   auto made = prepare(end);
   if (!made) return made.error();
   st->end_ = *made;
-  return st;
+  return {};
 }
 
 Status SolveStepper::run(Device& device, ProgramHandle program, DeviceTimes& times, bool first) {

@@ -24,9 +24,19 @@ class SolveStepper {
   /// Builds and prepares the programs; the last one ends with the
   /// statistics of `stats` (append_stats). [in] scene, buffers must outlive
   /// the call only.
+  /// mesh_contacts: the mesh contacts' buffers (or none): their colours
+  /// ride in every sweep; the residual checks measure the bodies'
+  /// constraints only.
   static Result<std::unique_ptr<SolveStepper>> create(Device& device, const CompiledScene& scene,
                                                       const XpbdBuffers& buffers, const SolverSettings& solver,
-                                                      const std::array<double, 3>& gravity, const StatsPlan& stats);
+                                                      const std::array<double, 3>& gravity, const StatsPlan& stats,
+                                                      const MeshContactBuffers* mesh_contacts = nullptr);
+  /// Destroys the programs and builds them again (same buffers for the
+  /// checks and the accelerator): after the mesh contacts outgrew their
+  /// buffers or colours.
+  Status rebuild(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
+                 const std::array<double, 3>& gravity, const StatsPlan& stats,
+                 const MeshContactBuffers* mesh_contacts);
 
   /// Runs one frame; fills stats.sweeps, stop, checked_residual,
   /// residual_checks and the device times (summed over the programs run).
@@ -40,6 +50,9 @@ class SolveStepper {
   [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
 
  private:
+  Status build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
+               const std::array<double, 3>& gravity, const StatsPlan& stats,
+               const MeshContactBuffers* mesh_contacts);
   Status run(Device& device, ProgramHandle program, DeviceTimes& times, bool first);
 
   SolverSettings solver_;
