@@ -16,6 +16,20 @@ namespace {
 
 class MeshContact : public BackendTest {};
 
+// The dropped blocks after a run: how deep either lies in the other [m] and
+// the upper block's lowest vertex [m].
+std::pair<double, double> blocks_at_rest(const Simulation& sim, const SceneDesc& scene) {
+  std::vector<float> x;
+  EXPECT_TRUE(sim.read_positions(x).ok());
+  const PlacedBody lower{&scene.tet_bodies[0].mesh, sim.info().tet_body_first_particle[0]};
+  const PlacedBody upper{&scene.tet_bodies[1].mesh, sim.info().tet_body_first_particle[1]};
+  const double depth = std::max(penetration(x, upper, lower), penetration(x, lower, upper));
+  double lowest_upper = 1e9;
+  for (std::uint32_t v = 0; v < scene.tet_bodies[1].mesh.vertices.size(); ++v)
+    lowest_upper = std::min(lowest_upper, at(x, upper.first + v)[1]);
+  return {depth, lowest_upper};
+}
+
 // A 3 cm block dropped from 1 cm onto a 4 cm block resting on the floor,
 // offset so that its edges and corners meet the lower block's faces and its
 // vertices fall between the lower one's (finer and coarser meshes).
@@ -25,14 +39,7 @@ TEST_P(MeshContact, DroppedBlocksRestOnEachOtherWithinTheThickness) {
   auto sim = create_or_skip(scene, GetParam());
   SINEW_ASSERT_OK(sim);
   for (int f = 0; f < 120; ++f) SINEW_ASSERT_OK(sim->step());
-  std::vector<float> x;
-  SINEW_ASSERT_OK(sim->read_positions(x));
-  const PlacedBody lower{&scene.tet_bodies[0].mesh, sim->info().tet_body_first_particle[0]};
-  const PlacedBody upper{&scene.tet_bodies[1].mesh, sim->info().tet_body_first_particle[1]};
-  const double depth = std::max(penetration(x, upper, lower), penetration(x, lower, upper));
-  double lowest_upper = 1e9;
-  for (std::uint32_t v = 0; v < scene.tet_bodies[1].mesh.vertices.size(); ++v)
-    lowest_upper = std::min(lowest_upper, at(x, upper.first + v)[1]);
+  const auto [depth, lowest_upper] = blocks_at_rest(*sim, scene);
   const FrameStats& s = sim->last_frame();
   std::printf("[%s] depth %.3g mm, upper block's lowest %.4f m, KE %.3g J, %u contacts in %u colours, margin %.3g mm, %.2f ms\n",
               GetParam().c_str(), depth * 1e3, lowest_upper, s.kinetic_energy, s.mesh_contacts, s.mesh_contact_colors,
@@ -60,14 +67,7 @@ TEST_P(MeshContact, DroppedBlocksRestOnEachOtherInTheResidualMode) {
     SINEW_ASSERT_OK(sim->step());
     most_sweeps = std::max(most_sweeps, sim->last_frame().sweeps);
   }
-  std::vector<float> x;
-  SINEW_ASSERT_OK(sim->read_positions(x));
-  const PlacedBody lower{&scene.tet_bodies[0].mesh, sim->info().tet_body_first_particle[0]};
-  const PlacedBody upper{&scene.tet_bodies[1].mesh, sim->info().tet_body_first_particle[1]};
-  const double depth = std::max(penetration(x, upper, lower), penetration(x, lower, upper));
-  double lowest_upper = 1e9;
-  for (std::uint32_t v = 0; v < scene.tet_bodies[1].mesh.vertices.size(); ++v)
-    lowest_upper = std::min(lowest_upper, at(x, upper.first + v)[1]);
+  const auto [depth, lowest_upper] = blocks_at_rest(*sim, scene);
   const FrameStats& s = sim->last_frame();
   std::printf("[%s] residual mode: depth %.3g mm, upper block's lowest %.4f m, KE %.3g J, %u contacts, most sweeps "
               "per frame %llu, violation %.3g mm\n",
