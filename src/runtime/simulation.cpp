@@ -144,6 +144,8 @@ Status Simulation::step() {
             !s)
           return s;
         impl_->program = impl_->stepper->frame_program();
+        impl_->info.dispatches_per_frame = static_cast<std::uint32_t>(impl_->program.dispatch_count());
+        impl_->info.barriers_per_frame = static_cast<std::uint32_t>(impl_->program.barrier_count());
       } else if (Status s = impl_->prepare_program(impl_->program_shape); !s) {
         return s;
       }
