@@ -52,6 +52,15 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(const Bvh& tree) {
   return r;
 }
 
+// A tree over the surface's triangle boxes grown by `inflate`, and its cones
+// at the surface's positions.
+void build_with_cones(const Surface& s, float inflate, Bvh& tree, NormalCones& cones) {
+  std::vector<Aabb> boxes;
+  ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, inflate, boxes).ok());
+  tree.build(boxes);
+  cones.update(tree, s.triangles, s.positions);
+}
+
 std::array<double, 3> normal_of(std::span<const float> x, const std::uint32_t* t) {
   const float* a = &x[4 * std::size_t{t[0]}];
   const float* b = &x[4 * std::size_t{t[1]}];
@@ -106,12 +115,9 @@ TEST(NormalCones, EveryNodesConeHoldsItsTrianglesNormals) {
 TEST(NormalCones, ConnectivityEqualsASearchOverSharedVertices) {
   const Surface s = surface_of("meshes/tet/kidney_57k.node");
   ASSERT_FALSE(s.triangles.empty());
-  std::vector<Aabb> boxes;
-  ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, 0.0f, boxes).ok());
   Bvh tree;
-  tree.build(boxes);
   NormalCones cones;
-  cones.update(tree, s.triangles, s.positions);
+  build_with_cones(s, 0.0f, tree, cones);
   const auto r = ranges(tree);
   std::size_t checked = 0, connected = 0, disconnected = 0;
   for (std::size_t i = 0; i < tree.nodes().size(); ++i) {
@@ -158,12 +164,9 @@ TEST(NormalCones, TwoLayersFacingTheSameWayAreNeverCulled) {
         const std::uint32_t a = base + std::uint32_t(i * (n + 1) + j), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
         s.triangles.insert(s.triangles.end(), {a, b, c, b, d, c});
       }
-  std::vector<Aabb> boxes;
-  ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, 0.3f, boxes).ok());
   Bvh tree;
-  tree.build(boxes);
   NormalCones cones;
-  cones.update(tree, s.triangles, s.positions);
+  build_with_cones(s, 0.3f, tree, cones);
   const std::uint32_t per_layer = std::uint32_t(2 * n * n);
   const auto r = ranges(tree);
   std::size_t flat = 0;
@@ -220,12 +223,9 @@ TEST(NormalCones, ASlitWhoseLipsShearApartIsNeverCulled) {
         s.triangles.insert(s.triangles.end(), {p, r, q, q, r, t});
       }
   const float thickness = 0.05f;
-  std::vector<Aabb> boxes;
-  ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, 0.5f * thickness, boxes).ok());
   Bvh tree;
-  tree.build(boxes);
   NormalCones cones;
-  cones.update(tree, s.triangles, s.positions);
+  build_with_cones(s, 0.5f * thickness, tree, cones);
   std::vector<Pair> all, culled;
   self_overlapping_pairs_parallel(tree, SharesVertex{s.triangles}, all);
   self_overlapping_pairs_parallel(tree, SharesVertex{s.triangles}, culled, &cones);

@@ -96,8 +96,8 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   mc->solid_triangles_ = 0;
   while (mc->solid_triangles_ < mc->triangle_body_.size() && mc->triangle_body_[mc->solid_triangles_] < mc->solid_bodies_)
     ++mc->solid_triangles_;
-  mc->index_solid_edges();
   if (mc->desc_.self_collision) {
+    mc->index_solid_edges();
     std::vector<float> start(4 * compiled.positions.size());
     for (std::size_t p = 0; p < compiled.positions.size(); ++p) {
       const auto& x = compiled.positions[p];
@@ -599,15 +599,23 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   };
   all_.clear();
   const auto half = static_cast<float>(0.5 * common);
-  if (!triangles_.empty()) {
-    if (Status s = collision::primitive_boxes(positions_, triangles_, 3, half, boxes_); !s) return s;
+  // The primitives' boxes, swept, and each body's trees refitted to them:
+  // self_tree in the body's own frame of motion (self-collision only), tree
+  // with the velocities themselves.
+  const auto fit = [&](std::span<const std::uint32_t> indices, int arity, std::span<const std::uint32_t> body_of,
+                       std::vector<BodyTree>& trees) -> Status {
+    if (Status s = collision::primitive_boxes(positions_, indices, arity, half, boxes_); !s) return s;
     if (desc_.self_collision) {
       self_boxes_ = boxes_;
-      swell(triangles_, 3, triangle_body_, true, self_boxes_);
-      refit(triangle_trees_, self_boxes_, &BodyTree::self_tree);
+      swell(indices, arity, body_of, true, self_boxes_);
+      refit(trees, self_boxes_, &BodyTree::self_tree);
     }
-    swell(triangles_, 3, triangle_body_, false, boxes_);
-    refit(triangle_trees_, boxes_, &BodyTree::tree);
+    swell(indices, arity, body_of, false, boxes_);
+    refit(trees, boxes_, &BodyTree::tree);
+    return {};
+  };
+  if (!triangles_.empty()) {
+    if (Status s = fit(triangles_, 3, triangle_body_, triangle_trees_); !s) return s;
     candidate_pairs<3>(triangle_trees_, triangles_, triangle_trees_, pairs_);
     if (Status s = check_pairs(); !s) return s;
     if (Status s = collision::triangle_contacts(positions_, triangles_, ownership_, pairs_, reach, found_, wanted);
@@ -616,14 +624,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     keep();
   }
   if (!segments_.empty()) {
-    if (Status s = collision::primitive_boxes(positions_, segments_, 2, half, boxes_); !s) return s;
-    if (desc_.self_collision) {
-      self_boxes_ = boxes_;
-      swell(segments_, 2, segment_body_, true, self_boxes_);
-      refit(segment_trees_, self_boxes_, &BodyTree::self_tree);
-    }
-    swell(segments_, 2, segment_body_, false, boxes_);
-    refit(segment_trees_, boxes_, &BodyTree::tree);
+    if (Status s = fit(segments_, 2, segment_body_, segment_trees_); !s) return s;
     candidate_pairs<2>(segment_trees_, segments_, segment_trees_, pairs_);
     if (Status s = check_pairs(); !s) return s;
     if (Status s = collision::segment_contacts(positions_, segments_, pairs_, reach, found_, wanted); !s)

@@ -92,9 +92,8 @@ Status SolveStepper::rebuild(Device& device, const CompiledScene& scene, const X
 Status SolveStepper::build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
                            const std::array<double, 3>& gravity, const StatsPlan& stats,
                            const MeshContactBuffers* mesh_contacts) {
-  SolveStepper* st = this;
   const SolverSettings& solver = solver_;
-  SolvePrograms parts(scene, buffers, solver, gravity, st->chebyshev_, mesh_contacts);
+  SolvePrograms parts(scene, buffers, solver, gravity, chebyshev_, mesh_contacts);
   const int substeps = parts.substeps();
   const int iterations = solver.iterations;
   const auto prepare = [&](const FrameProgram& program) {
@@ -103,8 +102,8 @@ Status SolveStepper::build(Device& device, const CompiledScene& scene, const Xpb
     return device.create_program(counted);
   };
 
-  if (!st->residual_mode_) {
-    FrameProgram& p = st->shortest_frame_;
+  if (!residual_mode_) {
+    FrameProgram& p = shortest_frame_;
     for (int s = 0; s < substeps; ++s) {
       parts.append_predict(p, s);
       parts.append_sweeps(p, s, 1, iterations, false);  // warm_start needs residual mode
@@ -114,7 +113,7 @@ Status SolveStepper::build(Device& device, const CompiledScene& scene, const Xpb
     append_stats(p, stats, buffers);
     auto made = prepare(p);
     if (!made) return made.error();
-    st->whole_ = *made;
+    whole_ = *made;
     return {};
   }
 
@@ -127,44 +126,44 @@ Status SolveStepper::build(Device& device, const CompiledScene& scene, const Xpb
     const int until_started = (std::max(0, solver.chebyshev_delay + 1 - iterations) + c - 1) / c + 1;
     distinct = std::min(chunks_to_cap, std::max(until_started, kMostChunkPrograms / std::max(1, substeps)));
   }
-  st->begin_.resize(substeps);
-  st->chunks_.resize(substeps);
-  if (solver.warm_start) st->begin_cold_.resize(substeps);
+  begin_.resize(substeps);
+  chunks_.resize(substeps);
+  if (solver.warm_start) begin_cold_.resize(substeps);
   for (int s = 0; s < substeps; ++s) {
     const auto begin_program = [&](bool warm) {
       FrameProgram begin;
       if (s > 0) parts.append_update(begin, s - 1);
       parts.append_predict(begin, s);
       parts.append_sweeps(begin, s, 1, iterations, warm);
-      parts.append_check(begin, s, st->check_);
+      parts.append_check(begin, s, check_);
       return begin;
     };
     const FrameProgram begin = begin_program(solver.warm_start);
-    append_commands(st->shortest_frame_, Commands(begin.commands()));
+    append_commands(shortest_frame_, Commands(begin.commands()));
     auto made = prepare(begin);
     if (!made) return made.error();
-    st->begin_[s] = *made;
+    begin_[s] = *made;
     if (solver.warm_start) {
       made = prepare(begin_program(false));
       if (!made) return made.error();
-      st->begin_cold_[s] = *made;
+      begin_cold_[s] = *made;
     }
     for (int j = 0; j < distinct; ++j) {
       FrameProgram chunk;
       parts.append_sweeps(chunk, s, iterations + j * c + 1, c, false);
-      parts.append_check(chunk, s, st->check_);
+      parts.append_check(chunk, s, check_);
       auto chunk_made = prepare(chunk);
       if (!chunk_made) return chunk_made.error();
-      st->chunks_[s].push_back(*chunk_made);
+      chunks_[s].push_back(*chunk_made);
     }
   }
   FrameProgram end;
   parts.append_update(end, substeps - 1);
   append_stats(end, stats, buffers);
-  append_commands(st->shortest_frame_, Commands(end.commands()));
+  append_commands(shortest_frame_, Commands(end.commands()));
   auto made = prepare(end);
   if (!made) return made.error();
-  st->end_ = *made;
+  end_ = *made;
   return {};
 }
 
