@@ -310,6 +310,117 @@ TEST(NarrowPhase, TriangleDistanceMatchesASampledOracle) {
   EXPECT_GT(crossing, 0);  // some pairs cross: the zero case is checked too
 }
 
+// Oracle: the distance between two triangles in double, the least of their
+// six vertex-triangle and nine edge-edge distances.
+double triangle_triangle(const double4 (&a)[3], const double4 (&b)[3]) {
+  double best = INFINITY;
+  for (int k = 0; k < 3; ++k) {
+    best = std::min({best, point_triangle(a[k], b[0], b[1], b[2]), point_triangle(b[k], a[0], a[1], a[2])});
+    for (int l = 0; l < 3; ++l) best = std::min(best, segment_segment(a[k], a[(k + 1) % 3], b[l], b[(l + 1) % 3]));
+  }
+  return best;
+}
+
+// The narrow phase's first reject (triangles_apart: a separating axis
+// among the normals and in-plane edge normals) never calls a pair apart
+// that the double oracle puts within the gap, and triangle_contacts, which
+// rejects with it first, still finds every vertex-triangle and edge-edge
+// pair within the thickness: random pairs side by side in one plane (a
+// surface's neighbours), in parallel planes, near each other at random,
+// and tiny against large, half of them far from the origin.
+TEST(NarrowPhase, TheSeparatingAxisRejectNeverDropsAPairWithinTheThickness) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const float thickness = 0.1f;
+  const std::uint32_t ia[3] = {0, 1, 2}, ib[3] = {3, 4, 5};
+  const std::vector<Pair> pair = {{0, 1}};
+  const std::vector<std::uint32_t> tris = {0, 1, 2, 3, 4, 5};
+  TriangleOwnership both;  // each triangle owns its features: the pair tests all fifteen
+  both.owner = {{0, 0, 0, 0, 0, 0}, {1, 1, 1, 1, 1, 1}};
+  int rejected = 0, within = 0;
+  std::vector<Contact> contacts;
+  for (int n = 0; n < 20000; ++n) {
+    double4 a[3], b[3];
+    for (auto& p : a) p = random_point(rng);
+    const double4 normal = kernels::cross3(a[1] - a[0], a[2] - a[0]);
+    const double4 up = (1.0 / norm(normal)) * normal;
+    double4 along = kernels::cross3(up, random_point(rng));  // a direction in a's plane
+    along = (1.0 / norm(along)) * along;
+    switch (n % 4) {
+      case 0:  // side by side in one plane, slightly tilted
+        for (int k = 0; k < 3; ++k)
+          b[k] = kernels::add_scaled3(kernels::add_scaled3(a[k], 3.0 * u(rng), along), 0.02 * (u(rng) - 0.5), up);
+        break;
+      case 1:  // in a parallel plane about the thickness away
+        for (int k = 0; k < 3; ++k)
+          b[k] = kernels::add_scaled3(kernels::add_scaled3(a[(k + 1) % 3], 2.0 * u(rng), along), 0.2 * u(rng), up);
+        break;
+      case 2:  // at random nearby
+        for (auto& p : b) p = kernels::add_scaled3(a[0], 1.0, random_point(rng, 1.0));
+        break;
+      default: {  // a tiny triangle near a's surface
+        const double4 c = px::at<double>({0.2 + 0.3 * u(rng), 0.3, 0.0}, a[0], a[1], a[2]);
+        const double4 centre = {c.x, c.y, c.z, 0.0};
+        const double4 mid = px::at<double>({0.5, 0.2, 0.3}, a[0], a[1], a[2]);
+        const double4 p0 = kernels::add_scaled3(kernels::add_scaled3(mid, 0.0, centre), 0.15 * (u(rng) - 0.3), up);
+        for (auto& p : b) p = kernels::add_scaled3(p0, 1.0, random_point(rng, 0.05));
+        break;
+      }
+    }
+    const double shift = n % 2 == 0 ? 100.0 : 0.0;  // far from the origin: the reject works relative to the pair
+    std::vector<float> x(24, 0.0f);
+    double4 fa[3], fb[3];  // the float positions, in double, for the oracle
+    for (int k = 0; k < 3; ++k) {
+      const double4* src[2] = {&a[k], &b[k]};
+      for (int t = 0; t < 2; ++t) {
+        float* v = &x[4 * std::size_t(3 * t + k)];
+        v[0] = float(src[t]->x + shift), v[1] = float(src[t]->y), v[2] = float(src[t]->z);
+        (t == 0 ? fa : fb)[k] = {double(v[0]), double(v[1]), double(v[2]), 0.0};
+      }
+    }
+    const double distance = triangle_triangle(fa, fb);
+    if (triangles_apart(x, ia, ib, thickness)) {
+      ++rejected;
+      ASSERT_GT(distance, double(thickness)) << "pair " << n << " called apart";
+    }
+    ASSERT_TRUE(triangle_contacts(x, tris, both, pair, thickness, contacts).ok()) << "pair " << n;
+    const auto found = [&](Contact::Kind kind, std::array<std::uint32_t, 4> v) {
+      return std::any_of(contacts.begin(), contacts.end(), [&](const Contact& c) {
+        if (c.kind != kind) return false;
+        if (kind == Contact::Kind::vertex_triangle)
+          return c.v[0] == v[0] && std::is_permutation(c.v.begin() + 1, c.v.end(), v.begin() + 1);
+        const auto edge = [](std::uint32_t p, std::uint32_t q) { return std::pair{std::min(p, q), std::max(p, q)}; };
+        const auto e1 = edge(c.v[0], c.v[1]), e2 = edge(c.v[2], c.v[3]);
+        const auto f1 = edge(v[0], v[1]), f2 = edge(v[2], v[3]);
+        return (e1 == f1 && e2 == f2) || (e1 == f2 && e2 == f1);
+      });
+    };
+    const double inside = double(thickness) * (1.0 - 1e-4);  // clear of the float rounding at the boundary
+    for (int k = 0; k < 3; ++k) {
+      if (point_triangle(fa[k], fb[0], fb[1], fb[2]) < inside) {
+        ++within;
+        ASSERT_TRUE(found(Contact::Kind::vertex_triangle, {std::uint32_t(k), 3, 4, 5})) << "pair " << n;
+      }
+      if (point_triangle(fb[k], fa[0], fa[1], fa[2]) < inside) {
+        ++within;
+        ASSERT_TRUE(found(Contact::Kind::vertex_triangle, {std::uint32_t(3 + k), 0, 1, 2})) << "pair " << n;
+      }
+      for (int l = 0; l < 3; ++l)
+        if (segment_segment(fa[k], fa[(k + 1) % 3], fb[l], fb[(l + 1) % 3]) < inside) {
+          ++within;
+          ASSERT_TRUE(found(Contact::Kind::edge_edge, {std::uint32_t(k), std::uint32_t((k + 1) % 3),
+                                                       std::uint32_t(3 + l), std::uint32_t(3 + (l + 1) % 3)}))
+              << "pair " << n;
+        }
+    }
+  }
+  // Both branches are exercised: many pairs rejected, many features found.
+  EXPECT_GT(rejected, 2000);
+  EXPECT_GT(within, 2000);
+  std::printf("[ narrow ] 20000 random pairs: %d called apart, %d features within the thickness, all found\n",
+              rejected, within);
+}
+
 // A filter given to the narrow phase keeps exactly the contacts it would
 // keep afterwards (the solver passes its own: facing, within each pair's
 // reach), on the armadillo's surface.

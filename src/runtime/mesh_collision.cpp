@@ -148,22 +148,12 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
 // rest, the nearest 0.03 mm, and with self-collision on the organ example
 // blew up (28 m/s by frame 20, then the pair capacity error).
 Status MeshCollision::find_rest_close(std::span<const float> start) {
-  std::vector<collision::Aabb> boxes;
   std::vector<collision::Pair> pairs;
-  collision::Bvh tree;
   for (BodyTree& body : triangle_trees_) {
     const auto mine = std::span<const std::uint32_t>(triangles_).subspan(std::size_t{body.first} * 3,
                                                                          std::size_t{body.count} * 3);
-    if (Status s = collision::primitive_boxes(start, mine, 3, static_cast<float>(0.5 * desc_.thickness), boxes); !s)
-      return s;
-    tree.build(boxes);
-    collision::self_overlapping_pairs_parallel(tree, collision::SharesVertex{mine}, pairs);
-    body.rest_close.clear();
-    for (const auto& [i, j] : pairs)
-      if (collision::triangle_distance(start, &mine[3 * std::size_t{i}], &mine[3 * std::size_t{j}]) <
-          static_cast<float>(desc_.thickness))
-        body.rest_close.push_back({i, j});
-    std::sort(body.rest_close.begin(), body.rest_close.end());
+    if (Status s = collision::rest_close_pairs(start, mine, static_cast<float>(desc_.thickness), pairs); !s) return s;
+    body.rest_close = collision::PairSet(pairs, body.count);
   }
   return {};
 }
@@ -239,17 +229,16 @@ void MeshCollision::candidate_pairs(std::vector<BodyTree>& a, std::span<const st
   for (std::size_t i = 0; i < a.size(); ++i) {
     if (same && desc_.self_collision) {
       const auto mine = indices.subspan(std::size_t{a[i].first} * Arity, std::size_t{a[i].count} * Arity);
-      const collision::SharesVertexOf<Arity> shares{mine};
+      // Skipped: pairs that share a vertex, and those closer than the
+      // thickness at rest (triangles only; rest_close.h).
+      const collision::SharesVertexOrListed<Arity> skip{{mine}, a[i].rest_close.empty() ? nullptr : &a[i].rest_close};
       const collision::NormalCones* cones = nullptr;
       if (Arity == 3 && desc_.self_culling) {
         a[i].cones.update(a[i].self_tree, mine, positions_);
         cones = &a[i].cones;
       }
-      collision::self_overlapping_pairs_parallel(a[i].self_tree, shares, local_, cones);
-      const auto& close = a[i].rest_close;
-      for (const auto& [p, q] : local_)
-        if (close.empty() || !std::binary_search(close.begin(), close.end(), collision::Pair{p, q}))
-          pairs.push_back({a[i].first + p, a[i].first + q});
+      collision::self_overlapping_pairs_parallel(a[i].self_tree, skip, local_, cones);
+      for (const auto& [p, q] : local_) pairs.push_back({a[i].first + p, a[i].first + q});
     }
     for (std::size_t j = same ? i + 1 : 0; j < b.size(); ++j) {
       collision::overlapping_pairs(a[i].tree, b[j].tree, local_);

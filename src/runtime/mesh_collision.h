@@ -23,6 +23,7 @@
 #include "collision/bvh.h"
 #include "collision/narrow_phase.h"
 #include "collision/normal_cones.h"
+#include "collision/rest_close.h"
 #include "compiler/scene_compiler.h"
 #include "program/xpbd_program.h"
 #include "runtime/tool_contacts.h"
@@ -76,9 +77,9 @@ class MeshCollision {
     collision::Bvh tree;       // boxes swept by the vertices' velocities: against other bodies
     collision::Bvh self_tree;  // swept relative to the body's mean velocity: against itself (self-collision only)
     collision::NormalCones cones;  // of self_tree; triangle trees with self-culling only
-    // Triangle trees with self-collision: the pairs (local indices, sorted)
+    // Triangle trees with self-collision: the pairs (local indices)
     // closer than the thickness in the starting shape, never in contact.
-    std::vector<collision::Pair> rest_close;
+    collision::PairSet rest_close;
   };
   std::vector<BodyTree> triangle_trees_, segment_trees_;
   std::vector<collision::Pair> local_;
