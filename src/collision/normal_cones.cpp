@@ -160,9 +160,9 @@ void NormalCones::connect(const Bvh& tree, std::span<const std::uint32_t> triang
 }
 
 bool NormalCones::pair(std::uint32_t a, std::uint32_t b) const {
-  if (!connected_[a] || !connected_[b] || open_[a] || open_[b] || cones_[a].cos < flat_cos_ ||
-      cones_[b].cos < flat_cos_)
-    return false;
+  // flat_: connected, without open edges, a cone within kFlatDegrees (one
+  // byte per node; most node pairs stop here).
+  if (!flat_[a] || !flat_[b]) return false;
   float axis[3] = {sum_[3 * a] + sum_[3 * b], sum_[3 * a + 1] + sum_[3 * b + 1], sum_[3 * a + 2] + sum_[3 * b + 2]};
   const float length = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
   if (!(length > 0.0f)) return false;

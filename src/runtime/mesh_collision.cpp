@@ -14,6 +14,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "coloring/greedy_coloring.h"
 #include "collision/parallel_pairs.h"
@@ -208,7 +209,15 @@ void MeshCollision::refit(std::vector<BodyTree>& trees, std::span<const collisio
     const auto mine = boxes.subspan(t.first, t.count);
     collision::Bvh& tree = t.*which;
     if (tree.empty()) tree.build(mine);
-    else tree.update(mine);
+    else tree.refit(mine);
+  }
+}
+
+void MeshCollision::rebuild_degraded(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes,
+                                     collision::Bvh BodyTree::*which) {
+  for (BodyTree& t : trees) {
+    collision::Bvh& tree = t.*which;
+    if (tree.degradation() > kMaxDegradation) tree.build(boxes.subspan(t.first, t.count));
   }
 }
 
@@ -232,11 +241,7 @@ void MeshCollision::candidate_pairs(std::vector<BodyTree>& a, std::span<const st
       // Skipped: pairs that share a vertex, and those closer than the
       // thickness at rest (triangles only; rest_close.h).
       const collision::SharesVertexOrListed<Arity> skip{{mine}, a[i].rest_close.empty() ? nullptr : &a[i].rest_close};
-      const collision::NormalCones* cones = nullptr;
-      if (Arity == 3 && desc_.self_culling) {
-        a[i].cones.update(a[i].self_tree, mine, positions_);
-        cones = &a[i].cones;
-      }
+      const collision::NormalCones* cones = Arity == 3 && desc_.self_culling ? &a[i].cones : nullptr;
       collision::self_overlapping_pairs_parallel(a[i].self_tree, skip, local_, cones);
       for (const auto& [p, q] : local_) pairs.push_back({a[i].first + p, a[i].first + q});
     }
@@ -603,8 +608,37 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     refit(trees, boxes_, &BodyTree::tree);
     return {};
   };
+  // Trees that refitting degraded are rebuilt after it (Bvh::update's rule).
+  const auto rebuild = [&](std::vector<BodyTree>& trees) {
+    if (desc_.self_collision) rebuild_degraded(trees, self_boxes_, &BodyTree::self_tree);
+    rebuild_degraded(trees, boxes_, &BodyTree::tree);
+  };
   if (!triangles_.empty()) {
-    if (Status s = fit(triangles_, 3, triangle_body_, triangle_trees_); !s) return s;
+    // The normal cones (self-culling) need the positions and the self
+    // trees' shapes only, not their boxes: they are updated on a second
+    // thread while the boxes are computed and refitted (the liver's
+    // surface, bench_broad_phase: 0.8 ms less per frame on 2 cores). A tree
+    // built or rebuilt meanwhile has a new shape: its cones are redone.
+    const bool cull = desc_.self_collision && desc_.self_culling;
+    std::vector<std::uint64_t> shape(triangle_trees_.size());
+    for (std::size_t b = 0; b < triangle_trees_.size(); ++b) shape[b] = triangle_trees_[b].self_tree.build_id();
+    const auto cones_of = [&](BodyTree& body) {
+      body.cones.update(body.self_tree, std::span<const std::uint32_t>(triangles_).subspan(std::size_t{body.first} * 3,
+                                                                                          std::size_t{body.count} * 3),
+                        positions_);
+    };
+    Status fitted;
+    tbb::parallel_invoke([&] { fitted = fit(triangles_, 3, triangle_body_, triangle_trees_); },
+                         [&] {
+                           if (!cull) return;
+                           for (BodyTree& body : triangle_trees_)
+                             if (!body.self_tree.empty()) cones_of(body);
+                         });
+    if (!fitted) return fitted;
+    rebuild(triangle_trees_);
+    if (cull)
+      for (std::size_t b = 0; b < triangle_trees_.size(); ++b)
+        if (triangle_trees_[b].self_tree.build_id() != shape[b]) cones_of(triangle_trees_[b]);
     candidate_pairs<3>(triangle_trees_, triangles_, triangle_trees_, pairs_);
     if (Status s = check_pairs(); !s) return s;
     if (Status s = collision::triangle_contacts(positions_, triangles_, ownership_, pairs_, reach, found_, wanted);
@@ -614,6 +648,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   }
   if (!segments_.empty()) {
     if (Status s = fit(segments_, 2, segment_body_, segment_trees_); !s) return s;
+    rebuild(segment_trees_);
     candidate_pairs<2>(segment_trees_, segments_, segment_trees_, pairs_);
     if (Status s = check_pairs(); !s) return s;
     if (Status s = collision::segment_contacts(positions_, segments_, pairs_, reach, found_, wanted); !s)

@@ -111,8 +111,15 @@ class MeshCollision {
   // primitive's deepest point against a plane is always a corner) nor
   // tools (their reaction comes from the particle contacts only).
   void shape_faces(std::span<const PosedShape> colliders, double common);
+  // Refits each body's tree `which` to its primitives' boxes (builds it
+  // when empty); then rebuild_degraded rebuilds those whose refit left
+  // their degradation above kMaxDegradation (as Bvh::update does, in two
+  // steps so that the cones can be updated beside the refit).
   static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes,
                     collision::Bvh BodyTree::*which);
+  static void rebuild_degraded(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes,
+                               collision::Bvh BodyTree::*which);
+  static constexpr double kMaxDegradation = 2.0;
   // Fills each triangle tree's rest_close from the starting positions
   // (device order, xyzw).
   Status find_rest_close(std::span<const float> start);
