@@ -52,7 +52,7 @@ struct BufferHandle {
 /// of the program when the dispatch runs, and `count` is its capacity
 /// (see FrameProgram::dispatch_indirect).
 struct Dispatch {
-  static constexpr std::size_t max_bindings = 8;
+  static constexpr std::size_t max_bindings = 12;
   static constexpr std::size_t max_params_bytes = 64;
   Kernel kernel = Kernel::count_;
   std::uint32_t count = 0;                            ///< work items (the capacity when indirect)

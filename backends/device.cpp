@@ -122,6 +122,9 @@ Status check_program(const FrameProgram& program, std::span<const std::size_t> b
                    where + ": unknown kernel id " + std::to_string(static_cast<std::uint32_t>(d->kernel)));
     const KernelSignature& sig = kernel_signature(d->kernel);
     const std::string who = where + " (" + std::string(sig.name) + ")";
+    if (d->binding_count > Dispatch::max_bindings)
+      return Error(ErrorCode::internal, who + ": binds " + std::to_string(d->binding_count) + " buffers, at most " +
+                                            std::to_string(Dispatch::max_bindings));
     if (d->binding_count != sig.bindings)
       return Error(ErrorCode::internal, who + ": binds " + std::to_string(d->binding_count) +
                                             " buffers, the kernel takes " + std::to_string(sig.bindings));

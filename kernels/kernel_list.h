@@ -46,8 +46,8 @@
   SINEW_KERNEL(xpbd_solve_attachment, 6, SolveParams, 0)                         \
   SINEW_KERNEL(xpbd_solve_contacts, 8, SolveParams, 0)                           \
   /* contacts between meshes (kernels/shared/mesh_contact_params.h) */           \
-  SINEW_KERNEL(xpbd_solve_mesh_contacts, 7, MeshContactParams, 0)                \
-  SINEW_KERNEL(xpbd_mesh_contacts_jacobi, 8, MeshContactParams, 0)               \
+  SINEW_KERNEL(xpbd_solve_mesh_contacts, 9, MeshContactParams, 0)                \
+  SINEW_KERNEL(xpbd_mesh_contacts_jacobi, 10, MeshContactParams, 0)              \
   SINEW_KERNEL(xpbd_mesh_contacts_gather, 6, MeshContactParams, 0)               \
   /* device-side work of data-dependent size (kernels/shared/primitive_params.h) */ \
   SINEW_KERNEL(indirect_args, 2, IndirectArgsParams, 0)                          \

@@ -15,6 +15,7 @@
 #include "math/proximity_math.h"
 #include "sinew/mesh.h"
 #include "sinew/scene.h"
+#include "sinew/simulation.h"
 
 namespace sinew::test {
 
@@ -431,6 +432,39 @@ struct ThinProbe {
   /// The probe's centre at the end of frame f [m] (f = -1: the start).
   static std::array<double, 3> probe_at(int f) {
     return {0.03, 0.007 - 0.015 * std::min(1.0, (f + 1) / 30.0), 0.03};  // over the middle of cell (1, 1)
+  }
+  /// The same membrane with the probe as a rigid tool of `mass` [kg] (no
+  /// collider, no gravity) starting 0.1 mm above it over the middle of
+  /// cell (1, 1) (no vertex under it), to be held by couple().
+  static SceneDesc tool_scene(double mass) {
+    SceneDesc scene = ThinProbe::scene();
+    const ColliderDesc probe = scene.colliders[0];
+    scene.colliders.clear();
+    ToolDesc tool;
+    tool.radius = probe.radius;
+    tool.half_height = probe.half_height;
+    tool.mass = mass;
+    tool.gravity = false;
+    const double length = 2.0 * probe.half_height;  // a solid rod's moments, about its centre
+    tool.inertia = {mass * length * length / 12.0, 0.5 * mass * probe.radius * probe.radius,
+                    mass * length * length / 12.0};
+    tool.rotation = probe.rotation;  // its axis along z
+    tool.position = {0.03, 0.0001 + probe.radius + scene.mesh_collision.thickness, 0.03};
+    scene.tools.push_back(tool);
+    return scene;
+  }
+  /// A virtual coupling, as a haptic device drives a tool (rigid_tool.h): a
+  /// critically damped spring of kCoupling [N/m] from the tool of `mass`
+  /// [kg] to kTarget, 10 mm under the membrane, applied for the coming
+  /// frame from the tool's state. [out] pull: the spring's force [N].
+  static constexpr double kCoupling = 20.0;
+  static constexpr std::array<double, 3> kTarget{0.03, -0.01, 0.03};
+  static Status couple(Simulation& sim, double mass, std::array<double, 3>& pull) {
+    auto state = sim.tool_state(0);
+    if (!state) return state.error();
+    const double damping = 2.0 * std::sqrt(kCoupling * mass);
+    for (int k = 0; k < 3; ++k) pull[k] = kCoupling * (kTarget[k] - state->position[k]) - damping * state->velocity[k];
+    return sim.apply_tool_force(0, pull, {0.0, 0.0, 0.0});
   }
 };
 

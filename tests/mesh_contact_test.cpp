@@ -450,10 +450,76 @@ TEST_P(MeshContact, ThinProbePressesACoarseThreadBetweenItsVertices) {
   EXPECT_LT(lowest, lowest_tip + 1e-3);                          // pressed down with it
 }
 
+// A rigid tool (the thin probe's capsule, 20 g, no gravity) held by a
+// virtual coupling (ThinProbe::couple: a critically damped spring of 20 N/m,
+// as a haptic device drives a tool) to a target 10 mm under the middle of
+// a coarse membrane's cell (no vertex under it, the border pinned): only
+// the triangles' faces can hold it. Its axis never crosses the membrane, it
+// stops on the membrane well above the target, and the reaction the faces
+// give it (MeshCollision::add_tool_reactions) balances the spring: over
+// the last 60 frames the mean contact force is the mean spring force's
+// opposite within 10%, with no sideways part to speak of. With the faces
+// turned off (MeshCollisionDesc::tool_faces) the tool passes through the
+// cell to the target.
+TEST_P(MeshContact, AToolHeldByACouplingPressesACoarseMembraneBetweenItsVertices) {
+  const double mass = 0.02;
+  const SceneDesc scene = ThinProbe::tool_scene(mass);
+  const double target = ThinProbe::kTarget[1];
+  auto sim = create_or_skip(scene, GetParam());
+  SINEW_ASSERT_OK(sim);
+  const std::uint32_t first = sim->info().tri_body_first_particle[0];
+  const ToolDesc& tool = scene.tools[0];
+  std::vector<float> x;
+  int crossings = 0;
+  double force[3] = {0.0, 0.0, 0.0}, spring = 0.0;
+  constexpr int kFrames = 150, kAveraged = 60;
+  for (int f = 0; f < kFrames; ++f) {
+    std::array<double, 3> pull{};
+    SINEW_ASSERT_OK(ThinProbe::couple(*sim, mass, pull));
+    SINEW_ASSERT_OK(sim->step());
+    SINEW_ASSERT_OK(sim->read_positions(x));
+    auto state = sim->tool_state(0);
+    SINEW_ASSERT_OK(state);
+    const P3 c{state->position[0], state->position[1], state->position[2]};
+    const P3 axis0{c[0], c[1], c[2] - tool.half_height}, axis1{c[0], c[1], c[2] + tool.half_height};
+    for (const auto& t : scene.tri_bodies[0].mesh.triangles)
+      crossings += segment_crosses_triangle(axis0, axis1, at(x, first + t[0]), at(x, first + t[1]), at(x, first + t[2]));
+    if (f >= kFrames - kAveraged) {
+      for (int k = 0; k < 3; ++k) force[k] += state->contact_force[k] / kAveraged;
+      spring += pull[1] / kAveraged;
+    }
+  }
+  auto state = sim->tool_state(0);
+  SINEW_ASSERT_OK(state);
+  std::printf("[%s] tool at %.2f mm (target %.2f), mean contact force (%.4f, %.4f, %.4f) N against a mean spring "
+              "force of %.4f N, %d crossings, %u contacts\n",
+              GetParam().c_str(), 1e3 * state->position[1], 1e3 * target, force[0], force[1], force[2], spring,
+              crossings, sim->last_frame().mesh_contacts);
+  EXPECT_EQ(crossings, 0);
+  EXPECT_GT(state->position[1], target + 0.003) << "through the membrane";
+  EXPECT_LT(spring, -0.05) << "the spring presses the tool down";
+  EXPECT_NEAR(force[1], -spring, 0.1 * std::abs(spring));
+  EXPECT_LT(std::hypot(force[0], force[2]), 0.1 * std::abs(spring));
+
+  SceneDesc without = scene;
+  without.mesh_collision.tool_faces = false;
+  auto through = create_or_skip(without, GetParam());
+  SINEW_ASSERT_OK(through);
+  for (int f = 0; f < kFrames; ++f) {
+    std::array<double, 3> pull{};
+    SINEW_ASSERT_OK(ThinProbe::couple(*through, mass, pull));
+    SINEW_ASSERT_OK(through->step());
+  }
+  auto passed = through->tool_state(0);
+  SINEW_ASSERT_OK(passed);
+  EXPECT_NEAR(passed->position[1], target, 5e-4) << "without the faces nothing holds the tool";
+}
+
 // Every backend against the CPU reference after 100 frames: the dropped
 // blocks with either schedule (contacts from the third frame on), the
 // folded membrane (self-contacts from about the 40th) and the thin probe
-// (triangle-shape contacts) with either schedule: positions within
+// (triangle-shape contacts) with either schedule, and the coupled tool on
+// the membrane (its faces' reaction moves the tool): positions within
 // 1e-5 m (the kernels follow the CPU's operation order without fused
 // multiply-adds, so they are expected to agree bitwise; the test prints how
 // many coordinates do). The contacts are found on the host from each
@@ -465,6 +531,7 @@ TEST_P(MeshContact, BackendsAgreeWithTheCpuReference) {
     const char* name;
     SceneDesc scene;
     bool fold, probe;
+    bool tool = false;  // held by ThinProbe::couple
   };
   SceneDesc probe_jacobi = ThinProbe::scene();
   probe_jacobi.mesh_collision.schedule = ContactSchedule::jacobi;
@@ -472,7 +539,8 @@ TEST_P(MeshContact, BackendsAgreeWithTheCpuReference) {
                         {"blocks, jacobi", dropped_blocks_scene(ContactSchedule::jacobi), false, false},
                         {"fold, colored", FoldedStrip::scene(ContactSchedule::colored), true, false},
                         {"thin probe, colored", ThinProbe::scene(), false, true},
-                        {"thin probe, jacobi", probe_jacobi, false, true}};
+                        {"thin probe, jacobi", probe_jacobi, false, true},
+                        {"coupled tool on the membrane", ThinProbe::tool_scene(0.02), false, false, true}};
   for (const Case& c : cases) {
     auto reference = create_or_skip(c.scene, "cpu");
     auto sim = create_or_skip(c.scene, GetParam());
@@ -483,6 +551,11 @@ TEST_P(MeshContact, BackendsAgreeWithTheCpuReference) {
       for (int k = 0; c.fold && k <= FoldedStrip::nz; ++k) {
         SINEW_ASSERT_OK(reference->set_target(k, FoldedStrip::target(f, k)));
         SINEW_ASSERT_OK(sim->set_target(k, FoldedStrip::target(f, k)));
+      }
+      if (c.tool) {
+        std::array<double, 3> pull{};
+        SINEW_ASSERT_OK(ThinProbe::couple(*reference, 0.02, pull));
+        SINEW_ASSERT_OK(ThinProbe::couple(*sim, 0.02, pull));
       }
       if (c.probe) {
         const auto at = ThinProbe::probe_at(f % ThinProbe::frames);  // pressed, then again from the top

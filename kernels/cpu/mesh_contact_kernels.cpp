@@ -85,9 +85,11 @@ Step solve_contact(const float4 (&xk)[4], const float4 (&prev)[4], const float (
   return out;
 }
 
-// Contact i's particles, their positions and the solve, as both schedules read them.
-Step solve_item(std::uint32_t i, const MeshContactParams& p, std::byte* const* bindings, const std::uint32_t*& v,
-                float4 (&xk)[4]) {
+// Contact i's particles, their positions and the solve, as both schedules
+// read them; in a substep's first sweep the last substep's lambda is added
+// to the frame's sum at `sum` (or the sum zeroed in the frame's first).
+Step solve_item(std::uint32_t i, const MeshContactParams& p, std::byte* const* bindings, float4* sum,
+                const float* motion, const std::uint32_t*& v, float4 (&xk)[4]) {
   const auto* x = reinterpret_cast<const float4*>(bindings[0]);
   const auto* prev = reinterpret_cast<const float4*>(bindings[1]);
   const auto* particles = reinterpret_cast<const std::uint32_t*>(bindings[3]);  // 4 per contact
@@ -99,8 +101,11 @@ Step solve_item(std::uint32_t i, const MeshContactParams& p, std::byte* const* b
   for (int k = 0; k < 4; ++k) xk[k] = x[v[k]], before[k] = prev[v[k]];
   const float c[4] = {coefficients[i].x, coefficients[i].y, coefficients[i].z, coefficients[i].w};
   const float4 n{normals[i].x, normals[i].y, normals[i].z, 0.0f};
-  const float4 lambda_i = p.reset_lambda ? float4{0.0f, 0.0f, 0.0f, 0.0f} : lambda[i];
-  return solve_contact(xk, before, c, n, normals[i].w, lambda_i, p);
+  const float4 lambda_old = lambda[i];
+  if (p.reset_lambda == 2u) sum[i] = float4{0.0f, 0.0f, 0.0f, 0.0f};
+  if (p.reset_lambda == 1u) sum[i] = sum[i] + lambda_old;
+  const float4 lambda_i = p.reset_lambda != 0u ? float4{0.0f, 0.0f, 0.0f, 0.0f} : lambda_old;
+  return solve_contact(xk, before, c, n, normals[i].w + motion[i] * (1.0f - p.substep_end), lambda_i, p);
 }
 
 }  // namespace
@@ -111,13 +116,15 @@ void xpbd_solve_mesh_contacts(const void* params, std::byte* const* bindings, st
   auto* x = reinterpret_cast<float4*>(bindings[0]);
   const auto* table = reinterpret_cast<const std::uint32_t*>(bindings[2]);
   auto* lambda = reinterpret_cast<float4*>(bindings[6]);
+  auto* sum = reinterpret_cast<float4*>(bindings[7]);
+  const auto* motion = reinterpret_cast<const float*>(bindings[8]);
   const std::uint32_t count = table[p.color];
   const std::uint32_t first = table[p.colors + p.color];
   for (std::uint32_t item = begin; item < std::min(end, count); ++item) {
     const std::uint32_t i = first + item;
     const std::uint32_t* v = nullptr;
     float4 xk[4];
-    const Step s = solve_item(i, p, bindings, v, xk);
+    const Step s = solve_item(i, p, bindings, sum, motion, v, xk);
     // Immovable particles are never written (contacts of a colour may share one).
     for (int k = 0; k < 4; ++k)
       if (xk[k].w > 0.0f) x[v[k]] = float4{s.z[k].x, s.z[k].y, s.z[k].z, xk[k].w};
@@ -131,10 +138,12 @@ void xpbd_mesh_contacts_jacobi(const void* params, std::byte* const* bindings, s
   const auto* table = reinterpret_cast<const std::uint32_t*>(bindings[2]);
   auto* lambda = reinterpret_cast<float4*>(bindings[6]);
   auto* delta = reinterpret_cast<float4*>(bindings[7]);  // 4 per contact
+  auto* sum = reinterpret_cast<float4*>(bindings[8]);
+  const auto* motion = reinterpret_cast<const float*>(bindings[9]);
   for (std::uint32_t i = begin; i < std::min(end, table[0]); ++i) {
     const std::uint32_t* v = nullptr;
     float4 xk[4];
-    const Step s = solve_item(i, p, bindings, v, xk);
+    const Step s = solve_item(i, p, bindings, sum, motion, v, xk);
     for (int k = 0; k < 4; ++k)
       delta[4 * std::size_t{i} + k] = float4{s.z[k].x - xk[k].x, s.z[k].y - xk[k].y, s.z[k].z - xk[k].z, 0.0f};
     lambda[i] = s.lambda;

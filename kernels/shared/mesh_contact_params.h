@@ -20,9 +20,12 @@
  *   segment-shape    c = (0, 1 - s, 0, s) on particles (a, a, b, b) alike;
  * n points from the second primitive to the first (from the shape). With
  * o = normal.w (0 between meshes; thickness - n . s for a shape's surface
- * point s, so the triangle touches the shape like a vertex does) the
- * constraint is
- *   C = n . sum_k c_k x_k + o - thickness >= 0
+ * point s at the frame's end, so the triangle touches the shape like a
+ * vertex does) and m the plane's motion (binding 8: 0 but for a rigid
+ * tool's faces, o_start - o_end, so that the plane moves with the tool
+ * across the frame instead of jumping to where it ends: t = substep_end)
+ * the constraint is
+ *   C = n . sum_k c_k x_k + o + m (1 - t) - thickness >= 0
  * keeps the first primitive on its side of the plane through the second's
  * closest point (a separating plane at the frame's start: conservative),
  * at least `thickness` away. Gradient for particle k: c_k n; with
@@ -52,7 +55,19 @@
  *   4 coefficients float4 per contact (c_0..c_3) [in]
  *   5 normal float4 per contact (xyz unit, w the offset o) [in]
  *   6 lambda float4 per contact [in/out]: (lambda_n, lambda_t xyz), [kg m],
- *     reset to 0 in a substep's first sweep (reset_lambda) */
+ *     reset to 0 in a substep's first sweep (reset_lambda)
+ *   7 lambda sum float4 per contact [in/out]: the final lambda of each of
+ *     the frame's earlier substeps, summed: set to 0 in the frame's first
+ *     sweep (reset_lambda 2), lambda added to it before the reset of every
+ *     later substep (reset_lambda 1). At the frame's end, (sum + lambda) /
+ *     h is the impulse the contact gave its first primitive over the frame,
+ *     lambda / h over its last substep [N s] as vectors lambda_n n +
+ *     lambda_t: the host reads them back for the contacts of triangles and
+ *     segments with a rigid tool, whose reaction they are
+ *     (src/runtime/mesh_collision.h, tool_reactions).
+ *   8 motion float per contact [in]: m above [m].
+ * xpbd_mesh_contacts_jacobi takes the same bindings 0-6, its corrections
+ * at 7, the lambda sum at 8 and the motion at 9. */
 #ifndef SINEW_MESH_CONTACT_PARAMS_H
 #define SINEW_MESH_CONTACT_PARAMS_H
 
@@ -66,11 +81,15 @@ SINEW_STRUCT_BEGIN(MeshContactParams)
   uint color;              /* this dispatch's colour */
   uint colors;             /* colours in the table */
   float inv_h2;            /* 1 / h^2 [1/s^2] */
-  uint reset_lambda;       /* nonzero in a substep's first sweep */
+  uint reset_lambda;       /* a substep's first sweep: 1, the frame's first: 2; else 0 (binding 7) */
   float thickness;         /* [m], > 0: the distance the surfaces keep */
   float compliance;        /* alpha [m/N], >= 0 */
   float static_friction;   /* mu_s */
   float dynamic_friction;  /* mu_k <= mu_s */
+  float substep_end;       /* fraction of the frame done at the end of this substep, in (0, 1] (binding 8) */
+  uint pad0;               /* 16-byte size */
+  uint pad1;
+  uint pad2;
 SINEW_STRUCT_END(MeshContactParams)
 
 #ifdef __cplusplus

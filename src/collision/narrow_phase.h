@@ -53,6 +53,13 @@ struct Contact {
   /// shape_face: thickness - n . (the shape's surface point) [m], the
   /// constant of its constraint (mesh_contact_params.h); 0 otherwise.
   float offset = 0.0f;
+  /// shape_face of a moving shape: the offset at the frame's start minus
+  /// `offset` (at its end) [m] (mesh_contact_params.h: the plane's motion).
+  float motion = 0.0f;
+  /// shape_face: which shape, in the caller's numbering (the solver: the
+  /// rigid tool whose reaction it is, or kNoShape for a collider).
+  std::uint32_t shape = kNoShape;
+  static constexpr std::uint32_t kNoShape = 0xffffffffu;
 };
 
 /// cos 25.8 degrees: how far a contact's normal may turn from the direction

@@ -178,7 +178,15 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
   int best_start = 0;
   for (int k = 1; k < 7; ++k)
     if (const double v = f(starts[k]); v < best) best = v, w = starts[k], best_start = k;
-  if (best > reach) return false;
+  // Every point of the triangle lies in one of the four halves the edges'
+  // midpoints cut it into, within half the longest edge of that half's
+  // corners, all of which are starts; the distance changes no faster than
+  // the point moves, so nothing is within reach if the best start is more
+  // than that beyond it. (Returning when the best start alone was beyond
+  // the reach missed a thin tool pressed into a large triangle's middle.)
+  double longest = 0.0;
+  for (int k = 0; k < 3; ++k) longest = std::max(longest, math::norm(math::sub(corner[(k + 1) % 3], corner[k])));
+  if (best > reach + 0.5 * longest) return false;
   // A corner where the distance grows along both edges is the minimum of
   // a convex distance over the triangle (first-order optimality): most
   // triangles against a shape smoother than they are end here.
@@ -187,7 +195,8 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
     bool rises = true;
     for (int k = 0; k < 3; ++k)
       if (k != best_start) rises &= math::dot(gradient, math::sub(corner[k], corner[best_start])) >= 0.0;
-    if (rises) {
+    if (rises) {  // the least distance, at a corner
+      if (best > reach) return false;
       out.weights = starts[best_start];
       return true;
     }
@@ -216,7 +225,41 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
     if (!(v < best)) break;
     best = v, w = next;
   }
-  if (best > reach) return false;
+  // Frank-Wolfe may stop above the least distance (it zig-zags towards the
+  // corners; tests/shape_distance_test.cpp measures how far). Whether the
+  // triangle comes within reach is not left to it: when it stopped beyond
+  // the reach, nested golden-section searches over the barycentric
+  // coordinates decide, exact for a convex shape (the least over s of the
+  // least over t of a convex function; each search finds its minimum to
+  // 0.618^28 ~ 1e-6 of its range, its ends included). They are not the
+  // first choice: among the near-equal minima of a thin capsule lying along
+  // a tilted triangle they find the one under its end cap, whose normal
+  // slid a coarse membrane off the probe in MeshContact's thin-probe test,
+  // where Frank-Wolfe's stays nearer the middle.
+  if (best > reach) {
+    constexpr int kSteps = 28;
+    const auto golden = [&](double lo, double hi, auto&& value, double& at_min) {
+      const double first = lo, last = hi;
+      double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = value(x1), f2 = value(x2);
+      for (int k = 0; k < kSteps; ++k) {
+        if (f1 <= f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = value(x1);
+        else lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = value(x2);
+      }
+      at_min = 0.5 * (lo + hi);
+      double least = value(at_min);
+      for (const double end : {first, last})  // a least on an edge or at a corner
+        if (const double v = value(end); v < least) least = v, at_min = end;
+      return least;
+    };
+    const auto inner = [&](double s, double& t) {
+      return golden(0.0, 1.0 - s, [&](double u) { return f({std::max(0.0, 1.0 - s - u), s, u}); }, t);
+    };
+    double s_min = 0.0, t_min = 0.0;
+    const double nested = golden(0.0, 1.0, [&](double s) { double t = 0.0; return inner(s, t); }, s_min);
+    if (!(nested <= reach)) return false;
+    (void)inner(s_min, t_min);
+    w = {std::max(0.0, 1.0 - s_min - t_min), s_min, t_min};
+  }
   const Vec3 q = at(w);
   const ShapeDistance d = shape_distance(shape, position, rotation, q);
   out.weights = w;

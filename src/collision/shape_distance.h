@@ -55,15 +55,21 @@ CapsuleContact capsule_against(const ColliderDesc& shape, const math::Vec3& posi
 /// distance there (negative inside), the shape's normal there and its
 /// surface point under it. Frank-Wolfe iterations (Frank and Wolfe, Naval
 /// Research Logistics Quarterly 3, 1956) with a golden-section line search,
-/// from the best of the corners, edge midpoints and centroid: the global
-/// minimum for the convex shapes (the distance is convex over the
-/// triangle), a local one for implicit shapes. A triangle whose centroid
+/// from the best of the corners, edge midpoints and centroid: a descent
+/// that may stop above the least distance (on random triangles near convex
+/// shapes up to 7% of the triangle's longest edge,
+/// tests/shape_distance_test.cpp), so the point is deep, not always the
+/// deepest. Whether the triangle is within reach is exact for the convex
+/// shapes: when the descent stops beyond it, nested golden-section searches
+/// (Kiefer, Proc. AMS 4, 1953) decide and give the point. For implicit
+/// shapes (not convex) both are local searches. A triangle whose centroid
 /// is farther than reach + its circumradius is skipped after one
-/// evaluation (signed distances are 1-Lipschitz); one whose deepest point
-/// is a corner (the distance rising from it along both edges) returns just
-/// that corner's weights (1 at the corner), the other fields unset: a
-/// corner is a vertex, which meets the shape on its own. Returns false when
-/// the triangle stays beyond reach.
+/// evaluation (signed distances are 1-Lipschitz), as is one whose best of
+/// those seven points is farther than reach + half its longest edge; one
+/// whose deepest point is a corner (the distance rising from it along both
+/// edges) returns just that corner's weights (1 at the corner), the other
+/// fields unset: a corner is a vertex, which meets the shape on its own.
+/// Returns false when the triangle stays beyond reach.
 struct TriangleContact {
   std::array<double, 3> weights{};
   double distance = 0.0;

@@ -142,12 +142,14 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
         kernels::MeshContactParams m = mesh_contacts->params;
         m.colors = mesh_contacts->colors;
         m.inv_h2 = inv_h2;
-        m.reset_lambda = p.reset_lambda;
+        m.reset_lambda = p.reset_lambda == 0u ? 0u : s == 0 ? 2u : 1u;  // 2: the frame's first sweep
+        m.substep_end = p.substep_end;
         if (mesh_contacts->jacobi) {
           program.dispatch_indirect(Kernel::xpbd_mesh_contacts_jacobi, contact_counters[0],
                                     {buffers.position, buffers.previous, mesh_contacts->table,
                                      mesh_contacts->particles, mesh_contacts->coefficients, mesh_contacts->normals,
-                                     mesh_contacts->lambda, mesh_contacts->delta},
+                                     mesh_contacts->lambda, mesh_contacts->delta, mesh_contacts->lambda_sum,
+                                     mesh_contacts->motion},
                                     m);
           program.barrier();
           program.dispatch_indirect(Kernel::xpbd_mesh_contacts_gather, contact_counters[1],
@@ -161,7 +163,7 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
           program.dispatch_indirect(Kernel::xpbd_solve_mesh_contacts, contact_counters[k],
                                     {buffers.position, buffers.previous, mesh_contacts->table,
                                      mesh_contacts->particles, mesh_contacts->coefficients, mesh_contacts->normals,
-                                     mesh_contacts->lambda},
+                                     mesh_contacts->lambda, mesh_contacts->lambda_sum, mesh_contacts->motion},
                                     m);
           program.barrier();
         }

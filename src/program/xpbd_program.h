@@ -26,6 +26,8 @@ struct XpbdBuffers {
 /// `capacity` contacts and `colors` colours.
 struct MeshContactBuffers {
   BufferHandle table, particles, coefficients, normals, lambda;
+  BufferHandle lambda_sum;  ///< the earlier substeps' lambdas, summed per contact (mesh_contact_params.h)
+  BufferHandle motion;      ///< per contact, how far its shape's plane moves over the frame [m]
   std::uint32_t capacity = 0;
   std::uint32_t colors = 0;
   /// The Jacobi schedule (ContactSchedule::jacobi): table word 0 counts the

@@ -19,6 +19,7 @@ struct ContactState {
   bool targets_dirty = false;    ///< the target buffer changed since its last upload
   std::vector<ToolBody> tools;
   std::vector<ColliderDesc> shapes;  ///< the scene's colliders (the tools meet them on the host, tool_contacts.h)
+  std::vector<ColliderDesc> tool_shapes;  ///< each tool's capsule, for the meshes' faces (mesh_collision.h)
 };
 
 }  // namespace sinew

@@ -124,7 +124,9 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
         std::tuple{&b.particles, contact_bytes, "mesh contact particles"},
         std::tuple{&b.coefficients, contact_bytes, "mesh contact coefficients"},
         std::tuple{&b.normals, contact_bytes, "mesh contact normals"},
-        std::tuple{&b.lambda, contact_bytes, "mesh contact lambdas"}})
+        std::tuple{&b.lambda, contact_bytes, "mesh contact lambdas"},
+        std::tuple{&b.lambda_sum, contact_bytes, "mesh contact lambda sums"},
+        std::tuple{&b.motion, contact_bytes / 4, "mesh contact plane motions"}})
     if (Status s = make(device, bytes, label, *handle); !s) return s.error();
   b.jacobi = mc->desc_.schedule == ContactSchedule::jacobi;
   b.touched_capacity = static_cast<std::uint32_t>(mc->collidable_.size());
@@ -344,6 +346,15 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
 
 Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffers) {
   if (Status s = read_back(device, scene_buffers); !s) return s;
+  // The multipliers of the contacts with tools (their reaction): the whole
+  // frame's contacts are read, those few picked out in add_tool_reactions.
+  if (!tool_slots_.empty()) {
+    const std::size_t bytes = std::size_t{contact_count_} * 16;
+    tool_lambda_.resize(std::size_t{contact_count_} * 4);
+    tool_lambda_sum_.resize(std::size_t{contact_count_} * 4);
+    if (Status s = device.read_buffer(buffers_.lambda, 0, tool_lambda_.data(), bytes); !s) return s;
+    if (Status s = device.read_buffer(buffers_.lambda_sum, 0, tool_lambda_sum_.data(), bytes); !s) return s;
+  }
   // How far the frame's contacts ended inside their thickness, from the
   // very positions the next frame's detection starts from.
   double worst = 0.0;
@@ -363,10 +374,82 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
   return {};
 }
 
-void MeshCollision::shape_faces(std::span<const PosedShape> colliders, double common) {
+void MeshCollision::add_tool_reactions(std::vector<ToolBody>& tools, double frame, double h) const {
+  using V3 = math::Vec3;
+  for (const auto& [slot, t] : tool_slots_) {
+    if (t >= tools.size()) continue;
+    ToolBody& tool = tools[t];
+    const std::size_t at = std::size_t{slot} * 4;
+    const V3 n{upload_normals_[at], upload_normals_[at + 1], upload_normals_[at + 2]};
+    // The multiplier as a vector, lambda_n n + lambda_t [kg m].
+    const auto vector_of = [&](const std::vector<float>& l) {
+      return math::add(math::mul(n, double(l[at])), V3{l[at + 1], l[at + 2], l[at + 3]});
+    };
+    const V3 last = vector_of(tool_lambda_);
+    const V3 earlier = vector_of(tool_lambda_sum_);
+    // The contact's point on the triangle or segment at the frame's end.
+    V3 point{0.0, 0.0, 0.0};
+    for (int k = 0; k < 4; ++k)
+      for (int a = 0; a < 3; ++a)
+        point[a] += double(upload_coefficients_[at + k]) * positions_[4 * std::size_t{upload_particles_[at + k]} + a];
+    const V3 r = math::sub(point, tool.position);
+    // The tissue was pushed by +lambda / h per substep; the tool takes the opposite.
+    const V3 frame_impulse = math::mul(math::add(earlier, last), -1.0 / h);
+    const V3 last_impulse = math::mul(last, -1.0 / h);
+    tool.contact_force = math::add(tool.contact_force, math::mul(frame_impulse, 1.0 / frame));
+    tool.contact_torque = math::add(tool.contact_torque, math::mul(math::cross(r, frame_impulse), 1.0 / frame));
+    tool.coupling_force = math::add(tool.coupling_force, math::mul(last_impulse, 1.0 / h));
+    tool.coupling_torque = math::add(tool.coupling_torque, math::mul(math::cross(r, last_impulse), 1.0 / h));
+    if (!(tool_lambda_[at] > 0.0f)) continue;  // not touching at the frame's end
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t p = upload_particles_[at + k];
+      const double c = upload_coefficients_[at + k], w = positions_[4 * std::size_t{p} + 3];
+      if (!(c > 0.0) || !(w > 0.0)) continue;
+      const double m = c / w;
+      const V3 rk = math::sub(V3{positions_[4 * std::size_t{p}], positions_[4 * std::size_t{p} + 1],
+                                 positions_[4 * std::size_t{p} + 2]},
+                              tool.position);
+      tool.touching_mass += m;
+      const double r2 = math::dot(rk, rk);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          tool.touching_inertia[std::size_t(3 * i + j)] += m * ((i == j ? r2 : 0.0) - rk[i] * rk[j]);
+    }
+  }
+}
+
+namespace {
+
+// A capsule's ends (the segment its radius swells) at a pose.
+std::array<math::Vec3, 2> capsule_ends(const PosedShape& s) {
+  const math::Vec3 axis = math::rotate(s.rotation, math::Vec3{0.0, s.shape->half_height, 0.0});
+  return {math::sub(s.position, axis), math::add(s.position, axis)};
+}
+
+}  // namespace
+
+void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<const PosedShape> ends, double common) {
   const double dt = time_step_;
   const std::size_t triangles = triangle_body_.size();
-  for (const PosedShape& shape : colliders) {
+  const bool tools = !ends.empty();
+  for (std::size_t index = 0; index < shapes.size(); ++index) {
+    const PosedShape& shape = shapes[index];
+    const std::uint32_t which = tools ? static_cast<std::uint32_t>(index) : Contact::kNoShape;
+    // A tool: how far any point of its capsule moves in the frame (its
+    // segment's ends move linearly between the poses, and so bound it), and
+    // the offset of the plane that touches it where it ends, on the face's
+    // side (n points from the tool to the face): thickness - the largest
+    // n . p over the capsule.
+    double moved = 0.0;
+    std::array<math::Vec3, 2> first{}, last{};
+    if (tools) {
+      first = capsule_ends(shape);
+      last = capsule_ends(ends[index]);
+      for (int k = 0; k < 2; ++k) moved = std::max(moved, math::norm(math::sub(last[k], first[k])));
+    }
+    const auto offset_at = [&](const std::array<math::Vec3, 2>& ends_at, const math::Vec3& n) {
+      return desc_.thickness - (std::max(math::dot(n, ends_at[0]), math::dot(n, ends_at[1])) + shape.shape->radius);
+    };
     if (shape.shape->shape == ColliderShape::plane) continue;
     // Triangles in parallel (one evaluation each for most), joined in
     // triangle order so the contacts do not depend on the threads.
@@ -384,7 +467,7 @@ void MeshCollision::shape_faces(std::span<const PosedShape> colliders, double co
         }
         collision::TriangleContact hit;
         if (!collision::triangle_against(*shape.shape, shape.position, shape.rotation, corner[0], corner[1],
-                                         corner[2], common + 2.0 * dt * speed, hit))
+                                         corner[2], common + 2.0 * dt * speed + moved, hit))
           continue;
         if (std::max({hit.weights[0], hit.weights[1], hit.weights[2]}) > 1.0 - 1e-6) continue;  // a corner
         Contact& c = found_[t];
@@ -393,7 +476,9 @@ void MeshCollision::shape_faces(std::span<const PosedShape> colliders, double co
         c.w = {0.0f, float(hit.weights[0]), float(hit.weights[1]), float(hit.weights[2])};
         c.normal = {float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2])};
         c.distance = float(hit.distance);
-        c.offset = float(desc_.thickness - math::dot(hit.normal, hit.surface));
+        c.offset = float(tools ? offset_at(last, hit.normal) : desc_.thickness - math::dot(hit.normal, hit.surface));
+        if (tools) c.motion = float(offset_at(first, hit.normal)) - c.offset;
+        c.shape = which;
         face_hit_[t] = 1;
       }
     });
@@ -408,7 +493,7 @@ void MeshCollision::shape_faces(std::span<const PosedShape> colliders, double co
       math::Vec3 end[2];
       for (int k = 0; k < 2; ++k)
         for (int a = 0; a < 3; ++a) end[k][a] = positions_[4 * std::size_t{v[k]} + a];
-      const double reach = common + 2.0 * dt * std::max(speed_[v[0]], speed_[v[1]]);
+      const double reach = common + 2.0 * dt * std::max(speed_[v[0]], speed_[v[1]]) + moved;
       const math::Vec3 ab = math::sub(end[1], end[0]);
       const double length2 = math::dot(ab, ab);
       if (!(length2 > 0.0)) continue;
@@ -423,14 +508,18 @@ void MeshCollision::shape_faces(std::span<const PosedShape> colliders, double co
       c.w = {0.0f, float(1.0 - along), 0.0f, float(along)};
       c.normal = {float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2])};
       c.distance = float(-hit.depth);
-      c.offset = float(desc_.thickness - math::dot(hit.normal, hit.point) - hit.depth);
+      c.offset = float(tools ? offset_at(last, hit.normal)
+                             : desc_.thickness - math::dot(hit.normal, hit.point) - hit.depth);
+      if (tools) c.motion = float(offset_at(first, hit.normal)) - c.offset;
+      c.shape = which;
       all_.push_back(c);
     }
   }
 }
 
 Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buffers,
-                                   std::span<const PosedShape> colliders, bool& grew) {
+                                   std::span<const PosedShape> colliders, std::span<const PosedShape> tool_starts,
+                                   std::span<const PosedShape> tool_ends, bool& grew) {
   grew = false;
   const std::size_t particles = movable_.size();
   // The positions and velocities the last frame ended with (after_frame);
@@ -666,7 +755,8 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   }
 
   prune();
-  shape_faces(colliders, common);
+  shape_faces(colliders, {}, common);
+  if (desc_.tool_faces) shape_faces(tool_starts, tool_ends, common);
 
   // Coefficients c_k (mesh_contact_params.h); contacts of immovable
   // particles only are dropped (nothing to solve).
@@ -686,8 +776,9 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   MeshContactBuffers& b = buffers_;
   if (count > b.capacity) {
     b.capacity = std::max(count, 2 * b.capacity);
-    for (BufferHandle h : {b.particles, b.coefficients, b.normals, b.lambda})
+    for (BufferHandle h : {b.particles, b.coefficients, b.normals, b.lambda, b.lambda_sum})
       if (Status s = device.resize_buffer(h, std::size_t{b.capacity} * 16); !s) return s;
+    if (Status s = device.resize_buffer(b.motion, std::size_t{b.capacity} * 4); !s) return s;
     if (b.jacobi) {
       if (Status s = device.resize_buffer(b.delta, std::size_t{b.capacity} * 64); !s) return s;
       if (Status s = device.resize_buffer(b.slots, std::size_t{b.capacity} * 16); !s) return s;
@@ -721,9 +812,12 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   upload_particles_.resize(std::size_t{count} * 4);
   upload_coefficients_.resize(std::size_t{count} * 4);
   upload_normals_.resize(std::size_t{count} * 4);
+  upload_motion_.assign(count, 0.0f);
+  tool_slots_.clear();
   for (std::uint32_t k = 0; k < count; ++k) {
     const Contact& c = all_[kept_[k]];
     const std::size_t at = std::size_t{slot_of[k]} * 4;
+    if (c.shape != Contact::kNoShape) tool_slots_.push_back({slot_of[k], c.shape});
     const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
     const float sign = c.kind == Contact::Kind::shape_face ? 1.0f : -1.0f;  // both weights on the triangle's side
     const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], sign * c.w[2], sign * c.w[3]};
@@ -735,6 +829,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     upload_normals_[at + 1] = c.normal[1];
     upload_normals_[at + 2] = c.normal[2];
     upload_normals_[at + 3] = c.offset;
+    upload_motion_[slot_of[k]] = c.motion;
   }
   if (b.jacobi) {
     // Per touched (movable) particle, its correction slots 4 i + k in
@@ -778,6 +873,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     if (Status s = device.write_buffer(b.particles, 0, upload_particles_.data(), bytes); !s) return s;
     if (Status s = device.write_buffer(b.coefficients, 0, upload_coefficients_.data(), bytes); !s) return s;
     if (Status s = device.write_buffer(b.normals, 0, upload_normals_.data(), bytes); !s) return s;
+    if (Status s = device.write_buffer(b.motion, 0, upload_motion_.data(), bytes / 4); !s) return s;
   }
   return {};
 }

@@ -2,9 +2,12 @@
 // (issue 12, part 3; SceneDesc::mesh_collision): before every frame the
 // host reads the particles back, finds the frame's contacts (BVH broad
 // phase and narrow phase of src/collision), keeps the nearest few of each
-// vertex's, triangle's and edge's contacts against each other body, colours them and
-// writes them to the device, where xpbd_solve_mesh_contacts solves them in
-// every sweep (kernels/shared/mesh_contact_params.h).
+// vertex's, triangle's and edge's contacts against each other body, adds
+// the triangles' and segments' contacts with the colliders' and tools'
+// shapes, colours them and writes them to the device, where
+// xpbd_solve_mesh_contacts solves them in every sweep
+// (kernels/shared/mesh_contact_params.h). After the frame it reads back the
+// multipliers of the contacts with tools: their reaction on the tools.
 //
 // Why per frame, inflated by the motion: one detection serves all the
 // substeps and sweeps, and contacts found within thickness + margin hold
@@ -43,13 +46,34 @@ class MeshCollision {
   /// outgrew the frame program, which must be rebuilt with buffers().
   /// Errors: a non-finite position or a collapsed triangle, named.
   /// [in] colliders: the scene's colliders at their poses at the end of
-  /// the frame; the triangles meet them face-on (shape_faces()).
+  /// the frame; the triangles and segments meet them face-on
+  /// (shape_faces()). [in] tool_starts, tool_ends: the rigid tools'
+  /// capsules at their poses at the start and the end of the frame (tool t
+  /// at index t): a tool can move more than its radius in a frame, so its
+  /// faces' contacts are found where it starts, on the side the face is
+  /// then, and hold the face beyond the plane that touches the tool where
+  /// it ends; their reaction comes back through add_tool_reactions.
   Status before_frame(Device& device, const XpbdBuffers& scene_buffers, std::span<const PosedShape> colliders,
-                      bool& grew);
+                      std::span<const PosedShape> tool_starts, std::span<const PosedShape> tool_ends, bool& grew);
 
   /// Reads the positions and velocities the frame ended with (the next
-  /// frame's detection starts from them) and measures violation().
+  /// frame's detection starts from them) and measures violation(); with
+  /// face contacts on tools, reads their multipliers back too.
   Status after_frame(Device& device, const XpbdBuffers& scene_buffers);
+
+  /// Adds to each tool's reaction (rigid_tool.h: contact_force and torque,
+  /// the frame's average; coupling_force and torque, its last substep's;
+  /// the touching mass and inertia) what the meshes' faces and segments
+  /// gave it in the last frame: per contact, -(sum + lambda) / h over the
+  /// frame and -lambda / h over its last substep [N s], as vectors
+  /// lambda_n n + lambda_t (mesh_contact_params.h), at the contact's point
+  /// on the triangle or segment at the frame's end (the moments of the
+  /// earlier substeps are taken there too: exact for the last substep,
+  /// which the coupling uses). A touching face's particles count with
+  /// their weights c_k in the touching mass and inertia (a particle that
+  /// also touches the tool itself counts twice). [in] frame, h: the frame
+  /// and substep lengths [s].
+  void add_tool_reactions(std::vector<ToolBody>& tools, double frame, double h) const;
   /// How far the last frame's contacts ended inside their thickness [m]:
   /// the largest thickness - gap over them, 0 when none is inside.
   [[nodiscard]] double violation() const { return violation_; }
@@ -104,13 +128,21 @@ class MeshCollision {
   std::vector<TriangleKey> triangle_keys_;
   std::vector<std::uint8_t> chosen_;
   void prune();
-  // Contacts of the triangles and segments against the colliders' shapes,
-  // where a primitive's deepest point is inside it or on an edge (a corner
-  // is the vertex's own collider contact): a sharp or thin shape pressed
-  // between a coarse mesh's or thread's vertices. Not for planes (a
-  // primitive's deepest point against a plane is always a corner) nor
-  // tools (their reaction comes from the particle contacts only).
-  void shape_faces(std::span<const PosedShape> colliders, double common);
+  // Contacts of the triangles and segments against the colliders' or the
+  // tools' shapes, where a primitive's deepest point is inside it or on an
+  // edge (a corner is the vertex's own collider contact): a sharp or thin
+  // shape pressed between a coarse mesh's or thread's vertices. Not for
+  // planes (a primitive's deepest point against a plane is always a
+  // corner). Colliders (`ends` empty) are met at their end pose. Tools:
+  // shape i is tool i (Contact::shape), met at its start pose `shapes[i]`
+  // within the reach widened by its motion, the plane of the contact moved
+  // to touch its end pose `ends[i]` (a capsule) along the start's normal.
+  void shape_faces(std::span<const PosedShape> shapes, std::span<const PosedShape> ends, double common);
+  // The uploaded contacts with a tool's capsule: (slot, tool), and after
+  // the frame their multipliers (lambda, then the earlier substeps' sum).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> tool_slots_;
+  std::vector<float> tool_lambda_, tool_lambda_sum_;
+  std::vector<float> upload_motion_;  // per contact slot (Contact::motion)
   // Refits each body's tree `which` to its primitives' boxes (builds it
   // when empty); then rebuild_degraded rebuilds those whose refit left
   // their degradation above kMaxDegradation (as Bvh::update does, in two

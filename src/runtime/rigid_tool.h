@@ -43,13 +43,17 @@
 //    light or hand-held tool through a virtual coupling (a spring-damper
 //    from the user's pose, via apply_tool_force, stiff no more than the
 //    bound allows) or use a shorter time step.
-//  - Tunnelling: contacts are between particles (mesh vertices) and the
-//    tool's surface, not the tissue's faces. A tool M times as heavy as the
-//    N particles of mass m it rests on pushes them about
-//    (M / (N m)) g h^2 / iterations deep per substep before the tissue's
-//    response reaches them; when that nears the vertex spacing, or a tool
-//    is narrower than it, the tool pushes vertices apart and passes between
-//    them. More substeps (smaller h) or a finer surface mesh cure it.
+//  - Tunnelling: without mesh collision, contacts are between particles
+//    (mesh vertices) and the tool's surface, not the tissue's faces. A tool
+//    M times as heavy as the N particles of mass m it rests on pushes them
+//    about (M / (N m)) g h^2 / iterations deep per substep before the
+//    tissue's response reaches them; when that nears the vertex spacing, or
+//    a tool is narrower than it, the tool pushes vertices apart and passes
+//    between them. More substeps (smaller h) or a finer surface mesh cure
+//    it. With mesh collision on (SceneDesc::mesh_collision) the tissue's
+//    triangles and thread segments meet the tool too, and their reaction
+//    joins the particles' (runtime/mesh_collision.h, add_tool_reactions),
+//    read back per contact after the frame.
 //  - A resting tool keeps a small jitter (no damping is added); compare
 //    averages of tool_state over a few frames.
 #pragma once

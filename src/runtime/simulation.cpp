@@ -134,7 +134,8 @@ Status Simulation::step() {
   if (Status s = impl_->before_frame(); !s) return s;
   if (impl_->mesh_collision) {
     bool grew = false;
-    if (Status s = impl_->mesh_collision->before_frame(*impl_->device, impl_->buffers, impl_->collider_shapes(), grew);
+    if (Status s = impl_->mesh_collision->before_frame(*impl_->device, impl_->buffers, impl_->collider_shapes(),
+                                                               impl_->tool_shapes(true), impl_->tool_shapes(false), grew);
         !s)
       return s;
     if (grew) {

@@ -145,6 +145,10 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
     b.radius = d.radius;
     b.half_height = d.half_height;
     b.dynamic_friction = d.dynamic_friction;
+    ColliderDesc& capsule = contacts.tool_shapes.emplace_back();
+    capsule.shape = ColliderShape::capsule;
+    capsule.radius = d.radius;
+    capsule.half_height = d.half_height;
   }
   contacts.shapes = scene.colliders;
   return {};
@@ -155,6 +159,19 @@ std::vector<PosedShape> Simulation::Impl::collider_shapes() const {
   for (std::uint32_t k = 0; k < contacts.colliders; ++k) {
     const auto e = load_words<ColliderEntry>(colliders, entry_at(k));
     shapes.push_back({&contacts.shapes[k], {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}});
+  }
+  return shapes;
+}
+
+std::vector<PosedShape> Simulation::Impl::tool_shapes(bool start) const {
+  std::vector<PosedShape> shapes;
+  for (std::size_t t = 0; t < contacts.tools.size(); ++t) {
+    const auto e = load_words<ColliderEntry>(colliders, entry_at(contacts.colliders + t));
+    if (start)
+      shapes.push_back({&contacts.tool_shapes[t], {e.start_px, e.start_py, e.start_pz},
+                        {e.start_qw, e.start_qx, e.start_qy, e.start_qz}});
+    else
+      shapes.push_back({&contacts.tool_shapes[t], {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}});
   }
   return shapes;
 }
@@ -223,6 +240,9 @@ Status Simulation::Impl::after_frame() {
     b.touching_mass = sums.mass;
     b.touching_inertia = sums.inertia;
   }
+  // The reaction through the meshes' faces and segments (mesh contacts
+  // with the tools' capsules), read back by the mesh collision.
+  if (mesh_collision) mesh_collision->add_tool_reactions(c.tools, time_step, h);
   return {};
 }
 

@@ -63,6 +63,9 @@ struct Simulation::Impl {
   Status before_frame();  ///< integrates the tools (rigid_tool.h), uploads what moved
   /// The scene's colliders at their poses at the end of the coming frame.
   [[nodiscard]] std::vector<PosedShape> collider_shapes() const;
+  /// Each tool's capsule at its pose at the start or the end of the coming
+  /// frame (after before_frame, which integrates the tools).
+  [[nodiscard]] std::vector<PosedShape> tool_shapes(bool start) const;
   Status after_frame();   ///< settles what moved, takes each tool's reaction from device_stats
 };
 
