@@ -358,11 +358,10 @@ TEST(NarrowPhase, TheSeparatingAxisRejectNeverDropsAPairWithinTheThickness) {
       case 2:  // at random nearby
         for (auto& p : b) p = kernels::add_scaled3(a[0], 1.0, random_point(rng, 1.0));
         break;
-      default: {  // a tiny triangle near a's surface
-        const double4 c = px::at<double>({0.2 + 0.3 * u(rng), 0.3, 0.0}, a[0], a[1], a[2]);
-        const double4 centre = {c.x, c.y, c.z, 0.0};
-        const double4 mid = px::at<double>({0.5, 0.2, 0.3}, a[0], a[1], a[2]);
-        const double4 p0 = kernels::add_scaled3(kernels::add_scaled3(mid, 0.0, centre), 0.15 * (u(rng) - 0.3), up);
+      default: {  // a tiny triangle near a random point of a's surface
+        const double wa = 0.1 + 0.6 * u(rng), wb = (1.0 - wa) * u(rng);
+        const double4 on = px::at<double>({wa, wb, 1.0 - wa - wb}, a[0], a[1], a[2]);
+        const double4 p0 = kernels::add_scaled3(on, 0.15 * (u(rng) - 0.3), up);
         for (auto& p : b) p = kernels::add_scaled3(p0, 1.0, random_point(rng, 0.05));
         break;
       }

@@ -302,8 +302,8 @@ struct SolverSettings {
   /// stops at max_iterations does pass its lambdas on (a cap far below what
   /// converges carries the fixed mode's risk). Only for
   /// scenes of distance and volume constraints (tet bodies without an FEM
-  /// material, line bodies without bending): others are an error naming
-  /// this setting.
+  /// material, line bodies without bending; no colliders, no mesh
+  /// collision): others are an error naming this setting.
   bool warm_start = false;
 
   // ---- Chebyshev semi-iterative accelerator (off by default).

@@ -64,7 +64,7 @@
  *     lambda / h over its last substep [N s] as vectors lambda_n n +
  *     lambda_t: the host reads them back for the contacts of triangles and
  *     segments with a rigid tool, whose reaction they are
- *     (src/runtime/mesh_collision.h, tool_reactions).
+ *     (src/runtime/mesh_collision.h, add_tool_reactions).
  *   8 motion float per contact [in]: m above [m].
  * xpbd_mesh_contacts_jacobi takes the same bindings 0-6, its corrections
  * at 7, the lambda sum at 8 and the motion at 9. */
@@ -81,12 +81,12 @@ SINEW_STRUCT_BEGIN(MeshContactParams)
   uint color;              /* this dispatch's colour */
   uint colors;             /* colours in the table */
   float inv_h2;            /* 1 / h^2 [1/s^2] */
-  uint reset_lambda;       /* a substep's first sweep: 1, the frame's first: 2; else 0 (binding 7) */
+  uint reset_lambda;       /* a substep's first sweep: 1, the frame's first: 2; else 0 (the lambda sum) */
   float thickness;         /* [m], > 0: the distance the surfaces keep */
   float compliance;        /* alpha [m/N], >= 0 */
   float static_friction;   /* mu_s */
   float dynamic_friction;  /* mu_k <= mu_s */
-  float substep_end;       /* fraction of the frame done at the end of this substep, in (0, 1] (binding 8) */
+  float substep_end;       /* fraction of the frame done at the end of this substep, in (0, 1] (the motion) */
   uint pad0;               /* 16-byte size */
   uint pad1;
   uint pad2;

@@ -181,7 +181,7 @@ bool separated(const float4 (&p)[3], const float4 (&q)[3], float gap) {
       alo = std::min(alo, u), ahi = std::max(ahi, u), blo = std::min(blo, v), bhi = std::max(bhi, v);
     }
     const float s = std::max(blo - ahi, alo - bhi);  // the gap between the projections, times |n|
-    return s > 0.0f && s * s > wide * wide * squared;
+    return s > 0.0f && s > wide * std::sqrt(squared);  // (not squared: |n|^2 of a needle underflows)
   };
   const float4 na = kernels::cross3(a[1], a[2]), nb = kernels::cross3(b[1] - b[0], b[2] - b[0]);
   if (apart_along(na) || apart_along(nb)) return true;

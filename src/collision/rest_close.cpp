@@ -3,6 +3,7 @@
 #include "collision/rest_close.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <string>
 
@@ -34,7 +35,9 @@ Status rest_close_pairs(std::span<const float> positions, std::span<const std::u
 
 PairSet::PairSet(std::span<const Pair> sorted, std::uint32_t primitives) : first_(std::size_t{primitives} + 1, 0) {
   second_.reserve(sorted.size());
-  for (const auto& [i, j] : sorted) {
+  for (std::size_t k = 0; k < sorted.size(); ++k) {
+    const auto [i, j] = sorted[k];
+    assert(i < j && j < primitives && (k == 0 || sorted[k - 1].first <= i));
     ++first_[std::size_t{i} + 1];
     second_.push_back(j);
   }

@@ -33,11 +33,13 @@ Status rest_close_pairs(std::span<const float> positions, std::span<const std::u
 class PairSet {
  public:
   PairSet() = default;
-  /// [in] sorted: pairs with i < j, sorted; primitives: more than any index.
+  /// [in] sorted: pairs with i < j, sorted by i (rest_close_pairs'
+  /// output); primitives: more than any index. A pair out of order or out
+  /// of range is a programming error (asserted).
   PairSet(std::span<const Pair> sorted, std::uint32_t primitives);
   /// Whether (i, j) is in the set; i < j.
   [[nodiscard]] bool contains(std::uint32_t i, std::uint32_t j) const {
-    if (i + 1 >= first_.size()) return false;
+    if (std::size_t{i} + 1 >= first_.size()) return false;
     for (std::uint32_t k = first_[i]; k < first_[i + 1]; ++k)
       if (second_[k] == j) return true;
     return false;

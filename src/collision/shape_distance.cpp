@@ -178,9 +178,9 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
   int best_start = 0;
   for (int k = 1; k < 7; ++k)
     if (const double v = f(starts[k]); v < best) best = v, w = starts[k], best_start = k;
-  // Every point of the triangle lies in one of the four halves the edges'
-  // midpoints cut it into, within half the longest edge of that half's
-  // corners, all of which are starts; the distance changes no faster than
+  // Every point of the triangle lies in one of the four smaller triangles
+  // the edges' midpoints cut it into, within half the longest edge of that
+  // one's corners, all of which are starts; the distance changes no faster than
   // the point moves, so nothing is within reach if the best start is more
   // than that beyond it. (Returning when the best start alone was beyond
   // the reach missed a thin tool pressed into a large triangle's middle.)
@@ -202,12 +202,19 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
     }
   }
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  // For a convex shape, f(w) + gradient . (corner_s - q) bounds the least
+  // distance over the triangle from below (the Frank-Wolfe gap; the
+  // distance's gradient is the shape's normal): the largest of these
+  // decides most near misses without the nested searches below.
+  const bool convex = shape.shape != ColliderShape::implicit;
+  double floor = -INFINITY;
   for (int iteration = 0; iteration < 16; ++iteration) {
     const Vec3 q = at(w);
     const Vec3 gradient = shape_distance(shape, position, rotation, q).normal;
     int s = 0;  // the corner the gradient descends to most
     for (int k = 1; k < 3; ++k)
       if (math::dot(gradient, corner[k]) < math::dot(gradient, corner[s])) s = k;
+    floor = std::max(floor, best + math::dot(gradient, math::sub(corner[s], q)));
     if (!(math::dot(gradient, math::sub(corner[s], q)) < -1e-12 * circumradius)) break;  // no descent left
     std::array<double, 3> target{0, 0, 0};
     target[s] = 1.0;
@@ -228,14 +235,16 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
   // Frank-Wolfe may stop above the least distance (it zig-zags towards the
   // corners; tests/shape_distance_test.cpp measures how far). Whether the
   // triangle comes within reach is not left to it: when it stopped beyond
-  // the reach, nested golden-section searches over the barycentric
-  // coordinates decide, exact for a convex shape (the least over s of the
+  // the reach and its lower bound does not settle it, nested golden-section
+  // searches over the barycentric coordinates decide, for a convex shape to
+  // within 0.618^28 ~ 1.4e-6 of the triangle's size (the least over s of the
   // least over t of a convex function; each search finds its minimum to
-  // 0.618^28 ~ 1e-6 of its range, its ends included). They are not the
+  // that fraction of its range, its ends included). They are not the
   // first choice: among the near-equal minima of a thin capsule lying along
   // a tilted triangle they find the one under its end cap, whose normal
   // slid a coarse membrane off the probe in MeshContact's thin-probe test,
   // where Frank-Wolfe's stays nearer the middle.
+  if (best > reach && convex && floor > reach) return false;
   if (best > reach) {
     constexpr int kSteps = 28;
     const auto golden = [&](double lo, double hi, auto&& value, double& at_min) {

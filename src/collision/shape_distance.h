@@ -59,10 +59,11 @@ CapsuleContact capsule_against(const ColliderDesc& shape, const math::Vec3& posi
 /// that may stop above the least distance (on random triangles near convex
 /// shapes up to 7% of the triangle's longest edge,
 /// tests/shape_distance_test.cpp), so the point is deep, not always the
-/// deepest. Whether the triangle is within reach is exact for the convex
-/// shapes: when the descent stops beyond it, nested golden-section searches
-/// (Kiefer, Proc. AMS 4, 1953) decide and give the point. For implicit
-/// shapes (not convex) both are local searches. A triangle whose centroid
+/// deepest. Whether the triangle is within reach is decided for the convex
+/// shapes to 1.4e-6 of its size: when the descent stops beyond it and its
+/// lower bound (the Frank-Wolfe gap) does not exclude the reach, nested
+/// golden-section searches (Kiefer, Proc. AMS 4, 1953) decide and give the
+/// point. For implicit shapes (not convex) both are local searches. A triangle whose centroid
 /// is farther than reach + its circumradius is skipped after one
 /// evaluation (signed distances are 1-Lipschitz), as is one whose best of
 /// those seven points is farther than reach + half its longest edge; one

@@ -332,6 +332,7 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
   positions_.resize(particles * 4);
   velocities_.resize(particles * 4);
   if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
+  read_back_bytes_ += positions_.size() * 4;
   if (have_start) {
     const auto inv_dt = static_cast<float>(1.0 / time_step_);
     for (std::size_t k = 0; k < positions_.size(); ++k)
@@ -339,6 +340,8 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
   } else if (Status s = device.read_buffer(scene_buffers.velocity, 0, velocities_.data(), velocities_.size() * 4);
              !s) {
     return s;
+  } else {
+    read_back_bytes_ += velocities_.size() * 4;
   }
   fresh_ = true;
   return {};
@@ -354,6 +357,7 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
     tool_lambda_sum_.resize(std::size_t{contact_count_} * 4);
     if (Status s = device.read_buffer(buffers_.lambda, 0, tool_lambda_.data(), bytes); !s) return s;
     if (Status s = device.read_buffer(buffers_.lambda_sum, 0, tool_lambda_sum_.data(), bytes); !s) return s;
+    read_back_bytes_ += 2 * bytes;
   }
   // How far the frame's contacts ended inside their thickness, from the
   // very positions the next frame's detection starts from.
@@ -521,6 +525,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
                                    std::span<const PosedShape> colliders, std::span<const PosedShape> tool_starts,
                                    std::span<const PosedShape> tool_ends, bool& grew) {
   grew = false;
+  read_back_bytes_ = 0;
   const std::size_t particles = movable_.size();
   // The positions and velocities the last frame ended with (after_frame);
   // read here only before the first frame.
@@ -716,12 +721,14 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
                                                                                           std::size_t{body.count} * 3),
                         positions_);
     };
+    // Only trees built before this frame: a first build happens inside fit,
+    // beside the cones (shape[b] == 0 until then; build ids start at 1).
     Status fitted;
     tbb::parallel_invoke([&] { fitted = fit(triangles_, 3, triangle_body_, triangle_trees_); },
                          [&] {
                            if (!cull) return;
-                           for (BodyTree& body : triangle_trees_)
-                             if (!body.self_tree.empty()) cones_of(body);
+                           for (std::size_t b = 0; b < triangle_trees_.size(); ++b)
+                             if (shape[b] != 0) cones_of(triangle_trees_[b]);
                          });
     if (!fitted) return fitted;
     rebuild(triangle_trees_);

@@ -171,7 +171,8 @@ Status Simulation::step() {
   const auto ran = std::chrono::steady_clock::now();
   if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
   impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4 +
-                                 (impl_->stepper ? impl_->stepper->read_back_bytes() : 0);
+                                 (impl_->stepper ? impl_->stepper->read_back_bytes() : 0) +
+                                 (impl_->mesh_collision ? impl_->mesh_collision->read_back_bytes() : 0);
   if (Status s = impl_->after_frame(); !s) return s;
   if (impl_->measure_errors) impl_->measure(impl_->stats);
   const auto end = std::chrono::steady_clock::now();

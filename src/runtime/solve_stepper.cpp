@@ -46,6 +46,11 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
                                                            const std::array<double, 3>& gravity,
                                                            const StatsPlan& stats,
                                                            const MeshContactBuffers* mesh_contacts) {
+  // The frame's mesh contacts change every frame (and their slots with
+  // them): no lambda of theirs may be carried into a substep.
+  if (solver.warm_start && mesh_contacts)
+    return Error(ErrorCode::bad_parameter, "solver.warm_start supports distance and volume constraints only; "
+                                           "the scene has mesh contacts (mesh_collision)");
   if (solver.warm_start)
     for (const ConstraintBlock& block : scene.blocks)
       if (block.kernel != Kernel::xpbd_solve_distance && block.kernel != Kernel::xpbd_solve_volume)
