@@ -99,6 +99,12 @@ bool triangles_apart(std::span<const float> positions, const std::uint32_t* a, c
 /// box, so the owner's box, inflated by d / 2, overlaps B's, and the broad
 /// phase pairs them, unless the owner shares a vertex with B (such pairs
 /// are skipped): then every pair around it tests it, as without owners.
+/// A broad phase that leaves out more pairs leaves out their owners' tests
+/// with them: the normal cones (normal_cones.h) drop only pairs whose
+/// vertex-triangle contacts cannot face each other, and the solver's
+/// rest-close pairs (rest_close.h) take the contacts of their owners'
+/// features with them, even when another pair around the feature is not
+/// rest-close (the rule is per pair of owners, not per feature).
 struct TriangleOwnership {
   /// Per triangle: the owner of its corners 0-2, then of its edges from
   /// corner c to c + 1 (mod 3).
