@@ -191,6 +191,16 @@ bool separated(const float4 (&p)[3], const float4 (&q)[3], float gap) {
   return false;
 }
 
+// The longest edge of two triangles, squared.
+float longest_edge2(const float4 (&p)[3], const float4 (&q)[3]) {
+  float longest = 0.0f;
+  for (int k = 0; k < 3; ++k) {
+    const float4 a = p[(k + 1) % 3] - p[k], b = q[(k + 1) % 3] - q[k];
+    longest = std::max({longest, kernels::dot3(a, a), kernels::dot3(b, b)});
+  }
+  return longest;
+}
+
 // One contact per (vertex, triangle) and per pair of edges, in a fixed order.
 void sort_unique(std::vector<Contact>& contacts) {
   const auto key = [](const Contact& c) { return std::tuple(c.kind, c.v[0], c.v[1], c.v[2], c.v[3]); };
@@ -351,7 +361,13 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
     float4 pi[3], pj[3];
     if (Status s = corners(positions, triangles, 3, "triangle", ti, ui, pi); !s) return s;
     if (Status s = corners(positions, triangles, 3, "triangle", tj, uj, pj); !s) return s;
-    if (separated(pi, pj, thickness)) return {};
+    // The reject pays where the gap is small beside the triangles (a
+    // surface's neighbours within a thin contact distance: 89% of the
+    // liver's self pairs in bench_broad_phase); against a gap as long as
+    // their edges it rejects almost nothing (the organ example's pressed
+    // kidney: 0.3% of 12M pairs, 0% of 1.1M without self-collision) and only
+    // costs, so it runs when the gap is under half the longest edge.
+    if (thickness * thickness < 0.25f * longest_edge2(pi, pj) && separated(pi, pj, thickness)) return {};
     // Decide from the indices alone; most pairs test nothing of their own.
     bool vertex_i[3], vertex_j[3], edges[3][3], any = false, any_edge = false;
     for (int c = 0; c < 3; ++c) {
