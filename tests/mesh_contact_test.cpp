@@ -140,6 +140,17 @@ TEST_P(MeshContact, MembraneFoldedOntoItselfNeverPassesThroughItself) {
   EXPECT_LT(lowest, 3.0 * scene.mesh_collision.thickness);
 }
 
+// An empty scene without gravity, 60 frames per second of `substeps`
+// substeps with 2 sweeps each.
+SceneDesc weightless_scene(int substeps) {
+  SceneDesc scene;
+  scene.gravity = {0.0, 0.0, 0.0};
+  scene.solver.time_step = 1.0 / 60.0;
+  scene.solver.substeps = substeps;
+  scene.solver.iterations = 2;
+  return scene;
+}
+
 // Two layers of one membrane 0.4 mm apart at the start, with a 1 mm
 // thickness (a fissure in an organ's surface, a pre-folded sheet): the pairs
 // of triangles already closer than the thickness are neighbours, never in
@@ -147,11 +158,7 @@ TEST_P(MeshContact, MembraneFoldedOntoItselfNeverPassesThroughItself) {
 // push the layers 0.6 mm apart in the first frame; on the liver_382k surface
 // at 1 mm, 683 such contacts blew the organ example up.)
 TEST_P(MeshContact, SurfacesCloserThanTheThicknessAtTheStartAreNotPushedApart) {
-  SceneDesc scene;
-  scene.gravity = {0.0, 0.0, 0.0};
-  scene.solver.time_step = 1.0 / 60.0;
-  scene.solver.substeps = 5;
-  scene.solver.iterations = 2;
+  SceneDesc scene = weightless_scene(5);
   TriBodyDesc sheet;
   const TriMesh lower = membrane(8, 4, 0.005, 0.01), upper = membrane(8, 4, 0.005, 0.0104);
   sheet.mesh = lower;
@@ -186,11 +193,7 @@ TEST_P(MeshContact, SurfacesCloserThanTheThicknessAtTheStartAreNotPushedApart) {
 // pressed by the probe reached 3.7 mm violations.)
 TEST_P(MeshContact, ASolidSqueezedThinMakesNoContactsAcrossItsMaterial) {
   const auto top_height = [&](bool collide) {
-    SceneDesc scene;
-    scene.gravity = {0.0, 0.0, 0.0};
-    scene.solver.time_step = 1.0 / 60.0;
-    scene.solver.substeps = 10;
-    scene.solver.iterations = 2;
+    SceneDesc scene = weightless_scene(10);
     TetBodyDesc slab;
     slab.mesh = *make_tet_grid({.nx = 4, .ny = 1, .nz = 4, .origin = {0, 0, 0}, .cell_size = {0.005, 0.003, 0.005}});
     (void)slab.set_elastic(1e5, 0.3);

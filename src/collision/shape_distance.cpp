@@ -114,6 +114,19 @@ ShapeDistance local_distance(const ColliderDesc& c, const Vec3& l) {
   return {};
 }
 
+// Golden-section search for the least of a unimodal `value` on [lo, hi]:
+// `steps` shrinkings of the bracket by 0.618, then the bracket's midpoint.
+template <class F>
+double golden_section(double lo, double hi, int steps, F&& value) {
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = value(x1), f2 = value(x2);
+  for (int k = 0; k < steps; ++k) {
+    if (f1 <= f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = value(x1);
+    else lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = value(x2);
+  }
+  return 0.5 * (lo + hi);
+}
+
 }  // namespace
 
 ShapeDistance shape_distance(const ColliderDesc& shape, const Vec3& position, const math::Quat& rotation,
@@ -201,7 +214,6 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
       return true;
     }
   }
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   // For a convex shape, f(w) + gradient . (corner_s - q) bounds the least
   // distance over the triangle from below (the Frank-Wolfe gap; the
   // distance's gradient is the shape's normal): the largest of these
@@ -222,12 +234,7 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
       return std::array<double, 3>{w[0] + t * (target[0] - w[0]), w[1] + t * (target[1] - w[1]),
                                    w[2] + t * (target[2] - w[2])};
     };
-    double lo = 0.0, hi = 1.0, x1 = hi - g, x2 = lo + g, f1 = f(blend(x1)), f2 = f(blend(x2));
-    for (int k = 0; k < 24; ++k) {
-      if (f1 <= f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(blend(x1));
-      else lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(blend(x2));
-    }
-    const std::array<double, 3> next = blend(0.5 * (lo + hi));
+    const std::array<double, 3> next = blend(golden_section(0.0, 1.0, 24, [&](double t) { return f(blend(t)); }));
     const double v = f(next);
     if (!(v < best)) break;
     best = v, w = next;
@@ -248,15 +255,9 @@ bool triangle_against(const ColliderDesc& shape, const Vec3& position, const mat
   if (best > reach) {
     constexpr int kSteps = 28;
     const auto golden = [&](double lo, double hi, auto&& value, double& at_min) {
-      const double first = lo, last = hi;
-      double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = value(x1), f2 = value(x2);
-      for (int k = 0; k < kSteps; ++k) {
-        if (f1 <= f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = value(x1);
-        else lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = value(x2);
-      }
-      at_min = 0.5 * (lo + hi);
+      at_min = golden_section(lo, hi, kSteps, value);
       double least = value(at_min);
-      for (const double end : {first, last})  // a least on an edge or at a corner
+      for (const double end : {lo, hi})  // a least on an edge or at a corner
         if (const double v = value(end); v < least) least = v, at_min = end;
       return least;
     };

@@ -116,6 +116,13 @@ bool settle(ColliderEntry& e) {
   return moved;
 }
 
+// `shape` at the start or end pose of collider entry k.
+PosedShape posed(const ColliderDesc& shape, const std::vector<float>& colliders, std::size_t k, bool start) {
+  const auto e = load_words<ColliderEntry>(colliders, entry_at(k));
+  if (start) return {&shape, {e.start_px, e.start_py, e.start_pz}, {e.start_qw, e.start_qx, e.start_qy, e.start_qz}};
+  return {&shape, {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}};
+}
+
 }  // namespace
 
 Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledScene& compiled) {
@@ -145,10 +152,7 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
     b.radius = d.radius;
     b.half_height = d.half_height;
     b.dynamic_friction = d.dynamic_friction;
-    ColliderDesc& capsule = contacts.tool_shapes.emplace_back();
-    capsule.shape = ColliderShape::capsule;
-    capsule.radius = d.radius;
-    capsule.half_height = d.half_height;
+    contacts.tool_shapes.push_back(tool_capsule(b));
   }
   contacts.shapes = scene.colliders;
   return {};
@@ -156,23 +160,14 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
 
 std::vector<PosedShape> Simulation::Impl::collider_shapes() const {
   std::vector<PosedShape> shapes;
-  for (std::uint32_t k = 0; k < contacts.colliders; ++k) {
-    const auto e = load_words<ColliderEntry>(colliders, entry_at(k));
-    shapes.push_back({&contacts.shapes[k], {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}});
-  }
+  for (std::uint32_t k = 0; k < contacts.colliders; ++k) shapes.push_back(posed(contacts.shapes[k], colliders, k, false));
   return shapes;
 }
 
 std::vector<PosedShape> Simulation::Impl::tool_shapes(bool start) const {
   std::vector<PosedShape> shapes;
-  for (std::size_t t = 0; t < contacts.tools.size(); ++t) {
-    const auto e = load_words<ColliderEntry>(colliders, entry_at(contacts.colliders + t));
-    if (start)
-      shapes.push_back({&contacts.tool_shapes[t], {e.start_px, e.start_py, e.start_pz},
-                        {e.start_qw, e.start_qx, e.start_qy, e.start_qz}});
-    else
-      shapes.push_back({&contacts.tool_shapes[t], {e.end_px, e.end_py, e.end_pz}, {e.end_qw, e.end_qx, e.end_qy, e.end_qz}});
-  }
+  for (std::size_t t = 0; t < contacts.tools.size(); ++t)
+    shapes.push_back(posed(contacts.tool_shapes[t], colliders, contacts.colliders + t, start));
   return shapes;
 }
 

@@ -42,13 +42,6 @@ void push(ToolBody& b, const V3& r, const V3& j) {
 
 V3 point_velocity(const ToolBody& b, const V3& r) { return math::add(b.velocity, math::cross(b.angular_velocity, r)); }
 
-ColliderDesc capsule_of(const ToolBody& b) {
-  ColliderDesc c;
-  c.shape = ColliderShape::capsule;
-  c.radius = b.radius;
-  c.half_height = b.half_height;
-  return c;
-}
 
 // One contact between tool `a` and either a collider (b == nullptr) or tool b.
 struct Contact {
@@ -105,6 +98,14 @@ double current_depth(const Contact& c) {
 
 }  // namespace
 
+ColliderDesc tool_capsule(const ToolBody& b) {
+  ColliderDesc c;
+  c.shape = ColliderShape::capsule;
+  c.radius = b.radius;
+  c.half_height = b.half_height;
+  return c;
+}
+
 void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<PosedShape>& colliders, double dt) {
   std::vector<Contact> contacts;
   for (std::size_t i = 0; i < tools.size(); ++i) {
@@ -112,7 +113,7 @@ void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<Posed
     for (const PosedShape& s : colliders)
       contacts_against(a, nullptr, *s.shape, s.position, s.rotation, std::min(s.shape->dynamic_friction, a.dynamic_friction), contacts);
     for (std::size_t j = i + 1; j < tools.size(); ++j)
-      contacts_against(a, &tools[j], capsule_of(tools[j]), tools[j].position, tools[j].rotation,
+      contacts_against(a, &tools[j], tool_capsule(tools[j]), tools[j].position, tools[j].rotation,
                        std::min(a.dynamic_friction, tools[j].dynamic_friction), contacts);
   }
   if (contacts.empty()) return;

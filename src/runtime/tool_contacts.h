@@ -29,6 +29,9 @@ struct PosedShape {
   math::Quat rotation{1.0, 0.0, 0.0, 0.0};
 };
 
+/// A tool's capsule as a collider shape (its pose is the tool's).
+ColliderDesc tool_capsule(const ToolBody& b);
+
 /// Moves the tools out of the colliders and out of each other and removes
 /// their velocity into the contacts (see above); dt [s] is the frame's
 /// length (it turns the positional corrections into the normal impulse
