@@ -14,7 +14,8 @@
 //                      (collision/normal_cones.h; their update counted)
 //   + narrow           and the contacts of those pairs: the goal,
 //                      refit + pairs + narrow phase, as the solver runs it
-//                      (the cones updated beside the boxes and the refit,
+//                      (the vertices gathered in the tree's leaf order, the
+//                      cones updated beside the boxes and the refit,
 //                      pairs closer than the thickness in the rest shape
 //                      skipped by the traversal, collision/rest_close.h)
 // Each counts the boxes' computation too, and reports the pairs found.
@@ -42,6 +43,7 @@
 
 #include "backends/backend.h"
 #include "collision/bvh.h"
+#include "collision/leaf_vertices.h"
 #include "collision/device_bvh.h"
 #include "collision/narrow_phase.h"
 #include "collision/normal_cones.h"
@@ -150,17 +152,21 @@ void BM_SelfBroadPhase(benchmark::State& state) {
   if (variant == kCulledRefitNarrow) (void)rest_close_pairs(s.rest, s.triangles, 2.0f * inflate, close);
   const PairSet rest_close(close, std::uint32_t(s.triangles.size() / 3));
   const SharesVertexOrListed<3> skip_rest_close{skip, &rest_close};
+  LeafVertices leaf;
   int frame = 0;
   for (auto _ : state) {
     state.PauseTiming();
     deform(s, x, ++frame);
     state.ResumeTiming();
     if (variant == kCulledRefitNarrow) {
-      // The solver's order (runtime/mesh_collision.cpp): the cones beside
-      // the boxes and the refit, on the second core; then the pairs
+      // The solver's order (runtime/mesh_collision.cpp): the vertices
+      // gathered in the tree's leaf order (leaf_vertices.h), the cones
+      // beside the boxes and the refit, on the second core; then the pairs
       // (rest-close ones skipped) and their contacts.
-      tbb::parallel_invoke([&] { (void)primitive_boxes(x, s.triangles, 3, inflate, boxes), tree.refit(boxes); },
-                           [&] { cones.update(tree, s.triangles, x); });
+      leaf.index(tree, s.triangles, 3);
+      (void)leaf.gather(x);
+      tbb::parallel_invoke([&] { leaf.boxes(inflate, boxes), tree.refit_leaves(boxes); },
+                           [&] { cones.update(tree, s.triangles, leaf); });
       self_overlapping_pairs_parallel(tree, skip_rest_close, pairs, &cones);
       (void)triangle_contacts(x, s.triangles, ownership, pairs, 2.0f * inflate, contacts);
       benchmark::DoNotOptimize(contacts.data());

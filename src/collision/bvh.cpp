@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <cmath>
 #include <string>
 
@@ -104,6 +105,22 @@ void Bvh::build_node(std::span<const Aabb> boxes, const std::vector<float>& cent
 
 void Bvh::refit(std::span<const Aabb> boxes) {
   for (std::size_t k = 0; k < leaf_boxes_.size(); ++k) leaf_boxes_[k] = boxes[order_[k]];
+  refit_nodes();
+}
+
+void Bvh::refit_leaves(std::vector<Aabb>& leaf_boxes) {
+  assert(leaf_boxes.size() == leaf_boxes_.size());
+  leaf_boxes_.swap(leaf_boxes);
+  refit_nodes();
+}
+
+void Bvh::rebuild() {
+  std::vector<Aabb> boxes(leaf_boxes_.size());
+  for (std::size_t k = 0; k < boxes.size(); ++k) boxes[order_[k]] = leaf_boxes_[k];
+  build(boxes);
+}
+
+void Bvh::refit_nodes() {
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     Node& node = nodes_[n];
     if (node.count > 0) {

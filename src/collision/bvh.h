@@ -45,6 +45,13 @@ class Bvh {
   /// Recomputes every node's box from the primitives' new boxes (same
   /// count as at build) bottom-up; the tree's shape is kept.
   void refit(std::span<const Aabb> boxes);
+  /// refit() with the boxes given in leaf order: leaf_boxes[k] is the box
+  /// of primitive order()[k] (e.g. LeafVertices::boxes, leaf_vertices.h).
+  /// [in,out] leaf_boxes: taken by the tree, which hands back its previous
+  /// leaf boxes (a swap, not a copy; the same count).
+  void refit_leaves(std::vector<Aabb>& leaf_boxes);
+  /// Builds anew over the boxes of the last build or refit (leaf_boxes()).
+  void rebuild();
   /// Sum of node half-areas over the root's: grows as a refitted tree's
   /// boxes swell and overlap. 0 for an empty tree.
   [[nodiscard]] double cost() const;
@@ -71,6 +78,7 @@ class Bvh {
   [[nodiscard]] std::uint64_t build_id() const { return build_id_; }
 
  private:
+  void refit_nodes();  // every node's box from leaf_boxes_, bottom-up
   void build_node(std::span<const Aabb> boxes, const std::vector<float>& centroids, std::uint32_t index,
                   std::uint32_t first, std::uint32_t count);
   std::vector<Node> nodes_;

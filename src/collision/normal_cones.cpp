@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <iterator>
 #include <cmath>
 #include <numeric>
@@ -187,8 +188,18 @@ bool NormalCones::pair(std::uint32_t a, std::uint32_t b) const {
 }
 
 void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangles, std::span<const float> positions) {
+  if (build_id_ != tree.build_id() || connected_.size() != tree.nodes().size()) connect(tree, triangles);
+  refresh(tree, corners_, positions);
+}
+
+void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangles, const LeafVertices& leaf) {
+  assert(leaf.build_id() == tree.build_id());
+  if (build_id_ != tree.build_id() || connected_.size() != tree.nodes().size()) connect(tree, triangles);
+  refresh(tree, leaf.corners(), leaf.positions());
+}
+
+void NormalCones::refresh(const Bvh& tree, std::span<const std::uint32_t> corners, std::span<const float> positions) {
   const auto& nodes = tree.nodes();
-  if (build_id_ != tree.build_id() || connected_.size() != nodes.size()) connect(tree, triangles);
   const std::size_t n = nodes.size();
   const float flat_cos = flat_cos_ = std::cos(kFlatDegrees * 3.14159265358979f / 180.0f);
   cones_.resize(n);
@@ -224,7 +235,7 @@ void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangl
     std::uint32_t m = 0;
     bool ok = true;
     for (std::uint32_t s = 0; s < node.count; ++s)
-      ok = ok && unit_normal(positions, &corners_[3 * (std::size_t{node.first} + s)], normals[m++]);
+      ok = ok && unit_normal(positions, &corners[3 * (std::size_t{node.first} + s)], normals[m++]);
     float* sum = &sum_[3 * i];
     sum[0] = sum[1] = sum[2] = 0.0f;
     for (std::uint32_t q = 0; ok && q < m; ++q)

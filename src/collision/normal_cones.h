@@ -50,6 +50,7 @@
 #include <vector>
 
 #include "collision/bvh.h"
+#include "collision/leaf_vertices.h"
 
 namespace sinew::collision {
 
@@ -65,6 +66,10 @@ class NormalCones {
   /// call (Bvh::build_id), from the triangles' shared vertices and edges. A
   /// zero-area triangle has no normal: the nodes above it are never flat.
   void update(const Bvh& tree, std::span<const std::uint32_t> triangles, std::span<const float> positions);
+  /// The same from the positions `leaf` gathered (indexed from `tree` and
+  /// `triangles`, leaf_vertices.h): the leaves' normals read nearly
+  /// consecutive memory.
+  void update(const Bvh& tree, std::span<const std::uint32_t> triangles, const LeafVertices& leaf);
 
   /// Per node of the tree: 1 where its triangles cannot touch themselves.
   [[nodiscard]] std::span<const std::uint8_t> flat() const { return flat_; }
@@ -91,6 +96,8 @@ class NormalCones {
 
  private:
   void connect(const Bvh& tree, std::span<const std::uint32_t> triangles);
+  // The cones from the triangles' corners in leaf order (3 per slot) into `positions` (xyzw).
+  void refresh(const Bvh& tree, std::span<const std::uint32_t> corners, std::span<const float> positions);
   std::uint64_t build_id_ = 0;
   std::vector<std::uint8_t> flat_, connected_, open_;  // open_: a triangle of the node has an open edge
   std::vector<Cone> cones_;

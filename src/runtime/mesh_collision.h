@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "collision/bvh.h"
+#include "collision/leaf_vertices.h"
 #include "collision/narrow_phase.h"
 #include "collision/normal_cones.h"
 #include "collision/rest_close.h"
@@ -105,6 +106,7 @@ class MeshCollision {
     std::uint32_t first = 0, count = 0;
     collision::Bvh tree;       // boxes swept by the vertices' velocities: against other bodies
     collision::Bvh self_tree;  // swept relative to the body's mean velocity: against itself (self-collision only)
+    collision::LeafVertices leaf;  // self_tree's vertices in its leaf order (self-collision only)
     collision::NormalCones cones;  // of self_tree; triangle trees with self-culling only
     // Triangle trees with self-collision: the pairs (local indices)
     // closer than the thickness in the starting shape, never in contact.
@@ -149,14 +151,10 @@ class MeshCollision {
   std::vector<float> tool_lambda_, tool_lambda_sum_;
   std::vector<float> upload_motion_;  // per contact slot (Contact::motion)
   std::uint64_t read_back_bytes_ = 0;
-  // Refits each body's tree `which` to its primitives' boxes (builds it
-  // when empty); then rebuild_degraded rebuilds those whose refit left
-  // their degradation above kMaxDegradation (as Bvh::update does, in two
-  // steps so that the cones can be updated beside the refit).
-  static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes,
-                    collision::Bvh BodyTree::*which);
-  static void rebuild_degraded(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes,
-                               collision::Bvh BodyTree::*which);
+  // Refits each body's tree (against other bodies) to its primitives'
+  // `boxes` (builds it when empty). Rebuilt, when degraded past
+  // kMaxDegradation, after the cones' update beside it (before_frame).
+  static void refit(std::vector<BodyTree>& trees, std::span<const collision::Aabb> boxes);
   static constexpr double kMaxDegradation = 2.0;
   // Fills each triangle tree's rest_close from the starting positions
   // (device order, xyzw).
@@ -175,7 +173,8 @@ class MeshCollision {
   std::uint32_t solid_bodies_ = 0;  // bodies 0 .. solid_bodies_ - 1 are tet bodies (closed, outward surfaces)
   std::uint32_t body_count_ = 0;      // collidable bodies: tet, then tri, then line bodies
   std::vector<double> mean_velocity_;  // per body: its surface vertices' mean velocity (xyz) [m/s]
-  std::vector<collision::Aabb> self_boxes_;
+  std::vector<collision::Aabb> self_boxes_;  // one body's self tree's, in its leaf order
+  std::vector<float> leaf_velocities_;       // one body's velocities gathered in its self tree's leaf order
   std::size_t solid_triangles_ = 0;  // triangles_ [0, solid_triangles_) are the solids' surfaces
   std::vector<std::pair<std::uint64_t, std::uint32_t>> solid_edges_;  // (edge key, face), sorted
   std::vector<float> vertex_out_;  // per particle of a solid's surface: its area-weighted normal (xyz)
