@@ -28,7 +28,9 @@
 // device (collision/device_bvh.h: Karras's build, the refit and the
 // bvh_self_pairs traversal in kernels) on each backend built: the boxes
 // computed on the host and written, the tree refitted (or rebuilt), the
-// pairs found, read back and sorted.
+// pairs found, read back and sorted; or, with narrow:1, the narrow phase
+// run on the device over them too (collision/device_narrow_phase.h) and
+// the contacts read back instead.
 //   bench_broad_phase --benchmark_out=broad.csv --benchmark_out_format=csv
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_invoke.h>
@@ -45,6 +47,7 @@
 #include "collision/bvh.h"
 #include "collision/leaf_vertices.h"
 #include "collision/device_bvh.h"
+#include "collision/device_narrow_phase.h"
 #include "collision/narrow_phase.h"
 #include "collision/normal_cones.h"
 #include "collision/parallel_pairs.h"
@@ -336,12 +339,18 @@ void BM_KidneyOnLiver(benchmark::State& state) {
 
 // The self broad phase of BM_SelfBroadPhase with the device BVH: range(0)
 // the mesh (0 kidney, 1 liver), range(1) the backend (0 cpu, 1 opencl, 2
-// vulkan), range(2) 1 to rebuild the tree every frame, 0 to refit it.
+// vulkan), range(2) 1 to rebuild the tree every frame, 0 to refit it,
+// range(3) 1 to add the narrow phase on the device
+// (collision/device_narrow_phase.h; thickness twice the inflation, as the
+// host's "+ narrow" rows): the positions written too, the contacts read
+// back (sorted, duplicates removed) instead of the pairs. No normal cones
+// or rest-close pairs on the device: it tests every self pair.
 void BM_DeviceSelfBroadPhase(benchmark::State& state) {
   const Surface& s = surface(int(state.range(0)));
   static const char* backends[] = {"cpu", "opencl", "vulkan"};
   const char* backend = backends[state.range(1)];
   const bool rebuild = state.range(2) != 0;
+  const bool narrow = state.range(3) != 0;
   if (s.triangles.empty()) {
     state.SkipWithError("mesh not found");
     return;
@@ -373,13 +382,20 @@ void BM_DeviceSelfBroadPhase(benchmark::State& state) {
   auto bvh = make_device_bvh(device, n);
   auto ids = device.create_buffer(s.triangles.size() * 4, "vertex ids");
   auto pair_buffer = device.create_buffer(std::size_t{capacity} * 8, "pairs");
-  auto counter = device.create_buffer(4, "pair counter");
-  if (!bvh || !ids || !pair_buffer || !counter) {
+  auto counter = device.create_buffer(16, "pair and contact counters");
+  auto positions = device.create_buffer(s.rest.size() * 4, "positions");
+  if (!bvh || !ids || !pair_buffer || !counter || !positions) {
     state.SkipWithError("device buffers");
     return;
   }
   (void)device.write_buffer(*ids, 0, s.triangles.data(), s.triangles.size() * 4);
   const sinew::DeviceCount count{*counter, 0, capacity};
+  auto triangles = make_device_triangles(device, s.triangles);
+  auto contact_room = make_device_contacts(device, capacity, *counter, 1);  // as many as pairs
+  if (!triangles || !contact_room) {
+    state.SkipWithError("device narrow phase buffers");
+    return;
+  }
   // The first frame builds; the timed frames rebuild or only refit.
   const auto program_of = [&](bool build) -> sinew::Result<sinew::ProgramHandle> {
     sinew::FrameProgram program;
@@ -389,6 +405,11 @@ void BM_DeviceSelfBroadPhase(benchmark::State& state) {
     if (sinew::Status st = append_device_bvh_refit(program, *bvh, n); !st) return st.error();
     if (sinew::Status st = append_device_bvh_self_pairs(program, *bvh, n, *ids, *pair_buffer, count); !st)
       return st.error();
+    if (narrow)
+      if (sinew::Status st = append_device_triangle_contacts(program, *positions, *triangles, *pair_buffer, count,
+                                                             *contact_room, 2.0f * inflate);
+          !st)
+        return st.error();
     return device.create_program(program);
   };
   auto first = program_of(true);
@@ -405,6 +426,8 @@ void BM_DeviceSelfBroadPhase(benchmark::State& state) {
   };
   std::vector<float> words = f(boxes);
   (void)device.write_buffer(bvh->boxes, 0, words.data(), words.size() * 4);
+  (void)device.write_buffer(*positions, 0, x.data(), x.size() * 4);
+  std::vector<Contact> contacts;
   if (!device.run_program(*first)) {
     state.SkipWithError("first frame failed");
     return;
@@ -417,9 +440,20 @@ void BM_DeviceSelfBroadPhase(benchmark::State& state) {
     (void)primitive_boxes(x, s.triangles, 3, inflate, boxes);
     words = f(boxes);
     (void)device.write_buffer(bvh->boxes, 0, words.data(), words.size() * 4);
+    if (narrow) (void)device.write_buffer(*positions, 0, x.data(), x.size() * 4);
     if (sinew::Status st = device.run_program(*frame_program); !st) {
       state.SkipWithError(st.error().message().c_str());
       break;
+    }
+    if (narrow) {
+      auto made_contacts = read_device_contacts(device, *contact_room);
+      if (!made_contacts) {
+        state.SkipWithError(made_contacts.error().message().c_str());
+        break;
+      }
+      contacts = std::move(*made_contacts);
+      benchmark::DoNotOptimize(contacts.data());
+      continue;
     }
     auto found = read_device_bvh_pairs(device, *pair_buffer, count);
     if (!found) {
@@ -430,10 +464,12 @@ void BM_DeviceSelfBroadPhase(benchmark::State& state) {
     benchmark::DoNotOptimize(pairs.data());
   }
   state.SetLabel(std::string(state.range(0) == 0 ? "kidney_57k" : "liver_382k") + " surface, device BVH on " + backend +
-                 (rebuild ? ", rebuild" : ", refit"));
+                 (rebuild ? ", rebuild" : ", refit") + (narrow ? " + narrow phase" : ""));
   state.counters["triangles"] = double(s.triangles.size() / 3);
-  state.counters["pairs"] = double(pairs.size());
-  state.counters["contacts"] = 0.0;  // the same counters as the other rows (CSV)
+  std::uint32_t found_pairs = 0;  // the last frame's (narrow: not read back, the counter only)
+  (void)device.read_buffer(*counter, 0, &found_pairs, 4);
+  state.counters["pairs"] = double(found_pairs);
+  state.counters["contacts"] = double(contacts.size());  // 0 without the narrow phase (the CSV wants every column)
 }
 
 BENCHMARK(BM_KidneyOnLiver)
@@ -451,8 +487,8 @@ BENCHMARK(BM_SelfBroadPhase)
     ->UseRealTime();
 
 BENCHMARK(BM_DeviceSelfBroadPhase)
-    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}})
-    ->ArgNames({"mesh", "backend", "rebuild"})
+    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}, {0, 1}})
+    ->ArgNames({"mesh", "backend", "rebuild", "narrow"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -70,6 +70,8 @@
   SINEW_KERNEL(bvh_karras_nodes, 3, KarrasParams, 0)                             \
   SINEW_KERNEL(bvh_refit_pass, 6, RefitParams, 0)                                \
   SINEW_KERNEL(bvh_self_pairs, 7, SelfPairsParams, 0)                            \
-  SINEW_KERNEL(bvh_tree_pairs, 7, TreePairsParams, 0)
+  SINEW_KERNEL(bvh_tree_pairs, 7, TreePairsParams, 0)                            \
+  /* the device narrow phase (kernels/shared/narrow_phase_params.h) */           \
+  SINEW_KERNEL(narrow_triangle_pairs, 6, TrianglePairsParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

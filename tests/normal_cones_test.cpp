@@ -23,24 +23,8 @@ namespace sinew::collision {
 namespace {
 
 using test::Surface;
+using test::bent;
 using test::surface_of;
-
-// A smooth bend of amplitude `amount` (mesh units), different per frame: the
-// organ deforms, its triangles keep their neighbours (as in
-// benchmarks/broad_phase_benchmark.cpp).
-std::vector<float> bent(const Surface& s, float amount, int frame) {
-  float lo = INFINITY, hi = -INFINITY;
-  for (std::size_t v = 0; v < s.positions.size(); v += 4) lo = std::min(lo, s.positions[v]), hi = std::max(hi, s.positions[v]);
-  const float k = 6.2831853f / (hi - lo);
-  std::vector<float> x = s.positions;
-  for (std::size_t v = 0; v < x.size(); v += 4) {
-    const float* r = &s.positions[v];
-    x[v] += amount * std::sin(k * r[1] + 0.1f * float(frame));
-    x[v + 1] += amount * std::sin(k * r[2] + 0.2f * float(frame));
-    x[v + 2] += amount * std::sin(k * r[0] + 0.3f * float(frame));
-  }
-  return x;
-}
 
 // Per node: its run of slots in order() (inner nodes: both children's).
 std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(const Bvh& tree) {

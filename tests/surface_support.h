@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -41,6 +42,24 @@ inline Surface surface_of(const std::string& mesh_file) {
   EXPECT_TRUE(mesh.ok()) << mesh_file << ": " << (mesh.ok() ? "" : mesh.error().message());
   if (!mesh.ok()) return {};
   return surface_of(extract_boundary_surface(*mesh));
+}
+
+// A smooth bend of amplitude `amount` (mesh units), different per frame: the
+// organ deforms, its triangles keep their neighbours (as in
+// benchmarks/broad_phase_benchmark.cpp): tests/normal_cones_test.cpp,
+// tests/device_narrow_phase_test.cpp.
+inline std::vector<float> bent(const Surface& s, float amount, int frame) {
+  float lo = INFINITY, hi = -INFINITY;
+  for (std::size_t v = 0; v < s.positions.size(); v += 4) lo = std::min(lo, s.positions[v]), hi = std::max(hi, s.positions[v]);
+  const float k = 6.2831853f / (hi - lo);
+  std::vector<float> x = s.positions;
+  for (std::size_t v = 0; v < x.size(); v += 4) {
+    const float* r = &s.positions[v];
+    x[v] += amount * std::sin(k * r[1] + 0.1f * float(frame));
+    x[v + 1] += amount * std::sin(k * r[2] + 0.2f * float(frame));
+    x[v + 2] += amount * std::sin(k * r[0] + 0.3f * float(frame));
+  }
+  return x;
 }
 
 }  // namespace sinew::test

@@ -1,8 +1,10 @@
 // proximity_math.h — closest points between a point and a triangle and
 // between two segments: the narrow phase of mesh collision (issue 12),
 // templated on the scalar: float in the CPU narrow phase
-// (src/collision/narrow_phase.cpp), double in the tests. The GPU narrow
-// phase does not exist yet; its kernels must round like this code.
+// (src/collision/narrow_phase.cpp) and the narrow phase kernel's CPU
+// reference (kernels/cpu/narrow_phase_kernels.cpp), double in the tests.
+// The GPU kernels' twin, kernels/gpu/proximity_math.h, rounds like this
+// code: change both together.
 //
 // Ericson, "Real-Time Collision Detection", Morgan Kaufmann 2005:
 // section 5.1.5 (closest point on a triangle by Voronoi regions, the

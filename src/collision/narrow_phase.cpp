@@ -201,15 +201,6 @@ float longest_edge2(const float4 (&p)[3], const float4 (&q)[3]) {
   return longest;
 }
 
-// One contact per (vertex, triangle) and per pair of edges, in a fixed order.
-void sort_unique(std::vector<Contact>& contacts) {
-  const auto key = [](const Contact& c) { return std::tuple(c.kind, c.v[0], c.v[1], c.v[2], c.v[3]); };
-  std::stable_sort(contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
-  contacts.erase(
-      std::unique(contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) { return key(a) == key(b); }),
-      contacts.end());
-}
-
 bool contains(const std::uint32_t* v, int n, std::uint32_t x) {
   for (int k = 0; k < n; ++k)
     if (v[k] == x) return true;
@@ -248,11 +239,19 @@ Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, const Contac
   for (const auto& f : found) total += f.size();
   contacts.reserve(total);
   for (const auto& f : found) contacts.insert(contacts.end(), f.begin(), f.end());
-  sort_unique(contacts);
+  sort_unique_contacts(contacts);
   return {};
 }
 
 }  // namespace
+
+void sort_unique_contacts(std::vector<Contact>& contacts) {
+  const auto key = [](const Contact& c) { return std::tuple(c.kind, c.v[0], c.v[1], c.v[2], c.v[3]); };
+  std::stable_sort(contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
+  contacts.erase(
+      std::unique(contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) { return key(a) == key(b); }),
+      contacts.end());
+}
 
 float triangle_distance(std::span<const float> positions, const std::uint32_t* a, const std::uint32_t* b) {
   float4 pa[3], pb[3];

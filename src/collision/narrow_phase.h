@@ -75,6 +75,11 @@ inline constexpr float kFacingCos = 0.9f;
 /// edges and zero-area triangles (no direction to face).
 bool facing(const Contact& contact, std::span<const float> positions);
 
+/// Sorts contacts by kind, then particles, and keeps the first of each
+/// (kind, particles): one contact per (vertex, triangle) and per pair of
+/// edges, in a fixed order (what every function below returns).
+void sort_unique_contacts(std::vector<Contact>& contacts);
+
 /// The distance between triangles a and b (three vertex indices each into
 /// `positions`, xyzw per vertex, finite) [m]: every edge of each against
 /// the other (proximity::closest_segment_triangle), so 0 where they cross.
