@@ -166,9 +166,9 @@ void BM_SelfBroadPhase(benchmark::State& state) {
       // gathered in the tree's leaf order (leaf_vertices.h), the cones
       // beside the boxes and the refit, on the second core; then the pairs
       // (rest-close ones skipped) and their contacts.
-      leaf.index(tree, s.triangles, 3);
+      (void)leaf.index(tree, s.triangles, 3);
       (void)leaf.gather(x);
-      tbb::parallel_invoke([&] { leaf.boxes(inflate, boxes), tree.refit_leaves(boxes); },
+      tbb::parallel_invoke([&] { leaf.boxes(inflate, boxes), (void)tree.refit_leaves(boxes); },
                            [&] { cones.update(tree, s.triangles, leaf); });
       self_overlapping_pairs_parallel(tree, skip_rest_close, pairs, &cones);
       (void)triangle_contacts(x, s.triangles, ownership, pairs, 2.0f * inflate, contacts);
@@ -446,7 +446,7 @@ void BM_DeviceSelfBroadPhase(benchmark::State& state) {
       break;
     }
     if (narrow) {
-      auto made_contacts = read_device_contacts(device, *contact_room);
+      auto made_contacts = read_device_contacts(device, *contact_room, count);
       if (!made_contacts) {
         state.SkipWithError(made_contacts.error().message().c_str());
         break;

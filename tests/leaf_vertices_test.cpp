@@ -52,7 +52,7 @@ TEST_P(LeafVerticesArity, BoxesAndRefitEqualThePrimitivesOrderOnTheKidney) {
   leafwise.build(boxes);
 
   LeafVertices leaf;
-  leaf.index(leafwise, indices, arity);
+  ASSERT_TRUE(leaf.index(leafwise, indices, arity).ok());
   EXPECT_EQ(leaf.build_id(), leafwise.build_id());
   EXPECT_EQ(leaf.corners().size(), indices.size());
   // Every vertex the primitives use, once.
@@ -71,7 +71,7 @@ TEST_P(LeafVerticesArity, BoxesAndRefitEqualThePrimitivesOrderOnTheKidney) {
   for (std::size_t k = 0; k < leaf_boxes.size(); ++k) differ += !same_box(leaf_boxes[k], boxes[leafwise.order()[k]]);
   EXPECT_EQ(differ, 0u) << "leaf-order boxes that are not the primitive's own box";
 
-  leafwise.refit_leaves(leaf_boxes);
+  ASSERT_TRUE(leafwise.refit_leaves(leaf_boxes).ok());
   ASSERT_EQ(leafwise.nodes().size(), reference.nodes().size());
   differ = 0;
   for (std::size_t n = 0; n < reference.nodes().size(); ++n)
@@ -90,7 +90,7 @@ TEST_P(LeafVerticesArity, BoxesAndRefitEqualThePrimitivesOrderOnTheKidney) {
     differ += !same_box(reference.nodes()[n].box, leafwise.nodes()[n].box);
   EXPECT_EQ(differ, 0u);
   // A new shape is indexed anew.
-  leaf.index(leafwise, indices, arity);
+  ASSERT_TRUE(leaf.index(leafwise, indices, arity).ok());
   EXPECT_EQ(leaf.build_id(), leafwise.build_id());
   ASSERT_TRUE(leaf.gather(x).ok());
   leaf.boxes(inflate, leaf_boxes);
@@ -111,7 +111,7 @@ TEST(LeafVertices, ConesFromTheGatheredVerticesEqualConesFromThePositions) {
   NormalCones direct, gathered;
   direct.update(tree, s.triangles, x);
   LeafVertices leaf;
-  leaf.index(tree, s.triangles, 3);
+  ASSERT_TRUE(leaf.index(tree, s.triangles, 3).ok());
   ASSERT_TRUE(leaf.gather(x).ok());
   gathered.update(tree, s.triangles, leaf);
   std::size_t flat = 0, differ = 0;
@@ -133,7 +133,7 @@ TEST(LeafVertices, ANonFinitePositionOrAMissingVertexIsNamed) {
   Bvh tree;
   tree.build(boxes);
   LeafVertices leaf;
-  leaf.index(tree, triangles, 3);
+  ASSERT_TRUE(leaf.index(tree, triangles, 3).ok());
   ASSERT_TRUE(leaf.gather(x).ok());
   for (const float bad : {NAN, INFINITY, -INFINITY}) {
     std::vector<float> y = x;
@@ -147,6 +147,39 @@ TEST(LeafVertices, ANonFinitePositionOrAMissingVertexIsNamed) {
   ASSERT_FALSE(short_positions.ok());
   EXPECT_NE(short_positions.error().message().find("names vertex 3 of 3"), std::string::npos)
       << short_positions.error().message();
+}
+
+// Mismatched inputs are errors, and cones from vertices gathered for an
+// older shape of the tree cull nothing.
+TEST(LeafVertices, MismatchesAreErrorsAndStaleVerticesCullNothing) {
+  const Surface s = surface_of("meshes/tet/armadillo_4k.node");
+  ASSERT_FALSE(s.triangles.empty());
+  std::vector<Aabb> boxes;
+  ASSERT_TRUE(primitive_boxes(s.positions, s.triangles, 3, 0.1f * s.mean_edge, boxes).ok());
+  Bvh tree;
+  tree.build(boxes);
+  LeafVertices leaf;
+  EXPECT_FALSE(leaf.index(tree, s.triangles, 2).ok()) << "triangles read as segments";
+  EXPECT_FALSE(leaf.index(tree, std::span<const std::uint32_t>(s.triangles).first(30), 3).ok());
+  EXPECT_FALSE(leaf.index(tree, s.triangles, 4).ok());
+  std::vector<Aabb> fewer(boxes.begin(), boxes.end() - 1);
+  const Status refit = tree.refit_leaves(fewer);
+  ASSERT_FALSE(refit.ok());
+  EXPECT_NE(refit.error().message().find("boxes for a tree over"), std::string::npos) << refit.error().message();
+  EXPECT_EQ(fewer.size(), boxes.size() - 1) << "nothing swapped";
+
+  ASSERT_TRUE(leaf.index(tree, s.triangles, 3).ok());
+  ASSERT_TRUE(leaf.gather(s.positions).ok());
+  NormalCones cones;
+  cones.update(tree, s.triangles, leaf);
+  std::size_t flat = 0;
+  for (const std::uint8_t f : cones.flat()) flat += f;
+  EXPECT_GT(flat, 0u);
+  tree.build(boxes);  // a new shape; leaf still holds the old one's order
+  cones.update(tree, s.triangles, leaf);
+  flat = 0;
+  for (const std::uint8_t f : cones.flat()) flat += f;
+  EXPECT_EQ(flat, 0u) << "stale vertices must not cull";
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "cpu/cpu_kernels.h"
 #include "math/proximity_math.h"
+#include "math/triangle_separation.h"
 #include "narrow_phase_params.h"
 
 namespace sinew::kernels {
@@ -64,7 +65,9 @@ Hit vertex_triangle(float4 p, float4 a, float4 b, float4 c, float thickness) {
   return r;
 }
 
-Hit edge_edge(float4 p1, float4 q1, float4 p2, float4 q2, float4 face, float thickness) {
+// face(): the fallback normal of parallel edges, called only then.
+template <class Face>
+Hit edge_edge(float4 p1, float4 q1, float4 p2, float4 q2, const Face& face, float thickness) {
   Hit r;
   const auto st = px::closest_between_segments(p1, q1, p2, q2);
   const float4 c1 = px::lerp3(p1, q1, st.s), c2 = px::lerp3(p2, q2, st.t);
@@ -72,7 +75,7 @@ Hit edge_edge(float4 p1, float4 q1, float4 p2, float4 q2, float4 face, float thi
   if (d >= thickness) return r;
   float4 fallback = cross3(q1 - p1, q2 - p2);  // touching edges: their common normal
   const float fl = length3(fallback);
-  fallback = fl > 0.0f ? (1.0f / fl) * fallback : face;
+  fallback = fl > 0.0f ? (1.0f / fl) * fallback : face();
   if (d <= 0.0f && length3(fallback) <= 0.0f) return r;
   r.hit = true;
   r.w[0] = 1.0f - st.s, r.w[1] = st.s, r.w[2] = 1.0f - st.t, r.w[3] = st.t;
@@ -126,13 +129,15 @@ void narrow_triangle_pairs(const void* params, std::byte* const* bindings, std::
         const float* q = positions + 4 * std::size_t{v[side][c]};
         x[side][c] = {q[0], q[1], q[2], 0.0f};
       }
-    bool degenerate = false;
+    bool degenerate = false;  // zero area, or a non-finite position (NaN fails the test too)
     for (int side = 0; side < 2; ++side)
-      degenerate = degenerate || length3(cross3(x[side][1] - x[side][0], x[side][2] - x[side][0])) <= 0.0f;
+      degenerate = degenerate || !(length3(cross3(x[side][1] - x[side][0], x[side][2] - x[side][0])) > 0.0f);
     if (degenerate) {
       std::atomic_ref<std::uint32_t>(counts[p.bad_word]).fetch_add(1u, std::memory_order_relaxed);
       continue;
     }
+    if (separation::worth_separating(x[0], x[1], p.thickness) && separation::separated(x[0], x[1], p.thickness))
+      continue;
     // The ownership rule (narrow_phase_params.h).
     bool vertex_test[2][3], edge_test[3][3], any = false, any_edge = false;
     for (int side = 0; side < 2; ++side) {
@@ -170,7 +175,16 @@ void narrow_triangle_pairs(const void* params, std::byte* const* bindings, std::
         if (h.hit) append(contacts, counts, p, 0u, {v[side][c], v[other][0], v[other][1], v[other][2]}, h);
       }
     if (!any_edge) continue;
-    const float4 face[2] = {face_normal(x[0][0], x[0][1], x[0][2]), face_normal(x[1][0], x[1][1], x[1][2])};
+    // The fallback normal of parallel edges: the face of the second edge's
+    // owner triangle (the host's, narrow_phase.cpp).
+    const auto owner_face = [&](std::uint32_t owner) {
+      float4 c[3];
+      for (int m = 0; m < 3; ++m) {
+        const float* q = positions + 4 * std::size_t{triangles[3 * std::size_t{owner} + std::size_t(m)]};
+        c[m] = {q[0], q[1], q[2], 0.0f};
+      }
+      return face_normal(c[0], c[1], c[2]);
+    };
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
         if (!edge_test[a][b]) continue;
@@ -184,7 +198,10 @@ void narrow_triangle_pairs(const void* params, std::byte* const* bindings, std::
         // Each edge with its lower vertex first.
         for (const int side : {first, second})
           if (e[side][0] > e[side][1]) std::swap(e[side][0], e[side][1]), std::swap(y[side][0], y[side][1]);
-        const Hit h = edge_edge(y[first][0], y[first][1], y[second][0], y[second][1], face[second], p.thickness);
+        const std::uint32_t second_owner =
+            owners[6 * std::size_t{t[second]} + 3 + std::size_t(second == 0 ? a : b)];
+        const Hit h = edge_edge(y[first][0], y[first][1], y[second][0], y[second][1],
+                                [&] { return owner_face(second_owner); }, p.thickness);
         if (h.hit) append(contacts, counts, p, 1u, {e[first][0], e[first][1], e[second][0], e[second][1]}, h);
       }
   }

@@ -11,18 +11,22 @@
  * One item per candidate pair k < n, n = min(counts[pair_count_word],
  * pair_capacity) (the traversal's counter, read when the kernel runs: an
  * indirect dispatch over it, FrameProgram::dispatch_indirect). Pair (ti,
- * tj) tests each vertex of one triangle against the other triangle and
+ * tj), after the host's separating-axis reject (kernels/math/
+ * triangle_separation.h, where the gap is under half the pair's longest
+ * edge), tests each vertex of one triangle against the other triangle and
  * each edge of one against each edge of the other, with the host's
  * ownership rule (collision::TriangleOwnership: a vertex or an edge is
  * tested from its owner's pair, or from every pair around it when its
  * owner shares a vertex with the other triangle), skipping vertices of the
  * other triangle and edges that share a vertex; a feature pair closer than
- * `thickness` [m] makes a contact. The ownership rule leaves some feature
- * pairs to several candidate pairs: the host sorts and removes the
- * duplicates (they are equal bit for bit: the same inputs, the same
- * operations). A pair holding a zero-area triangle (no normal to push
- * along; the host reference's error) makes no contact and adds 1 to
- * counts[bad_word].
+ * `thickness` [m] makes a contact. Two parallel edges fall back on the
+ * normal of the second edge's owner triangle (owners[6 t + 3 + edge]), so
+ * whichever pair tests them gives the same contact. The ownership rule
+ * leaves some feature pairs to several candidate pairs: the host sorts and
+ * removes the duplicates (equal bit for bit: the same inputs, the same
+ * operations). A pair holding a zero-area triangle or a non-finite corner
+ * (no normal to push along; the host reference's error) makes no contact
+ * and adds 1 to counts[bad_word].
  *
  * Each contact takes slot = atomic add of 1 to counts[contact_count_word]
  * and is written when slot < contact_capacity (the host declares the
@@ -62,7 +66,7 @@ SINEW_STRUCT_BEGIN(TrianglePairsParams)
   uint pair_count_word;    /* counts[pair_count_word]: pairs found */
   uint contact_capacity;   /* contacts the contacts buffer holds */
   uint contact_count_word; /* counts[contact_count_word]: contacts made (zeroed by the host) */
-  uint bad_word;           /* counts[bad_word]: pairs with a zero-area triangle (zeroed by the host) */
+  uint bad_word;           /* counts[bad_word]: pairs with a zero-area triangle or a non-finite corner (zeroed by the host) */
   float thickness;         /* [m], > 0 */
   uint pad0;
   uint pad1;

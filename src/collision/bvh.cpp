@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <cmath>
 #include <string>
 
@@ -108,10 +107,14 @@ void Bvh::refit(std::span<const Aabb> boxes) {
   refit_nodes();
 }
 
-void Bvh::refit_leaves(std::vector<Aabb>& leaf_boxes) {
-  assert(leaf_boxes.size() == leaf_boxes_.size());
+Status Bvh::refit_leaves(std::vector<Aabb>& leaf_boxes) {
+  if (leaf_boxes.size() != leaf_boxes_.size())
+    return Error(ErrorCode::bad_parameter, "refit_leaves: " + std::to_string(leaf_boxes.size()) +
+                                               " boxes for a tree over " + std::to_string(leaf_boxes_.size()) +
+                                               " primitives");
   leaf_boxes_.swap(leaf_boxes);
   refit_nodes();
+  return {};
 }
 
 void Bvh::rebuild() {

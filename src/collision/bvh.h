@@ -48,8 +48,9 @@ class Bvh {
   /// refit() with the boxes given in leaf order: leaf_boxes[k] is the box
   /// of primitive order()[k] (e.g. LeafVertices::boxes, leaf_vertices.h).
   /// [in,out] leaf_boxes: taken by the tree, which hands back its previous
-  /// leaf boxes (a swap, not a copy; the same count).
-  void refit_leaves(std::vector<Aabb>& leaf_boxes);
+  /// leaf boxes (a swap, not a copy). Errors (bad_parameter): a count other
+  /// than the tree's primitives' (nothing changed then).
+  Status refit_leaves(std::vector<Aabb>& leaf_boxes);
   /// Builds anew over the boxes of the last build or refit (leaf_boxes()).
   void rebuild();
   /// Sum of node half-areas over the root's: grows as a refitted tree's

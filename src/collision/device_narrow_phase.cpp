@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "narrow_phase_params.h"
 
@@ -36,7 +37,9 @@ Result<DeviceTriangles> make_device_triangles(Device& device, std::span<const st
 
 Result<DeviceContacts> make_device_contacts(Device& device, std::uint32_t capacity, BufferHandle counts,
                                             std::uint32_t first_free_word) {
-  if (capacity == 0) return Error(ErrorCode::bad_parameter, "device contacts: the capacity must be > 0");
+  if (capacity == 0 || capacity > (1u << 27))
+    return Error(ErrorCode::bad_parameter, "device contacts: the capacity must be 1 .. 2^27 (got " +
+                                               std::to_string(capacity) + "): the kernel indexes 16 words per contact in 32 bits");
   if (!counts.valid()) return Error(ErrorCode::bad_parameter, "device contacts: the counts buffer must be valid");
   auto made = device.create_buffer(std::size_t{capacity} * SINEW_CONTACT_WORDS * 4, "narrow phase contacts");
   if (!made) return made.error();
@@ -69,6 +72,15 @@ Status append_device_triangle_contacts(FrameProgram& program, BufferHandle posit
     return Error(ErrorCode::bad_parameter,
                  "device narrow phase: no traversal before it declared the pair count (word " +
                      std::to_string(pair_count.word) + ") a counter");
+  if (counter->capacity != pair_count.capacity)
+    return Error(ErrorCode::bad_parameter, "device narrow phase: the pair counter was declared with capacity " +
+                                               std::to_string(counter->capacity) + ", not " +
+                                               std::to_string(pair_count.capacity));
+  if (out.contact_word == pair_count.word || out.bad_word == pair_count.word || out.contact_word == out.bad_word)
+    return Error(ErrorCode::bad_parameter, "device narrow phase: the pair, contact and bad-pair counts need three "
+                                           "different words (pairs " + std::to_string(pair_count.word) + ", contacts " +
+                                               std::to_string(out.contact_word) + ", bad pairs " +
+                                               std::to_string(out.bad_word) + ")");
   kernels::TrianglePairsParams p{};
   p.pair_capacity = pair_count.capacity;
   p.pair_count_word = pair_count.word;
@@ -86,14 +98,21 @@ Status append_device_triangle_contacts(FrameProgram& program, BufferHandle posit
   return {};
 }
 
-Result<std::vector<Contact>> read_device_contacts(Device& device, const DeviceContacts& out) {
-  std::uint32_t words[2] = {0, 0};
-  if (Status s = device.read_buffer(out.counts, std::size_t{out.contact_word} * 4, words, 8); !s) return s.error();
-  const std::uint32_t made = words[0], bad = words[1];
+Result<std::vector<Contact>> read_device_contacts(Device& device, const DeviceContacts& out,
+                                                  const DeviceCount& pair_count) {
+  std::uint32_t made = 0, bad = 0, pairs = 0;
+  for (auto [word, value] : {std::pair{out.contact_word, &made}, std::pair{out.bad_word, &bad},
+                             std::pair{pair_count.word, &pairs}})
+    if (Status s = device.read_buffer(out.counts, std::size_t{word} * 4, value, 4); !s) return s.error();
+  if (pairs > pair_count.capacity)
+    return Error(ErrorCode::capacity_exceeded, "device narrow phase: the traversal found " + std::to_string(pairs) +
+                                                   " pairs, more than the capacity of " +
+                                                   std::to_string(pair_count.capacity) +
+                                                   ": the pairs past it made no contacts");
   if (bad > 0)
     return Error(ErrorCode::bad_parameter, "device narrow phase: " + std::to_string(bad) +
-                                               " candidate pairs hold a zero-area triangle: a colliding triangle "
-                                               "needs a normal");
+                                               " candidate pairs hold a zero-area triangle or a non-finite corner: a "
+                                               "colliding triangle needs a normal");
   if (made > out.capacity)
     return Error(ErrorCode::capacity_exceeded, "device narrow phase: " + std::to_string(made) +
                                                    " contacts made, more than the capacity of " +

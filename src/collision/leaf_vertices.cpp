@@ -3,15 +3,17 @@
 #include "collision/leaf_vertices.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <string>
 
 namespace sinew::collision {
 
-void LeafVertices::index(const Bvh& tree, std::span<const std::uint32_t> indices, int arity) {
-  if (build_id_ == tree.build_id() && build_id_ != 0) return;
-  assert(arity >= 1 && arity <= 3 && indices.size() == tree.order().size() * std::size_t(arity));
+Status LeafVertices::index(const Bvh& tree, std::span<const std::uint32_t> indices, int arity) {
+  if (build_id_ == tree.build_id() && build_id_ != 0) return {};
+  if (arity < 1 || arity > 3 || indices.size() != tree.order().size() * std::size_t(arity))
+    return Error(ErrorCode::bad_parameter, "leaf vertices: " + std::to_string(indices.size()) + " indices of arity " +
+                                               std::to_string(arity) + " for a tree over " +
+                                               std::to_string(tree.order().size()) + " primitives");
   build_id_ = tree.build_id();
   arity_ = arity;
   const auto& order = tree.order();
@@ -30,6 +32,7 @@ void LeafVertices::index(const Bvh& tree, std::span<const std::uint32_t> indices
       corners_[slot * std::size_t(arity) + std::size_t(c)] = local[v];
     }
   positions_.assign(4 * vertices_.size(), 0.0f);
+  return {};
 }
 
 Status LeafVertices::gather(std::span<const float> positions) {

@@ -30,8 +30,10 @@ class LeafVertices {
   /// Renumbers from `tree`, built over primitives of `arity` (1-3) corners
   /// each given by `indices` (vertex indices into the positions gather()
   /// will read), when the tree was rebuilt since the last call
-  /// (Bvh::build_id); otherwise does nothing.
-  void index(const Bvh& tree, std::span<const std::uint32_t> indices, int arity);
+  /// (Bvh::build_id); otherwise does nothing. Errors (bad_parameter): an
+  /// arity outside 1-3, or indices that are not `arity` per primitive of
+  /// the tree.
+  Status index(const Bvh& tree, std::span<const std::uint32_t> indices, int arity);
 
   /// Copies the positions (xyzw per vertex) of the vertices the tree's
   /// primitives use into positions(), in local order. Errors: a vertex

@@ -12,12 +12,15 @@
 #include <tbb/parallel_for.h>
 
 #include "math/proximity_math.h"
+#include "math/triangle_separation.h"
 
 namespace sinew::collision {
 namespace {
 
 using kernels::float4;
 namespace px = kernels::proximity;
+using kernels::separation::separated;
+using kernels::separation::worth_separating;
 
 float4 vertex(std::span<const float> x, std::uint32_t v) { return {x[4 * v], x[4 * v + 1], x[4 * v + 2], 0.0f}; }
 
@@ -111,11 +114,13 @@ void vertex_triangle(std::uint32_t vertex_id, float4 p, const std::uint32_t (&tv
 }
 
 // Edge (e0, e1) at (p1, q1) against edge (e2, e3) at (p2, q2): a contact if
-// closer than the thickness and sharing no vertex. `face` is the normal to
-// fall back on when the edges touch and are parallel (zero for none: then
-// no contact, there is no direction to push along).
+// closer than the thickness and sharing no vertex. face() gives the normal to
+// fall back on when the edges are parallel (zero for none: then touching
+// edges make no contact, there is no direction to push along); it is called
+// only then.
+template <class Face>
 void edge_edge(std::uint32_t e0, std::uint32_t e1, float4 p1, float4 q1, std::uint32_t e2, std::uint32_t e3,
-               float4 p2, float4 q2, float4 face, float thickness, std::vector<Contact>& contacts) {
+               float4 p2, float4 q2, const Face& face, float thickness, std::vector<Contact>& contacts) {
   if (e0 == e2 || e0 == e3 || e1 == e2 || e1 == e3) return;
   if (apart(p1, q1, p2, q2, thickness)) return;
   // One orientation per edge (lower vertex first), so every primitive
@@ -128,7 +133,7 @@ void edge_edge(std::uint32_t e0, std::uint32_t e1, float4 p1, float4 q1, std::ui
   if (d >= thickness) return;
   float4 fallback = kernels::cross3(q1 - p1, q2 - p2);  // touching edges: their common normal
   const float fl = length3(fallback);
-  fallback = fl > 0.0f ? (1.0f / fl) * fallback : face;
+  fallback = fl > 0.0f ? (1.0f / fl) * fallback : face();
   if (d <= 0.0f && length3(fallback) <= 0.0f) return;
   Contact c;
   c.kind = Contact::Kind::edge_edge;
@@ -141,9 +146,10 @@ void edge_edge(std::uint32_t e0, std::uint32_t e1, float4 p1, float4 q1, std::ui
 
 // Two edges of one set (a surface or a thread against itself): ordered by
 // their vertices first, so (a, b) and (b, a) make the same contact; the
-// fallback normal is that of the second edge's face (zero for none).
-void edge_edge_within_one_set(std::uint32_t a0, std::uint32_t a1, float4 pa0, float4 pa1, float4 face_a,
-                              std::uint32_t b0, std::uint32_t b1, float4 pb0, float4 pb1, float4 face_b,
+// fallback normal is face_a() or face_b(), that of the edge that goes second.
+template <class FaceA, class FaceB>
+void edge_edge_within_one_set(std::uint32_t a0, std::uint32_t a1, float4 pa0, float4 pa1, const FaceA& face_a,
+                              std::uint32_t b0, std::uint32_t b1, float4 pb0, float4 pb1, const FaceB& face_b,
                               float thickness, std::vector<Contact>& contacts) {
   const bool b_first = std::min(b0, b1) < std::min(a0, a1) ||
                        (std::min(b0, b1) == std::min(a0, a1) && std::max(b0, b1) < std::max(a0, a1));
@@ -153,53 +159,6 @@ void edge_edge_within_one_set(std::uint32_t a0, std::uint32_t a1, float4 pa0, fl
     edge_edge(a0, a1, pa0, pa1, b0, b1, pb0, pb1, face_b, thickness, contacts);
 }
 
-// Whether triangles p and q are farther apart than `gap` along one of eight
-// axes (their normals and each edge's normal within its triangle's plane):
-// if their projections on a line are more than `gap` apart, so are all
-// their points, and the pair makes no contact. A subset of the separating
-// axis theorem's axes (the edge-edge cross products are left out): enough
-// for neighbours side by side on a surface, the pairs it is for.
-// Conservative under rounding: the points are taken relative to p[0] (the
-// error scales with the pair's extent, not its distance from the origin),
-// and the gap is widened by a thousandth of itself and a millionth of that
-// extent, far more than the float error of the projections (~1e-7 of the
-// extent); a pair this keeps is tested exactly as before.
-bool separated(const float4 (&p)[3], const float4 (&q)[3], float gap) {
-  const float4 o = p[0];
-  const float4 a[3] = {p[0] - o, p[1] - o, p[2] - o}, b[3] = {q[0] - o, q[1] - o, q[2] - o};
-  float extent = 0.0f;
-  for (int k = 0; k < 3; ++k)
-    extent = std::max({extent, std::abs(a[k].x), std::abs(a[k].y), std::abs(a[k].z), std::abs(b[k].x),
-                       std::abs(b[k].y), std::abs(b[k].z)});
-  const float wide = 1.001f * gap + 1e-6f * extent;
-  const auto apart_along = [&](float4 n) {
-    const float squared = kernels::dot3(n, n);
-    if (!(squared > 0.0f)) return false;
-    float alo = INFINITY, ahi = -INFINITY, blo = INFINITY, bhi = -INFINITY;
-    for (int k = 0; k < 3; ++k) {
-      const float u = kernels::dot3(n, a[k]), v = kernels::dot3(n, b[k]);
-      alo = std::min(alo, u), ahi = std::max(ahi, u), blo = std::min(blo, v), bhi = std::max(bhi, v);
-    }
-    const float s = std::max(blo - ahi, alo - bhi);  // the gap between the projections, times |n|
-    return s > 0.0f && s > wide * std::sqrt(squared);  // (not squared: |n|^2 of a needle underflows)
-  };
-  const float4 na = kernels::cross3(a[1], a[2]), nb = kernels::cross3(b[1] - b[0], b[2] - b[0]);
-  if (apart_along(na) || apart_along(nb)) return true;
-  for (int k = 0; k < 3; ++k)
-    if (apart_along(kernels::cross3(na, a[(k + 1) % 3] - a[k])) || apart_along(kernels::cross3(nb, b[(k + 1) % 3] - b[k])))
-      return true;
-  return false;
-}
-
-// The longest edge of two triangles, squared.
-float longest_edge2(const float4 (&p)[3], const float4 (&q)[3]) {
-  float longest = 0.0f;
-  for (int k = 0; k < 3; ++k) {
-    const float4 a = p[(k + 1) % 3] - p[k], b = q[(k + 1) % 3] - q[k];
-    longest = std::max({longest, kernels::dot3(a, a), kernels::dot3(b, b)});
-  }
-  return longest;
-}
 
 bool contains(const std::uint32_t* v, int n, std::uint32_t x) {
   for (int k = 0; k < n; ++k)
@@ -366,7 +325,7 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
     // their edges it rejects almost nothing (the organ example's pressed
     // kidney: 0.3% of 12M pairs, 0% of 1.1M without self-collision) and only
     // costs, so it runs when the gap is under half the longest edge.
-    if (thickness * thickness < 0.25f * longest_edge2(pi, pj) && separated(pi, pj, thickness)) return {};
+    if (worth_separating(pi, pj, thickness) && separated(pi, pj, thickness)) return {};
     // Decide from the indices alone; most pairs test nothing of their own.
     bool vertex_i[3], vertex_j[3], edges[3][3], any = false, any_edge = false;
     for (int c = 0; c < 3; ++c) {
@@ -387,12 +346,20 @@ Status triangle_contacts(std::span<const float> positions, std::span<const std::
       if (vertex_j[c]) vertex_triangle(uj[c], pj[c], ui, pi, thickness, out);
     }
     if (!any_edge) return {};
-    const float4 ni = face_normal(pi[0], pi[1], pi[2]), nj = face_normal(pj[0], pj[1], pj[2]);
+    // The fallback normal of two parallel edges: the face of the second
+    // edge's owner triangle, the same whichever candidate pair tests the two
+    // edges (each pair's own triangle would make the duplicates differ, and
+    // which one is kept depend on the pairs' order).
+    const auto owner_face = [&](std::uint32_t owner) {
+      const std::uint32_t* v = &triangles[3 * std::size_t{owner}];
+      return face_normal(vertex(positions, v[0]), vertex(positions, v[1]), vertex(positions, v[2]));
+    };
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b)
         if (edges[a][b])
-          edge_edge_within_one_set(ui[a], ui[(a + 1) % 3], pi[a], pi[(a + 1) % 3], ni, uj[b], uj[(b + 1) % 3], pj[b],
-                                   pj[(b + 1) % 3], nj, thickness, out);
+          edge_edge_within_one_set(
+              ui[a], ui[(a + 1) % 3], pi[a], pi[(a + 1) % 3], [&] { return owner_face(oi[3 + a]); }, uj[b],
+              uj[(b + 1) % 3], pj[b], pj[(b + 1) % 3], [&] { return owner_face(oj[3 + b]); }, thickness, out);
     return {};
   });
 }
@@ -408,7 +375,7 @@ Status segment_contacts(std::span<const float> positions, std::span<const std::u
     float4 pi[3], pj[3];
     if (Status s = corners(positions, segments, 2, "segment", si, vi, pi); !s) return s;
     if (Status s = corners(positions, segments, 2, "segment", sj, vj, pj); !s) return s;
-    const float4 none{0, 0, 0, 0};  // segments have no face: touching parallel segments make no contact
+    const auto none = [] { return float4{0, 0, 0, 0}; };  // segments have no face: touching parallel segments make no contact
     edge_edge_within_one_set(vi[0], vi[1], pi[0], pi[1], none, vj[0], vj[1], pj[0], pj[1], none, thickness, out);
     return {};
   });
@@ -427,7 +394,7 @@ Status segment_triangle_contacts(std::span<const float> positions, std::span<con
     if (Status s = corners(positions, triangles, 3, "triangle", tj, vt, pt); !s) return s;
     for (int c = 0; c < 2; ++c)
       if (!contains(vt, 3, vs[c])) vertex_triangle(vs[c], ps[c], vt, pt, thickness, out);
-    const float4 face = face_normal(pt[0], pt[1], pt[2]);
+    const auto face = [&] { return face_normal(pt[0], pt[1], pt[2]); };
     for (int b = 0; b < 3; ++b)
       edge_edge(vs[0], vs[1], ps[0], ps[1], vt[b], vt[(b + 1) % 3], pt[b], pt[(b + 1) % 3], face, thickness, out);
     return {};

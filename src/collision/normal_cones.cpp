@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <iterator>
 #include <cmath>
 #include <numeric>
@@ -193,8 +192,11 @@ void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangl
 }
 
 void NormalCones::update(const Bvh& tree, std::span<const std::uint32_t> triangles, const LeafVertices& leaf) {
-  assert(leaf.build_id() == tree.build_id());
   if (build_id_ != tree.build_id() || connected_.size() != tree.nodes().size()) connect(tree, triangles);
+  if (leaf.build_id() != tree.build_id()) {  // gathered for another shape: cull nothing rather than guess
+    flat_.assign(tree.nodes().size(), 0);
+    return;
+  }
   refresh(tree, leaf.corners(), leaf.positions());
 }
 

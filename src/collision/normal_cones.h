@@ -68,7 +68,8 @@ class NormalCones {
   void update(const Bvh& tree, std::span<const std::uint32_t> triangles, std::span<const float> positions);
   /// The same from the positions `leaf` gathered (indexed from `tree` and
   /// `triangles`, leaf_vertices.h): the leaves' normals read nearly
-  /// consecutive memory.
+  /// consecutive memory. A `leaf` indexed from another build of the tree
+  /// leaves no node flat (nothing culled) rather than cones of stale data.
   void update(const Bvh& tree, std::span<const std::uint32_t> triangles, const LeafVertices& leaf);
 
   /// Per node of the tree: 1 where its triangles cannot touch themselves.

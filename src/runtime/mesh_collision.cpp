@@ -692,9 +692,12 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   const bool cross = body_count_ > 1;
   const double still[3] = {0.0, 0.0, 0.0};
   // Gathers each body's vertices for its self tree (built before this frame).
-  const auto gather_body = [&](BodyTree& body, std::span<const std::uint32_t> indices, int arity) {
-    body.leaf.index(body.self_tree, indices.subspan(std::size_t{body.first} * arity, std::size_t{body.count} * arity),
-                    arity);
+  const auto gather_body = [&](BodyTree& body, std::span<const std::uint32_t> indices, int arity) -> Status {
+    if (Status s = body.leaf.index(body.self_tree,
+                                   indices.subspan(std::size_t{body.first} * arity, std::size_t{body.count} * arity),
+                                   arity);
+        !s)
+      return s;
     return body.leaf.gather(positions_);
   };
   const auto gather = [&](std::span<const std::uint32_t> indices, int arity, std::vector<BodyTree>& trees) -> Status {
@@ -720,7 +723,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
         body.leaf.boxes(half, self_boxes_);
         body.leaf.gather(velocities_, leaf_velocities_);
         sweep(body.leaf.corners(), arity, leaf_velocities_, mean, self_boxes_);
-        body.self_tree.refit_leaves(self_boxes_);
+        if (Status s = body.self_tree.refit_leaves(self_boxes_); !s) return s;
       }
     if (!cross) return {};
     if (Status s = collision::primitive_boxes(positions_, indices, arity, half, boxes_); !s) return s;
