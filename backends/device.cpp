@@ -18,6 +18,7 @@
 #include "backends/kernel_table.h"
 #include "accelerator_params.h"
 #include "bvh_params.h"
+#include "ccd_params.h"
 #include "narrow_phase_params.h"
 #include "mesh_contact_params.h"
 #include "primitive_params.h"

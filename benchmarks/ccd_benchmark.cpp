@@ -7,6 +7,8 @@
 // default). Reports the time per query, the queries per second, the false
 // negatives (must be 0; tests/ccd_test.cpp asserts it) and false positives
 // (as a count and a fraction of the negatives), and the queries that gave up.
+// BM_DeviceHandcraftedQueries: the same through the single-precision kernel
+// on each backend (src/ccd/device_ccd.h).
 //   bench_ccd --benchmark_out=ccd.csv --benchmark_out_format=csv
 #include <benchmark/benchmark.h>
 
@@ -14,7 +16,9 @@
 #include <string>
 #include <vector>
 
+#include "backends/backend.h"
 #include "ccd/benchmark_queries.h"
+#include "ccd/device_ccd.h"
 
 namespace {
 
@@ -26,6 +30,18 @@ const std::vector<BenchmarkQuery>& queries() {
     return read ? *read : std::vector<BenchmarkQuery>{};
   }();
   return all;
+}
+
+// The counters every row reports (the CSV reporter wants the same columns).
+void report(benchmark::State& state, std::size_t queries, std::size_t false_negatives, std::size_t false_positives,
+            std::size_t negatives, std::size_t gave_up, std::size_t boxes) {
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(queries));
+  state.counters["queries"] = double(queries);
+  state.counters["false_negatives"] = double(false_negatives);
+  state.counters["false_positives"] = double(false_positives);
+  state.counters["fp_fraction"] = double(false_positives) / double(negatives);
+  state.counters["gave_up"] = double(gave_up);
+  state.counters["boxes_per_query"] = double(boxes) / double(queries);
 }
 
 void BM_HandcraftedQueries(benchmark::State& state) {
@@ -55,17 +71,57 @@ void BM_HandcraftedQueries(benchmark::State& state) {
       boxes += hit->boxes;
     }
   }
-  const double n = double(mine.size());
-  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(mine.size()));
-  state.counters["queries"] = n;
-  state.counters["false_negatives"] = double(false_negatives);
-  state.counters["false_positives"] = double(false_positives);
-  state.counters["fp_fraction"] = double(false_positives) / double(negatives);
-  state.counters["gave_up"] = double(gave_up);
-  state.counters["boxes_per_query"] = double(boxes) / n;
+  report(state, mine.size(), false_negatives, false_positives, negatives, gave_up, boxes);
   state.SetLabel(std::string(vertex_face ? "vertex-face" : "edge-edge") + ", tolerance 1e" +
                  std::to_string(state.range(1)) + " m");
 }
+
+// The same queries through the single-precision kernel on a device
+// (src/ccd/device_ccd.h): range(0) the kind as above, range(1) the backend
+// (0 cpu, 1 opencl, 2 vulkan; Vulkan refuses it for now), all queries of
+// the kind in one dispatch per iteration, uploads and read-back included.
+void BM_DeviceHandcraftedQueries(benchmark::State& state) {
+  const bool vertex_face = state.range(0) == 0;
+  static const char* backends[] = {"cpu", "opencl", "vulkan"};
+  auto made = sinew::create_device({.backend = backends[state.range(1)], .quiet = true});
+  if (!made) {
+    state.SkipWithError(made.error().message().c_str());
+    return;
+  }
+  std::vector<DeviceQuery> mine;
+  std::vector<bool> truth;
+  for (const BenchmarkQuery& q : queries())
+    if (q.vertex_face == vertex_face) mine.push_back({q.vertex_face, q.points}), truth.push_back(q.truth);
+  if (mine.empty()) {
+    state.SkipWithError("no queries: data/ccd/handcrafted not found");
+    return;
+  }
+  std::size_t false_negatives = 0, false_positives = 0, negatives = 0, gave_up = 0, boxes = 0;
+  for (auto _ : state) {
+    const auto hits = device_queries(**made, mine);
+    if (!hits) {
+      state.SkipWithError(hits.error().message().c_str());
+      return;
+    }
+    false_negatives = false_positives = negatives = gave_up = boxes = 0;
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      const Hit& hit = (*hits)[k];
+      false_negatives += truth[k] && !hit.touch;
+      negatives += !truth[k];
+      false_positives += !truth[k] && hit.touch;
+      gave_up += hit.gave_up;
+      boxes += hit.boxes;
+    }
+  }
+  report(state, mine.size(), false_negatives, false_positives, negatives, gave_up, boxes);
+  state.SetLabel(std::string(vertex_face ? "vertex-face" : "edge-edge") + ", float kernel on " + backends[state.range(1)]);
+}
+
+BENCHMARK(BM_DeviceHandcraftedQueries)
+    ->ArgsProduct({{0, 1}, {0, 1, 2}})
+    ->ArgNames({"edge_edge", "backend"})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 BENCHMARK(BM_HandcraftedQueries)
     ->ArgsProduct({{0, 1}, {-6, -4, -8}})

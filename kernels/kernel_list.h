@@ -72,6 +72,8 @@
   SINEW_KERNEL(bvh_self_pairs, 7, SelfPairsParams, 0)                            \
   SINEW_KERNEL(bvh_tree_pairs, 7, TreePairsParams, 0)                            \
   /* the device narrow phase (kernels/shared/narrow_phase_params.h) */           \
-  SINEW_KERNEL(narrow_triangle_pairs, 6, TrianglePairsParams, 0)
+  SINEW_KERNEL(narrow_triangle_pairs, 6, TrianglePairsParams, 0)                \
+  /* continuous collision queries (kernels/shared/ccd_params.h) */              \
+  SINEW_KERNEL(ccd_queries, 3, CcdParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

@@ -17,10 +17,11 @@
 // misses the axes alone separate only in tiny boxes). A box whose bound
 // excludes 0 on an axis or a direction (widened by the minimum separation
 // and by a certified bound of the double-precision rounding, see below)
-// holds no root and is dropped; the others are split, depth first and earlier times first,
-// until they are narrower than the tolerance or a corner of them is within
-// the tolerance of touching; the search goes on below the earliest such
-// box's start, which is the time returned.
+// holds no root and is dropped; the others are split, depth first and
+// earlier times first, until they are narrower than the tolerance or a
+// corner of them at the box's start time is within the tolerance of
+// touching; the search goes on below the earliest such box's start, which
+// is the time returned.
 //
 // Guarantee and its assumptions:
 //  - inputs are finite doubles with |coordinate| <= 1e100 (checked; larger
@@ -57,8 +58,10 @@ struct Settings {
   /// Distance the primitives may keep and still count as touching [m], >= 0.
   double min_separation = 0.0;
   /// Boxes are split until moving across one changes the primitives'
-  /// points by at most this much [m] (> 0): the resolution of the answer,
-  /// and how near a miss may be reported as a touch.
+  /// points by at most about this much [m] (> 0): the resolution of the
+  /// answer, and how near a miss may be reported as a touch. A box side
+  /// never goes below 2^-31 of the step (its corners stay exact): with more
+  /// than 2^31 tolerances of motion in a step the resolution is coarser.
   double tolerance = 1e-6;
   /// The most boxes one query examines (> 0); past it the query reports a
   /// touch at the earliest time still open (conservative, counted as

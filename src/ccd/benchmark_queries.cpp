@@ -81,7 +81,7 @@ Result<std::vector<BenchmarkQuery>> read_benchmark_queries(const std::filesystem
         const auto [end, err] = std::from_chars(n.data(), n.data() + n.size(), numerator);
         if (err != std::errc() || end != n.data() + n.size())
           return bad(name, row, "numerator '" + n + "' is not an integer of 64 bits");
-        if (std::llabs(numerator) > (std::int64_t{1} << 53))
+        if (numerator > (std::int64_t{1} << 53) || numerator < -(std::int64_t{1} << 53))
           return bad(name, row, "numerator " + n + " has more than 53 bits: not exact in a double");
         const int exponent = power_of_two(cols[std::size_t(2 * k + 1)]);
         if (exponent < 0) return bad(name, row, "denominator '" + cols[std::size_t(2 * k + 1)] + "' is not a positive power of two");

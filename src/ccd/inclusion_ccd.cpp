@@ -63,19 +63,22 @@ struct Query {
 };
 
 enum class Inclusion {
-  apart,  // on some axis F stays beyond the threshold over the whole box: no touch in it
-  maybe,  // F may reach 0 in it
-  close,  // F comes within the threshold plus the tolerance on every axis at a corner of it
+  apart,       // on some axis F stays beyond the threshold over the whole box: no touch in it
+  maybe,       // F may reach 0 in it
+  close_late,  // maybe, and F comes within the threshold plus the tolerance at a corner at box.t1
+  close,       // F comes within the threshold plus the tolerance on every axis at a corner at box.t0
 };
 
 // Where F over `box` lies against the threshold: its eight corner values
 // per axis bound it (affine in each parameter).
 Inclusion include(const Query& q, const Box& box) {
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   double f[2][2][2][3];  // [t][u][v][axis]
   const double ts[2] = {box.t0, box.t1}, us[2] = {box.u0, box.u1}, vs[2] = {box.v0, box.v1};
-  for (int it = 0; it < 2; ++it)
-    for (int k = 0; k < 3; ++k) {
+  // Axis by axis, each tested as soon as its eight values are known: most
+  // boxes are dropped by the first axis that separates them.
+  for (int k = 0; k < 3; ++k) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (int it = 0; it < 2; ++it) {
       double x[4];
       for (int i = 0; i < 4; ++i) x[i] = q.x0[i][k] + ts[it] * q.d[i][k];
       // vertex-face: points p, a, b, c; edge-edge: a0, a1, b0, b1.
@@ -94,13 +97,13 @@ Inclusion include(const Query& q, const Box& box) {
         for (int iv = 0; iv < 2; ++iv) {
           const double value = w - vs[iv] * e2;
           f[it][iu][iv][k] = value;
-          lo[k] = std::min(lo[k], value);
-          hi[k] = std::max(hi[k], value);
+          lo = std::min(lo, value);
+          hi = std::max(hi, value);
         }
       }
     }
-  for (int k = 0; k < 3; ++k)
-    if (lo[k] > q.threshold[k] || hi[k] < -q.threshold[k]) return Inclusion::apart;
+    if (lo > q.threshold[k] || hi < -q.threshold[k]) return Inclusion::apart;
+  }
   // Along a fixed direction n, n . F is affine in each parameter too, so its
   // corner values bound it as well: a box whose corners all lie beyond the
   // direction's threshold on one side holds no touch (|n . F| <= |n|_1
@@ -119,18 +122,27 @@ Inclusion include(const Query& q, const Box& box) {
         }
     if (g_lo > q.normal_threshold[d] || g_hi < -q.normal_threshold[d]) return Inclusion::apart;
   }
-  // A corner where the primitives' points are within the tolerance (and the
-  // separation) on every axis: a touch at the resolution asked for. For
-  // vertex-face, only corners on the face (u + v <= 1) count.
+  // A corner at the box's start time where the primitives' points are within
+  // the tolerance (and the separation) on every axis: a touch at the
+  // resolution asked for, at box.t0 (the time returned). Corners at box.t1
+  // do not count: a box wide in time, close only at its end, would return a
+  // time far before the touch (found in review: a vertex reaching a
+  // triangle's corner at t = 1 came back at t = 0). For vertex-face, only
+  // corners on the face (u + v <= 1) count.
+  // A close corner at box.t1 says a touch lies within the box's time: the
+  // box is then split in time first (the search narrows onto it).
+  bool late = false;
   for (int it = 0; it < 2; ++it)
     for (int iu = 0; iu < 2; ++iu)
       for (int iv = 0; iv < 2; ++iv) {
         if (q.vertex_face && us[iu] + vs[iv] > 1.0) continue;
         const double* value = f[it][iu][iv];
-        if (std::abs(value[0]) <= q.close[0] && std::abs(value[1]) <= q.close[1] && std::abs(value[2]) <= q.close[2])
-          return Inclusion::close;
+        if (std::abs(value[0]) <= q.close[0] && std::abs(value[1]) <= q.close[1] && std::abs(value[2]) <= q.close[2]) {
+          if (it == 0) return Inclusion::close;
+          late = true;
+        }
       }
-  return Inclusion::maybe;
+  return late ? Inclusion::close_late : Inclusion::maybe;
 }
 
 Result<Hit> solve(Query& q, const double (&start)[4][3], const double (&end)[4][3], const Settings& s) {
@@ -164,7 +176,8 @@ Result<Hit> solve(Query& q, const double (&start)[4][3], const double (&end)[4][
   // touch has every |F_k| <= min_separation, so |n . F| <= min_separation
   // |n|_1; plus the corner values' error, sum |n_k| 64 eps M_k, and the dot
   // product's own rounding, 3 eps sum |n_k| |F_k| with |F_k| <= 6.1 M_k
-  // (the bound in this file's header): 84 eps sum |n_k| M_k in all, rounded up.
+  // (|F_k| <= |base| + |u e1| + |v e2| <= 6 M_k, plus rounding): 84 eps
+  // sum |n_k| M_k in all, rounded up.
   const auto cross = [](const double* a, const double* b, double* out) {
     out[0] = a[1] * b[2] - a[2] * b[1];
     out[1] = a[2] * b[0] - a[0] * b[2];
@@ -267,7 +280,7 @@ Result<Hit> solve(Query& q, const double (&start)[4][3], const double (&end)[4][
     // pass through each other took 10^6 boxes: every box along the line of
     // touching parameters was split across the primitives before in time.)
     int split = -1;
-    if (box.t1 > earliest && width[0] > q.tol[0]) {
+    if ((box.t1 > earliest || inclusion == Inclusion::close_late) && width[0] > q.tol[0]) {
       split = 0;
     } else {
       double widest = 1.0;
