@@ -78,7 +78,7 @@ void BM_HandcraftedQueries(benchmark::State& state) {
 
 // The same queries through the single-precision kernel on a device
 // (src/ccd/device_ccd.h): range(0) the kind as above, range(1) the backend
-// (0 cpu, 1 opencl, 2 vulkan; Vulkan refuses it for now), all queries of
+// (0 cpu, 1 opencl, 2 vulkan), all queries of
 // the kind in one dispatch per iteration, uploads and read-back included.
 void BM_DeviceHandcraftedQueries(benchmark::State& state) {
   const bool vertex_face = state.range(0) == 0;

@@ -20,15 +20,6 @@ Result<std::vector<Hit>> device_queries(Device& device, std::span<const DeviceQu
     return Error(ErrorCode::bad_parameter,
                  "device ccd: the tolerance must be finite, > 0 and <= 1e15 [m] (got " + std::to_string(settings.tolerance) + ")");
   if (settings.max_boxes == 0) return Error(ErrorCode::bad_parameter, "device ccd: max_boxes must be > 0");
-  // Refused, not run: on Mesa's lavapipe the SPIR-V build of this kernel
-  // missed a touch of the hand-crafted benchmark (unit-tests/edge-edge,
-  // query 7011 of the set in file order) that the same kernel finds on the
-  // CPU backend and through OpenCL; until that is explained, a path that can
-  // miss is not offered (README, "Continuous collision detection").
-  if (device.backend_name() == "vulkan")
-    return Error(ErrorCode::backend_unavailable,
-                 "device ccd: not offered on the Vulkan backend: its kernel missed a touch on lavapipe (under "
-                 "investigation); use the cpu or opencl backend, or sinew::ccd on the host");
   std::vector<Hit> hits(queries.size());
   if (queries.empty()) return hits;
   std::vector<float> points(queries.size() * 32);

@@ -28,9 +28,8 @@ struct DeviceQuery {
 /// `settings.min_separation` is rounded up to float, so no touch within
 /// the asked separation is lost. Errors (bad_parameter): a coordinate not
 /// finite or beyond 1e15 (the float kernel's range: products of
-/// coordinates must not overflow), a bad setting; backend_unavailable on
-/// the Vulkan backend (its build of the kernel missed a touch on lavapipe,
-/// under investigation); device errors pass through.
+/// coordinates must not overflow), a bad setting; device errors pass
+/// through.
 Result<std::vector<Hit>> device_queries(Device& device, std::span<const DeviceQuery> queries,
                                         const Settings& settings = {});
 
