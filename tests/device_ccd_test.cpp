@@ -88,6 +88,35 @@ TEST_P(DeviceCcd, TimeIsNeverLaterThanTheFirstTouch) {
   }
 }
 
+// The finest resolution (tolerance 1e-9 m, clamped to the float kernel's
+// 2^-23 of a step): 25 queries need more than 65,535 boxes. On lavapipe,
+// whose loop cap (65,535 iterations per invocation) cuts those searches,
+// they report a touch (given up), never a miss; elsewhere they run on or
+// reach max_boxes. Either way: 0 false negatives.
+TEST_P(DeviceCcd, SearchesCutShortStayConservative) {
+  const auto queries = ccd::read_benchmark_queries(data_path("ccd/handcrafted"));
+  ASSERT_TRUE(queries.ok()) << queries.error().message();
+  std::vector<DeviceQuery> mine;
+  for (const auto& q : *queries) mine.push_back({q.vertex_face, q.points});
+  auto device = create_device({.backend = GetParam(), .quiet = true});
+  ASSERT_TRUE(device.ok()) << device.error().message();
+  ccd::Settings fine;
+  fine.tolerance = 1e-9;
+  const auto hits = ccd::device_queries(**device, mine, fine);
+  ASSERT_TRUE(hits.ok()) << hits.error().message();
+  std::size_t gave_up = 0, long_searches = 0;
+  for (std::size_t k = 0; k < queries->size(); ++k) {
+    if ((*queries)[k].truth) {
+      ASSERT_TRUE((*hits)[k].touch) << "a false negative at the finest resolution: query " << k;
+    }
+    gave_up += (*hits)[k].gave_up;
+    long_searches += (*hits)[k].boxes > 65535 || (*hits)[k].gave_up;
+  }
+  EXPECT_GT(long_searches, 0u) << "the case this test is for";
+  std::printf("[ device ccd ] %s, tolerance 1e-9: %zu searches longer than 65,535 boxes or given up, %zu gave up\n",
+              GetParam().c_str(), long_searches, gave_up);
+}
+
 TEST_P(DeviceCcd, BadInputIsNamed) {
   auto device = create_device({.backend = GetParam(), .quiet = true});
   ASSERT_TRUE(device.ok()) << device.error().message();
