@@ -24,7 +24,11 @@
  * step's start, then at its end; edge-edge a0, a1, b0, b1, then at the end;
  * its kind in `kinds` (0 vertex-face, 1 edge-edge). Depth-first search with
  * a stack of SINEW_CCD_STACK boxes and at most max_boxes boxes; a query that
- * would outgrow either reports a touch (gave up: never a miss).
+ * would outgrow either reports a touch (gave up: never a miss), and so does
+ * a search the device itself cuts short (lavapipe breaks every loop of an
+ * invocation after 65,535 iterations in all: the search loop's body has no
+ * loop of its own, so only the search loop is cut, and it ends with boxes
+ * still open, which the kernel reports as a touch).
  * bindings: 0 points float4, 8 per query [in]
  *           1 kinds uint, 1 per query [in]
  *           2 hits uint, 4 per query [out]: touch (0/1), the time (float
