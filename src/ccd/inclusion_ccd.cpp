@@ -19,11 +19,15 @@
 //    value, whose magnitude is <= M (a convex combination);
 //  - a difference of two of them (q = p - a, e = b - a; or a0 - b0, a1 - a0,
 //    b1 - b0) is within 2 x 7.01 + 2 (its own rounding of a value <= 2M)
-//    = 16.03 eps M, and <= 2M (1 + 9 eps);
-//  - fl(u e) adds 2 eps M: 18.04; fl(q - u e) adds 4 eps M: 16.03 + 18.04
-//    + 4 = 38.07; fl(that - v e') adds 18.04 + 6: 62.11 eps M.
+//    = 16.02 eps M, and <= 2M (1 + 9 eps);
+//  - fl(u e) adds its own rounding of a value <= 2M: 16.02 + 2 = 18.02;
+//    w = fl(q - u e), |w| <= 4M, adds 4 eps M: 16.02 + 18.02 + 4 = 38.04;
+//    fl(w - v e'), a value <= 6M, adds 18.02 + 6: 62.06 eps M.
 // So every corner value is within 64 eps M of the exact one (64 with room
-// for the second-order terms), on its axis. A box is dropped only when on
+// for the second-order terms), on its axis, and |F_k| <= 6 M_k (1 + small).
+// (A review measured the actual worst case against exact arithmetic: 8.5
+// eps M; the bound is loose, not tight.) Fused multiply-adds only remove
+// roundings, so the bound holds with or without -ffp-contract=off. A box is dropped only when on
 // some axis all eight corner values exceed min_separation + 64 eps M (the
 // sum itself rounded up), or all are below minus that: then the exact F is
 // beyond min_separation there on the whole box. Underflow (values below
@@ -176,8 +180,8 @@ Result<Hit> solve(Query& q, const double (&start)[4][3], const double (&end)[4][
   // touch has every |F_k| <= min_separation, so |n . F| <= min_separation
   // |n|_1; plus the corner values' error, sum |n_k| 64 eps M_k, and the dot
   // product's own rounding, 3 eps sum |n_k| |F_k| with |F_k| <= 6.1 M_k
-  // (|F_k| <= |base| + |u e1| + |v e2| <= 6 M_k, plus rounding): 84 eps
-  // sum |n_k| M_k in all, rounded up.
+  // (6 M_k, the header's bound, plus rounding): 84 eps sum |n_k| M_k in all,
+  // rounded up.
   const auto cross = [](const double* a, const double* b, double* out) {
     out[0] = a[1] * b[2] - a[2] * b[1];
     out[1] = a[2] * b[0] - a[0] * b[2];
