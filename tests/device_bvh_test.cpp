@@ -27,6 +27,7 @@
 #include "collision/aabb.h"
 #include "collision/bvh.h"
 #include "collision/device_bvh.h"
+#include "device_bvh_support.h"
 #include "program/primitives.h"
 #include "surface_support.h"
 #include "test_support.h"
@@ -322,24 +323,6 @@ constexpr std::uint32_t kNone = SINEW_BVH_NONE;
 constexpr std::uint32_t kSentinel = 0xDEADBEEFu;  // pairs-buffer words past the capacity must keep it
 constexpr std::uint32_t kSpare = 64;              // pairs of sentinel room past the capacity
 
-std::vector<float> flat(const std::vector<Aabb>& boxes) {
-  std::vector<float> f;
-  f.reserve(6 * boxes.size());
-  for (const Aabb& b : boxes) f.insert(f.end(), {b.lo[0], b.lo[1], b.lo[2], b.hi[0], b.hi[1], b.hi[2]});
-  return f;
-}
-
-// The bounds of the boxes' centres' cells (the build's lo, hi).
-std::pair<std::array<float, 3>, std::array<float, 3>> bounds_of(const std::vector<Aabb>& boxes) {
-  std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-  for (const Aabb& b : boxes)
-    for (int k = 0; k < 3; ++k) {
-      lo[std::size_t(k)] = std::min(lo[std::size_t(k)], b.lo[std::size_t(k)]);
-      hi[std::size_t(k)] = std::max(hi[std::size_t(k)], b.hi[std::size_t(k)]);
-    }
-  return {lo, hi};
-}
-
 // The reference's skip for vertex ids of 3 per primitive, kNone unused.
 struct SharesValidId {
   const std::vector<std::uint32_t>* ids;
@@ -369,19 +352,8 @@ DevicePairs pairs_on(Device& device, const std::vector<Aabb>& boxes, const std::
                      std::uint32_t capacity, const std::vector<Aabb>* a_boxes = nullptr) {
   DevicePairs r;
   const auto n = std::uint32_t(boxes.size());
-  auto bvh = collision::make_device_bvh(device, n);
-  EXPECT_TRUE(bvh.ok());
-  if (!bvh.ok()) return r;
-  const std::vector<float> f = flat(boxes);
-  EXPECT_TRUE(device.write_buffer(bvh->boxes, 0, f.data(), f.size() * 4).ok());
-  const auto [lo, hi] = bounds_of(boxes);
-  FrameProgram build;
-  EXPECT_TRUE(collision::append_device_bvh_build(build, *bvh, n, lo, hi).ok());
-  EXPECT_TRUE(collision::append_device_bvh_refit(build, *bvh, n).ok());
-  auto built = device.create_program(build);
-  EXPECT_TRUE(built.ok()) << (built.ok() ? "" : built.error().message());
-  if (!built.ok()) return r;
-  EXPECT_TRUE(device.run_program(*built).ok());
+  const auto bvh = built_device_bvh(device, boxes);
+  if (!bvh) return r;
 
   const std::size_t pair_words = 2 * (std::size_t{capacity} + kSpare);
   auto pairs = device.create_buffer(pair_words * 4, "pairs");

@@ -24,11 +24,27 @@ using ccd::Point;
 
 class DeviceCcd : public BackendTest {};
 
+// The benchmark's hand-crafted queries (read once), as device queries.
+struct Handcrafted {
+  std::vector<ccd::BenchmarkQuery> queries;
+  std::vector<DeviceQuery> device;
+};
+const Handcrafted& handcrafted() {
+  static const Handcrafted set = [] {
+    Handcrafted h;
+    auto read = ccd::read_benchmark_queries(data_path("ccd/handcrafted"));
+    EXPECT_TRUE(read.ok()) << (read.ok() ? "" : read.error().message());
+    if (read.ok()) h.queries = std::move(*read);
+    for (const auto& q : h.queries) h.device.push_back({q.vertex_face, q.points});
+    return h;
+  }();
+  return set;
+}
+
 TEST_P(DeviceCcd, NoFalseNegativeOnTheHandcraftedBenchmark) {
-  const auto queries = ccd::read_benchmark_queries(data_path("ccd/handcrafted"));
-  ASSERT_TRUE(queries.ok()) << queries.error().message();
-  std::vector<DeviceQuery> mine;
-  for (const auto& q : *queries) mine.push_back({q.vertex_face, q.points});
+  const auto* queries = &handcrafted().queries;
+  const std::vector<DeviceQuery>& mine = handcrafted().device;
+  ASSERT_EQ(queries->size(), 7279u);
   auto device = create_device({.backend = GetParam(), .quiet = true});
   ASSERT_TRUE(device.ok()) << device.error().message();
   const auto hits = ccd::device_queries(**device, mine);
@@ -94,10 +110,9 @@ TEST_P(DeviceCcd, TimeIsNeverLaterThanTheFirstTouch) {
 // they report a touch (given up), never a miss; elsewhere they run on or
 // reach max_boxes. Either way: 0 false negatives.
 TEST_P(DeviceCcd, SearchesCutShortStayConservative) {
-  const auto queries = ccd::read_benchmark_queries(data_path("ccd/handcrafted"));
-  ASSERT_TRUE(queries.ok()) << queries.error().message();
-  std::vector<DeviceQuery> mine;
-  for (const auto& q : *queries) mine.push_back({q.vertex_face, q.points});
+  const auto* queries = &handcrafted().queries;
+  const std::vector<DeviceQuery>& mine = handcrafted().device;
+  ASSERT_EQ(queries->size(), 7279u);
   auto device = create_device({.backend = GetParam(), .quiet = true});
   ASSERT_TRUE(device.ok()) << device.error().message();
   ccd::Settings fine;

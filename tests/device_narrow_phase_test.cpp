@@ -22,6 +22,7 @@
 #include "collision/device_bvh.h"
 #include "collision/device_narrow_phase.h"
 #include "collision/narrow_phase.h"
+#include "device_bvh_support.h"
 #include "surface_support.h"
 #include "test_support.h"
 
@@ -59,23 +60,8 @@ DeviceRun run_on(Device& device, const std::vector<float>& x, const std::vector<
   if (given_boxes) boxes = *given_boxes;
   else EXPECT_TRUE(collision::primitive_boxes(x, triangles, 3, inflate, boxes).ok());
   const auto n = std::uint32_t(boxes.size());
-  auto bvh = collision::make_device_bvh(device, n);
-  EXPECT_TRUE(bvh.ok());
-  if (!bvh.ok()) return r;
-  std::vector<float> flat;
-  std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-  for (const Aabb& b : boxes) {
-    flat.insert(flat.end(), {b.lo[0], b.lo[1], b.lo[2], b.hi[0], b.hi[1], b.hi[2]});
-    for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], b.lo[k]), hi[k] = std::max(hi[k], b.hi[k]);
-  }
-  EXPECT_TRUE(device.write_buffer(bvh->boxes, 0, flat.data(), flat.size() * 4).ok());
-  FrameProgram build;
-  EXPECT_TRUE(collision::append_device_bvh_build(build, *bvh, n, lo, hi).ok());
-  EXPECT_TRUE(collision::append_device_bvh_refit(build, *bvh, n).ok());
-  auto built = device.create_program(build);
-  EXPECT_TRUE(built.ok()) << (built.ok() ? "" : built.error().message());
-  if (!built.ok()) return r;
-  EXPECT_TRUE(device.run_program(*built).ok());
+  const auto bvh = built_device_bvh(device, boxes);
+  if (!bvh) return r;
 
   auto positions = device.create_buffer(x.size() * 4, "positions");
   auto ids = device.create_buffer(triangles.size() * 4, "vertex ids");

@@ -2,7 +2,10 @@
 // (kernels/shared/ccd_params.h): the inclusion-based query of
 // src/ccd/inclusion_ccd.cpp (Wang et al., TOG 2021) in single precision,
 // with the float error bound, written in the GPU twin's order
-// (kernels/gpu/ccd_queries.gpu). One query per item.
+// (kernels/gpu/ccd_queries.gpu). One query per item. The twin writes its
+// search loop without inner loops and keeps a least-start-time per stack
+// entry (a device may cap loop iterations); here loops are free, and giving
+// up scans the open boxes for the same least start time.
 #include <algorithm>
 #include <bit>
 #include <cmath>
