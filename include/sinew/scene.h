@@ -397,6 +397,29 @@ struct MeshCollisionDesc {
   double compliance = 0.0;        ///< of each contact [m/N], >= 0
   double static_friction = 0.3;   ///< >= 0
   double dynamic_friction = 0.2;  ///< >= 0, <= static_friction
+
+  /// Continuous collision detection for threads (issue 13, part 3): after
+  /// every substep's sweeps the host tests the motion each line body's
+  /// segments made in it — from the substep's start to its end, linearly —
+  /// against every other segment (skipping neighbours, which share a
+  /// vertex) and every triangle of the tet bodies' surfaces and the tri
+  /// bodies, with the CCD queries of sinew/ccd.h (no false negatives). Each
+  /// touch becomes a contact for the rest of the frame (the normal the
+  /// primitives meet along, kept at `thickness`), the substep's sweeps
+  /// run again (`iterations` more) and the motion is tested again; after
+  /// `continuous_repairs` such rounds, the particles of every pair that
+  /// still touches stop where the substep started (their velocity becomes
+  /// 0), until no moving pair touches. So a thread never passes through
+  /// itself, another thread or a surface, however fast it is pulled,
+  /// provided the scene starts with none passing through another
+  /// (README, "Continuous collision detection"). Costs a read-back of the
+  /// positions per substep. Needs at least one line body and
+  /// ContactSchedule::colored; surfaces against surfaces are not tested
+  /// continuously (the frame's contacts hold them).
+  bool continuous = false;
+  /// Repair rounds per substep before the fail-safe stops the touching
+  /// particles, >= 0 (0: stop them at once, no repair sweeps).
+  int continuous_repairs = 4;
 };
 
 struct SceneDesc {

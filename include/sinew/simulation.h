@@ -95,6 +95,15 @@ struct FrameStats {
   /// thickness [m], max(thickness - gap) at the frame's end (0 when none
   /// touches): how well the sweeps converged on the contacts.
   double contact_violation = 0.0;
+  /// Continuous collision detection (MeshCollisionDesc::continuous), 0
+  /// without: pairs of primitives found touching in the frame's substeps
+  /// (each round's touches counted), the repair rounds run, the particles
+  /// the fail-safe stopped at their substep's start, and the wall time
+  /// [ms] of the tests (read-back, broad phase, queries; part of wall_ms).
+  std::uint32_t ccd_hits = 0;
+  std::uint32_t ccd_repairs = 0;
+  std::uint32_t ccd_reverted = 0;
+  double ccd_ms = 0.0;
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;

@@ -299,6 +299,17 @@ Status check_mesh_collision(const SceneDesc& scene) {
     return Error(ErrorCode::bad_parameter,
                  "mesh_collision.enabled is not supported with solver.chebyshev_rho > 0 (got " +
                      str(scene.solver.chebyshev_rho) + ")");
+  if (!c.continuous) return {};
+  if (c.continuous_repairs < 0)
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.continuous_repairs must be >= 0 (got " + std::to_string(c.continuous_repairs) + ")");
+  // CCD contacts join the frame's in colours of their own, appended mid-frame.
+  if (c.schedule != ContactSchedule::colored)
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.continuous needs mesh_collision.schedule = ContactSchedule::colored");
+  if (scene.line_bodies.empty())
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.continuous tests thread segments (line bodies) and the scene has none");
   return {};
 }
 

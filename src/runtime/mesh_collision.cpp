@@ -27,6 +27,9 @@ namespace {
 using collision::Contact;
 
 constexpr std::uint32_t kFirstColors = 16;
+// Colours kept free for continuous collision's contacts at first (doubled,
+// up to 32, when a frame needs more: append_contacts).
+constexpr std::uint32_t kContinuousColors = 8;
 // Vertex-triangle contacts kept per triangle and other body (see prune).
 constexpr std::size_t kPerTriangle = 3;
 // Edge-edge contacts kept per edge and other body (see prune).
@@ -37,6 +40,16 @@ constexpr std::size_t kMaxPairs = std::size_t{1} << 23;
 // by kTurn dt |v| in every direction besides: room for the motion to turn
 // within the frame (half the speed, reversed) without missing a pair.
 constexpr double kTurn = 1.0;
+
+// A contact's coefficients c_k (mesh_contact_params.h) from its weights.
+void coefficients_of(const collision::Contact& c, float out[4]) {
+  const bool vertex_triangle = c.kind == collision::Contact::Kind::vertex_triangle;
+  const float sign = c.kind == collision::Contact::Kind::shape_face ? 1.0f : -1.0f;  // both weights on the triangle's side
+  out[0] = c.w[0];
+  out[1] = vertex_triangle ? -c.w[1] : c.w[1];
+  out[2] = sign * c.w[2];
+  out[3] = sign * c.w[3];
+}
 
 Status make(Device& device, std::size_t bytes, const char* label, BufferHandle& handle) {
   auto made = device.create_buffer(std::max<std::size_t>(bytes, 16), label);
@@ -139,6 +152,11 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
         std::tuple{&b.offsets, b.jacobi ? std::size_t{b.touched_capacity + 1} * 4 : 16, "mesh contact offsets"},
         std::tuple{&b.slots, b.jacobi ? contact_bytes : 16, "mesh contact slots"}})
     if (Status s = make(device, bytes, label, *handle); !s) return s.error();
+  if (mc->desc_.continuous) {
+    // Room for the touches of continuous collision detection (append_contacts).
+    mc->reserve_colors_ = kContinuousColors;
+    mc->reserve_slots_ = std::max<std::uint32_t>(256, static_cast<std::uint32_t>(mc->segments_.size()));
+  }
   b.params.thickness = static_cast<float>(mc->desc_.thickness);
   b.params.compliance = static_cast<float>(mc->desc_.compliance);
   b.params.static_friction = static_cast<float>(mc->desc_.static_friction);
@@ -355,7 +373,8 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
   // How far the frame's contacts ended inside their thickness, from the
   // very positions the next frame's detection starts from.
   double worst = 0.0;
-  for (std::uint32_t k = 0; k < contact_count_; ++k) {
+  const auto slots = contact_count_ + static_cast<std::uint32_t>(appended_.size());
+  for (std::uint32_t k = 0; k < slots; ++k) {
     double gap = 0.0;
     for (int a = 0; a < 3; ++a) {
       double along = 0.0;
@@ -820,8 +839,16 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   const auto count = static_cast<std::uint32_t>(kept_.size());
   contact_count_ = count;
   MeshContactBuffers& b = buffers_;
-  if (count > b.capacity) {
-    b.capacity = std::max(count, 2 * b.capacity);
+  appended_.clear();
+  appended_slots_.clear();
+  appended_colors_ = 0;
+  if (want_room_) {
+    reserve_colors_ = std::min<std::uint32_t>(32, 2 * reserve_colors_);
+    reserve_slots_ *= 2;
+    want_room_ = false;
+  }
+  if (count + reserve_slots_ > b.capacity) {
+    b.capacity = std::max(count + reserve_slots_, 2 * b.capacity);
     for (BufferHandle h : {b.particles, b.coefficients, b.normals, b.lambda, b.lambda_sum})
       if (Status s = device.resize_buffer(h, std::size_t{b.capacity} * 16); !s) return s;
     if (Status s = device.resize_buffer(b.motion, std::size_t{b.capacity} * 4); !s) return s;
@@ -844,8 +871,8 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     const Coloring coloring = color_constraints(vertices, 4, movable_);
     const std::uint32_t colors = coloring.color_count();
     color_count_ = colors;
-    if (colors > b.colors) {
-      b.colors = std::max(colors, 2 * b.colors);
+    if (colors + reserve_colors_ > b.colors) {
+      b.colors = std::max(colors + reserve_colors_, 2 * b.colors);
       if (Status s = device.resize_buffer(b.table, std::size_t{2} * b.colors * 4); !s) return s;
       grew = true;
     }
@@ -864,9 +891,8 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     const Contact& c = all_[kept_[k]];
     const std::size_t at = std::size_t{slot_of[k]} * 4;
     if (c.shape != Contact::kNoShape) tool_slots_.push_back({slot_of[k], c.shape});
-    const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
-    const float sign = c.kind == Contact::Kind::shape_face ? 1.0f : -1.0f;  // both weights on the triangle's side
-    const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], sign * c.w[2], sign * c.w[3]};
+    float coefficient[4];
+    coefficients_of(c, coefficient);
     for (int j = 0; j < 4; ++j) {
       upload_particles_[at + j] = c.v[j];
       upload_coefficients_[at + j] = coefficient[j];
@@ -922,6 +948,105 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
     if (Status s = device.write_buffer(b.motion, 0, upload_motion_.data(), bytes / 4); !s) return s;
   }
   return {};
+}
+
+}  // namespace sinew
+
+namespace sinew {
+
+Result<bool> MeshCollision::append_contacts(Device& device, std::span<const collision::Contact> contacts) {
+  MeshContactBuffers& b = buffers_;
+  if (b.jacobi) return false;  // scene_checks: continuous needs the coloured schedule
+  std::vector<collision::Contact> all = appended_;
+  all.insert(all.end(), contacts.begin(), contacts.end());
+  const auto n = static_cast<std::uint32_t>(all.size());
+  const std::uint32_t colors = std::min<std::uint32_t>(32, b.colors - color_count_);
+  if (contact_count_ + n > b.capacity) {
+    want_room_ = true;
+    return false;
+  }
+  // Greedy colours: the first whose contacts share no movable particle with this one.
+  color_mask_.resize(movable_.size(), 0);
+  std::vector<std::uint32_t> color_of(n), sizes(colors, 0);
+  bool fits = true;
+  for (std::uint32_t i = 0; i < n && fits; ++i) {
+    std::uint32_t used = 0;
+    for (std::uint32_t p : all[i].v)
+      if (movable_[p]) used |= color_mask_[p];
+    std::uint32_t k = 0;
+    while (k < colors && (used >> k & 1u)) ++k;
+    if (k == colors) {
+      fits = false;
+      break;
+    }
+    color_of[i] = k;
+    ++sizes[k];
+    for (std::uint32_t p : all[i].v)
+      if (movable_[p]) color_mask_[p] |= 1u << k;
+  }
+  for (const collision::Contact& c : all)
+    for (std::uint32_t p : c.v) color_mask_[p] = 0;
+  if (!fits) {
+    want_room_ = true;
+    return false;
+  }
+  std::uint32_t used_colors = 0;
+  for (std::uint32_t k = 0; k < colors; ++k)
+    if (sizes[k] > 0) used_colors = k + 1;
+  // The layout: colour color_count_ + k at [first_k, first_k + sizes[k]) after the frame's contacts.
+  std::vector<std::uint32_t> next(colors, contact_count_);
+  for (std::uint32_t k = 1; k < colors; ++k) next[k] = next[k - 1] + sizes[k - 1];
+  for (std::uint32_t k = 0; k < std::max(used_colors, appended_colors_); ++k) {
+    table_[color_count_ + k] = k < colors ? sizes[k] : 0;
+    table_[b.colors + color_count_ + k] = next[k];
+  }
+  std::vector<std::uint32_t> slot_of(n);
+  for (std::uint32_t i = 0; i < n; ++i) slot_of[i] = next[color_of[i]]++;
+
+  // The earlier additions' multipliers move with them; the new ones start at 0.
+  std::vector<float> lambda(std::size_t{n} * 4, 0.0f);
+  if (!appended_.empty()) {
+    std::vector<float> old(appended_.size() * 4);
+    if (Status s = device.read_buffer(b.lambda, std::size_t{contact_count_} * 16, old.data(), old.size() * 4); !s)
+      return s.error();
+    for (std::size_t i = 0; i < appended_.size(); ++i)
+      std::copy_n(&old[std::size_t{appended_slots_[i] - contact_count_} * 4], 4,
+                  &lambda[std::size_t{slot_of[i] - contact_count_} * 4]);
+  }
+  const std::size_t end = std::size_t{contact_count_ + n} * 4;
+  upload_particles_.resize(end);
+  upload_coefficients_.resize(end);
+  upload_normals_.resize(end);
+  upload_motion_.resize(contact_count_ + n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const collision::Contact& c = all[i];
+    const std::size_t at = std::size_t{slot_of[i]} * 4;
+    float coefficient[4];
+    coefficients_of(c, coefficient);
+    for (int j = 0; j < 4; ++j) {
+      upload_particles_[at + j] = c.v[j];
+      upload_coefficients_[at + j] = coefficient[j];
+    }
+    for (int a = 0; a < 3; ++a) upload_normals_[at + a] = c.normal[a];
+    upload_normals_[at + 3] = 0.0f;
+    upload_motion_[slot_of[i]] = 0.0f;
+  }
+  const std::size_t first = std::size_t{contact_count_} * 4, bytes = std::size_t{n} * 16;
+  if (Status s = device.write_buffer(b.particles, first * 4, &upload_particles_[first], bytes); !s) return s.error();
+  if (Status s = device.write_buffer(b.coefficients, first * 4, &upload_coefficients_[first], bytes); !s)
+    return s.error();
+  if (Status s = device.write_buffer(b.normals, first * 4, &upload_normals_[first], bytes); !s) return s.error();
+  if (Status s = device.write_buffer(b.motion, std::size_t{contact_count_} * 4, &upload_motion_[contact_count_], bytes / 4);
+      !s)
+    return s.error();
+  if (Status s = device.write_buffer(b.lambda, first * 4, lambda.data(), bytes); !s) return s.error();
+  const std::vector<float> zeros(std::size_t{n} * 4, 0.0f);
+  if (Status s = device.write_buffer(b.lambda_sum, first * 4, zeros.data(), bytes); !s) return s.error();
+  if (Status s = device.write_buffer(b.table, 0, table_.data(), table_.size() * 4); !s) return s.error();
+  appended_ = std::move(all);
+  appended_slots_ = std::move(slot_of);
+  appended_colors_ = std::max(appended_colors_, used_colors);
+  return true;
 }
 
 }  // namespace sinew

@@ -57,6 +57,25 @@ class MeshCollision {
   Status before_frame(Device& device, const XpbdBuffers& scene_buffers, std::span<const PosedShape> colliders,
                       std::span<const PosedShape> tool_starts, std::span<const PosedShape> tool_ends, bool& grew);
 
+  /// Adds contacts for the rest of the frame, after the frame's own
+  /// (continuous collision detection's touches, continuous_collision.h):
+  /// they and the frame's earlier additions are coloured greedily into the
+  /// colours the program has beyond the frame's (MeshCollisionDesc::
+  /// continuous reserves some), laid out after the frame's contacts, and
+  /// uploaded with the earlier additions' multipliers carried over and the
+  /// new ones' at 0. [in] contacts: vertex_triangle or edge_edge, with
+  /// their weights and normal. Returns false, changing nothing, when they
+  /// do not fit the reserved colours or slots (the next frame reserves
+  /// more).
+  Result<bool> append_contacts(Device& device, std::span<const collision::Contact> contacts);
+  /// Particles of the scene (device order).
+  [[nodiscard]] std::size_t particles() const { return movable_.size(); }
+  /// The collidable primitives (device particles): every line body's
+  /// segments (2 each) and every surface's triangles (3 each: the tet
+  /// bodies' boundaries, then the tri bodies).
+  [[nodiscard]] const std::vector<std::uint32_t>& segments() const { return segments_; }
+  [[nodiscard]] const std::vector<std::uint32_t>& triangles() const { return triangles_; }
+
   /// Reads the positions and velocities the frame ended with (the next
   /// frame's detection starts from them) and measures violation(); with
   /// face contacts on tools, reads their multipliers back too.
@@ -164,6 +183,15 @@ class MeshCollision {
                        const std::vector<BodyTree>& b, std::vector<collision::Pair>& pairs);
   MeshContactBuffers buffers_;
   std::uint32_t contact_count_ = 0, color_count_ = 0;
+  // Continuous collision's contacts (append_contacts): the colours and
+  // slots kept free beyond the frame's, the frame's additions and their
+  // slots, the colours they take, and whether the last frame needed more.
+  std::uint32_t reserve_colors_ = 0, reserve_slots_ = 0;
+  std::vector<collision::Contact> appended_;
+  std::vector<std::uint32_t> appended_slots_;
+  std::uint32_t appended_colors_ = 0;
+  bool want_room_ = false;
+  std::vector<std::uint32_t> color_mask_;  // per particle: the appended colours it is in (bit k)
   double margin_ = 0.0;
   double violation_ = 0.0;
   bool fresh_ = false;  // positions_ and velocities_ hold the device's current state

@@ -79,12 +79,18 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->program_shape = *compiled;
     for (ConstraintBlock& block : impl->program_shape.blocks) block.data = {};
   }
-  if (SolveStepper::needed(scene.solver)) {
+  const bool continuous = scene.mesh_collision.enabled && scene.mesh_collision.continuous;
+  if (continuous)
+    impl->continuous = std::make_unique<ContinuousCollision>(
+        impl->mesh_collision->segments(), impl->mesh_collision->triangles(), *impl->mesh_collision, impl->buffers,
+        scene.mesh_collision.continuous_repairs);
+  if (SolveStepper::needed(scene.solver, continuous)) {
     impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
     append_stats(impl->program, impl->stats_plan, impl->buffers);
     auto stepper = SolveStepper::create(*impl->device, *compiled, impl->buffers, scene.solver, scene.gravity,
                                         impl->stats_plan,
-                                        impl->mesh_collision ? &impl->mesh_collision->buffers() : nullptr);
+                                        impl->mesh_collision ? &impl->mesh_collision->buffers() : nullptr,
+                                        continuous);
     if (!stepper) return stepper.error();
     impl->stepper = std::move(*stepper);
     impl->program = impl->stepper->frame_program();
@@ -158,7 +164,14 @@ Status Simulation::step() {
   const auto collided = std::chrono::steady_clock::now();
   impl_->stats.collision_ms = std::chrono::duration<double, std::milli>(collided - start).count();
   if (impl_->stepper) {
-    if (Status s = impl_->stepper->run_frame(*impl_->device, impl_->stats); !s) return s;
+    if (impl_->continuous) impl_->continuous->begin_frame();
+    if (Status s = impl_->stepper->run_frame(*impl_->device, impl_->stats, impl_->continuous.get()); !s) return s;
+    if (const ContinuousCollision* c = impl_->continuous.get()) {
+      impl_->stats.ccd_hits = c->hits();
+      impl_->stats.ccd_repairs = c->repairs();
+      impl_->stats.ccd_reverted = c->reverted();
+      impl_->stats.ccd_ms = c->wall_ms();
+    }
   } else {
     if (Status s = impl_->device->run_program(impl_->prepared); !s) return s;
     if (Status s = impl_->device->last_run_times(impl_->stats.device); !s) return s;

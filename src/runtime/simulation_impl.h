@@ -12,6 +12,7 @@
 #include "program/xpbd_program.h"
 #include "runtime/contact_state.h"
 #include "runtime/tool_contacts.h"
+#include "runtime/continuous_collision.h"
 #include "runtime/mesh_collision.h"
 #include "runtime/solve_stepper.h"
 #include "sinew/simulation.h"
@@ -48,6 +49,9 @@ struct Simulation::Impl {
   // none). The program is rebuilt when they outgrow it, from the compiled
   // scene's shape (its blocks without their data) kept here for that.
   std::unique_ptr<MeshCollision> mesh_collision;
+  // The threads' continuous collision detection, run by the stepper after
+  // every substep's sweeps (null unless MeshCollisionDesc::continuous).
+  std::unique_ptr<ContinuousCollision> continuous;
   CompiledScene program_shape;
   SolverSettings solver;
   std::array<double, 3> gravity{};

@@ -45,7 +45,8 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
                                                            const XpbdBuffers& buffers, const SolverSettings& solver,
                                                            const std::array<double, 3>& gravity,
                                                            const StatsPlan& stats,
-                                                           const MeshContactBuffers* mesh_contacts) {
+                                                           const MeshContactBuffers* mesh_contacts,
+                                                           bool per_substep) {
   // The frame's mesh contacts change every frame (and their slots with
   // them): no lambda of theirs may be carried into a substep.
   if (solver.warm_start && mesh_contacts)
@@ -60,6 +61,7 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
   auto st = std::unique_ptr<SolveStepper>(new SolveStepper());
   st->solver_ = solver;
   st->residual_mode_ = solver.residual_tolerance > 0.0;
+  st->per_substep_ = per_substep;
   if (solver.chebyshev_rho > 0.0) {
     auto made = make_chebyshev_buffers(device, scene);
     if (!made) return made.error();
@@ -79,6 +81,7 @@ Status SolveStepper::rebuild(Device& device, const CompiledScene& scene, const X
                              const MeshContactBuffers* mesh_contacts) {
   std::vector<ProgramHandle> all{whole_, end_};
   all.insert(all.end(), begin_.begin(), begin_.end());
+  all.insert(all.end(), repair_.begin(), repair_.end());
   all.insert(all.end(), begin_cold_.begin(), begin_cold_.end());
   for (const auto& chunks : chunks_) all.insert(all.end(), chunks.begin(), chunks.end());
   for (const ProgramHandle p : all)
@@ -86,6 +89,7 @@ Status SolveStepper::rebuild(Device& device, const CompiledScene& scene, const X
       if (Status s = device.destroy_program(p); !s) return s;
   whole_ = end_ = ProgramHandle{};
   begin_.clear();
+  repair_.clear();
   begin_cold_.clear();
   chunks_.clear();
   shortest_frame_ = FrameProgram{};
@@ -106,7 +110,44 @@ Status SolveStepper::build(Device& device, const CompiledScene& scene, const Xpb
     parts.declare_counters(counted);
     return device.create_program(counted);
   };
+  // end_: (the last substep's measuring pass,) its velocity update and the statistics.
+  const auto build_end = [&](bool measure) -> Status {
+    FrameProgram end;
+    if (measure) parts.append_measure(end, substeps - 1);
+    parts.append_update(end, substeps - 1);
+    append_stats(end, stats, buffers);
+    append_commands(shortest_frame_, Commands(end.commands()));
+    auto made = prepare(end);
+    if (!made) return made.error();
+    end_ = *made;
+    return {};
+  };
 
+  // The hook's repair programs: `iterations` more sweeps of substep s,
+  // the multipliers carried on (no reset).
+  if (per_substep_)
+    for (int s = 0; s < substeps; ++s) {
+      FrameProgram repair;
+      parts.append_sweeps(repair, s, iterations + 1, iterations, false);
+      auto made = prepare(repair);
+      if (!made) return made.error();
+      repair_.push_back(*made);
+    }
+  if (!residual_mode_ && per_substep_) {
+    // The fixed mode's frame cut at every substep's end (before its velocity update).
+    begin_.resize(substeps);
+    for (int s = 0; s < substeps; ++s) {
+      FrameProgram begin;
+      if (s > 0) parts.append_update(begin, s - 1);
+      parts.append_predict(begin, s);
+      parts.append_sweeps(begin, s, 1, iterations, false);
+      append_commands(shortest_frame_, Commands(begin.commands()));
+      auto made = prepare(begin);
+      if (!made) return made.error();
+      begin_[s] = *made;
+    }
+    return build_end(solver.measure_errors);
+  }
   if (!residual_mode_) {
     FrameProgram& p = shortest_frame_;
     for (int s = 0; s < substeps; ++s) {
@@ -162,14 +203,7 @@ Status SolveStepper::build(Device& device, const CompiledScene& scene, const Xpb
       chunks_[s].push_back(*chunk_made);
     }
   }
-  FrameProgram end;
-  parts.append_update(end, substeps - 1);
-  append_stats(end, stats, buffers);
-  append_commands(shortest_frame_, Commands(end.commands()));
-  auto made = prepare(end);
-  if (!made) return made.error();
-  end_ = *made;
-  return {};
+  return build_end(false);
 }
 
 Status SolveStepper::run(Device& device, ProgramHandle program, DeviceTimes& times, bool first) {
@@ -189,8 +223,33 @@ Status SolveStepper::run(Device& device, ProgramHandle program, DeviceTimes& tim
   return {};
 }
 
-Status SolveStepper::run_frame(Device& device, FrameStats& stats) {
+// The hook after substep s's sweeps, and the repairs it asks for.
+Status SolveStepper::run_hook(Device& device, SubstepHook* hook, int s, FrameStats& stats,
+                              std::uint64_t& sweeps) {
+  if (!hook) return {};
+  for (int round = 0;; ++round) {
+    bool repair = false;
+    if (Status st = hook->after_sweeps(device, s, round, repair); !st) return st;
+    if (!repair) return {};
+    if (Status st = run(device, repair_[s], stats.device, false); !st) return st;
+    sweeps += std::uint64_t(solver_.iterations);
+  }
+}
+
+Status SolveStepper::run_frame(Device& device, FrameStats& stats, SubstepHook* hook) {
   const int iterations = solver_.iterations;
+  if (!residual_mode_ && per_substep_) {
+    std::uint64_t sweeps = 0;
+    for (int s = 0; s < static_cast<int>(begin_.size()); ++s) {
+      if (Status st = run(device, begin_[s], stats.device, s == 0); !st) return st;
+      sweeps += std::uint64_t(iterations);
+      if (Status st = run_hook(device, hook, s, stats, sweeps); !st) return st;
+    }
+    if (Status st = run(device, end_, stats.device, false); !st) return st;
+    stats.sweeps = sweeps;
+    stats.stop = SolveStop::fixed;
+    return {};
+  }
   if (!residual_mode_) {
     if (Status s = run(device, whole_, stats.device, true); !s) return s;
     stats.sweeps = std::uint64_t(solver_.substeps) * std::uint64_t(iterations);
@@ -254,6 +313,8 @@ Status SolveStepper::run_frame(Device& device, FrameStats& stats) {
     warm_ = stop != SolveStop::time_budget;
     if (rank(stop) > rank(worst)) worst = stop;
     sweeps_total += std::uint64_t(sweeps);
+    if (per_substep_)
+      if (Status st = run_hook(device, hook, s, stats, sweeps_total); !st) return st;
   }
   if (Status st = run(device, end_, stats.device, false); !st) return st;
   stats.sweeps = sweeps_total;

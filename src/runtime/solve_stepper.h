@@ -15,11 +15,24 @@
 
 namespace sinew {
 
+/// Work the host does between a substep's sweeps and its velocity update
+/// (continuous collision detection, runtime/continuous_collision.h).
+class SubstepHook {
+ public:
+  virtual ~SubstepHook() = default;
+  /// Called after substep `substep`'s sweeps (round 0) and after each of
+  /// its repair programs (round r > 0: r repairs run). [out] repair: run
+  /// the substep's repair program (`iterations` more sweeps, the
+  /// multipliers carried on), then call again.
+  virtual Status after_sweeps(Device& device, int substep, int round, bool& repair) = 0;
+};
+
 class SolveStepper {
  public:
-  /// Whether a solver needs this (residual mode or the accelerator on).
-  static bool needed(const SolverSettings& solver) {
-    return solver.residual_tolerance > 0.0 || solver.chebyshev_rho > 0.0 || solver.warm_start;
+  /// Whether a solver needs this (residual mode or the accelerator on, or
+  /// a SubstepHook: `per_substep`).
+  static bool needed(const SolverSettings& solver, bool per_substep = false) {
+    return per_substep || solver.residual_tolerance > 0.0 || solver.chebyshev_rho > 0.0 || solver.warm_start;
   }
   /// Builds and prepares the programs; the last one ends with the
   /// statistics of `stats` (append_stats). [in] scene, buffers must outlive
@@ -30,7 +43,8 @@ class SolveStepper {
   static Result<std::unique_ptr<SolveStepper>> create(Device& device, const CompiledScene& scene,
                                                       const XpbdBuffers& buffers, const SolverSettings& solver,
                                                       const std::array<double, 3>& gravity, const StatsPlan& stats,
-                                                      const MeshContactBuffers* mesh_contacts = nullptr);
+                                                      const MeshContactBuffers* mesh_contacts = nullptr,
+                                                      bool per_substep = false);
   /// Destroys the programs and builds them again (same buffers for the
   /// checks and the accelerator): after the mesh contacts outgrew their
   /// buffers or colours.
@@ -40,7 +54,9 @@ class SolveStepper {
 
   /// Runs one frame; fills stats.sweeps, stop, checked_residual,
   /// residual_checks and the device times (summed over the programs run).
-  Status run_frame(Device& device, FrameStats& stats);
+  /// [in] hook: called after every substep's sweeps (only when made with
+  /// per_substep; may be null then too).
+  Status run_frame(Device& device, FrameStats& stats, SubstepHook* hook = nullptr);
 
   /// The frame's commands when every substep stops at its first check
   /// (fixed mode with the accelerator: the whole frame): what SceneInfo
@@ -54,9 +70,14 @@ class SolveStepper {
                const std::array<double, 3>& gravity, const StatsPlan& stats,
                const MeshContactBuffers* mesh_contacts);
   Status run(Device& device, ProgramHandle program, DeviceTimes& times, bool first);
+  Status run_hook(Device& device, SubstepHook* hook, int s, FrameStats& stats, std::uint64_t& sweeps);
 
   SolverSettings solver_;
   bool residual_mode_ = false;
+  // A frame cut per substep for a SubstepHook: begin_[s], then repair_[s]
+  // as often as the hook asks, then end_ (in the fixed mode too).
+  bool per_substep_ = false;
+  std::vector<ProgramHandle> repair_;
   ChebyshevBuffers chebyshev_;
   ResidualCheck check_;
   FrameProgram shortest_frame_;
