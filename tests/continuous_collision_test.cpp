@@ -10,9 +10,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include "math/vec3.h"
 #include "mesh_contact_support.h"
 #include "runtime/continuous_collision.h"
 #include "test_support.h"
+#include "thread_scenes.h"
 #include "thread_topology.h"
 
 namespace sinew::test {
@@ -20,65 +22,15 @@ namespace {
 
 class ContinuousCollisionTest : public BackendTest {};
 
-constexpr double kFrame = 1.0 / 60.0;
-
-// The tests' common settings: no gravity, 60 frames per second of 8
-// substeps with 10 sweeps, mesh collision at 0.5 mm with CCD on or off.
-SceneDesc thread_scene(bool continuous) {
-  SceneDesc scene;
-  scene.gravity = {0.0, 0.0, 0.0};
-  scene.solver.time_step = kFrame;
-  scene.solver.substeps = 8;
-  scene.solver.iterations = 10;
-  scene.mesh_collision.enabled = true;
-  scene.mesh_collision.thickness = 5e-4;
-  scene.mesh_collision.continuous = continuous;
-  return scene;
+// The rings' linking count from the positions.
+LinkingCount linking(const Simulation& sim) {
+  std::vector<float> x;
+  EXPECT_TRUE(sim.read_positions(x).ok());
+  std::vector<Point3> a, b;
+  for (int i = 0; i < LinkedRings::n; ++i) a.push_back(at(x, static_cast<std::uint32_t>(i)));
+  for (int i = 0; i < LinkedRings::n; ++i) b.push_back(at(x, static_cast<std::uint32_t>(LinkedRings::n + i)));
+  return linking_count(a, b);
 }
-
-// ---- Two linked rings of one thread, pulled apart.
-
-// One line body of two closed rings of `n` segments and radius r = 1 cm,
-// linked like chain links: ring A in the z = 0 plane around the origin,
-// ring B in the y = 0 plane around (r, 0, 0), each passing through the
-// other's centre. A's vertex 0 (at (-r, 0, 0)) is attached to target 0, B's
-// vertex 0 (at (2r, 0, 0)) to target 1; moving the targets apart along x
-// pulls the rings tight against each other, hooked at A's (r, 0, 0) and B's
-// origin. The segments are inextensible (compliance 0).
-struct LinkedRings {
-  static constexpr int n = 32;
-  static constexpr double r = 0.01;
-  static SceneDesc scene(bool continuous) {
-    SceneDesc scene = thread_scene(continuous);
-    LineBodyDesc t;
-    for (int ring = 0; ring < 2; ++ring)
-      for (int i = 0; i < n; ++i) {
-        const double a = 2.0 * M_PI * i / n;
-        if (ring == 0) t.vertices.push_back({-r * std::cos(a), -r * std::sin(a), 0.0});
-        else t.vertices.push_back({r + r * std::cos(a), 0.0, r * std::sin(a)});
-        t.masses.push_back(1e-4);
-        t.segments.push_back({static_cast<std::uint32_t>(ring * n + i), static_cast<std::uint32_t>(ring * n + (i + 1) % n)});
-      }
-    t.bending_compliance = 1.0;
-    t.velocity_damping = 1.0;
-    scene.line_bodies.push_back(t);
-    scene.targets = {{-r, 0.0, 0.0}, {2.0 * r, 0.0, 0.0}};
-    scene.attachments = {{{BodyKind::line, 0, 0}, 0, 0.0}, {{BodyKind::line, 0, static_cast<std::uint32_t>(n)}, 1, 0.0}};
-    return scene;
-  }
-  // Each target's distance from its start after frame f: `speed` [m/s]
-  // until 3 cm (past where the rings are tight: they hook after 1 cm and
-  // can stretch about 2.3 cm more), then held.
-  static double pulled(int f, double speed) { return std::min(speed * (f + 1) * kFrame, 0.03); }
-  static LinkingCount linking(const Simulation& sim) {
-    std::vector<float> x;
-    EXPECT_TRUE(sim.read_positions(x).ok());
-    std::vector<Point3> a, b;
-    for (int i = 0; i < n; ++i) a.push_back(at(x, static_cast<std::uint32_t>(i)));
-    for (int i = 0; i < n; ++i) b.push_back(at(x, static_cast<std::uint32_t>(n + i)));
-    return linking_count(a, b);
-  }
-};
 
 struct RunSummary {
   int first_change = -1;  // the first frame whose linking number differs from the start's (-1: none)
@@ -87,13 +39,11 @@ struct RunSummary {
 
 RunSummary pull_rings(Simulation& sim, double speed, int frames) {
   RunSummary out;
-  const LinkingCount start = LinkedRings::linking(sim);
+  const LinkingCount start = linking(sim);
   EXPECT_EQ(start.over, start.under);
   EXPECT_EQ(std::abs(start.over), 1) << "the rings start linked";
   for (int f = 0; f < frames; ++f) {
-    const double d = LinkedRings::pulled(f, speed);
-    EXPECT_TRUE(sim.set_target(0, {-LinkedRings::r - d, 0.0, 0.0}).ok());
-    EXPECT_TRUE(sim.set_target(1, {2.0 * LinkedRings::r + d, 0.0, 0.0}).ok());
+    EXPECT_TRUE(LinkedRings::drive(sim, f, speed).ok());
     const Status s = sim.step();
     EXPECT_TRUE(s.ok()) << s.error().message();
     if (!s.ok()) break;
@@ -101,7 +51,7 @@ RunSummary pull_rings(Simulation& sim, double speed, int frames) {
     out.hits += st.ccd_hits;
     out.repairs += st.ccd_repairs;
     out.reverted += st.ccd_reverted;
-    const LinkingCount now = LinkedRings::linking(sim);
+    const LinkingCount now = linking(sim);
     EXPECT_EQ(now.over, now.under) << "frame " << f << ": a degenerate projection";
     if (out.first_change < 0 && now.over != start.over) out.first_change = f;
   }
@@ -164,43 +114,6 @@ TEST(ContinuousCollision, TheFailSafeAloneKeepsTheRingsLinked) {
   EXPECT_GT(run.reverted, 0u);
 }
 
-// ---- A thread pulled up into a membrane.
-
-// A 6 x 6 cm membrane (12 x 12 cells, 1 mm thick) in the y = 0 plane,
-// pinned all round; under it, 3 mm down, a 4 cm thread of 16 segments
-// (offset from the membrane's grid lines, so no vertex sits under an edge)
-// whose ends are attached to targets that rise at `speed` to 2 cm above
-// the membrane's plane and stay there: the thread must tent the membrane.
-struct ThreadUnderMembrane {
-  static constexpr int segments = 16;
-  static SceneDesc scene(bool continuous) {
-    SceneDesc scene = thread_scene(continuous);
-    TriBodyDesc m;
-    m.mesh = membrane(12, 12, 0.005, 0.0);
-    for (int i = 0; i <= 12; ++i)
-      for (int k = 0; k <= 12; ++k)
-        if (i == 0 || i == 12 || k == 0 || k == 12) m.pinned.push_back(static_cast<std::uint32_t>(i * 13 + k));
-    m.velocity_damping = 2.0;
-    scene.tri_bodies.push_back(m);
-    LineBodyDesc t;
-    for (int i = 0; i <= segments; ++i) {
-      t.vertices.push_back({end_x(0) + (end_x(1) - end_x(0)) * i / segments, -0.003, z});
-      t.masses.push_back(1e-4);
-      if (i < segments) t.segments.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)});
-    }
-    t.bending_compliance = 1.0;
-    t.velocity_damping = 2.0;
-    scene.line_bodies.push_back(t);
-    scene.targets = {{end_x(0), -0.003, z}, {end_x(1), -0.003, z}};
-    scene.attachments = {{{BodyKind::line, 0, 0}, 0, 0.0},
-                         {{BodyKind::line, 0, static_cast<std::uint32_t>(segments)}, 1, 0.0}};
-    return scene;
-  }
-  static constexpr double z = 0.03013;
-  static double end_x(int side) { return side == 0 ? 0.01071 : 0.04971; }
-  static double height(int f, double speed) { return std::min(-0.003 + speed * (f + 1) * kFrame, 0.02); }
-};
-
 // The thread's vertices that are not under the membrane (an even number of
 // its triangles above them), and the first frame with one (-1: none).
 struct MembraneRun {
@@ -216,9 +129,7 @@ MembraneRun pull_into_membrane(Simulation& sim, const SceneDesc& scene, double s
   const std::uint32_t thread_first = sim.info().line_body_first_particle[0];
   std::vector<float> x;
   for (int f = 0; f < frames; ++f) {
-    const double y = ThreadUnderMembrane::height(f, speed);
-    for (int side = 0; side < 2; ++side)
-      EXPECT_TRUE(sim.set_target(side, {ThreadUnderMembrane::end_x(side), y, ThreadUnderMembrane::z}).ok());
+    EXPECT_TRUE(ThreadUnderMembrane::drive(sim, f, speed).ok());
     const Status s = sim.step();
     EXPECT_TRUE(s.ok()) << s.error().message();
     if (!s.ok()) break;
@@ -256,6 +167,120 @@ TEST(ContinuousCollision, WithoutItTheThreadPassesThroughTheMembrane) {
   SINEW_ASSERT_OK(sim);
   const MembraneRun run = pull_into_membrane(*sim, scene, 1.0, 30);
   EXPECT_GE(run.first_through, 0);
+}
+
+struct ProbeRun {
+  int first_through = -1;  // the first frame whose tip is not under the membrane (-1: none)
+  std::uint32_t hits = 0, repairs = 0, carried = 0, forced = 0;
+};
+
+ProbeRun push_probe(Simulation& sim, const SceneDesc& scene, int frames) {
+  ProbeRun out;
+  const TriMesh& mesh = scene.tri_bodies[0].mesh;
+  const std::uint32_t first = sim.info().tri_body_first_particle[0];
+  std::vector<float> x;
+  for (int f = 0; f < frames; ++f) {
+    const double tip = ProbeUnderMembrane::tip(f, 1.0);
+    EXPECT_TRUE(ProbeUnderMembrane::drive(sim, f, 1.0).ok());
+    const Status s = sim.step();
+    EXPECT_TRUE(s.ok()) << s.error().message();
+    if (!s.ok()) break;
+    const FrameStats& st = sim.last_frame();
+    out.hits += st.ccd_hits, out.repairs += st.ccd_repairs, out.carried += st.ccd_carried, out.forced += st.ccd_forced;
+    EXPECT_TRUE(sim.read_positions(x).ok());
+    std::vector<Point3> vertices;
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) vertices.push_back(at(x, first + v));
+    const Point3 tip_point{ProbeUnderMembrane::x, tip, ProbeUnderMembrane::z};
+    if (out.first_through < 0 && crossings_above(tip_point, vertices, mesh.triangles) % 2 == 0) out.first_through = f;
+  }
+  return out;
+}
+
+// The probe's tip rises at 1 m/s and stays 15 mm above the membrane's rest
+// plane for half a second: the membrane, tented over it, stays above the
+// tip every frame (its axis never passes through).
+TEST_P(ContinuousCollisionTest, AThinProbePushedIntoAMembraneAtAToolsSpeedNeverPassesThrough) {
+  const SceneDesc scene = ProbeUnderMembrane::scene(true);
+  auto sim = create_or_skip(scene, GetParam());
+  SINEW_ASSERT_OK(sim);
+  const ProbeRun run = push_probe(*sim, scene, 30);
+  std::printf("[%s] probe through the membrane at frame %d; %u touches, %u repairs, %u particles carried, %u forced\n",
+              GetParam().c_str(), run.first_through, run.hits, run.repairs, run.carried, run.forced);
+  EXPECT_EQ(run.first_through, -1);
+  EXPECT_GT(run.hits, 0u) << "the probe must touch the membrane, or the test shows nothing";
+  EXPECT_EQ(run.forced, 0u);
+}
+
+// Without continuous collision the probe passes through the membrane.
+TEST(ContinuousCollision, WithoutItTheProbePassesThroughTheMembrane) {
+  const SceneDesc scene = ProbeUnderMembrane::scene(false);
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  SINEW_ASSERT_OK(sim);
+  EXPECT_GE(push_probe(*sim, scene, 30).first_through, 0);
+}
+
+// The fail-safe alone (no repair rounds): the membrane's particles the
+// probe's axis would cross move with the probe over their substep.
+TEST(ContinuousCollision, TheFailSafeCarriesTheMembraneWithTheProbe) {
+  SceneDesc scene = ProbeUnderMembrane::scene(true);
+  scene.mesh_collision.continuous_repairs = 0;
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  SINEW_ASSERT_OK(sim);
+  const ProbeRun run = push_probe(*sim, scene, 30);
+  EXPECT_EQ(run.first_through, -1);
+  EXPECT_EQ(run.repairs, 0u);
+  EXPECT_GT(run.carried, 0u);
+  EXPECT_EQ(run.forced, 0u);
+}
+
+// A rigid tool of the probe's shape (10 g, no gravity) pushed up by 1 N
+// from under the membrane: it passes 1 m/s as its tip meets the membrane
+// and keeps pushing for a sixth of a second. Its tip stays under the
+// membrane every frame,
+// and the membrane pushes it back: the continuous contacts' reaction
+// reaches the tool.
+TEST_P(ContinuousCollisionTest, AToolPushedIntoAMembraneNeverPassesThroughAndFeelsIt) {
+  SceneDesc scene = ProbeUnderMembrane::scene(true);
+  scene.colliders.clear();
+  ToolDesc tool;
+  tool.radius = 5e-4;
+  tool.half_height = ProbeUnderMembrane::half;
+  tool.mass = 0.01;
+  tool.gravity = false;
+  tool.position = {ProbeUnderMembrane::x, -0.005 - ProbeUnderMembrane::half, ProbeUnderMembrane::z};
+  scene.tools.push_back(tool);
+  auto sim = create_or_skip(scene, GetParam());
+  SINEW_ASSERT_OK(sim);
+  const TriMesh& mesh = scene.tri_bodies[0].mesh;
+  const std::uint32_t first = sim->info().tri_body_first_particle[0];
+  std::vector<float> x;
+  int first_through = -1;
+  double fastest = 0.0, strongest_push = 0.0;
+  std::uint32_t hits = 0, forced = 0;
+  for (int f = 0; f < 10; ++f) {
+    SINEW_ASSERT_OK(sim->apply_tool_force(0, {0.0, 1.0, 0.0}, {0.0, 0.0, 0.0}));
+    SINEW_ASSERT_OK(sim->step());
+    hits += sim->last_frame().ccd_hits;
+    forced += sim->last_frame().ccd_forced;
+    auto state = sim->tool_state(0);
+    SINEW_ASSERT_OK(state);
+    fastest = std::max(fastest, state->velocity[1]);
+    strongest_push = std::min(strongest_push, state->contact_force[1]);
+    const math::Vec3 tip = math::add(math::Vec3{state->position[0], state->position[1], state->position[2]},
+                                     math::rotate(state->rotation, math::Vec3{0.0, ProbeUnderMembrane::half, 0.0}));
+    SINEW_ASSERT_OK(sim->read_positions(x));
+    std::vector<Point3> vertices;
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) vertices.push_back(at(x, first + v));
+    if (first_through < 0 && crossings_above({tip[0], tip[1], tip[2]}, vertices, mesh.triangles) % 2 == 0)
+      first_through = f;
+  }
+  std::printf("[%s] tool through the membrane at frame %d; fastest %.2f m/s, pushed back by up to %.3f N; %u touches\n",
+              GetParam().c_str(), first_through, fastest, -strongest_push, hits);
+  EXPECT_EQ(first_through, -1);
+  EXPECT_GT(fastest, 0.8);
+  EXPECT_GT(hits, 0u);
+  EXPECT_EQ(forced, 0u);
+  EXPECT_LT(strongest_push, -0.1) << "the membrane must push the tool back";
 }
 
 // ---- Nothing to find: no change.

@@ -304,11 +304,21 @@ class CpuDevice final : public Device {
   // are member 0's alone; consecutive ones need no barrier between them.
   // The result does not depend on the split: a dispatch's items (or
   // groups) are independent.
+  // An indirect dispatch that found no items wrote nothing: the barrier
+  // after it is skipped (the one before it already ordered everything
+  // earlier, and every member read the same count there, so all skip it).
+  // Mesh contacts dispatch every colour their program has room for, most
+  // of them empty in most frames (measured, medians of 2-3 runs alternating
+  // with the previous build, 2 threads: bench_mesh_contacts' coloured
+  // blocks 1.45 -> 1.12 ms per frame, fold 2.21 -> 1.90; the continuous
+  // collision benchmark's probe scene, 32 colours per sweep, 3.6 -> 1.56).
   void run_steps(const std::vector<CpuStep>& steps, unsigned member) {
     const unsigned members = team_.members();
+    bool after_empty = false;
     for (std::size_t i = 0; i < steps.size(); ++i) {
       const CpuStep& s = steps[i];
-      if (i > 0 && !(steps[i - 1].solo && s.solo)) team_.barrier();
+      if (i > 0 && !(steps[i - 1].solo && s.solo) && !after_empty) team_.barrier();
+      after_empty = false;
       switch (s.kind) {
         case CpuStep::Kind::fill:
           if (member == 0) std::fill_n(s.target, s.words, s.value);
@@ -323,7 +333,10 @@ class CpuDevice final : public Device {
       std::uint32_t items = s.indirect ? std::min(*s.indirect, s.count) : s.count;
       if (s.group_size > 0)
         items = static_cast<std::uint32_t>((std::uint64_t{items} + s.group_size - 1) / s.group_size);
-      if (items == 0) continue;
+      if (items == 0) {
+        after_empty = true;
+        continue;
+      }
       const std::uint64_t item_ns = std::uint64_t{s.cost_ns} * (s.group_size > 0 ? s.group_size : 1);
       if (members == 1 || items * item_ns < kSerialBelowNs) {
         if (member == 0) s.fn(s.params, s.bindings, 0, items);

@@ -398,24 +398,32 @@ struct MeshCollisionDesc {
   double static_friction = 0.3;   ///< >= 0
   double dynamic_friction = 0.2;  ///< >= 0, <= static_friction
 
-  /// Continuous collision detection for threads (issue 13, part 3): after
-  /// every substep's sweeps the host tests the motion each line body's
-  /// segments made in it — from the substep's start to its end, linearly —
-  /// against every other segment (skipping neighbours, which share a
-  /// vertex) and every triangle of the tet bodies' surfaces and the tri
-  /// bodies, with the CCD queries of sinew/ccd.h (no false negatives). Each
-  /// touch becomes a contact for the rest of the frame (the normal the
-  /// primitives meet along, kept at `thickness`), the substep's sweeps
-  /// run again (`iterations` more) and the motion is tested again; after
-  /// `continuous_repairs` such rounds, the particles of every pair that
-  /// still touches stop where the substep started (their velocity becomes
-  /// 0), until no moving pair touches. So a thread never passes through
-  /// itself, another thread or a surface, however fast it is pulled,
-  /// provided the scene starts with none passing through another
-  /// (README, "Continuous collision detection"). Costs a read-back of the
-  /// positions per substep. Needs at least one line body and
-  /// ContactSchedule::colored; surfaces against surfaces are not tested
-  /// continuously (the frame's contacts hold them).
+  /// Continuous collision detection (issue 13, part 3): after every
+  /// substep's sweeps the host tests the motion the primitives made in it,
+  /// from the substep's start to its end, linearly, with the CCD queries of
+  /// sinew/ccd.h (no false negatives):
+  ///  - each line body's segments against every other segment (skipping
+  ///    neighbours, which share a vertex) and every triangle of the tet
+  ///    bodies' surfaces and the tri bodies;
+  ///  - the axis of every rigid tool and capsule collider (a tool's tip,
+  ///    a needle) against those segments and triangles.
+  /// Each touch becomes a contact for the rest of the frame (along the
+  /// normal the primitives meet along, kept at `thickness`; against a
+  /// capsule, its surface), the substep's sweeps run again (`iterations`
+  /// more) and the motion is tested again. After `continuous_repairs` such
+  /// rounds the fail-safe acts on the pairs that still touch until none
+  /// does: tissue against tissue, the moving particles stop where the
+  /// substep started (their velocity becomes 0); tissue against a capsule,
+  /// they move with it. So a thread never passes through itself, another
+  /// thread or a surface, and a tool's axis never through a membrane or a
+  /// thread, however fast they move, provided the scene starts with none
+  /// through another; the one exception, counted in FrameStats::ccd_forced,
+  /// is a tool forcing tissue it carries or pinned tissue through other
+  /// tissue (README, "Continuous collision detection"). Costs a read-back
+  /// of the positions per substep. Needs ContactSchedule::colored, and
+  /// a line body, or a tool or capsule collider and a surface. Surfaces
+  /// against surfaces are not tested continuously (the frame's contacts
+  /// hold them).
   bool continuous = false;
   /// Repair rounds per substep before the fail-safe stops the touching
   /// particles, >= 0 (0: stop them at once, no repair sweeps).

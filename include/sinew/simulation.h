@@ -64,7 +64,9 @@ struct FrameStats {
   double measure_ms = 0.0;  ///< of which reading back and combining the statistics [ms]
   std::uint64_t read_back_bytes = 0;  ///< bytes the host read from the device in the last step()
                                       ///< (with mesh collision: the positions too, 16 per particle,
-                                      ///< and 32 per contact when a tool has face contacts)
+                                      ///< and 32 per contact when a tool has face contacts; with
+                                      ///< continuous collision, 32 per particle per substep and 16 per
+                                      ///< particle per repair round more)
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,
   /// rest volume, ...): 0 when the xPBD system is solved exactly. Contact
@@ -103,6 +105,14 @@ struct FrameStats {
   std::uint32_t ccd_hits = 0;
   std::uint32_t ccd_repairs = 0;
   std::uint32_t ccd_reverted = 0;
+  /// The particles the fail-safe moved with a tool or capsule collider
+  /// (rigidly, over their substep) so its axis could not cross them.
+  std::uint32_t ccd_carried = 0;
+  /// Touching pairs the fail-safe could not act on, let through: a tool
+  /// or capsule collider forcing tissue it carries, or pinned tissue,
+  /// through other tissue (it is kinematic within the frame). 0 but for such
+  /// scenes.
+  std::uint32_t ccd_forced = 0;
   double ccd_ms = 0.0;
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).

@@ -307,9 +307,14 @@ Status check_mesh_collision(const SceneDesc& scene) {
   if (c.schedule != ContactSchedule::colored)
     return Error(ErrorCode::bad_parameter,
                  "mesh_collision.continuous needs mesh_collision.schedule = ContactSchedule::colored");
-  if (scene.line_bodies.empty())
+  // What is tested: threads against anything, tools' and capsule colliders' axes against surfaces.
+  bool capsules = !scene.tools.empty();
+  for (const ColliderDesc& c : scene.colliders) capsules |= c.shape == ColliderShape::capsule;
+  const bool surfaces = !scene.tet_bodies.empty() || !scene.tri_bodies.empty();
+  if (scene.line_bodies.empty() && !(capsules && surfaces))
     return Error(ErrorCode::bad_parameter,
-                 "mesh_collision.continuous tests thread segments (line bodies) and the scene has none");
+                 "mesh_collision.continuous tests thread segments (line bodies), and tools and capsule colliders "
+                 "against surfaces; the scene has neither");
   return {};
 }
 

@@ -102,7 +102,8 @@ void ContinuousSearch::fit(std::span<const float> start, std::span<const float> 
 }
 
 Status ContinuousSearch::find(std::span<const float> start, std::span<const float> end,
-                              std::vector<Contact>& hits) {
+                              std::vector<Contact>& hits, std::span<const Capsule> capsules,
+                              std::span<const std::uint8_t> carried) {
   hits.clear();
   queries_ = 0;
   for (const auto* list : {&segments_, &triangles_})
@@ -111,67 +112,76 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
         if (!std::isfinite(start[std::size_t{p} * 4 + a]) || !std::isfinite(end[std::size_t{p} * 4 + a]))
           return Error(ErrorCode::bad_parameter, "continuous collision: particle " + std::to_string(p) +
                                                      " (device order) has a non-finite position");
-  const ccd::Settings settings;  // min_separation 0: a true touch
-  // Edge (a0, a1) against edge (b0, b1), particles as given.
-  const auto edge_edge = [&](std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) -> Status {
-    const std::uint32_t p[4] = {a0, a1, b0, b1};
-    if (!moves(start, end, p)) return {};
-    const Motion m[4] = {motion_of(start, end, a0), motion_of(start, end, a1), motion_of(start, end, b0),
-                         motion_of(start, end, b1)};
+  // Edge (a0, a1) against edge (b0, b1), given as motions; [out] s, t the
+  // touching points' parameters, plane the normal of the plane the edges
+  // meet in, apart the first point minus the second at the start.
+  struct Touch {
+    double w[4];  // weights: edge-edge (1 - s, s, 1 - t, t); vertex-face (1, wa, wb, wc)
+    Point plane, apart;
+  };
+  const auto edges = [&](const Motion* m, double separation, Touch& touch) -> Result<bool> {
+    ccd::Settings settings;
+    settings.min_separation = separation;
     ++queries_;
     const auto hit = ccd::edge_edge(m[0], m[1], m[2], m[3], settings);
-    if (Status s = check_query(hit); !s) return s;
-    if (!hit->touch) return {};
+    if (Status s = check_query(hit); !s) return s.error();
+    if (!hit->touch) return false;
     // The touching points: the closest points at the time returned (the
     // hit's own parameters are only its box's corner, up to a box's width off).
     const double t = hit->time;
-    const auto params = kernels::proximity::closest_between_segments(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
-    const double wa[2] = {1.0 - params.s, params.s}, wb[2] = {1.0 - params.t, params.t};
-    const Point plane = cross(sub(lerp(m[1], t), lerp(m[0], t)), sub(lerp(m[3], t), lerp(m[2], t)));
-    const Point apart = sub(weighted({m, 2}, wa, 0.0), weighted({m + 2, 2}, wb, 0.0));
-    Contact c;
-    c.kind = Contact::Kind::edge_edge;
-    c.v = {a0, a1, b0, b1};
-    c.w = {static_cast<float>(wa[0]), static_cast<float>(wa[1]), static_cast<float>(wb[0]), static_cast<float>(wb[1])};
-    c.normal = contact_normal(plane, apart);
-    hits.push_back(c);
-    return {};
+    const auto st = kernels::proximity::closest_between_segments(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
+    touch.w[0] = 1.0 - st.s, touch.w[1] = st.s, touch.w[2] = 1.0 - st.t, touch.w[3] = st.t;
+    touch.plane = cross(sub(lerp(m[1], t), lerp(m[0], t)), sub(lerp(m[3], t), lerp(m[2], t)));
+    touch.apart = sub(weighted({m, 2}, {touch.w, 2}, 0.0), weighted({m + 2, 2}, {touch.w + 2, 2}, 0.0));
+    return true;
   };
-  // Vertex q against triangle (a, b, c).
-  const auto vertex_face = [&](std::uint32_t q, const std::uint32_t* tri) -> Status {
-    const std::uint32_t p[4] = {q, tri[0], tri[1], tri[2]};
-    if (!moves(start, end, p)) return {};
-    const Motion m[4] = {motion_of(start, end, q), motion_of(start, end, tri[0]), motion_of(start, end, tri[1]),
-                         motion_of(start, end, tri[2])};
+  // Vertex m[0] against triangle m[1..3].
+  const auto vertex_face = [&](const Motion* m, double separation, Touch& touch) -> Result<bool> {
+    ccd::Settings settings;
+    settings.min_separation = separation;
     ++queries_;
     const auto hit = ccd::vertex_face(m[0], m[1], m[2], m[3], settings);
-    if (Status s = check_query(hit); !s) return s;
-    if (!hit->touch) return {};
+    if (Status s = check_query(hit); !s) return s.error();
+    if (!hit->touch) return false;
     const double t = hit->time;
-    const auto bary = kernels::proximity::closest_on_triangle(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
-    const double w[3] = {bary.wa, bary.wb, bary.wc};
-    const Point plane = cross(sub(lerp(m[2], t), lerp(m[1], t)), sub(lerp(m[3], t), lerp(m[1], t)));
-    const Point apart = sub(m[0][0], weighted({m + 1, 3}, w, 0.0));
+    const auto w = kernels::proximity::closest_on_triangle(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
+    touch.w[0] = 1.0, touch.w[1] = w.wa, touch.w[2] = w.wb, touch.w[3] = w.wc;
+    touch.plane = cross(sub(lerp(m[2], t), lerp(m[1], t)), sub(lerp(m[3], t), lerp(m[1], t)));
+    touch.apart = sub(m[0][0], weighted({m + 1, 3}, {touch.w + 1, 3}, 0.0));
+    return true;
+  };
+  const auto motions = [&](std::span<const std::uint32_t> particles, Motion* m) {
+    for (std::size_t k = 0; k < particles.size(); ++k) m[k] = motion_of(start, end, particles[k]);
+  };
+  const auto add = [&](Contact::Kind kind, std::array<std::uint32_t, 4> v, const Touch& touch) {
     Contact c;
-    c.kind = Contact::Kind::vertex_triangle;
-    c.v = {q, tri[0], tri[1], tri[2]};
-    c.w = {1.0f, static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2])};
-    c.normal = contact_normal(plane, apart);
+    c.kind = kind;
+    c.v = v;
+    for (int k = 0; k < 4; ++k) c.w[k] = static_cast<float>(touch.w[k]);
+    c.normal = contact_normal(touch.plane, touch.apart);
     hits.push_back(c);
-    return {};
   };
 
-  if (segments_.empty()) return {};
-  fit(start, end, segments_, 2, segment_tree_);
-  collision::self_overlapping_pairs(segment_tree_, collision::SharesVertexOf<2>{segments_}, pairs_);
-  for (const collision::Pair& pr : pairs_) {
-    const std::uint32_t* a = &segments_[std::size_t{pr.first} * 2];
-    const std::uint32_t* b = &segments_[std::size_t{pr.second} * 2];
-    if (Status s = edge_edge(a[0], a[1], b[0], b[1]); !s) return s;
+  if (!segments_.empty()) fit(start, end, segments_, 2, segment_tree_);
+  if (!triangles_.empty() && (!segments_.empty() || !capsules.empty())) fit(start, end, triangles_, 3, triangle_tree_);
+  Touch touch;
+  // Thread against thread.
+  if (!segments_.empty()) {
+    collision::self_overlapping_pairs(segment_tree_, collision::SharesVertexOf<2>{segments_}, pairs_);
+    for (const collision::Pair& pr : pairs_) {
+      const std::uint32_t* a = &segments_[std::size_t{pr.first} * 2];
+      const std::uint32_t* b = &segments_[std::size_t{pr.second} * 2];
+      const std::uint32_t p[4] = {a[0], a[1], b[0], b[1]};
+      if (!moves(start, end, p)) continue;
+      Motion m[4];
+      motions(p, m);
+      auto hit = edges(m, 0.0, touch);
+      if (!hit) return hit.error();
+      if (*hit) add(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch);
+    }
   }
-  if (!triangles_.empty()) {
-    // The segment tree's boxes are still the segments' (fit above).
-    fit(start, end, triangles_, 3, triangle_tree_);
+  // Thread against surfaces: each end against the face, the segment against its edges.
+  if (!segments_.empty() && !triangles_.empty()) {
     collision::overlapping_pairs(segment_tree_, triangle_tree_, pairs_);
     for (const collision::Pair& pr : pairs_) {
       const std::uint32_t* s = &segments_[std::size_t{pr.first} * 2];
@@ -180,77 +190,263 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
       for (int i = 0; i < 2; ++i)
         for (int j = 0; j < 3; ++j) shared |= s[i] == t[j];
       if (shared) continue;
-      for (int i = 0; i < 2; ++i)
-        if (Status st = vertex_face(s[i], t); !st) return st;
-      for (int j = 0; j < 3; ++j)
-        if (Status st = edge_edge(s[0], s[1], t[j], t[(j + 1) % 3]); !st) return st;
+      for (int i = 0; i < 2; ++i) {
+        const std::uint32_t p[4] = {s[i], t[0], t[1], t[2]};
+        if (!moves(start, end, p)) continue;
+        Motion m[4];
+        motions(p, m);
+        auto hit = vertex_face(m, 0.0, touch);
+        if (!hit) return hit.error();
+        if (*hit) add(Contact::Kind::vertex_triangle, {p[0], p[1], p[2], p[3]}, touch);
+      }
+      for (int j = 0; j < 3; ++j) {
+        const std::uint32_t p[4] = {s[0], s[1], t[j], t[(j + 1) % 3]};
+        if (!moves(start, end, p)) continue;
+        Motion m[4];
+        motions(p, m);
+        auto hit = edges(m, 0.0, touch);
+        if (!hit) return hit.error();
+        if (*hit) add(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch);
+      }
     }
+  }
+  // Capsules' axes against the threads and the surfaces. The tissue is the
+  // first primitive (its weights first), the axis the second.
+  if (!capsules.empty()) {
+    boxes_.resize(capsules.size());
+    for (std::size_t i = 0; i < capsules.size(); ++i)
+      for (int a = 0; a < 3; ++a) {
+        double lo = capsules[i].ends[0][0][a], hi = lo;
+        for (const Motion& e : capsules[i].ends)
+          for (const Point& x : e) lo = std::min(lo, x[a]), hi = std::max(hi, x[a]);
+        // Widened by the stray and rounded outwards to float.
+        boxes_[i].lo[a] = std::nextafter(static_cast<float>(lo - capsules[i].stray), -INFINITY);
+        boxes_[i].hi[a] = std::nextafter(static_cast<float>(hi + capsules[i].stray), INFINITY);
+      }
+    capsule_tree_.build(boxes_);
+    const auto all_carried = [&](std::span<const std::uint32_t> particles) {
+      if (carried.empty()) return false;
+      for (std::uint32_t p : particles)
+        if (!carried[p]) return false;
+      return true;
+    };
+    // The touch of tissue `p` (arity 2 or 3) with capsule c, as a shape_face hit.
+    const auto add_capsule = [&](std::span<const std::uint32_t> p, std::uint32_t c, const double* w, const Touch& t) {
+      Contact hit;
+      hit.kind = Contact::Kind::shape_face;
+      if (p.size() == 3) {
+        hit.v = {p[0], p[0], p[1], p[2]};
+        hit.w = {0.0f, float(w[0]), float(w[1]), float(w[2])};
+      } else {
+        hit.v = {p[0], p[0], p[1], p[1]};
+        hit.w = {0.0f, float(w[0]), 0.0f, float(w[1])};
+      }
+      hit.normal = contact_normal(t.plane, t.apart);
+      hit.shape = c;
+      hits.push_back(hit);
+    };
+    const auto against = [&](const collision::Bvh& tree, const std::vector<std::uint32_t>& indices, int arity) -> Status {
+      if (indices.empty()) return {};
+      collision::overlapping_pairs(tree, capsule_tree_, pairs_);
+      for (const collision::Pair& pr : pairs_) {
+        const Capsule& cap = capsules[pr.second];
+        const std::span<const std::uint32_t> p(&indices[std::size_t{pr.first} * arity], std::size_t(arity));
+        if (all_carried(p)) continue;
+        Motion m[4];
+        const Motion& a0 = cap.ends[0];
+        const Motion& a1 = cap.ends[1];
+        if (a0[0] == a0[1] && a1[0] == a1[1] && !moves(start, end, p)) continue;  // neither moves
+        // The tissue's edges against the axis.
+        for (int j = 0; j < (arity == 3 ? 3 : 1); ++j) {
+          m[0] = motion_of(start, end, p[j]), m[1] = motion_of(start, end, p[(j + 1) % arity]);
+          m[2] = a0, m[3] = a1;
+          auto hit = edges(m, cap.stray, touch);
+          if (!hit) return hit.error();
+          if (!*hit) continue;
+          double w[3] = {0.0, 0.0, 0.0};
+          w[j] = touch.w[0], w[(j + 1) % arity] = touch.w[1];
+          add_capsule(p, pr.second, w, touch);
+        }
+        if (arity != 3) continue;
+        // The axis' ends against the face: the touch's normal is the face's,
+        // towards the side the face came from (from the axis to the face).
+        for (const Motion& tip : {a0, a1}) {
+          m[0] = tip;
+          for (int k = 0; k < 3; ++k) m[k + 1] = motion_of(start, end, p[k]);
+          auto hit = vertex_face(m, cap.stray, touch);
+          if (!hit) return hit.error();
+          if (!*hit) continue;
+          touch.apart = {-touch.apart[0], -touch.apart[1], -touch.apart[2]};
+          add_capsule(p, pr.second, touch.w + 1, touch);
+        }
+      }
+      return {};
+    };
+    if (Status s = against(segment_tree_, segments_, 2); !s) return s;
+    if (Status s = against(triangle_tree_, triangles_, 3); !s) return s;
   }
   collision::sort_unique_contacts(hits);
   return {};
 }
 
 ContinuousCollision::ContinuousCollision(std::vector<std::uint32_t> segments, std::vector<std::uint32_t> triangles,
-                                         MeshCollision& mesh_collision, const XpbdBuffers& buffers, int repairs)
+                                         MeshCollision& mesh_collision, const XpbdBuffers& buffers,
+                                         const MeshCollisionDesc& desc, int substeps)
     : search_(std::move(segments), std::move(triangles)),
       mesh_collision_(mesh_collision),
       buffers_(buffers),
-      repairs_(repairs) {}
+      thickness_(desc.thickness),
+      repairs_(desc.continuous_repairs),
+      substeps_(substeps) {}
 
-void ContinuousCollision::begin_frame() {
-  hits_ = repair_rounds_ = reverted_ = 0;
+void ContinuousCollision::begin_frame(std::vector<FrameCapsule> capsules) {
+  frame_capsules_ = std::move(capsules);
+  hits_ = repair_rounds_ = reverted_ = carried_count_ = forced_ = 0;
+  read_back_bytes_ = 0;
   wall_ms_ = 0.0;
 }
 
-Status ContinuousCollision::after_sweeps(Device& device, int /*substep*/, int round, bool& repair) {
+namespace {
+
+// A capsule's pose at fraction u of the frame, as the kernels interpolate
+// it (contact_params.h): position linearly, rotation by normalised lerp.
+PosedShape pose_at(const FrameCapsule& c, double u) {
+  PosedShape p = c.start;
+  for (int a = 0; a < 3; ++a) p.position[a] = c.start.position[a] + u * (c.end.position[a] - c.start.position[a]);
+  p.rotation = math::nlerp(c.start.rotation, c.end.rotation, u);
+  return p;
+}
+
+// The ends of a capsule's axis at a pose.
+std::array<math::Vec3, 2> axis_ends(const PosedShape& s) {
+  const math::Vec3 axis = math::rotate(s.rotation, math::Vec3{0.0, s.shape->half_height, 0.0});
+  return {math::sub(s.position, axis), math::add(s.position, axis)};
+}
+
+}  // namespace
+
+void ContinuousCollision::substep_capsules(int substep) {
+  capsules_.clear();
+  substep_poses_.clear();
+  for (const FrameCapsule& c : frame_capsules_) {
+    const PosedShape from = pose_at(c, double(substep) / substeps_), to = pose_at(c, double(substep + 1) / substeps_);
+    substep_poses_.push_back({from, to});
+    const auto a = axis_ends(from), b = axis_ends(to);
+    ContinuousSearch::Capsule cap;
+    for (int k = 0; k < 2; ++k) cap.ends[k] = {Point{a[k][0], a[k][1], a[k][2]}, Point{b[k][0], b[k][1], b[k][2]}};
+    // Linearising the ends' motion: a rotation by theta moves them along an
+    // arc of radius L (the half-height), at most L theta^2 / 8 from its
+    // chord, and the normalised lerp's pace differs from the chord's by
+    // O(L theta^3): L (theta^2 / 4 + theta^3) bounds both, plus 1e-7 m for
+    // the kernels' float poses against these double ones.
+    const double cos_half = std::min(1.0, std::abs(math::qdot(from.rotation, to.rotation)));
+    const double theta = 2.0 * std::acos(cos_half);
+    cap.stray = c.start.shape->half_height * (theta * theta / 4.0 + theta * theta * theta) + 1e-7;
+    capsules_.push_back(cap);
+  }
+}
+
+Contact ContinuousCollision::capsule_contact(const Contact& hit) const {
+  const FrameCapsule& capsule = frame_capsules_[hit.shape];
+  const math::Vec3 n{hit.normal[0], hit.normal[1], hit.normal[2]};
+  // thickness - the largest n . p over the capsule at a pose: the plane
+  // that touches it, `thickness` out along n.
+  const auto offset_at = [&](const PosedShape& pose) {
+    const auto e = axis_ends(pose);
+    return thickness_ - (std::max(math::dot(n, e[0]), math::dot(n, e[1])) + pose.shape->radius);
+  };
+  Contact c = hit;
+  c.offset = static_cast<float>(offset_at(capsule.end));
+  c.motion = static_cast<float>(offset_at(capsule.start)) - c.offset;
+  c.shape = capsule.tool;
+  return c;
+}
+
+Status ContinuousCollision::after_sweeps(Device& device, int substep, int round, bool& repair) {
   const auto began = std::chrono::steady_clock::now();
   repair = false;
   const std::size_t floats = mesh_collision_.particles() * 4;
   start_.resize(floats);
   end_.resize(floats);
-  // The substep's start does not change across its rounds, but a round
-  // costs one read more than it would need: kept simple.
-  if (Status s = device.read_buffer(buffers_.previous, 0, start_.data(), floats * 4); !s) return s;
+  if (round == 0) {
+    substep_capsules(substep);
+    carried_.assign(floats / 4, 0);
+    // The substep's start does not change across its rounds.
+    if (Status s = device.read_buffer(buffers_.previous, 0, start_.data(), floats * 4); !s) return s;
+    read_back_bytes_ += floats * 4;
+  }
   if (Status s = device.read_buffer(buffers_.position, 0, end_.data(), floats * 4); !s) return s;
-  if (Status s = search_.find(start_, end_, hits_found_); !s) return s;
+  read_back_bytes_ += floats * 4;
+  if (Status s = search_.find(start_, end_, hits_found_, capsules_); !s) return s;
   hits_ += static_cast<std::uint32_t>(hits_found_.size());
   Status done;
   if (!hits_found_.empty()) {
     bool appended = false;
     if (round < repairs_) {
-      auto added = mesh_collision_.append_contacts(device, hits_found_);
+      contacts_.clear();
+      for (const Contact& h : hits_found_)
+        contacts_.push_back(h.kind == Contact::Kind::shape_face ? capsule_contact(h) : h);
+      auto added = mesh_collision_.append_contacts(device, contacts_);
       if (!added) return added.error();
-      appended = *added;
+      appended = *added > 0;
     }
     if (appended) {
       repair = true;
       ++repair_rounds_;
     } else {
-      done = stop_touching(device);
+      done = fail_safe(device);
     }
   }
   wall_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - began).count();
   return done;
 }
 
-Status ContinuousCollision::stop_touching(Device& device) {
+Status ContinuousCollision::fail_safe(Device& device) {
+  const auto moving = [&](std::uint32_t p) {
+    const std::size_t at = std::size_t{p} * 4;
+    return end_[at + 3] > 0.0f && (end_[at] != start_[at] || end_[at + 1] != start_[at + 1] || end_[at + 2] != start_[at + 2]);
+  };
   while (!hits_found_.empty()) {
-    const std::uint32_t before = reverted_;
-    for (const Contact& c : hits_found_)
-      for (std::uint32_t p : c.v) {
-        const std::size_t at = std::size_t{p} * 4;
-        if (!(end_[at + 3] > 0.0f)) continue;  // immovable
-        bool moved = false;
-        for (int a = 0; a < 3; ++a) moved |= end_[at + a] != start_[at + a];
-        if (!moved) continue;
-        for (int a = 0; a < 3; ++a) end_[at + a] = start_[at + a];
-        ++reverted_;
+    bool acted = false;
+    for (const Contact& c : hits_found_) {
+      bool here = false;
+      if (c.kind == Contact::Kind::shape_face) {
+        // Against a capsule: the tissue's movable particles move with it
+        // (the capsule's rigid motion over the substep), so the axis cannot
+        // cross them.
+        const auto& [from, to] = substep_poses_[c.shape];
+        for (std::uint32_t p : c.v) {
+          const std::size_t at = std::size_t{p} * 4;
+          if (!(end_[at + 3] > 0.0f) || carried_[p]) continue;
+          const math::Vec3 local = math::rotate(math::conj(from.rotation),
+                                                math::sub(math::Vec3{start_[at], start_[at + 1], start_[at + 2]}, from.position));
+          const math::Vec3 x = math::add(to.position, math::rotate(to.rotation, local));
+          for (int a = 0; a < 3; ++a) end_[at + a] = static_cast<float>(x[a]);
+          carried_[p] = 1;
+          ++carried_count_;
+          here = true;
+        }
+      } else {
+        // Between tissues: the moving particles stop where the substep
+        // started (those a capsule carries keep moving with it).
+        for (std::uint32_t p : c.v) {
+          if (carried_[p] || !moving(p)) continue;
+          const std::size_t at = std::size_t{p} * 4;
+          for (int a = 0; a < 3; ++a) end_[at + a] = start_[at + a];
+          ++reverted_;
+          here = true;
+        }
       }
-    // Every touching pair has a moving particle (find skips the others),
-    // and only movable particles move: a round always stops one.
-    if (reverted_ == before)
-      return Error(ErrorCode::internal, "internal: the continuous collision's fail-safe stopped no particle");
-    if (Status s = search_.find(start_, end_, hits_found_); !s) return s;
+      acted |= here;
+    }
+    // The pairs left are those nothing can be done for: a capsule forcing
+    // tissue it carries, or pinned tissue, through other tissue. Counted,
+    // let through (FrameStats::ccd_forced).
+    if (!acted) {
+      forced_ += static_cast<std::uint32_t>(hits_found_.size());
+      break;
+    }
+    if (Status s = search_.find(start_, end_, hits_found_, capsules_, carried_); !s) return s;
     hits_ += static_cast<std::uint32_t>(hits_found_.size());
   }
   return device.write_buffer(buffers_.position, 0, end_.data(), end_.size() * 4);

@@ -42,6 +42,7 @@
 #include "collision/narrow_phase.h"
 #include "runtime/mesh_collision.h"
 #include "runtime/solve_stepper.h"
+#include "runtime/tool_contacts.h"
 #include "sinew/result.h"
 
 namespace sinew {
@@ -49,6 +50,15 @@ namespace sinew {
 /// The search itself, on positions in host memory (device particle order).
 class ContinuousSearch {
  public:
+  using Motion = std::array<std::array<double, 3>, 2>;  ///< a point at the substep's start and end [m]
+  /// A tool's or capsule collider's axis over the substep: its two ends'
+  /// motion, linearised, and how far their true path (a rotation) can
+  /// stray from it [m], used as the queries' minimum separation.
+  struct Capsule {
+    std::array<Motion, 2> ends{};
+    double stray = 0.0;
+  };
+
   /// [in] segments: 2 particles per segment (every line body's); triangles:
   /// 3 per triangle (the surfaces a thread meets).
   ContinuousSearch(std::vector<std::uint32_t> segments, std::vector<std::uint32_t> triangles);
@@ -61,15 +71,24 @@ class ContinuousSearch {
   /// [out] hits: one contact per touch (kind vertex_triangle or edge_edge,
   /// the touch's parameters as weights, the normal described above,
   /// distance 0), sorted and unique (sort_unique_contacts).
+  /// [in] capsules: axes the segments and triangles must not cross either
+  /// (the segments' and triangles' edges against the axis, the triangles
+  /// against its ends); their touches come as kind shape_face on the
+  /// tissue's particles ((a, a, b, c) or (a, a, b, b), mesh_contact_params.h)
+  /// with `shape` the capsule's index and the normal from the axis towards
+  /// the side the tissue came from. carried: per particle (or empty), those
+  /// moving with a capsule this substep (the fail-safe): a capsule's pairs
+  /// whose tissue particles are all carried are skipped.
   /// Errors (bad_parameter): a non-finite position, naming the particle.
-  Status find(std::span<const float> start, std::span<const float> end, std::vector<collision::Contact>& hits);
+  Status find(std::span<const float> start, std::span<const float> end, std::vector<collision::Contact>& hits,
+              std::span<const Capsule> capsules = {}, std::span<const std::uint8_t> carried = {});
 
   /// Queries run by the last find().
   [[nodiscard]] std::uint64_t queries() const { return queries_; }
 
  private:
   std::vector<std::uint32_t> segments_, triangles_;
-  collision::Bvh segment_tree_, triangle_tree_;
+  collision::Bvh segment_tree_, triangle_tree_, capsule_tree_;
   std::vector<collision::Aabb> boxes_;
   std::vector<collision::Pair> pairs_;
   std::uint64_t queries_ = 0;
@@ -77,38 +96,67 @@ class ContinuousSearch {
            int arity, collision::Bvh& tree);
 };
 
+/// A capsule the threads and surfaces must not pass through, at its poses
+/// at the frame's start and end: a rigid tool (`tool` its index) or a
+/// capsule collider (`tool` = collision::Contact::kNoShape).
+struct FrameCapsule {
+  PosedShape start, end;
+  std::uint32_t tool = collision::Contact::kNoShape;
+};
+
 /// The search wired into the solver: reads the substep's motion from the
 /// device, hands the touches to the mesh collision as contacts, runs the
 /// fail-safe. A SubstepHook for SolveStepper.
 class ContinuousCollision final : public SubstepHook {
  public:
-  /// [in] mesh_collision, buffers: outlive this. repairs: rounds per
-  /// substep before the fail-safe (MeshCollisionDesc::continuous_repairs).
+  /// [in] mesh_collision, buffers: outlive this. desc: the scene's
+  /// (thickness, continuous_repairs: rounds per substep before the
+  /// fail-safe); substeps: per frame.
   ContinuousCollision(std::vector<std::uint32_t> segments, std::vector<std::uint32_t> triangles,
-                      MeshCollision& mesh_collision, const XpbdBuffers& buffers, int repairs);
+                      MeshCollision& mesh_collision, const XpbdBuffers& buffers, const MeshCollisionDesc& desc,
+                      int substeps);
 
   Status after_sweeps(Device& device, int substep, int round, bool& repair) override;
 
-  /// Zeroes the frame's counters (before each frame).
-  void begin_frame();
+  /// Before each frame: zeroes the frame's counters; [in] capsules: the
+  /// tools and capsule colliders over the frame (interpolated per substep
+  /// like the kernels do: position linearly, rotation by normalised lerp).
+  void begin_frame(std::vector<FrameCapsule> capsules);
   // The frame's counters (FrameStats::ccd_*).
   [[nodiscard]] std::uint32_t hits() const { return hits_; }
   [[nodiscard]] std::uint32_t repairs() const { return repair_rounds_; }
   [[nodiscard]] std::uint32_t reverted() const { return reverted_; }
+  [[nodiscard]] std::uint32_t carried() const { return carried_count_; }
+  [[nodiscard]] std::uint32_t forced() const { return forced_; }
+  [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
   [[nodiscard]] double wall_ms() const { return wall_ms_; }
 
  private:
   ContinuousSearch search_;
   MeshCollision& mesh_collision_;
   const XpbdBuffers& buffers_;
-  int repairs_ = 0;
+  double thickness_ = 0.0;
+  int repairs_ = 0, substeps_ = 1;
+  std::vector<FrameCapsule> frame_capsules_;
+  std::vector<ContinuousSearch::Capsule> capsules_;  // this substep's
+  // This substep's rigid motion of each capsule: start and end poses.
+  std::vector<std::array<PosedShape, 2>> substep_poses_;
+  std::vector<std::uint8_t> carried_;  // per particle, this substep (the fail-safe)
   std::vector<float> start_, end_;
-  std::vector<collision::Contact> hits_found_;
-  std::uint32_t hits_ = 0, repair_rounds_ = 0, reverted_ = 0;
+  std::vector<collision::Contact> hits_found_, contacts_;
+  std::uint32_t hits_ = 0, repair_rounds_ = 0, reverted_ = 0, carried_count_ = 0, forced_ = 0;
+  std::uint64_t read_back_bytes_ = 0;
   double wall_ms_ = 0.0;
-  // Stops the movable particles of `hits_found_` at their start positions,
-  // then searches again, until no moving pair touches; writes the positions.
-  Status stop_touching(Device& device);
+  void substep_capsules(int substep);
+  // The contact of a capsule touch (hit.shape: the capsule's index): the
+  // plane that touches the capsule along the normal, moving with it over
+  // the frame, as the mesh collision's tool faces (mesh_contact_params.h).
+  collision::Contact capsule_contact(const collision::Contact& hit) const;
+  // The fail-safe: stops the moving particles of each pair that still
+  // touches where the substep started, or, against a capsule, moves them
+  // with it; searches again until no pair it can act on touches; writes
+  // the positions.
+  Status fail_safe(Device& device);
 };
 
 }  // namespace sinew

@@ -363,9 +363,10 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
   // The multipliers of the contacts with tools (their reaction): the whole
   // frame's contacts are read, those few picked out in add_tool_reactions.
   if (!tool_slots_.empty()) {
-    const std::size_t bytes = std::size_t{contact_count_} * 16;
-    tool_lambda_.resize(std::size_t{contact_count_} * 4);
-    tool_lambda_sum_.resize(std::size_t{contact_count_} * 4);
+    const std::size_t slots = contact_count_ + appended_.size();  // continuous collision's too
+    const std::size_t bytes = slots * 16;
+    tool_lambda_.resize(slots * 4);
+    tool_lambda_sum_.resize(slots * 4);
     if (Status s = device.read_buffer(buffers_.lambda, 0, tool_lambda_.data(), bytes); !s) return s;
     if (Status s = device.read_buffer(buffers_.lambda_sum, 0, tool_lambda_sum_.data(), bytes); !s) return s;
     read_back_bytes_ += 2 * bytes;
@@ -842,11 +843,10 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   appended_.clear();
   appended_slots_.clear();
   appended_colors_ = 0;
-  if (want_room_) {
-    reserve_colors_ = std::min<std::uint32_t>(32, 2 * reserve_colors_);
-    reserve_slots_ *= 2;
-    want_room_ = false;
-  }
+  // The last frame's continuous contacts outgrew the room kept for them.
+  if (want_colors_) reserve_colors_ = std::min<std::uint32_t>(32, 2 * reserve_colors_);
+  if (want_slots_) reserve_slots_ *= 2;
+  want_colors_ = want_slots_ = false;
   if (count + reserve_slots_ > b.capacity) {
     b.capacity = std::max(count + reserve_slots_, 2 * b.capacity);
     for (BufferHandle h : {b.particles, b.coefficients, b.normals, b.lambda, b.lambda_sum})
@@ -954,42 +954,49 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
 
 namespace sinew {
 
-Result<bool> MeshCollision::append_contacts(Device& device, std::span<const collision::Contact> contacts) {
+Result<std::uint32_t> MeshCollision::append_contacts(Device& device, std::span<const collision::Contact> contacts) {
   MeshContactBuffers& b = buffers_;
-  if (b.jacobi) return false;  // scene_checks: continuous needs the coloured schedule
-  std::vector<collision::Contact> all = appended_;
-  all.insert(all.end(), contacts.begin(), contacts.end());
-  const auto n = static_cast<std::uint32_t>(all.size());
+  if (b.jacobi) return 0u;  // scene_checks: continuous needs the coloured schedule
   const std::uint32_t colors = std::min<std::uint32_t>(32, b.colors - color_count_);
-  if (contact_count_ + n > b.capacity) {
-    want_room_ = true;
-    return false;
-  }
-  // Greedy colours: the first whose contacts share no movable particle with this one.
+  // Greedy colours, the frame's earlier additions first (they get the
+  // colours they had): the first colour whose contacts share no movable
+  // particle with this one. New contacts without a colour or a slot left
+  // are not added.
+  std::vector<collision::Contact> all = appended_;
   color_mask_.resize(movable_.size(), 0);
-  std::vector<std::uint32_t> color_of(n), sizes(colors, 0);
-  bool fits = true;
-  for (std::uint32_t i = 0; i < n && fits; ++i) {
+  std::vector<std::uint32_t> color_of, sizes(colors, 0);
+  const auto place = [&](const collision::Contact& c) {
     std::uint32_t used = 0;
-    for (std::uint32_t p : all[i].v)
+    for (std::uint32_t p : c.v)
       if (movable_[p]) used |= color_mask_[p];
     std::uint32_t k = 0;
     while (k < colors && (used >> k & 1u)) ++k;
-    if (k == colors) {
-      fits = false;
+    if (k == colors) return false;
+    color_of.push_back(k);
+    ++sizes[k];
+    for (std::uint32_t p : c.v)
+      if (movable_[p]) color_mask_[p] |= 1u << k;
+    return true;
+  };
+  for (const collision::Contact& c : appended_)
+    if (!place(c)) return Error(ErrorCode::internal, "internal: a continuous contact lost its colour");
+  std::uint32_t added = 0;
+  for (const collision::Contact& c : contacts) {
+    if (contact_count_ + all.size() >= b.capacity) {
+      want_slots_ = true;
       break;
     }
-    color_of[i] = k;
-    ++sizes[k];
-    for (std::uint32_t p : all[i].v)
-      if (movable_[p]) color_mask_[p] |= 1u << k;
+    if (!place(c)) {
+      want_colors_ = true;
+      continue;
+    }
+    all.push_back(c);
+    ++added;
   }
   for (const collision::Contact& c : all)
     for (std::uint32_t p : c.v) color_mask_[p] = 0;
-  if (!fits) {
-    want_room_ = true;
-    return false;
-  }
+  if (added == 0) return 0u;
+  const auto n = static_cast<std::uint32_t>(all.size());
   std::uint32_t used_colors = 0;
   for (std::uint32_t k = 0; k < colors; ++k)
     if (sizes[k] > 0) used_colors = k + 1;
@@ -1028,9 +1035,13 @@ Result<bool> MeshCollision::append_contacts(Device& device, std::span<const coll
       upload_coefficients_[at + j] = coefficient[j];
     }
     for (int a = 0; a < 3; ++a) upload_normals_[at + a] = c.normal[a];
-    upload_normals_[at + 3] = 0.0f;
-    upload_motion_[slot_of[i]] = 0.0f;
+    upload_normals_[at + 3] = c.offset;
+    upload_motion_[slot_of[i]] = c.motion;
   }
+  // Contacts with a tool: their reaction goes to it (add_tool_reactions).
+  std::erase_if(tool_slots_, [&](const auto& slot) { return slot.first >= contact_count_; });
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (all[i].shape != collision::Contact::kNoShape) tool_slots_.push_back({slot_of[i], all[i].shape});
   const std::size_t first = std::size_t{contact_count_} * 4, bytes = std::size_t{n} * 16;
   if (Status s = device.write_buffer(b.particles, first * 4, &upload_particles_[first], bytes); !s) return s.error();
   if (Status s = device.write_buffer(b.coefficients, first * 4, &upload_coefficients_[first], bytes); !s)
@@ -1046,7 +1057,7 @@ Result<bool> MeshCollision::append_contacts(Device& device, std::span<const coll
   appended_ = std::move(all);
   appended_slots_ = std::move(slot_of);
   appended_colors_ = std::max(appended_colors_, used_colors);
-  return true;
+  return added;
 }
 
 }  // namespace sinew

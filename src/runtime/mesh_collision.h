@@ -61,13 +61,16 @@ class MeshCollision {
   /// (continuous collision detection's touches, continuous_collision.h):
   /// they and the frame's earlier additions are coloured greedily into the
   /// colours the program has beyond the frame's (MeshCollisionDesc::
-  /// continuous reserves some), laid out after the frame's contacts, and
-  /// uploaded with the earlier additions' multipliers carried over and the
-  /// new ones' at 0. [in] contacts: vertex_triangle or edge_edge, with
-  /// their weights and normal. Returns false, changing nothing, when they
-  /// do not fit the reserved colours or slots (the next frame reserves
-  /// more).
-  Result<bool> append_contacts(Device& device, std::span<const collision::Contact> contacts);
+  /// continuous reserves some, at most 32), laid out after the frame's
+  /// contacts, and uploaded with the earlier additions' multipliers carried
+  /// over and the new ones' at 0. [in] contacts: vertex_triangle, edge_edge
+  /// or shape_face (with its offset, motion and tool,
+  /// mesh_contact_params.h), with their weights and normal; a tool's
+  /// reaction comes back through add_tool_reactions. Returns how many were
+  /// added: those that found no colour or slot left are not (the next
+  /// frame keeps more room; the caller's next round finds their touches
+  /// again, or its fail-safe acts on them).
+  Result<std::uint32_t> append_contacts(Device& device, std::span<const collision::Contact> contacts);
   /// Particles of the scene (device order).
   [[nodiscard]] std::size_t particles() const { return movable_.size(); }
   /// The collidable primitives (device particles): every line body's
@@ -190,7 +193,7 @@ class MeshCollision {
   std::vector<collision::Contact> appended_;
   std::vector<std::uint32_t> appended_slots_;
   std::uint32_t appended_colors_ = 0;
-  bool want_room_ = false;
+  bool want_colors_ = false, want_slots_ = false;
   std::vector<std::uint32_t> color_mask_;  // per particle: the appended colours it is in (bit k)
   double margin_ = 0.0;
   double violation_ = 0.0;

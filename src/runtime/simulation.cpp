@@ -83,7 +83,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   if (continuous)
     impl->continuous = std::make_unique<ContinuousCollision>(
         impl->mesh_collision->segments(), impl->mesh_collision->triangles(), *impl->mesh_collision, impl->buffers,
-        scene.mesh_collision.continuous_repairs);
+        scene.mesh_collision, scene.solver.substeps);
   if (SolveStepper::needed(scene.solver, continuous)) {
     impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
     append_stats(impl->program, impl->stats_plan, impl->buffers);
@@ -164,12 +164,14 @@ Status Simulation::step() {
   const auto collided = std::chrono::steady_clock::now();
   impl_->stats.collision_ms = std::chrono::duration<double, std::milli>(collided - start).count();
   if (impl_->stepper) {
-    if (impl_->continuous) impl_->continuous->begin_frame();
+    if (impl_->continuous) impl_->continuous->begin_frame(impl_->frame_capsules());
     if (Status s = impl_->stepper->run_frame(*impl_->device, impl_->stats, impl_->continuous.get()); !s) return s;
     if (const ContinuousCollision* c = impl_->continuous.get()) {
       impl_->stats.ccd_hits = c->hits();
       impl_->stats.ccd_repairs = c->repairs();
       impl_->stats.ccd_reverted = c->reverted();
+      impl_->stats.ccd_carried = c->carried();
+      impl_->stats.ccd_forced = c->forced();
       impl_->stats.ccd_ms = c->wall_ms();
     }
   } else {
@@ -185,7 +187,8 @@ Status Simulation::step() {
   if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
   impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4 +
                                  (impl_->stepper ? impl_->stepper->read_back_bytes() : 0) +
-                                 (impl_->mesh_collision ? impl_->mesh_collision->read_back_bytes() : 0);
+                                 (impl_->mesh_collision ? impl_->mesh_collision->read_back_bytes() : 0) +
+                                 (impl_->continuous ? impl_->continuous->read_back_bytes() : 0);
   if (Status s = impl_->after_frame(); !s) return s;
   if (impl_->measure_errors) impl_->measure(impl_->stats);
   const auto end = std::chrono::steady_clock::now();

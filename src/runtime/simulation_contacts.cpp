@@ -171,6 +171,20 @@ std::vector<PosedShape> Simulation::Impl::tool_shapes(bool start) const {
   return shapes;
 }
 
+std::vector<FrameCapsule> Simulation::Impl::frame_capsules() const {
+  std::vector<FrameCapsule> capsules;
+  for (std::uint32_t k = 0; k < contacts.colliders; ++k)
+    if (contacts.shapes[k].shape == ColliderShape::capsule)
+      capsules.push_back({posed(contacts.shapes[k], colliders, k, true), posed(contacts.shapes[k], colliders, k, false),
+                          collision::Contact::kNoShape});
+  for (std::size_t t = 0; t < contacts.tools.size(); ++t) {
+    const std::size_t k = contacts.colliders + t;
+    capsules.push_back({posed(contacts.tool_shapes[t], colliders, k, true),
+                        posed(contacts.tool_shapes[t], colliders, k, false), static_cast<std::uint32_t>(t)});
+  }
+  return capsules;
+}
+
 Status Simulation::Impl::before_frame() {
   ContactState& c = contacts;
   for (ToolBody& b : c.tools) integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);

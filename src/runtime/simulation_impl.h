@@ -70,6 +70,9 @@ struct Simulation::Impl {
   /// Each tool's capsule at its pose at the start or the end of the coming
   /// frame (after before_frame, which integrates the tools).
   [[nodiscard]] std::vector<PosedShape> tool_shapes(bool start) const;
+  /// The tools and capsule colliders over the coming frame, for the
+  /// continuous collision detection (after before_frame).
+  [[nodiscard]] std::vector<FrameCapsule> frame_capsules() const;
   Status after_frame();   ///< settles what moved, takes each tool's reaction from device_stats
 };
 
