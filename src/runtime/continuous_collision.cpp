@@ -82,7 +82,41 @@ Status check_query(const Result<ccd::Hit>& hit) {
 }  // namespace
 
 ContinuousSearch::ContinuousSearch(std::vector<std::uint32_t> segments, std::vector<std::uint32_t> triangles)
-    : segments_(std::move(segments)), triangles_(std::move(triangles)) {}
+    : segments_(std::move(segments)), triangles_(std::move(triangles)) {
+  triangle_vertices_ = triangles_;
+  std::sort(triangle_vertices_.begin(), triangle_vertices_.end());
+  triangle_vertices_.erase(std::unique(triangle_vertices_.begin(), triangle_vertices_.end()), triangle_vertices_.end());
+}
+
+void ContinuousSearch::set_reference(std::span<const float> positions) {
+  reference_.assign(positions.begin(), positions.end());
+  if (!triangles_.empty()) fit(reference_, reference_, triangles_, 3, triangle_tree_);
+}
+
+double ContinuousSearch::drift(std::span<const float> start, std::span<const float> end) const {
+  float farthest = 0.0f;
+  for (std::uint32_t p : triangle_vertices_)
+    for (int a = 0; a < 3; ++a) {
+      const std::size_t at = std::size_t{p} * 4 + a;
+      farthest = std::max({farthest, std::abs(start[at] - reference_[at]), std::abs(end[at] - reference_[at])});
+    }
+  // The float differences are exact up to half an ulp of the coordinates: a
+  // relative 2^-23 of the largest one covers it.
+  return double(farthest) * (1.0 + 1e-6) + 1e-9;
+}
+
+namespace {
+
+// `boxes` grown by d [m] on every side, rounded outwards to float.
+void grow(std::vector<collision::Aabb>& boxes, double d) {
+  for (collision::Aabb& b : boxes)
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = std::nextafter(static_cast<float>(double(b.lo[a]) - d), -INFINITY);
+      b.hi[a] = std::nextafter(static_cast<float>(double(b.hi[a]) + d), INFINITY);
+    }
+}
+
+}  // namespace
 
 void ContinuousSearch::fit(std::span<const float> start, std::span<const float> end,
                            std::span<const std::uint32_t> indices, int arity, collision::Bvh& tree) {
@@ -106,7 +140,9 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
                               std::span<const std::uint8_t> carried) {
   hits.clear();
   queries_ = 0;
-  for (const auto* list : {&segments_, &triangles_})
+  // Every vertex of a segment or triangle, once (a NaN would fail every
+  // box test silently).
+  for (const auto* list : {&segments_, &triangle_vertices_})
     for (std::uint32_t p : *list)
       for (int a = 0; a < 3; ++a)
         if (!std::isfinite(start[std::size_t{p} * 4 + a]) || !std::isfinite(end[std::size_t{p} * 4 + a]))
@@ -162,8 +198,22 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
     hits.push_back(c);
   };
 
-  if (!segments_.empty()) fit(start, end, segments_, 2, segment_tree_);
-  if (!triangles_.empty() && (!segments_.empty() || !capsules.empty())) fit(start, end, triangles_, 3, triangle_tree_);
+  if (!segments_.empty()) {
+    fit(start, end, segments_, 2, segment_tree_);
+    segment_boxes_ = boxes_;
+  }
+  // Against the triangles: boxes grown by the drift from the triangles' reference.
+  const bool surfaces = !triangles_.empty() && (!segments_.empty() || !capsules.empty());
+  double reach = 0.0;
+  if (surfaces) {
+    if (reference_.size() != start.size()) set_reference(start);
+    reach = drift(start, end);
+  }
+  if (surfaces && !segments_.empty()) {
+    boxes_ = segment_boxes_;
+    grow(boxes_, reach);
+    segment_reach_tree_.build(boxes_);
+  }
   Touch touch;
   // Thread against thread.
   if (!segments_.empty()) {
@@ -182,7 +232,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
   }
   // Thread against surfaces: each end against the face, the segment against its edges.
   if (!segments_.empty() && !triangles_.empty()) {
-    collision::overlapping_pairs(segment_tree_, triangle_tree_, pairs_);
+    collision::overlapping_pairs(segment_reach_tree_, triangle_tree_, pairs_);
     for (const collision::Pair& pr : pairs_) {
       const std::uint32_t* s = &segments_[std::size_t{pr.first} * 2];
       const std::uint32_t* t = &triangles_[std::size_t{pr.second} * 3];
@@ -213,17 +263,22 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
   // Capsules' axes against the threads and the surfaces. The tissue is the
   // first primitive (its weights first), the axis the second.
   if (!capsules.empty()) {
-    boxes_.resize(capsules.size());
+    capsule_boxes_.resize(capsules.size());
     for (std::size_t i = 0; i < capsules.size(); ++i)
       for (int a = 0; a < 3; ++a) {
         double lo = capsules[i].ends[0][0][a], hi = lo;
         for (const Motion& e : capsules[i].ends)
           for (const Point& x : e) lo = std::min(lo, x[a]), hi = std::max(hi, x[a]);
         // Widened by the stray and rounded outwards to float.
-        boxes_[i].lo[a] = std::nextafter(static_cast<float>(lo - capsules[i].stray), -INFINITY);
-        boxes_[i].hi[a] = std::nextafter(static_cast<float>(hi + capsules[i].stray), INFINITY);
+        capsule_boxes_[i].lo[a] = std::nextafter(static_cast<float>(lo - capsules[i].stray), -INFINITY);
+        capsule_boxes_[i].hi[a] = std::nextafter(static_cast<float>(hi + capsules[i].stray), INFINITY);
       }
-    capsule_tree_.build(boxes_);
+    capsule_tree_.build(capsule_boxes_);
+    if (surfaces) {
+      boxes_ = capsule_boxes_;
+      grow(boxes_, reach);
+      capsule_reach_tree_.build(boxes_);
+    }
     const auto all_carried = [&](std::span<const std::uint32_t> particles) {
       if (carried.empty()) return false;
       for (std::uint32_t p : particles)
@@ -245,9 +300,10 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
       hit.shape = c;
       hits.push_back(hit);
     };
-    const auto against = [&](const collision::Bvh& tree, const std::vector<std::uint32_t>& indices, int arity) -> Status {
+    const auto against = [&](const collision::Bvh& tree, const collision::Bvh& capsule_tree,
+                             const std::vector<std::uint32_t>& indices, int arity) -> Status {
       if (indices.empty()) return {};
-      collision::overlapping_pairs(tree, capsule_tree_, pairs_);
+      collision::overlapping_pairs(tree, capsule_tree, pairs_);
       for (const collision::Pair& pr : pairs_) {
         const Capsule& cap = capsules[pr.second];
         const std::span<const std::uint32_t> p(&indices[std::size_t{pr.first} * arity], std::size_t(arity));
@@ -282,8 +338,9 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
       }
       return {};
     };
-    if (Status s = against(segment_tree_, segments_, 2); !s) return s;
-    if (Status s = against(triangle_tree_, triangles_, 3); !s) return s;
+    if (Status s = against(segment_tree_, capsule_tree_, segments_, 2); !s) return s;
+    if (surfaces)
+      if (Status s = against(triangle_tree_, capsule_reach_tree_, triangles_, 3); !s) return s;
   }
   collision::sort_unique_contacts(hits);
   return {};
@@ -374,6 +431,7 @@ Status ContinuousCollision::after_sweeps(Device& device, int substep, int round,
     // The substep's start does not change across its rounds.
     if (Status s = device.read_buffer(buffers_.previous, 0, start_.data(), floats * 4); !s) return s;
     read_back_bytes_ += floats * 4;
+    if (substep == 0) search_.set_reference(start_);  // the frame's start
   }
   if (Status s = device.read_buffer(buffers_.position, 0, end_.data(), floats * 4); !s) return s;
   read_back_bytes_ += floats * 4;
