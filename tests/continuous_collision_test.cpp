@@ -37,13 +37,13 @@ struct RunSummary {
   std::uint32_t hits = 0, repairs = 0, reverted = 0;
 };
 
-RunSummary pull_rings(Simulation& sim, double speed, int frames) {
+RunSummary pull_rings(Simulation& sim, double speed, int frames, double frame = kFrame) {
   RunSummary out;
   const LinkingCount start = linking(sim);
   EXPECT_EQ(start.over, start.under);
   EXPECT_EQ(std::abs(start.over), 1) << "the rings start linked";
   for (int f = 0; f < frames; ++f) {
-    EXPECT_TRUE(LinkedRings::drive(sim, f, speed).ok());
+    EXPECT_TRUE(LinkedRings::drive(sim, f, speed, frame).ok());
     const Status s = sim.step();
     EXPECT_TRUE(s.ok()) << s.error().message();
     if (!s.ok()) break;
@@ -75,6 +75,23 @@ TEST_P(ContinuousCollisionTest, LinkedRingsPulledApartAtAToolsSpeedStayLinked) {
   std::vector<float> x;
   SINEW_ASSERT_OK(sim->read_positions(x));
   for (float v : x) ASSERT_TRUE(std::isfinite(v));
+}
+
+// A crossing and its undoing within one frame would leave the frame's
+// linking number as it was: here a frame is one substep (1/480 s, the
+// substep of the test above), so the linking number is checked after every
+// substep of the same pull.
+TEST_P(ContinuousCollisionTest, LinkedRingsStayLinkedAfterEverySubstep) {
+  SceneDesc scene = LinkedRings::scene(true);
+  scene.solver.substeps = 1;
+  scene.solver.time_step = kFrame / 8.0;
+  auto sim = create_or_skip(scene, GetParam());
+  SINEW_ASSERT_OK(sim);
+  const RunSummary run = pull_rings(*sim, 1.0, 8 * 20, kFrame / 8.0);
+  std::printf("[%s] per substep: linking changed at substep %d; %u touches, %u repair rounds, %u particles stopped\n",
+              GetParam().c_str(), run.first_change, run.hits, run.repairs, run.reverted);
+  EXPECT_EQ(run.first_change, -1);
+  EXPECT_GT(run.hits, 0u);
 }
 
 // The same pull with the frame's contacts only (continuous off): the rings

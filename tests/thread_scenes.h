@@ -60,12 +60,12 @@ struct LinkedRings {
     scene.attachments = {{{BodyKind::line, 0, 0}, 0, 0.0}, {{BodyKind::line, 0, static_cast<std::uint32_t>(n)}, 1, 0.0}};
     return scene;
   }
-  // Each target's distance from its start after frame f: `speed` [m/s]
-  // until 3 cm (past where the rings are tight: they hook after 1 cm and
+  // Each target's distance from its start after frame f (of `frame` [s]):
+  // `speed` [m/s] until 3 cm (past where the rings are tight: they hook after 1 cm and
   // can stretch about 2.3 cm more), then held.
-  static double pulled(int f, double speed) { return std::min(speed * (f + 1) * kFrame, 0.03); }
-  static Status drive(Simulation& sim, int f, double speed) {
-    const double d = pulled(f, speed);
+  static double pulled(int f, double speed, double frame = kFrame) { return std::min(speed * (f + 1) * frame, 0.03); }
+  static Status drive(Simulation& sim, int f, double speed, double frame = kFrame) {
+    const double d = pulled(f, speed, frame);
     if (Status s = sim.set_target(0, {-r - d, 0.0, 0.0}); !s) return s;
     return sim.set_target(1, {2.0 * r + d, 0.0, 0.0});
   }
