@@ -250,14 +250,48 @@ TEST(ContinuousCollision, TheFailSafeCarriesTheMembraneWithTheProbe) {
   EXPECT_EQ(run.forced, 0u);
 }
 
-// A rigid tool of the probe's shape (10 g, no gravity) pushed up by 1 N
-// from under the membrane: it passes 1 m/s as its tip meets the membrane
-// and keeps pushing for a sixth of a second. Its tip stays under the
-// membrane every frame,
-// and the membrane pushes it back: the continuous contacts' reaction
-// reaches the tool.
-TEST_P(ContinuousCollisionTest, AToolPushedIntoAMembraneNeverPassesThroughAndFeelsIt) {
+// Two probes squeeze the membrane, one rising from under it, the other
+// (1 mm beside it) coming down from above, with the fail-safe alone: the
+// first carries the membrane up with it, so the second must cross it and
+// nothing can stop that. Such a crossing is never silent: the frames in
+// which the second probe's tip passes through count forced pairs.
+TEST(ContinuousCollision, AMembraneSqueezedBetweenTwoProbesCountsTheForcedCrossing) {
   SceneDesc scene = ProbeUnderMembrane::scene(true);
+  scene.mesh_collision.continuous_repairs = 0;
+  ColliderDesc down = scene.colliders[0];
+  const double x = ProbeUnderMembrane::x + 0.001, half = ProbeUnderMembrane::half;
+  const auto bottom = [](int f) { return std::max(0.005 - 1.0 * (f + 1) * kFrame, -0.015); };  // of the second
+  down.position = {x, bottom(-1) + half, ProbeUnderMembrane::z};
+  scene.colliders.push_back(down);
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  SINEW_ASSERT_OK(sim);
+  const TriMesh& mesh = scene.tri_bodies[0].mesh;
+  const std::uint32_t first = sim->info().tri_body_first_particle[0];
+  std::vector<float> positions;
+  int through = -1;
+  std::uint32_t carried = 0, forced = 0;
+  for (int f = 0; f < 30; ++f) {
+    SINEW_ASSERT_OK(ProbeUnderMembrane::drive(*sim, f, 1.0));
+    SINEW_ASSERT_OK(sim->set_collider_pose(1, {x, bottom(f) + half, ProbeUnderMembrane::z}, {1.0, 0.0, 0.0, 0.0}));
+    SINEW_ASSERT_OK(sim->step());
+    carried += sim->last_frame().ccd_carried;
+    forced += sim->last_frame().ccd_forced;
+    SINEW_ASSERT_OK(sim->read_positions(positions));
+    std::vector<Point3> vertices;
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) vertices.push_back(at(positions, first + v));
+    if (through < 0 && crossings_above({x, bottom(f), ProbeUnderMembrane::z}, vertices, mesh.triangles) % 2 == 1) {
+      through = f;
+      EXPECT_GT(forced, 0u) << "the second probe crossed the membrane at frame " << f << " and nothing said so";
+    }
+  }
+  std::printf("second probe through at frame %d; %u particles carried, %u pairs forced\n", through, carried, forced);
+  EXPECT_GE(through, 0) << "squeezed between the probes, the membrane cannot stay between them";
+  EXPECT_GT(carried, 0u);
+}
+
+// The probe scene's collider replaced by a rigid tool of its shape (10 g,
+// no gravity), its tip 5 mm under the membrane.
+void with_probe_tool(SceneDesc& scene) {
   scene.colliders.clear();
   ToolDesc tool;
   tool.radius = 5e-4;
@@ -266,6 +300,17 @@ TEST_P(ContinuousCollisionTest, AToolPushedIntoAMembraneNeverPassesThroughAndFee
   tool.gravity = false;
   tool.position = {ProbeUnderMembrane::x, -0.005 - ProbeUnderMembrane::half, ProbeUnderMembrane::z};
   scene.tools.push_back(tool);
+}
+
+// A rigid tool of the probe's shape (10 g, no gravity) pushed up by 1 N
+// from under the membrane: it passes 1 m/s as its tip meets the membrane
+// and keeps pushing for a sixth of a second. Its tip stays under the
+// membrane every frame,
+// and the membrane pushes it back: the continuous contacts' reaction
+// reaches the tool.
+TEST_P(ContinuousCollisionTest, AToolPushedIntoAMembraneNeverPassesThroughAndFeelsIt) {
+  SceneDesc scene = ProbeUnderMembrane::scene(true);
+  with_probe_tool(scene);
   auto sim = create_or_skip(scene, GetParam());
   SINEW_ASSERT_OK(sim);
   const TriMesh& mesh = scene.tri_bodies[0].mesh;
@@ -298,6 +343,56 @@ TEST_P(ContinuousCollisionTest, AToolPushedIntoAMembraneNeverPassesThroughAndFee
   EXPECT_GT(hits, 0u);
   EXPECT_EQ(forced, 0u);
   EXPECT_LT(strongest_push, -0.1) << "the membrane must push the tool back";
+}
+
+// The reaction is the whole frame's: a free membrane (no pins, no damping,
+// no gravity) gains exactly the momentum the tool loses to it. The tool's
+// contact force over each frame, times the frame, must match the change of
+// the membrane's momentum, which only the contacts change (its edges,
+// areas and bending conserve it). Contacts the continuous collision
+// appends in later rounds move the earlier ones to new slots; their
+// earlier substeps' multipliers must move with them, or the tool feels
+// only part of the push.
+TEST_P(ContinuousCollisionTest, AToolFeelsTheMomentumItGivesAFreeMembrane) {
+  SceneDesc scene = ProbeUnderMembrane::scene(true);
+  with_probe_tool(scene);
+  scene.tri_bodies[0].pinned.clear();
+  scene.tri_bodies[0].velocity_damping = 0.0;
+  // Rounds enough that the fail-safe never runs (it carries tissue without
+  // a reaction): with the default 4 it carries a few particles here.
+  scene.mesh_collision.continuous_repairs = 12;
+  auto sim = create_or_skip(scene, GetParam());
+  SINEW_ASSERT_OK(sim);
+  const std::uint32_t first = sim->info().tri_body_first_particle[0];
+  const std::size_t count = scene.tri_bodies[0].mesh.vertices.size();
+  std::vector<float> x, v;
+  const auto momentum = [&] {  // the membrane's, along y [kg m/s]
+    EXPECT_TRUE(sim->read_positions(x).ok());
+    EXPECT_TRUE(sim->read_velocities(v).ok());
+    double p = 0.0;
+    for (std::size_t k = first; k < first + count; ++k) p += double(v[4 * k + 1]) / x[4 * k + 3];
+    return p;
+  };
+  double given = 0.0, felt = 0.0;
+  std::uint32_t hits = 0, carried = 0, forced = 0;
+  for (int f = 0; f < 10; ++f) {
+    const double before = momentum();
+    SINEW_ASSERT_OK(sim->apply_tool_force(0, {0.0, 1.0, 0.0}, {0.0, 0.0, 0.0}));
+    SINEW_ASSERT_OK(sim->step());
+    hits += sim->last_frame().ccd_hits;
+    carried += sim->last_frame().ccd_carried;
+    forced += sim->last_frame().ccd_forced;
+    auto state = sim->tool_state(0);
+    SINEW_ASSERT_OK(state);
+    given += momentum() - before;
+    felt -= state->contact_force[1] * kFrame;
+  }
+  std::printf("[%s] membrane gained %.4g kg m/s, the tool felt %.4g (%u touches)\n", GetParam().c_str(), given, felt,
+              hits);
+  ASSERT_GT(hits, 0u) << "the tool must touch the membrane, or the test shows nothing";
+  ASSERT_EQ(carried + forced, 0u) << "the fail-safe moves tissue without a reaction";
+  EXPECT_GT(given, 1e-3);
+  EXPECT_NEAR(felt, given, 0.02 * given);
 }
 
 // ---- Nothing to find: no change.
@@ -357,6 +452,29 @@ TEST(ContinuousSearch, SegmentsCrossingWithinTheStepTouchWithTheNormalTheyCameFr
     EXPECT_NEAR(c.w[3], 0.5, 1e-5);
     EXPECT_NEAR(c.normal[1], -1.0f, 1e-6f);
   }
+}
+
+// Touching already at the step's start (the second segment lying on the
+// first, then moving down through it, or a thread end on a face moving
+// through it): the start tells no side, the motion does. The normal still
+// points the way the second came from (-y), not along the segments.
+TEST(ContinuousSearch, PrimitivesTouchingAtTheStartTakeTheSideFromTheirMotion) {
+  ContinuousSearch segments({0, 1, 2, 3}, {});
+  std::vector<collision::Contact> hits;
+  for (const double dx : {0.0, 3e-3}) {  // crossing in the middle, or off it (the points apart along x)
+    const auto start = positions({{-1e-2, 0, 0}, {1e-2, 0, 0}, {dx, 0, -1e-2}, {dx, 0, 1e-2}});
+    const auto end = positions({{-1e-2, 0, 0}, {1e-2, 0, 0}, {dx, -1e-3, -1e-2}, {dx, -1e-3, 1e-2}});
+    SINEW_ASSERT_OK(segments.find(start, end, hits));
+    ASSERT_EQ(hits.size(), 1u) << "dx " << dx;
+    EXPECT_NEAR(hits[0].normal[1], -1.0f, 1e-6f) << "dx " << dx;
+  }
+  // A thread end (particle 0) on the face 2-3-4 at the start, then 1 mm up through it.
+  ContinuousSearch face({0, 1}, {2, 3, 4});
+  const auto start = positions({{2e-3, 0, 2e-3}, {2e-3, -1e-2, 2e-3}, {0, 0, 0}, {1e-2, 0, 0}, {0, 0, 1e-2}});
+  const auto end = positions({{2e-3, 1e-3, 2e-3}, {2e-3, -1e-2, 2e-3}, {0, 0, 0}, {1e-2, 0, 0}, {0, 0, 1e-2}});
+  SINEW_ASSERT_OK(face.find(start, end, hits));
+  ASSERT_FALSE(hits.empty());
+  for (const collision::Contact& c : hits) EXPECT_NEAR(c.normal[1], -1.0f, 1e-6f) << "kind " << int(c.kind);
 }
 
 // Neighbours (segments sharing a vertex) are never tested, however they

@@ -110,6 +110,40 @@ TEST_P(DeviceCommands, IndirectDispatchCoversTheCountItsCounterHolds) {
   }
 }
 
+// A step right after an indirect dispatch that found nothing to do may
+// write that dispatch's counter (here a fill sets it for the next
+// dispatch): every thread of a backend must still see the count the empty
+// dispatch had (the CPU backend skips barriers after empty dispatches only
+// where that cannot race: cpu_device.cpp, run_steps). Run many times, so a
+// race shows as wrong sums (or a hang, which the test's timeout catches).
+TEST_P(DeviceCommands, AStepAfterAnEmptyIndirectDispatchMayRewriteItsCount) {
+  const std::uint32_t capacity = 1000;  // 4 blocks of scan_add's 256
+  const BufferHandle data = words(std::vector<std::uint32_t>(capacity, 0));
+  const BufferHandle sums = words(std::vector<std::uint32_t>(4, 1));
+  const BufferHandle counts = words({7, 0});
+  FrameProgram program;
+  program.fill(data, 0, capacity, 0);
+  program.fill(counts, 1, 1, 0);
+  program.barrier();
+  const std::uint32_t counter = program.counter("items", counts, 1, capacity);
+  kernels::ScanParams p{};
+  p.count_word = 1;
+  p.capacity = capacity;
+  program.dispatch_indirect(Kernel::scan_add, counter, {counts, data, sums}, p);  // empty
+  program.barrier();
+  program.fill(counts, 1, 1, capacity);
+  program.barrier();
+  program.dispatch_indirect(Kernel::scan_add, counter, {counts, data, sums}, p);  // every item, once
+  auto prepared = device->create_program(program);
+  ASSERT_TRUE(prepared.ok()) << prepared.error().message();
+  for (int run = 0; run < 4000; ++run) {
+    SINEW_ASSERT_OK(device->run_program(*prepared));
+    const auto got = read(data, capacity);
+    ASSERT_EQ(std::count(got.begin(), got.end(), 1u), std::ptrdiff_t{capacity}) << "run " << run;
+  }
+  SINEW_ASSERT_OK(device->destroy_program(*prepared));
+}
+
 // How many items an indirect dispatch launches, seen through a kernel that
 // does not read the counter (xpbd_predict guards with its own parameter):
 // exactly n on the CPU; whole groups of 64 covering n with Vulkan's

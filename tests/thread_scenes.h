@@ -18,7 +18,7 @@ inline constexpr double kFrame = 1.0 / 60.0;
 
 // The tests' common settings: no gravity, 60 frames per second of 8
 // substeps with 10 sweeps, mesh collision at 0.5 mm with CCD on or off.
-SceneDesc thread_scene(bool continuous) {
+inline SceneDesc thread_scene(bool continuous) {
   SceneDesc scene;
   scene.gravity = {0.0, 0.0, 0.0};
   scene.solver.time_step = kFrame;

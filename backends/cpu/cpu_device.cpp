@@ -111,6 +111,11 @@ struct CpuStep {
   std::uint32_t cost_ns = 4;     // item_cost_ns of the kernel (per item, or per group member)
   bool solo = false;             // known at resolve time to run on member 0 alone (see run_steps)
   const std::uint32_t* indirect = nullptr;  // the counter word of an indirect dispatch
+  std::uint32_t indirect_buffer = UINT32_MAX;  // the buffer id holding it
+  // An indirect dispatch of the same kernel on the same buffers as the step
+  // before, its counter in the same buffer (mesh contacts' colours): after
+  // an empty one no barrier is needed before it (run_steps).
+  bool chains_previous = false;
   std::byte* bindings[Dispatch::max_bindings] = {};
   alignas(16) std::byte params[Dispatch::max_params_bytes] = {};
   std::uint32_t* target = nullptr;  // fill, copy
@@ -274,7 +279,10 @@ class CpuDevice final : public Device {
         c.count = d->count;
         c.group_size = kernel_signature(d->kernel).group_size;
         c.cost_ns = item_cost_ns(d->kernel);
-        if (d->indirect.buffer.valid()) c.indirect = words(d->indirect.buffer, d->indirect.word);
+        if (d->indirect.buffer.valid()) {
+          c.indirect = words(d->indirect.buffer, d->indirect.word);
+          c.indirect_buffer = d->indirect.buffer.id;
+        }
         for (std::uint32_t b = 0; b < d->binding_count; ++b) c.bindings[b] = buffers_[d->bindings[b].id].data.get();
         std::memcpy(c.params, d->params, d->params_bytes);
       } else {
@@ -287,6 +295,12 @@ class CpuDevice final : public Device {
                                                      : c.count;
         c.solo = team_.members() == 1 ||
                  items * c.cost_ns * (c.group_size > 0 ? c.group_size : 1) < kSerialBelowNs;
+      }
+      if (c.indirect && !steps.empty()) {
+        const CpuStep& before = steps.back();
+        c.chains_previous = before.kind == CpuStep::Kind::dispatch && before.indirect && before.fn == c.fn &&
+                            before.indirect_buffer == c.indirect_buffer &&
+                            std::equal(std::begin(before.bindings), std::end(before.bindings), std::begin(c.bindings));
       }
       steps.push_back(c);
     }
@@ -304,9 +318,16 @@ class CpuDevice final : public Device {
   // are member 0's alone; consecutive ones need no barrier between them.
   // The result does not depend on the split: a dispatch's items (or
   // groups) are independent.
-  // An indirect dispatch that found no items wrote nothing: the barrier
-  // after it is skipped (the one before it already ordered everything
-  // earlier, and every member read the same count there, so all skip it).
+  // An indirect dispatch that found no items wrote nothing, so the barrier
+  // after it can be skipped when the next step is another of its chain
+  // (chains_previous: the same kernel on the same buffers, its count in the
+  // same buffer, as the mesh contacts' colours are). Why only then: a
+  // member may still be reading the empty dispatch's count while another
+  // runs the next step, which must therefore not write that count; a
+  // kernel writing the counters its own dispatches read (a fill of them, a
+  // kernel consuming them) would race, and members that read different
+  // counts would meet different barriers and hang. Kernels never write the
+  // counter words their own chain is dispatched by.
   // Mesh contacts dispatch every colour their program has room for, most
   // of them empty in most frames (measured, medians of 2-3 runs alternating
   // with the previous build, 2 threads: bench_mesh_contacts' coloured
@@ -317,7 +338,7 @@ class CpuDevice final : public Device {
     bool after_empty = false;
     for (std::size_t i = 0; i < steps.size(); ++i) {
       const CpuStep& s = steps[i];
-      if (i > 0 && !(steps[i - 1].solo && s.solo) && !after_empty) team_.barrier();
+      if (i > 0 && !(steps[i - 1].solo && s.solo) && !(after_empty && s.chains_previous)) team_.barrier();
       after_empty = false;
       switch (s.kind) {
         case CpuStep::Kind::fill:

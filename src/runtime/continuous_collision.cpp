@@ -48,18 +48,27 @@ Point weighted(std::span<const Motion> m, std::span<const double> w, double t) {
 
 // The contact normal (continuous_collision.h): `plane`, the normal of the
 // plane the primitives meet in, turned towards the first primitive's side
-// at the start (`apart`, first point minus second); `apart` itself when the
-// motion lies in that plane or the plane is undefined.
-std::array<float, 3> contact_normal(Point plane, const Point& apart) {
+// at the start (`apart`, first point minus second). When they start closer
+// to that plane than kSameSide, the side is the one the first moved away
+// from (`moved`, the first point's displacement over the substep minus the
+// second's). When neither tells a side (motion within the plane, or no
+// plane), the normal is `apart`'s direction, else -`moved`'s.
+constexpr double kSameSide = 1e-9;  // [m], below a float coordinate's resolution at 10 cm
+std::array<float, 3> contact_normal(Point plane, const Point& apart, const Point& moved) {
   const double plane_length = std::sqrt(dot(plane, plane));
   const double apart_length = std::sqrt(dot(apart, apart));
-  const double along = dot(plane, apart);
-  Point n = plane;
-  // In-plane motion: the side is not along the plane's normal.
-  if (!(plane_length > 0.0) || std::abs(along) <= 1e-6 * plane_length * apart_length) n = apart;
-  else if (along < 0.0) n = {-n[0], -n[1], -n[2]};
+  Point n{0.0, 0.0, 0.0};
+  if (plane_length > 0.0) {
+    const double side = dot(plane, apart) / plane_length;   // [m]
+    const double went = dot(plane, moved) / plane_length;   // [m]
+    const double sign = std::abs(side) > std::max(1e-6 * apart_length, kSameSide) ? side
+                        : std::abs(went) > std::max(1e-6 * std::sqrt(dot(moved, moved)), kSameSide) ? -went
+                                                                                                        : 0.0;
+    if (sign != 0.0) n = sign > 0.0 ? plane : Point{-plane[0], -plane[1], -plane[2]};
+  }
+  if (dot(n, n) == 0.0) n = apart_length > 0.0 ? apart : Point{-moved[0], -moved[1], -moved[2]};
   double length = std::sqrt(dot(n, n));
-  if (!(length > 0.0)) {  // touching at the start and no plane: any direction off the first primitive
+  if (!(length > 0.0)) {  // touching at the start, not moving apart, no plane: any direction
     n = {0.0, 1.0, 0.0};
     length = 1.0;
   }
@@ -137,7 +146,7 @@ void ContinuousSearch::fit(std::span<const float> start, std::span<const float> 
 
 Status ContinuousSearch::find(std::span<const float> start, std::span<const float> end,
                               std::vector<Contact>& hits, std::span<const Capsule> capsules,
-                              std::span<const std::uint8_t> carried) {
+                              std::span<const std::uint32_t> carried) {
   hits.clear();
   queries_ = 0;
   // Every vertex of a segment or triangle, once (a NaN would fail every
@@ -153,7 +162,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
   // meet in, apart the first point minus the second at the start.
   struct Touch {
     double w[4];  // weights: edge-edge (1 - s, s, 1 - t, t); vertex-face (1, wa, wb, wc)
-    Point plane, apart;
+    Point plane, apart, moved;
   };
   const auto edges = [&](const Motion* m, double separation, Touch& touch) -> Result<bool> {
     ccd::Settings settings;
@@ -169,6 +178,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
     touch.w[0] = 1.0 - st.s, touch.w[1] = st.s, touch.w[2] = 1.0 - st.t, touch.w[3] = st.t;
     touch.plane = cross(sub(lerp(m[1], t), lerp(m[0], t)), sub(lerp(m[3], t), lerp(m[2], t)));
     touch.apart = sub(weighted({m, 2}, {touch.w, 2}, 0.0), weighted({m + 2, 2}, {touch.w + 2, 2}, 0.0));
+    touch.moved = sub(sub(weighted({m, 2}, {touch.w, 2}, 1.0), weighted({m + 2, 2}, {touch.w + 2, 2}, 1.0)), touch.apart);
     return true;
   };
   // Vertex m[0] against triangle m[1..3].
@@ -184,6 +194,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
     touch.w[0] = 1.0, touch.w[1] = w.wa, touch.w[2] = w.wb, touch.w[3] = w.wc;
     touch.plane = cross(sub(lerp(m[2], t), lerp(m[1], t)), sub(lerp(m[3], t), lerp(m[1], t)));
     touch.apart = sub(m[0][0], weighted({m + 1, 3}, {touch.w + 1, 3}, 0.0));
+    touch.moved = sub(sub(m[0][1], weighted({m + 1, 3}, {touch.w + 1, 3}, 1.0)), touch.apart);
     return true;
   };
   const auto motions = [&](std::span<const std::uint32_t> particles, Motion* m) {
@@ -194,7 +205,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
     c.kind = kind;
     c.v = v;
     for (int k = 0; k < 4; ++k) c.w[k] = static_cast<float>(touch.w[k]);
-    c.normal = contact_normal(touch.plane, touch.apart);
+    c.normal = contact_normal(touch.plane, touch.apart, touch.moved);
     hits.push_back(c);
   };
 
@@ -279,10 +290,11 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
       grow(boxes_, reach);
       capsule_reach_tree_.build(boxes_);
     }
-    const auto all_carried = [&](std::span<const std::uint32_t> particles) {
+    // Whether capsule c carries all of the particles (they cannot cross it).
+    const auto all_carried = [&](std::span<const std::uint32_t> particles, std::uint32_t c) {
       if (carried.empty()) return false;
       for (std::uint32_t p : particles)
-        if (!carried[p]) return false;
+        if (carried[p] != c) return false;
       return true;
     };
     // The touch of tissue `p` (arity 2 or 3) with capsule c, as a shape_face hit.
@@ -296,7 +308,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
         hit.v = {p[0], p[0], p[1], p[1]};
         hit.w = {0.0f, float(w[0]), 0.0f, float(w[1])};
       }
-      hit.normal = contact_normal(t.plane, t.apart);
+      hit.normal = contact_normal(t.plane, t.apart, t.moved);
       hit.shape = c;
       hits.push_back(hit);
     };
@@ -307,7 +319,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
       for (const collision::Pair& pr : pairs_) {
         const Capsule& cap = capsules[pr.second];
         const std::span<const std::uint32_t> p(&indices[std::size_t{pr.first} * arity], std::size_t(arity));
-        if (all_carried(p)) continue;
+        if (all_carried(p, pr.second)) continue;
         Motion m[4];
         const Motion& a0 = cap.ends[0];
         const Motion& a1 = cap.ends[1];
@@ -333,6 +345,7 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
           if (!hit) return hit.error();
           if (!*hit) continue;
           touch.apart = {-touch.apart[0], -touch.apart[1], -touch.apart[2]};
+          touch.moved = {-touch.moved[0], -touch.moved[1], -touch.moved[2]};
           add_capsule(p, pr.second, touch.w + 1, touch);
         }
       }
@@ -427,7 +440,7 @@ Status ContinuousCollision::after_sweeps(Device& device, int substep, int round,
   end_.resize(floats);
   if (round == 0) {
     substep_capsules(substep);
-    carried_.assign(floats / 4, 0);
+    carried_.assign(floats / 4, kNotCarried);
     // The substep's start does not change across its rounds.
     if (Status s = device.read_buffer(buffers_.previous, 0, start_.data(), floats * 4); !s) return s;
     read_back_bytes_ += floats * 4;
@@ -471,16 +484,17 @@ Status ContinuousCollision::fail_safe(Device& device) {
       if (c.kind == Contact::Kind::shape_face) {
         // Against a capsule: the tissue's movable particles move with it
         // (the capsule's rigid motion over the substep), so the axis cannot
-        // cross them.
+        // cross them. Those another capsule carries stay with that one: a
+        // pair left touching is forced.
         const auto& [from, to] = substep_poses_[c.shape];
         for (std::uint32_t p : c.v) {
           const std::size_t at = std::size_t{p} * 4;
-          if (!(end_[at + 3] > 0.0f) || carried_[p]) continue;
+          if (!(end_[at + 3] > 0.0f) || carried_[p] != kNotCarried) continue;
           const math::Vec3 local = math::rotate(math::conj(from.rotation),
                                                 math::sub(math::Vec3{start_[at], start_[at + 1], start_[at + 2]}, from.position));
           const math::Vec3 x = math::add(to.position, math::rotate(to.rotation, local));
           for (int a = 0; a < 3; ++a) end_[at + a] = static_cast<float>(x[a]);
-          carried_[p] = 1;
+          carried_[p] = c.shape;
           ++carried_count_;
           here = true;
         }
@@ -488,7 +502,7 @@ Status ContinuousCollision::fail_safe(Device& device) {
         // Between tissues: the moving particles stop where the substep
         // started (those a capsule carries keep moving with it).
         for (std::uint32_t p : c.v) {
-          if (carried_[p] || !moving(p)) continue;
+          if (carried_[p] != kNotCarried || !moving(p)) continue;
           const std::size_t at = std::size_t{p} * 4;
           for (int a = 0; a < 3; ++a) end_[at + a] = start_[at + a];
           ++reverted_;

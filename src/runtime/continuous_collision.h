@@ -36,9 +36,12 @@
 // Collisions, Contact and Friction for Cloth Animation", SIGGRAPH 2002,
 // section 7): the plane the primitives meet in at the time of the touch —
 // the two edges' cross product, or the triangle's normal — turned towards
-// the side the first primitive came from; when the motion lies in that
-// plane (parallel or coplanar primitives), the direction between the two
-// touching points at the substep's start.
+// the side the first primitive came from: the side its touching point
+// starts on, or, when it starts within 1 nm of the plane (touching at the
+// substep's start), the side its motion relative to the second leaves;
+// when neither tells (motion within that plane: parallel or coplanar
+// primitives), the direction between the two touching points at the
+// substep's start.
 #pragma once
 
 #include <cstdint>
@@ -83,12 +86,14 @@ class ContinuousSearch {
   /// against its ends); their touches come as kind shape_face on the
   /// tissue's particles ((a, a, b, c) or (a, a, b, b), mesh_contact_params.h)
   /// with `shape` the capsule's index and the normal from the axis towards
-  /// the side the tissue came from. carried: per particle (or empty), those
-  /// moving with a capsule this substep (the fail-safe): a capsule's pairs
-  /// whose tissue particles are all carried are skipped.
+  /// the side the tissue came from. carried: per particle (or empty), the
+  /// index of the capsule it moves with this substep (the fail-safe), or
+  /// kNotCarried: a capsule's pairs whose tissue particles it carries all
+  /// are skipped.
   /// Errors (bad_parameter): a non-finite position, naming the particle.
   Status find(std::span<const float> start, std::span<const float> end, std::vector<collision::Contact>& hits,
-              std::span<const Capsule> capsules = {}, std::span<const std::uint8_t> carried = {});
+              std::span<const Capsule> capsules = {}, std::span<const std::uint32_t> carried = {});
+  static constexpr std::uint32_t kNotCarried = UINT32_MAX;
 
   /// Refits the triangles' tree to their boxes at `positions` (xyzw per
   /// particle), the reference later searches measure the drift from (the
@@ -159,7 +164,9 @@ class ContinuousCollision final : public SubstepHook {
   std::vector<ContinuousSearch::Capsule> capsules_;  // this substep's
   // This substep's rigid motion of each capsule: start and end poses.
   std::vector<std::array<PosedShape, 2>> substep_poses_;
-  std::vector<std::uint8_t> carried_;  // per particle, this substep (the fail-safe)
+  // Per particle, this substep: the capsule the fail-safe moves it with, or kNotCarried.
+  std::vector<std::uint32_t> carried_;
+  static constexpr std::uint32_t kNotCarried = ContinuousSearch::kNotCarried;
   std::vector<float> start_, end_;
   std::vector<collision::Contact> hits_found_, contacts_;
   std::uint32_t hits_ = 0, repair_rounds_ = 0, reverted_ = 0, carried_count_ = 0, forced_ = 0;

@@ -1010,15 +1010,20 @@ Result<std::uint32_t> MeshCollision::append_contacts(Device& device, std::span<c
   std::vector<std::uint32_t> slot_of(n);
   for (std::uint32_t i = 0; i < n; ++i) slot_of[i] = next[color_of[i]]++;
 
-  // The earlier additions' multipliers move with them; the new ones start at 0.
-  std::vector<float> lambda(std::size_t{n} * 4, 0.0f);
+  // The earlier additions' multipliers move with them, this substep's
+  // (lambda) and the earlier substeps' sum (lambda_sum, the tool's
+  // reaction: add_tool_reactions); the new ones start at 0.
+  std::vector<float> lambda(std::size_t{n} * 4, 0.0f), lambda_sum(std::size_t{n} * 4, 0.0f);
   if (!appended_.empty()) {
     std::vector<float> old(appended_.size() * 4);
-    if (Status s = device.read_buffer(b.lambda, std::size_t{contact_count_} * 16, old.data(), old.size() * 4); !s)
-      return s.error();
-    for (std::size_t i = 0; i < appended_.size(); ++i)
-      std::copy_n(&old[std::size_t{appended_slots_[i] - contact_count_} * 4], 4,
-                  &lambda[std::size_t{slot_of[i] - contact_count_} * 4]);
+    for (const auto& [buffer, moved] : {std::pair{b.lambda, &lambda}, std::pair{b.lambda_sum, &lambda_sum}}) {
+      if (Status s = device.read_buffer(buffer, std::size_t{contact_count_} * 16, old.data(), old.size() * 4); !s)
+        return s.error();
+      read_back_bytes_ += old.size() * 4;
+      for (std::size_t i = 0; i < appended_.size(); ++i)
+        std::copy_n(&old[std::size_t{appended_slots_[i] - contact_count_} * 4], 4,
+                    &(*moved)[std::size_t{slot_of[i] - contact_count_} * 4]);
+    }
   }
   const std::size_t end = std::size_t{contact_count_ + n} * 4;
   upload_particles_.resize(end);
@@ -1051,8 +1056,7 @@ Result<std::uint32_t> MeshCollision::append_contacts(Device& device, std::span<c
       !s)
     return s.error();
   if (Status s = device.write_buffer(b.lambda, first * 4, lambda.data(), bytes); !s) return s.error();
-  const std::vector<float> zeros(std::size_t{n} * 4, 0.0f);
-  if (Status s = device.write_buffer(b.lambda_sum, first * 4, zeros.data(), bytes); !s) return s.error();
+  if (Status s = device.write_buffer(b.lambda_sum, first * 4, lambda_sum.data(), bytes); !s) return s.error();
   if (Status s = device.write_buffer(b.table, 0, table_.data(), table_.size() * 4); !s) return s.error();
   appended_ = std::move(all);
   appended_slots_ = std::move(slot_of);
