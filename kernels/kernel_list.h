@@ -49,6 +49,8 @@
   SINEW_KERNEL(xpbd_solve_mesh_contacts, 9, MeshContactParams, 0)                \
   SINEW_KERNEL(xpbd_mesh_contacts_jacobi, 10, MeshContactParams, 0)              \
   SINEW_KERNEL(xpbd_mesh_contacts_gather, 6, MeshContactParams, 0)               \
+  /* needles and sutures (kernels/shared/suture_params.h) */                     \
+  SINEW_KERNEL(xpbd_sutures, 9, SutureParams, 0)                                 \
   /* device-side work of data-dependent size (kernels/shared/primitive_params.h) */ \
   SINEW_KERNEL(indirect_args, 2, IndirectArgsParams, 0)                          \
   SINEW_KERNEL(scan_blocks, 4, ScanParams, 256)                                  \

@@ -239,6 +239,41 @@ struct ToolDesc {
   double compliance = 0.0;                              ///< of its contacts [m/N]
 };
 
+/// A suture needle (issue 13, part 4): a rigid curve, a polyline in its own
+/// frame from its tail (curve.front()) to its tip (curve.back()), moved
+/// kinematically (Simulation::set_needle_pose; its substeps interpolate
+/// each point linearly) and optionally pulling a thread tied to its tail.
+///
+/// The tip punctures the surfaces of the tet bodies (their boundary) and
+/// the tri bodies: when its path in a frame meets a surface triangle from
+/// outside, a contact pushes the tissue ahead of the tip; once the frame's
+/// average push passes `puncture_force` with the tip within
+/// `max_puncture_angle` of the surface's inward normal, the tissue point
+/// it pushed (triangle and barycentric weights) is held on the needle's
+/// curve, the closest point of the curve to it, as the needle slides
+/// through (Moore et al., "The interactive medical simulation toolkit
+/// (iMSTK)", Frontiers in Virtual Reality 2023, section 2.5). Leaving a tet
+/// body's surface from inside makes an exit puncture (no force needed).
+/// Once the needle's tail has passed a puncture, the puncture holds the
+/// thread instead, which slides through it with friction; the thread's last
+/// vertex is a knot that stops at the puncture. Punctures of a triangle
+/// that is degenerate or inverted (its tet turned inside out) are refused
+/// (NeedleState::refused). Details and limits: README, "Needles and
+/// sutures".
+struct NeedleDesc {
+  std::vector<std::array<double, 3>> curve;             ///< [m] in the needle's frame, tail to tip, >= 2 points, no zero-length segment
+  std::array<double, 3> position{0.0, 0.0, 0.0};       ///< initial [m]
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< initial unit quaternion (w, x, y, z)
+  double puncture_force = 0.5;                          ///< [N], > 0: the push that punctures a surface
+  double max_puncture_angle = 1.0;                      ///< [rad], in (0, pi/2]
+  /// Of the punctures and the tie to the thread [m/N], >= 0 (0: rigid).
+  double compliance = 0.0;
+  /// A line body whose vertex 0 is tied to the needle's tail, or -1 for none.
+  int thread = -1;
+  double thread_static_friction = 0.3;   ///< of the thread sliding through a puncture, >= 0
+  double thread_dynamic_friction = 0.2;  ///< >= 0, <= thread_static_friction
+};
+
 /// How each frame is solved: a frame of length time_step is split into
 /// `substeps` substeps of h = time_step / substeps; each substep predicts,
 /// runs `iterations` Gauss-Seidel sweeps over all constraints (colour by
@@ -440,6 +475,7 @@ struct SceneDesc {
   std::vector<std::array<double, 3>> targets;       ///< initial kinematic target positions [m]
   std::vector<AttachmentDesc> attachments;
   std::vector<ToolDesc> tools;
+  std::vector<NeedleDesc> needles;
   MeshCollisionDesc mesh_collision;  ///< contacts between the bodies' meshes (off by default)
 };
 

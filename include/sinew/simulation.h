@@ -159,6 +159,40 @@ class Simulation {
   };
   Result<ToolState> tool_state(std::size_t index) const;
 
+  /// Moves needle `index` to this pose [m, unit quaternion (w, x, y, z)]
+  /// by the end of the next frame (NeedleDesc); its substeps interpolate
+  /// each of its points linearly.
+  Status set_needle_pose(std::size_t index, const std::array<double, 3>& position,
+                         const std::array<double, 4>& rotation);
+
+  /// A tissue point held on a needle or its thread (NeedleDesc).
+  struct Puncture {
+    BodyKind body_kind = BodyKind::tet;  ///< tet (its boundary surface) or tri
+    std::uint32_t body = 0;              ///< index among the scene's bodies of that kind
+    /// The triangle: of extract_boundary_surface(mesh) for a tet body, of
+    /// mesh.triangles for a tri body.
+    std::uint32_t triangle = 0;
+    std::array<double, 3> weights{};  ///< barycentric weights of the point on it
+    bool exit = false;       ///< made leaving a tet body (else entering a surface)
+    bool on_thread = false;  ///< the needle has passed it: it holds the thread
+    std::uint32_t thread_segment = 0;  ///< on_thread: the thread's segment through it
+    double thread_s = 0.0;             ///< on_thread: where along that segment, in [0, 1]
+  };
+  /// A needle at the end of the last frame.
+  struct NeedleState {
+    std::array<double, 3> position{};            ///< [m]
+    std::array<double, 4> rotation{1, 0, 0, 0};  ///< unit quaternion (w, x, y, z)
+    std::vector<Puncture> punctures;             ///< in the order they were made
+    bool pushing = false;    ///< the tip pushes a surface it has not punctured
+    double tip_force = 0.0;  ///< that push, along the tip, averaged over the frame [N]
+    /// Since the start: surface triangles the tip met that it could not
+    /// puncture because they were degenerate (no area) or inverted (their
+    /// tet turned inside out), and frames in which the push passed
+    /// puncture_force at more than max_puncture_angle.
+    std::uint32_t refused_degenerate = 0, refused_inverted = 0, refused_angle = 0;
+  };
+  Result<NeedleState> needle_state(std::size_t index) const;
+
   [[nodiscard]] const SceneInfo& info() const;
   [[nodiscard]] const FrameStats& last_frame() const;
   /// The backend running the scene: "cpu", "opencl" or "vulkan".

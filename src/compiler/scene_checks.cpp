@@ -253,6 +253,35 @@ Status check_tool(const ToolDesc& t, const std::string& name) {
   return non_negative(name + ".compliance", t.compliance);
 }
 
+Status check_needle(const SceneDesc& scene, const NeedleDesc& n, const std::string& name) {
+  if (n.curve.size() < 2)
+    return Error(ErrorCode::bad_parameter,
+                 name + ".curve must have at least 2 points (tail to tip), got " + std::to_string(n.curve.size()));
+  for (std::size_t k = 0; k < n.curve.size(); ++k) {
+    if (Status s = finite3(name + ".curve[" + std::to_string(k) + "]", n.curve[k]); !s) return s;
+    if (k > 0 && n.curve[k] == n.curve[k - 1])
+      return Error(ErrorCode::bad_parameter, name + ".curve[" + std::to_string(k) + "] repeats the point before it "
+                                                    "(a segment of zero length has no direction)");
+  }
+  if (Status s = finite3(name + ".position", n.position); !s) return s;
+  if (Status s = unit_quaternion(name + ".rotation", n.rotation); !s) return s;
+  if (Status s = positive(name + ".puncture_force", n.puncture_force); !s) return s;
+  if (!(n.max_puncture_angle > 0.0 && n.max_puncture_angle <= M_PI / 2))
+    return Error(ErrorCode::bad_parameter,
+                 name + ".max_puncture_angle must be in (0, pi/2] radians (got " + str(n.max_puncture_angle) + ")");
+  if (Status s = non_negative(name + ".compliance", n.compliance); !s) return s;
+  if (Status s = check_friction(name + ".thread", n.thread_static_friction, n.thread_dynamic_friction); !s) return s;
+  if (n.thread < -1 || n.thread >= static_cast<int>(scene.line_bodies.size()))
+    return Error(ErrorCode::bad_parameter, name + ".thread = " + std::to_string(n.thread) +
+                                               " is not a line body (the scene has " +
+                                               std::to_string(scene.line_bodies.size()) + "; -1 for none)");
+  for (std::size_t other = 0; n.thread >= 0 && &scene.needles[other] != &n; ++other)
+    if (scene.needles[other].thread == n.thread)
+      return Error(ErrorCode::bad_parameter, name + ".thread = " + std::to_string(n.thread) +
+                                                 " is already needles[" + std::to_string(other) + "]'s thread");
+  return {};
+}
+
 std::size_t vertex_count(const SceneDesc& scene, const VertexRef& ref) {
   switch (ref.body_kind) {
     case BodyKind::tet: return ref.body < scene.tet_bodies.size() ? scene.tet_bodies[ref.body].mesh.vertices.size() : 0;
@@ -309,7 +338,7 @@ Status check_mesh_collision(const SceneDesc& scene) {
                  "mesh_collision.continuous needs mesh_collision.schedule = ContactSchedule::colored");
   // What is tested: threads against anything, tools' and capsule colliders' axes against surfaces.
   bool capsules = !scene.tools.empty();
-  for (const ColliderDesc& c : scene.colliders) capsules |= c.shape == ColliderShape::capsule;
+  for (const ColliderDesc& collider : scene.colliders) capsules |= collider.shape == ColliderShape::capsule;
   const bool surfaces = !scene.tet_bodies.empty() || !scene.tri_bodies.empty();
   if (scene.line_bodies.empty() && !(capsules && surfaces))
     return Error(ErrorCode::bad_parameter,
@@ -390,6 +419,12 @@ Status check_scene(const SceneDesc& scene) {
   if (Status s = check_all(scene.colliders, "colliders", check_collider); !s) return s;
   if (Status s = check_all(scene.tools, "tools", check_tool); !s) return s;
   if (Status s = check_mesh_collision(scene); !s) return s;
+  for (std::size_t i = 0; i < scene.needles.size(); ++i)
+    if (Status s = check_needle(scene, scene.needles[i], "needles[" + std::to_string(i) + "]"); !s) return s;
+  if (!scene.needles.empty() && scene.solver.chebyshev_rho > 0.0)
+    return Error(ErrorCode::bad_parameter, "needles are not supported with solver.chebyshev_rho > 0 (got " +
+                                               str(scene.solver.chebyshev_rho) +
+                                               "): the accelerator would extrapolate the punctured tissue");
   for (std::size_t i = 0; i < scene.targets.size(); ++i)
     if (Status s = finite3("targets[" + std::to_string(i) + "]", scene.targets[i]); !s) return s;
   for (std::size_t i = 0; i < scene.attachments.size(); ++i)

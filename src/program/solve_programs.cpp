@@ -85,14 +85,14 @@ void append_commands(FrameProgram& program, const Commands& commands) {
 
 SolvePrograms::SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
                              const std::array<double, 3>& gravity, ChebyshevBuffers chebyshev,
-                             const MeshContactBuffers* mesh_contacts)
+                             SweepExtras extras)
     : scene_(scene), buffers_(buffers), solver_(solver), chebyshev_(std::move(chebyshev)) {
   // Two iterations give one sweep of each kind; measuring on gives the
   // measuring pass (emitted once, in the last substep).
   SolverSettings cut = solver;
   cut.iterations = 2;
   cut.measure_errors = true;
-  const FrameProgram whole = build_xpbd_program(scene, buffers, cut, gravity, mesh_contacts);
+  const FrameProgram whole = build_xpbd_program(scene, buffers, cut, gravity, extras);
   counters_ = whole.counters();
   enum class Phase { predict, first_sweep, sweep, measure, update } phase = Phase::predict;
   for (const auto& command : whole.commands()) {

@@ -54,12 +54,12 @@ struct CheckedResidual {
 class SolvePrograms {
  public:
   /// [in] solver: the scene's settings; chebyshev: its buffers when
-  /// solver.chebyshev_rho > 0 (else unused); mesh_contacts: the mesh
-  /// contacts' buffers (or none), whose colours ride in every sweep after
-  /// the bodies' constraints, as in build_xpbd_program.
+  /// solver.chebyshev_rho > 0 (else unused); extras: the mesh contacts'
+  /// and the sutures' buffers (each or none), which ride in every sweep
+  /// after the bodies' constraints, as in build_xpbd_program.
   SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
                 const std::array<double, 3>& gravity, ChebyshevBuffers chebyshev,
-                const MeshContactBuffers* mesh_contacts = nullptr);
+                SweepExtras extras = {});
 
   /// Declares on `program` the counters of the whole frame's indirect
   /// dispatches (the mesh contacts' colours), so their capacity is checked

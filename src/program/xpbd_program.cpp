@@ -14,6 +14,7 @@
 #include <tuple>
 #include <utility>
 
+#include "suture_params.h"
 #include "xpbd_params.h"
 
 namespace sinew {
@@ -95,7 +96,8 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
 }
 
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
-                                const std::array<double, 3>& gravity, const MeshContactBuffers* mesh_contacts) {
+                                const std::array<double, 3>& gravity, SweepExtras extras) {
+  const MeshContactBuffers* mesh_contacts = extras.mesh_contacts;
   const bool measure_errors = solver.measure_errors;
   const double h = solver.time_step / solver.substeps;
   const auto particles = static_cast<std::uint32_t>(scene.positions.size());
@@ -167,6 +169,17 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
                                     m);
           program.barrier();
         }
+      }
+      if (const SutureBuffers* sutures = extras.sutures) {  // last: they hold the tissue on the needles
+        kernels::SutureParams q{};
+        q.inv_h2 = inv_h2;
+        q.reset_lambda = p.reset_lambda == 0u ? 0u : s == 0 ? 2u : 1u;  // 2: the frame's first sweep
+        q.substep_end = p.substep_end;
+        program.dispatch(Kernel::xpbd_sutures, 1,
+                         {buffers.position, buffers.previous, sutures->table, sutures->needles, sutures->curve,
+                          sutures->slots, sutures->rows, sutures->weights, sutures->lambda},
+                         q);
+        program.barrier();
       }
     }
     if (measure_errors && s + 1 == solver.substeps) {

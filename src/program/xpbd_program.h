@@ -40,14 +40,27 @@ struct MeshContactBuffers {
   kernels::MeshContactParams params{};  ///< thickness, compliance, friction (the rest set per dispatch)
 };
 
+/// The buffers of the needles' and sutures' rows (suture_params.h),
+/// rewritten by the host every frame (runtime/sutures.h).
+struct SutureBuffers {
+  BufferHandle table, needles, curve, slots, rows, weights, lambda;
+};
+
+/// The stages that end every sweep, after the bodies' constraints: the
+/// mesh contacts (colour by colour), then the sutures. Each may be absent.
+struct SweepExtras {
+  const MeshContactBuffers* mesh_contacts = nullptr;
+  const SutureBuffers* sutures = nullptr;
+};
+
 /// Creates the buffers on `device` and uploads the compiled scene.
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
 
 /// The dispatches of one frame of `solver`, with `gravity` [m/s^2].
-/// With `mesh_contacts`, every sweep ends with one indirect dispatch per
-/// contact colour (counts from its table, declared as counters).
+/// With mesh contacts, every sweep ends with one indirect dispatch per
+/// contact colour (counts from its table, declared as counters); with
+/// sutures, then one dispatch of one item for all their rows.
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
-                                const std::array<double, 3>& gravity,
-                                const MeshContactBuffers* mesh_contacts = nullptr);
+                                const std::array<double, 3>& gravity, SweepExtras extras = {});
 
 }  // namespace sinew

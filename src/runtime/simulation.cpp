@@ -79,6 +79,11 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->program_shape = *compiled;
     for (ConstraintBlock& block : impl->program_shape.blocks) block.data = {};
   }
+  if (!scene.needles.empty()) {
+    auto sutures = Sutures::create(scene, *compiled, *impl->device);
+    if (!sutures) return sutures.error();
+    impl->sutures = std::move(*sutures);
+  }
   const bool continuous = scene.mesh_collision.enabled && scene.mesh_collision.continuous;
   if (continuous)
     impl->continuous = std::make_unique<ContinuousCollision>(
@@ -88,9 +93,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
     append_stats(impl->program, impl->stats_plan, impl->buffers);
     auto stepper = SolveStepper::create(*impl->device, *compiled, impl->buffers, scene.solver, scene.gravity,
-                                        impl->stats_plan,
-                                        impl->mesh_collision ? &impl->mesh_collision->buffers() : nullptr,
-                                        continuous);
+                                        impl->stats_plan, impl->sweep_extras(), continuous);
     if (!stepper) return stepper.error();
     impl->stepper = std::move(*stepper);
     impl->program = impl->stepper->frame_program();
@@ -122,8 +125,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
 }
 
 Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
-  program = build_xpbd_program(compiled, buffers, solver, gravity,
-                               mesh_collision ? &mesh_collision->buffers() : nullptr);
+  program = build_xpbd_program(compiled, buffers, solver, gravity, sweep_extras());
   append_stats(program, stats_plan, buffers);
   if (prepared.id != UINT32_MAX)
     if (Status s = device->destroy_program(prepared); !s) return s;
@@ -147,7 +149,7 @@ Status Simulation::step() {
     if (grew) {
       if (impl_->stepper) {
         if (Status s = impl_->stepper->rebuild(*impl_->device, impl_->program_shape, impl_->buffers, impl_->gravity,
-                                               impl_->stats_plan, &impl_->mesh_collision->buffers());
+                                               impl_->stats_plan, impl_->sweep_extras());
             !s)
           return s;
         impl_->program = impl_->stepper->frame_program();
@@ -161,6 +163,8 @@ Status Simulation::step() {
     impl_->stats.mesh_contact_colors = impl_->mesh_collision->colors();
     impl_->stats.collision_margin = impl_->mesh_collision->margin();
   }
+  if (impl_->sutures)
+    if (Status s = impl_->sutures->before_frame(*impl_->device, impl_->buffers); !s) return s;
   const auto collided = std::chrono::steady_clock::now();
   impl_->stats.collision_ms = std::chrono::duration<double, std::milli>(collided - start).count();
   if (impl_->stepper) {
@@ -183,12 +187,18 @@ Status Simulation::step() {
     if (Status s = impl_->mesh_collision->after_frame(*impl_->device, impl_->buffers); !s) return s;
     impl_->stats.contact_violation = impl_->mesh_collision->violation();
   }
+  if (impl_->sutures)
+    if (Status s = impl_->sutures->after_frame(*impl_->device, impl_->buffers, impl_->time_step / impl_->substeps,
+                                               impl_->time_step);
+        !s)
+      return s;
   const auto ran = std::chrono::steady_clock::now();
   if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
   impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4 +
                                  (impl_->stepper ? impl_->stepper->read_back_bytes() : 0) +
                                  (impl_->mesh_collision ? impl_->mesh_collision->read_back_bytes() : 0) +
-                                 (impl_->continuous ? impl_->continuous->read_back_bytes() : 0);
+                                 (impl_->continuous ? impl_->continuous->read_back_bytes() : 0) +
+                                 (impl_->sutures ? impl_->sutures->read_back_bytes() : 0);
   if (Status s = impl_->after_frame(); !s) return s;
   if (impl_->measure_errors) impl_->measure(impl_->stats);
   const auto end = std::chrono::steady_clock::now();

@@ -313,3 +313,21 @@ Result<Simulation::ToolState> Simulation::tool_state(std::size_t index) const {
 }
 
 }  // namespace sinew
+
+namespace sinew {
+
+Status Simulation::set_needle_pose(std::size_t index, const std::array<double, 3>& position,
+                                   const std::array<double, 4>& rotation) {
+  if (!impl_->sutures) return Error(ErrorCode::bad_parameter, "set_needle_pose: the scene has no needles");
+  return impl_->sutures->set_pose(index, position, rotation);
+}
+
+Result<Simulation::NeedleState> Simulation::needle_state(std::size_t index) const {
+  const std::size_t count = impl_->sutures ? impl_->sutures->needles() : 0;
+  if (index >= count)
+    return Error(ErrorCode::bad_parameter, "needle_state: needle " + std::to_string(index) +
+                                               " does not exist (the scene has " + std::to_string(count) + ")");
+  return impl_->sutures->state(index);
+}
+
+}  // namespace sinew

@@ -15,6 +15,7 @@
 #include "runtime/continuous_collision.h"
 #include "runtime/mesh_collision.h"
 #include "runtime/solve_stepper.h"
+#include "runtime/sutures.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -52,6 +53,12 @@ struct Simulation::Impl {
   // The threads' continuous collision detection, run by the stepper after
   // every substep's sweeps (null unless MeshCollisionDesc::continuous).
   std::unique_ptr<ContinuousCollision> continuous;
+  // The needles and their punctures (sutures.h; null when the scene has none).
+  std::unique_ptr<Sutures> sutures;
+  /// The stages that end every sweep: the mesh contacts and the sutures.
+  [[nodiscard]] SweepExtras sweep_extras() const {
+    return {mesh_collision ? &mesh_collision->buffers() : nullptr, sutures ? &sutures->buffers() : nullptr};
+  }
   CompiledScene program_shape;
   SolverSettings solver;
   std::array<double, 3> gravity{};

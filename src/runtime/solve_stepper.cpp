@@ -45,13 +45,12 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
                                                            const XpbdBuffers& buffers, const SolverSettings& solver,
                                                            const std::array<double, 3>& gravity,
                                                            const StatsPlan& stats,
-                                                           const MeshContactBuffers* mesh_contacts,
-                                                           bool per_substep) {
+                                                           SweepExtras extras, bool per_substep) {
   // The frame's mesh contacts change every frame (and their slots with
   // them): no lambda of theirs may be carried into a substep.
-  if (solver.warm_start && mesh_contacts)
+  if (solver.warm_start && (extras.mesh_contacts || extras.sutures))
     return Error(ErrorCode::bad_parameter, "solver.warm_start supports distance and volume constraints only; "
-                                           "the scene has mesh contacts (mesh_collision)");
+                                           "the scene has mesh contacts (mesh_collision) or needles");
   if (solver.warm_start)
     for (const ConstraintBlock& block : scene.blocks)
       if (block.kernel != Kernel::xpbd_solve_distance && block.kernel != Kernel::xpbd_solve_volume)
@@ -72,13 +71,13 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
     if (!check) return check.error();
     st->check_ = std::move(*check);
   }
-  if (Status s = st->build(device, scene, buffers, gravity, stats, mesh_contacts); !s) return s.error();
+  if (Status s = st->build(device, scene, buffers, gravity, stats, extras); !s) return s.error();
   return st;
 }
 
 Status SolveStepper::rebuild(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
                              const std::array<double, 3>& gravity, const StatsPlan& stats,
-                             const MeshContactBuffers* mesh_contacts) {
+                             SweepExtras extras) {
   std::vector<ProgramHandle> all{whole_, end_};
   all.insert(all.end(), begin_.begin(), begin_.end());
   all.insert(all.end(), repair_.begin(), repair_.end());
@@ -93,16 +92,16 @@ Status SolveStepper::rebuild(Device& device, const CompiledScene& scene, const X
   begin_cold_.clear();
   chunks_.clear();
   shortest_frame_ = FrameProgram{};
-  return build(device, scene, buffers, gravity, stats, mesh_contacts);
+  return build(device, scene, buffers, gravity, stats, extras);
 }
 
 // The programs (the buffers exist): fixed mode one, residual mode the
 // begin, chunk and end programs of every substep.
 Status SolveStepper::build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
                            const std::array<double, 3>& gravity, const StatsPlan& stats,
-                           const MeshContactBuffers* mesh_contacts) {
+                           SweepExtras extras) {
   const SolverSettings& solver = solver_;
-  SolvePrograms parts(scene, buffers, solver, gravity, chebyshev_, mesh_contacts);
+  SolvePrograms parts(scene, buffers, solver, gravity, chebyshev_, extras);
   const int substeps = parts.substeps();
   const int iterations = solver.iterations;
   const auto prepare = [&](const FrameProgram& program) {

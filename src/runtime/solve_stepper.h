@@ -37,20 +37,18 @@ class SolveStepper {
   /// Builds and prepares the programs; the last one ends with the
   /// statistics of `stats` (append_stats). [in] scene, buffers must outlive
   /// the call only.
-  /// mesh_contacts: the mesh contacts' buffers (or none): their colours
+  /// extras: the mesh contacts' and sutures' buffers (each or none): they
   /// ride in every sweep; the residual checks measure the bodies'
   /// constraints only.
   static Result<std::unique_ptr<SolveStepper>> create(Device& device, const CompiledScene& scene,
                                                       const XpbdBuffers& buffers, const SolverSettings& solver,
                                                       const std::array<double, 3>& gravity, const StatsPlan& stats,
-                                                      const MeshContactBuffers* mesh_contacts = nullptr,
-                                                      bool per_substep = false);
+                                                      SweepExtras extras = {}, bool per_substep = false);
   /// Destroys the programs and builds them again (same buffers for the
   /// checks and the accelerator): after the mesh contacts outgrew their
   /// buffers or colours.
   Status rebuild(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
-                 const std::array<double, 3>& gravity, const StatsPlan& stats,
-                 const MeshContactBuffers* mesh_contacts);
+                 const std::array<double, 3>& gravity, const StatsPlan& stats, SweepExtras extras);
 
   /// Runs one frame; fills stats.sweeps, stop, checked_residual,
   /// residual_checks and the device times (summed over the programs run).
@@ -67,8 +65,7 @@ class SolveStepper {
 
  private:
   Status build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
-               const std::array<double, 3>& gravity, const StatsPlan& stats,
-               const MeshContactBuffers* mesh_contacts);
+               const std::array<double, 3>& gravity, const StatsPlan& stats, SweepExtras extras);
   Status run(Device& device, ProgramHandle program, DeviceTimes& times, bool first);
   Status run_hook(Device& device, SubstepHook* hook, int s, FrameStats& stats, std::uint64_t& sweeps);
 

@@ -1,0 +1,99 @@
+/* suture_params.h — needles and sutures in the solver (issue 13, part 4):
+ * the rows the host keeps (src/runtime/sutures.cpp) and the kernel that
+ * solves them, shared by every kernel language (see sinew_lang.h).
+ * Units: SI (metres, kilograms, seconds); compliance [m/N].
+ *
+ * After Moore, Scheirich et al., "The interactive medical simulation toolkit
+ * (iMSTK): an open source platform for surgical simulation", Frontiers in
+ * Virtual Reality 4, 2023, section 2.5 (needle puncture and suture thread
+ * constraints), written as xPBD constraints (Macklin, Müller,
+ * Chentanez, "XPBD", MIG 2016) with position-level Coulomb friction
+ * (Macklin et al., "Unified Particle Physics for Real-Time Applications",
+ * SIGGRAPH 2014, eq. 24-25).
+ *
+ * A needle is a rigid polyline, kinematic: the host writes each of its
+ * points in world space at the frame's start and end, and the kernel takes
+ * the point at fraction t = substep_end of the frame as the lerp of the two
+ * (a rotation's arc replaced by its chord: for a needle of radius R turning
+ * by theta in a frame, at most R theta^2 / 8 off, 0.015 mm for 8 mm and 7
+ * degrees). Its tail is its first point, its tip its last; d_tip is the unit
+ * direction of its last segment, d_tail of its first.
+ *
+ * A row joins the tissue point p = wa x_a + wb x_b + wc x_c (a surface
+ * triangle, barycentric weights) to the needle or its thread. Kinds:
+ *   1 tie          the thread's first vertex x_a held at the needle's
+ *                  tail q: C = |x_a - q| = 0;
+ *   2 tip contact  the tip pushing a surface before it punctures it:
+ *                  C = d_tip . (p - tip) >= 0, the tissue kept ahead of
+ *                  the tip (the host turns it into a puncture when its
+ *                  force passes NeedleDesc::puncture_force);
+ *   3 puncture     the tissue point held on the needle's curve: q its
+ *                  closest point on the polyline, C = |p - q| = 0, gradient
+ *                  (p - q) / |p - q| (the iMSTK paper's); the needle slides
+ *                  through it freely. When q is the tail and p lies behind
+ *                  it (d_tail . (p - tail) < 0) the needle has passed: with
+ *                  a thread the row becomes a thread puncture on the
+ *                  thread's first segment, without one it ends (kind 0);
+ *   4 thread       the tissue point held on the thread: q = (1 - s) x_i +
+ *                  s x_{i+1} on segment i (s its closest point, the
+ *                  segment followed to a neighbour when s leaves [0, 1]),
+ *                  C = |p - q| = 0, with friction along the segment's
+ *                  tangent: the relative slide over the substep is held
+ *                  while its multiplier stays within mu_s |lambda|, else
+ *                  limited to mu_k |lambda|. The thread's last vertex is a
+ *                  knot: it stops at the puncture (s <= 1 on the last
+ *                  segment).
+ * With W = sum_k w_k c_k^2 (c_k the coefficients of the gradient) and
+ * alpha~ = compliance / h^2 every row steps lambda by (-C - alpha~ lambda)
+ * / (W + alpha~) (kind 2 keeping lambda >= 0).
+ *
+ * ------------------------------------------------------------ xpbd_sutures
+ * One work item does every row in order (Gauss-Seidel: rows share
+ * particles through threads that slide, so they are not coloured; a scene
+ * has a few dozen at most). Dispatched after the bodies' constraints and
+ * the mesh contacts in every sweep.
+ * bindings:
+ *   0 position float4 (xyz, w = inverse mass) [in/out]
+ *   1 previous position float4 (the substep's start) [in]
+ *   2 table uint [in]: word 0 the rows; then per needle (first point, points)
+ *   3 needles float4 [in]: per needle (compliance, mu_s, mu_k, 0)
+ *   4 curve float4 [in]: per needle point, its world position at the
+ *     frame's start and at its end (2 per point)
+ *   5 thread slots uint [in]: the device slots of the threads' vertices
+ *   6 rows uint4 [in/out]: 2 per row, (kind, needle, a, b), (c, first
+ *     thread slot, thread vertices, segment)
+ *   7 weights float4 [in/out]: per row (wa, wb, wc, s)
+ *   8 lambda float4 [in/out]: 3 per row: (lambda, lambda_t, 0, 0); the
+ *     impulse vector lambda n + lambda_t t the row gave the tissue (or the
+ *     tied thread vertex) in this substep [kg m]; the sum of the frame's
+ *     earlier substeps' (reset like mesh_contact_params.h's lambda sum).
+ *     (sum + last) / h is the frame's impulse [N s]. */
+#ifndef SINEW_SUTURE_PARAMS_H
+#define SINEW_SUTURE_PARAMS_H
+
+#include "sinew_lang.h"
+
+#define SINEW_SUTURE_DEAD 0u
+#define SINEW_SUTURE_TIE 1u
+#define SINEW_SUTURE_TIP 2u
+#define SINEW_SUTURE_PUNCTURE 3u
+#define SINEW_SUTURE_THREAD 4u
+/* How many segments a thread puncture may move along its thread per solve. */
+#define SINEW_SUTURE_MAX_MOVES 4u
+
+#ifdef __cplusplus
+namespace sinew::kernels {
+#endif
+
+SINEW_STRUCT_BEGIN(SutureParams)
+  float inv_h2;       /* 1 / h^2 [1/s^2] */
+  uint reset_lambda;  /* a substep's first sweep: 1, the frame's first: 2; else 0 */
+  float substep_end;  /* fraction of the frame done at the end of this substep, in (0, 1] */
+  uint pad0;          /* 16-byte size */
+SINEW_STRUCT_END(SutureParams)
+
+#ifdef __cplusplus
+}  /* namespace sinew::kernels */
+#endif
+
+#endif /* SINEW_SUTURE_PARAMS_H */

@@ -1,0 +1,359 @@
+// sutures.cpp — needles and the threads they pull through tissue (issue 13,
+// part 4); see sutures.h, and kernels/shared/suture_params.h for the rows.
+// After Moore et al., "The interactive medical simulation toolkit (iMSTK)",
+// Frontiers in Virtual Reality 2023, section 2.5.
+#include "runtime/sutures.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <tuple>
+
+#include "suture_params.h"
+
+namespace sinew {
+namespace {
+
+using math::Vec3;
+
+// How far behind the tip its path starts, and beyond its end it reaches
+// [m]: a surface the tip holds (its contact keeps it at the tip, up to the
+// sweeps' slop) is found again in the next frame.
+constexpr double kTipReach = 2e-4;
+// How far ahead of the needle's tip a puncture's tissue point may be
+// before the needle counts as pulled out of it [m].
+constexpr double kPulledOut = 5e-4;
+
+Vec3 unit(const Vec3& v) {
+  const double n = math::norm(v);
+  return n > 0.0 ? math::mul(v, 1.0 / n) : Vec3{0.0, 0.0, 0.0};
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const CompiledScene& compiled,
+                                                 Device& device) {
+  auto out = std::unique_ptr<Sutures>(new Sutures());
+  const auto& slot = compiled.order.device_of;
+  for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
+    const TetMesh& mesh = scene.tet_bodies[b].mesh;
+    const std::uint32_t first = compiled.tet_body_first_particle[b];
+    // Each face's opposite vertex in its tet: a boundary face has one tet.
+    std::map<std::array<std::uint32_t, 3>, std::uint32_t> opposite;
+    for (const auto& t : mesh.tets)
+      for (int k = 0; k < 4; ++k) {
+        std::array<std::uint32_t, 3> face{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
+        std::sort(face.begin(), face.end());
+        opposite[face] = t[k];
+      }
+    Surface s;
+    s.kind = BodyKind::tet;
+    s.body = static_cast<std::uint32_t>(b);
+    for (const auto& f : extract_boundary_surface(mesh).triangles) {
+      std::array<std::uint32_t, 3> key{f[0], f[1], f[2]};
+      std::sort(key.begin(), key.end());
+      s.triangles.push_back({slot[first + f[0]], slot[first + f[1]], slot[first + f[2]]});
+      s.opposite.push_back(slot[first + opposite.at(key)]);
+    }
+    out->surfaces_.push_back(std::move(s));
+  }
+  for (std::size_t b = 0; b < scene.tri_bodies.size(); ++b) {
+    const std::uint32_t first = compiled.tri_body_first_particle[b];
+    Surface s;
+    s.kind = BodyKind::tri;
+    s.body = static_cast<std::uint32_t>(b);
+    for (const auto& f : scene.tri_bodies[b].mesh.triangles) {
+      s.triangles.push_back({slot[first + f[0]], slot[first + f[1]], slot[first + f[2]]});
+      s.opposite.push_back(kNone);
+    }
+    out->surfaces_.push_back(std::move(s));
+  }
+  for (std::size_t i = 0; i < scene.needles.size(); ++i) {
+    Needle n;
+    n.desc = scene.needles[i];
+    n.position_start = n.position_end = n.desc.position;
+    n.rotation_start = n.rotation_end = n.desc.rotation;
+    if (n.desc.thread >= 0) {
+      const auto body = static_cast<std::size_t>(n.desc.thread);
+      const std::uint32_t first = compiled.line_body_first_particle[body];
+      n.thread_first = static_cast<std::uint32_t>(out->slots_.size());
+      n.thread_vertices = static_cast<std::uint32_t>(scene.line_bodies[body].vertices.size());
+      for (std::uint32_t v = 0; v < n.thread_vertices; ++v) out->slots_.push_back(slot[first + v]);
+      Row tie;
+      const std::uint32_t tail = out->slots_[n.thread_first];
+      tie.words = {SINEW_SUTURE_TIE, static_cast<std::uint32_t>(i), tail, tail, tail, n.thread_first,
+                   n.thread_vertices, 0};
+      tie.weights = {1.0f, 0.0f, 0.0f, 0.0f};
+      n.rows.push_back(tie);
+    }
+    out->curve_points_ += static_cast<std::uint32_t>(n.desc.curve.size());
+    out->needles_.push_back(std::move(n));
+  }
+  out->positions_.resize(compiled.positions.size() * 4);
+  out->rows_capacity_ = static_cast<std::uint32_t>(out->needles_.size()) * kRowsPerNeedle;
+  SutureBuffers& b = out->buffers_;
+  const std::size_t needles = out->needles_.size();
+  for (auto [handle, bytes, label] :
+       {std::tuple{&b.table, (1 + 2 * needles) * 4, "suture table"}, std::tuple{&b.needles, needles * 16, "needles"},
+        std::tuple{&b.curve, std::size_t{out->curve_points_} * 32, "needle curves"},
+        std::tuple{&b.slots, std::max<std::size_t>(out->slots_.size(), 1) * 4, "thread slots"},
+        std::tuple{&b.rows, std::size_t{out->rows_capacity_} * 32, "suture rows"},
+        std::tuple{&b.weights, std::size_t{out->rows_capacity_} * 16, "suture weights"},
+        std::tuple{&b.lambda, std::size_t{out->rows_capacity_} * 48, "suture lambdas"}}) {
+    auto made = device.create_buffer(std::max<std::size_t>(bytes, 16), label);
+    if (!made) return made.error();
+    *handle = *made;
+  }
+  if (!out->slots_.empty())
+    if (Status s = device.write_buffer(b.slots, 0, out->slots_.data(), out->slots_.size() * 4); !s) return s.error();
+  std::vector<float> params;
+  for (const Needle& n : out->needles_)
+    params.insert(params.end(), {float(n.desc.compliance), float(n.desc.thread_static_friction),
+                                 float(n.desc.thread_dynamic_friction), 0.0f});
+  if (Status s = device.write_buffer(b.needles, 0, params.data(), params.size() * 4); !s) return s.error();
+  return out;
+}
+
+Status Sutures::set_pose(std::size_t index, const Vec3& position, const math::Quat& rotation) {
+  const std::string name = "needle " + std::to_string(index);
+  if (index >= needles_.size())
+    return Error(ErrorCode::bad_parameter,
+                 name + " does not exist (the scene has " + std::to_string(needles_.size()) + ")");
+  if (!math::finite(position) || !math::finite(rotation))
+    return Error(ErrorCode::bad_parameter, name + ": the pose must be finite");
+  if (std::abs(math::qnorm(rotation) - 1.0) > 1e-6)
+    return Error(ErrorCode::bad_parameter, name + ": the rotation must be a unit quaternion (its norm is " +
+                                               std::to_string(math::qnorm(rotation)) + ")");
+  needles_[index].position_end = position;
+  needles_[index].rotation_end = rotation;
+  return {};
+}
+
+std::vector<Vec3> Sutures::curve_at(const Needle& n, bool end) const {
+  std::vector<Vec3> out;
+  for (const auto& p : n.desc.curve)
+    out.push_back(math::add(end ? n.position_end : n.position_start,
+                            math::rotate(end ? n.rotation_end : n.rotation_start, p)));
+  return out;
+}
+
+Vec3 Sutures::position_of(std::uint32_t slot) const {
+  const std::size_t at = std::size_t{slot} * 4;
+  return {positions_[at], positions_[at + 1], positions_[at + 2]};
+}
+
+Vec3 Sutures::point_of(const Row& row) const {
+  Vec3 p{0.0, 0.0, 0.0};
+  for (int k = 0; k < 3; ++k)
+    p = math::add(p, math::mul(position_of(row.words[2 + k]), double(row.weights[k])));
+  return p;
+}
+
+bool Sutures::first_crossing(const Vec3& a, const Vec3& b, bool entering, Needle& needle, Row& row) {
+  const Vec3 dir = math::sub(b, a);
+  Vec3 lo = a, hi = a;
+  for (int k = 0; k < 3; ++k) lo[k] = std::min(a[k], b[k]), hi[k] = std::max(a[k], b[k]);
+  double best = 2.0;
+  for (std::uint32_t s = 0; s < surfaces_.size(); ++s) {
+    const Surface& surface = surfaces_[s];
+    if (!entering && surface.kind != BodyKind::tet) continue;  // a membrane has no inside
+    for (std::uint32_t t = 0; t < surface.triangles.size(); ++t) {
+      const auto& tri = surface.triangles[t];
+      const Vec3 A = position_of(tri[0]), B = position_of(tri[1]), C = position_of(tri[2]);
+      bool apart = false;
+      for (int k = 0; k < 3; ++k)
+        apart |= std::max({A[k], B[k], C[k]}) < lo[k] || std::min({A[k], B[k], C[k]}) > hi[k];
+      if (apart) continue;
+      // The hole a puncture made: its triangle and those sharing a vertex
+      // with it (the tip leaves through them just after puncturing).
+      const bool held = std::any_of(needle.rows.begin(), needle.rows.end(), [&](const Row& r) {
+        if (r.surface != s || r.words[0] == SINEW_SUTURE_TIP || r.words[0] == SINEW_SUTURE_TIE) return false;
+        const auto& h = surface.triangles[r.triangle];
+        for (std::uint32_t v : tri)
+          if (v == h[0] || v == h[1] || v == h[2]) return true;
+        return false;
+      });
+      if (held) continue;
+      const Vec3 e1 = math::sub(B, A), e2 = math::sub(C, A);
+      const Vec3 n = math::cross(e1, e2);  // outward on a tet body's surface
+      const double longest = std::max({math::dot(e1, e1), math::dot(e2, e2), math::dot(math::sub(C, B), math::sub(C, B))});
+      const double along = math::dot(dir, n);
+      if (surface.kind == BodyKind::tet && (entering ? along >= 0.0 : along <= 0.0)) continue;
+      if (along == 0.0) continue;
+      const double u = math::dot(math::sub(A, a), n) / along;
+      if (!(u >= 0.0 && u <= 1.0) || u >= best) continue;
+      // The segment meets the triangle's plane within its box: a triangle
+      // with no area or turned inside out cannot be punctured.
+      if (!(math::norm(n) > 1e-6 * longest)) {
+        ++needle.refused_degenerate;
+        continue;
+      }
+      const Vec3 x = math::add(a, math::mul(dir, u));
+      const Vec3 v2 = math::sub(x, A);
+      const double d00 = math::dot(e1, e1), d01 = math::dot(e1, e2), d11 = math::dot(e2, e2);
+      const double d20 = math::dot(v2, e1), d21 = math::dot(v2, e2);
+      const double denominator = d00 * d11 - d01 * d01;
+      const double wb = (d11 * d20 - d01 * d21) / denominator, wc = (d00 * d21 - d01 * d20) / denominator;
+      const double wa = 1.0 - wb - wc;
+      if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
+      if (surface.opposite[t] != kNone && math::dot(n, math::sub(position_of(surface.opposite[t]), A)) >= 0.0) {
+        ++needle.refused_inverted;
+        continue;
+      }
+      best = u;
+      row.surface = s;
+      row.triangle = t;
+      row.words[2] = tri[0], row.words[3] = tri[1], row.words[4] = tri[2];
+      row.weights = {float(wa), float(wb), float(wc), 0.0f};
+    }
+  }
+  return best <= 1.0;
+}
+
+Status Sutures::before_frame(Device& device, const XpbdBuffers& scene_buffers) {
+  read_back_bytes_ = 0;
+  if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
+  read_back_bytes_ += positions_.size() * 4;
+  for (std::size_t i = 0; i < needles_.size(); ++i) {
+    Needle& n = needles_[i];
+    std::erase_if(n.rows, [](const Row& r) { return r.words[0] == SINEW_SUTURE_TIP; });
+    const std::vector<Vec3> start = curve_at(n, false), end = curve_at(n, true);
+    const Vec3 d0 = unit(math::sub(start.back(), start[start.size() - 2]));
+    const Vec3 d1 = unit(math::sub(end.back(), end[end.size() - 2]));
+    Row tip;
+    if (first_crossing(math::sub(start.back(), math::mul(d0, kTipReach)), math::add(end.back(), math::mul(d1, kTipReach)),
+                       true, n, tip)) {
+      tip.words[0] = SINEW_SUTURE_TIP;
+      tip.words[1] = static_cast<std::uint32_t>(i);
+      if (n.rows.size() >= kRowsPerNeedle)
+        return Error(ErrorCode::capacity_exceeded, "needle " + std::to_string(i) + " holds more than " +
+                                                       std::to_string(kRowsPerNeedle) + " punctures");
+      n.rows.push_back(tip);
+    }
+  }
+  return upload(device);
+}
+
+Status Sutures::upload(Device& device) {
+  std::vector<std::uint32_t> table{0};
+  std::vector<std::uint32_t> words;
+  std::vector<float> weights, curve;
+  std::uint32_t first_point = 0;
+  for (const Needle& n : needles_) {
+    table.insert(table.end(), {first_point, static_cast<std::uint32_t>(n.desc.curve.size())});
+    first_point += static_cast<std::uint32_t>(n.desc.curve.size());
+    const std::vector<Vec3> start = curve_at(n, false), end = curve_at(n, true);
+    for (std::size_t k = 0; k < start.size(); ++k)
+      curve.insert(curve.end(), {float(start[k][0]), float(start[k][1]), float(start[k][2]), 0.0f, float(end[k][0]),
+                                 float(end[k][1]), float(end[k][2]), 0.0f});
+    for (const Row& r : n.rows) {
+      words.insert(words.end(), r.words.begin(), r.words.end());
+      weights.insert(weights.end(), r.weights.begin(), r.weights.end());
+    }
+  }
+  table[0] = static_cast<std::uint32_t>(weights.size() / 4);
+  if (Status s = device.write_buffer(buffers_.table, 0, table.data(), table.size() * 4); !s) return s;
+  if (Status s = device.write_buffer(buffers_.curve, 0, curve.data(), curve.size() * 4); !s) return s;
+  if (table[0] == 0) return {};
+  if (Status s = device.write_buffer(buffers_.rows, 0, words.data(), words.size() * 4); !s) return s;
+  if (Status s = device.write_buffer(buffers_.weights, 0, weights.data(), weights.size() * 4); !s) return s;
+  const std::vector<float> zeros(std::size_t{table[0]} * 12, 0.0f);
+  return device.write_buffer(buffers_.lambda, 0, zeros.data(), zeros.size() * 4);
+}
+
+Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame) {
+  std::size_t rows = 0;
+  for (const Needle& n : needles_) rows += n.rows.size();
+  std::vector<std::uint32_t> words(rows * 8);
+  std::vector<float> weights(rows * 4), lambda(rows * 12);
+  if (rows > 0) {
+    if (Status s = device.read_buffer(buffers_.rows, 0, words.data(), words.size() * 4); !s) return s;
+    if (Status s = device.read_buffer(buffers_.weights, 0, weights.data(), weights.size() * 4); !s) return s;
+    if (Status s = device.read_buffer(buffers_.lambda, 0, lambda.data(), lambda.size() * 4); !s) return s;
+    read_back_bytes_ += rows * 96;
+  }
+  if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
+  read_back_bytes_ += positions_.size() * 4;
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < needles_.size(); ++i) {
+    Needle& n = needles_[i];
+    const std::vector<Vec3> start = curve_at(n, false), end = curve_at(n, true);
+    const Vec3 tip = end.back(), d = unit(math::sub(end.back(), end[end.size() - 2]));
+    n.tip_force = 0.0;
+    for (Row& r : n.rows) {
+      std::copy_n(&words[at * 8], 8, r.words.begin());
+      std::copy_n(&weights[at * 4], 4, r.weights.begin());
+      const float* l = &lambda[at * 12];
+      ++at;
+      if (r.words[0] == SINEW_SUTURE_TIP) {
+        // The frame's impulse on the tissue, (sum + last) / h [N s], averaged over the frame.
+        const Vec3 impulse{double(l[8]) + l[4], double(l[9]) + l[5], double(l[10]) + l[6]};
+        n.tip_force = math::dot(impulse, d) / (h * frame);
+        if (n.tip_force < n.desc.puncture_force) continue;
+        const auto& tri = surfaces_[r.surface].triangles[r.triangle];
+        const Vec3 A = position_of(tri[0]);
+        const Vec3 normal = unit(math::cross(math::sub(position_of(tri[1]), A), math::sub(position_of(tri[2]), A)));
+        // The angle to the inward normal (a membrane's: the side the tip is on).
+        const double cosine = surfaces_[r.surface].kind == BodyKind::tet ? -math::dot(d, normal)
+                                                                         : std::abs(math::dot(d, normal));
+        if (cosine < std::cos(n.desc.max_puncture_angle)) {
+          ++n.refused_angle;
+          continue;
+        }
+        r.words[0] = SINEW_SUTURE_PUNCTURE;
+        r.words[5] = n.thread_first, r.words[6] = n.thread_vertices;
+      } else if (r.words[0] == SINEW_SUTURE_PUNCTURE) {
+        // Pulled back out: the tissue point ahead of the tip, past its last segment.
+        const Vec3 p = point_of(r);
+        const Vec3 e = math::sub(end.back(), end[end.size() - 2]);
+        const double u = math::dot(math::sub(p, end[end.size() - 2]), e) / math::dot(e, e);
+        if (u > 1.0 && math::dot(d, math::sub(p, tip)) > kPulledOut) r.words[0] = SINEW_SUTURE_DEAD;
+      }
+    }
+    std::erase_if(n.rows, [](const Row& r) { return r.words[0] == SINEW_SUTURE_DEAD; });
+    // Leaving a tet body: its surface crossed from inside by the tip's path.
+    Row exit;
+    if (first_crossing(start.back(), end.back(), false, n, exit)) {
+      if (n.rows.size() >= kRowsPerNeedle)
+        return Error(ErrorCode::capacity_exceeded, "needle " + std::to_string(i) + " holds more than " +
+                                                       std::to_string(kRowsPerNeedle) + " punctures");
+      exit.words[0] = SINEW_SUTURE_PUNCTURE;
+      exit.words[1] = static_cast<std::uint32_t>(i);
+      exit.words[5] = n.thread_first, exit.words[6] = n.thread_vertices;
+      exit.exit = true;
+      n.rows.push_back(exit);
+    }
+    n.position_start = n.position_end;
+    n.rotation_start = n.rotation_end;
+  }
+  return {};
+}
+
+Simulation::NeedleState Sutures::state(std::size_t index) const {
+  const Needle& n = needles_[index];
+  Simulation::NeedleState out;
+  out.position = n.position_start;
+  out.rotation = n.rotation_start;
+  out.tip_force = n.tip_force;
+  out.refused_degenerate = n.refused_degenerate;
+  out.refused_inverted = n.refused_inverted;
+  out.refused_angle = n.refused_angle;
+  for (const Row& r : n.rows) {
+    if (r.words[0] == SINEW_SUTURE_TIP) out.pushing = true;
+    if (r.words[0] != SINEW_SUTURE_PUNCTURE && r.words[0] != SINEW_SUTURE_THREAD) continue;
+    Simulation::Puncture p;
+    p.body_kind = surfaces_[r.surface].kind;
+    p.body = surfaces_[r.surface].body;
+    p.triangle = r.triangle;
+    p.weights = {r.weights[0], r.weights[1], r.weights[2]};
+    p.exit = r.exit;
+    p.on_thread = r.words[0] == SINEW_SUTURE_THREAD;
+    p.thread_segment = r.words[7];
+    p.thread_s = r.weights[3];
+    out.punctures.push_back(p);
+  }
+  return out;
+}
+
+}  // namespace sinew

@@ -1,0 +1,110 @@
+// sutures.h — needles and the threads they pull through tissue (issue 13,
+// part 4; SceneDesc::needles): the host side of the rows that
+// kernels/shared/suture_params.h describes and xpbd_sutures solves in every
+// sweep.
+//
+// Every frame, before it: the positions are read back; each needle's tip
+// path over the frame (its tip at the frame's start to its tip at the end)
+// is tested against the punctureable surfaces (tet bodies' boundaries, tri
+// bodies), and the first triangle it meets from outside gets a tip contact
+// row (kind 2), which keeps the tissue ahead of the tip. The needles'
+// points at the frame's start and end and the rows are uploaded.
+// After it: the rows come back. A tip contact whose frame-average push
+// passed NeedleDesc::puncture_force, with the tip within
+// max_puncture_angle of the inward normal, becomes a puncture (kind 3) at
+// the same tissue point; a tip path that left a tet body through its
+// surface makes an exit puncture where it crossed. The kernel itself turns
+// a puncture the needle's tail has passed into a thread puncture (kind 4).
+// Punctures the needle was pulled back out of end.
+//
+// Why the detection is on the host: a needle is one polyline and its tip
+// path one segment per frame, tested against the surfaces' triangles in a
+// linear pass (60,000 triangles: a fraction of a millisecond); the read-back
+// of the positions is the cost (16 bytes per particle per frame).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "compiler/scene_compiler.h"
+#include "math/vec3.h"
+#include "program/xpbd_program.h"
+#include "sinew/simulation.h"
+
+namespace sinew {
+
+class Sutures {
+ public:
+  /// Most rows a needle may hold (its tie, tip contact and punctures).
+  static constexpr std::uint32_t kRowsPerNeedle = 32;
+
+  /// [in] scene: its needles (checked), surfaces and threads; compiled: the
+  /// particles' device order. Creates the buffers on `device`.
+  static Result<std::unique_ptr<Sutures>> create(const SceneDesc& scene, const CompiledScene& compiled, Device& device);
+
+  [[nodiscard]] const SutureBuffers& buffers() const { return buffers_; }
+
+  /// The pose needle `index` reaches at the end of the next frame.
+  Status set_pose(std::size_t index, const math::Vec3& position, const math::Quat& rotation);
+
+  /// Before a frame: reads the positions, finds the tips' contacts,
+  /// uploads the needles and the rows.
+  Status before_frame(Device& device, const XpbdBuffers& scene_buffers);
+  /// After it: reads the rows back, makes and ends punctures. [in] h: the
+  /// substep [s]; frame: the frame's length [s].
+  Status after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame);
+
+  [[nodiscard]] Simulation::NeedleState state(std::size_t index) const;
+  [[nodiscard]] std::size_t needles() const { return needles_.size(); }
+  /// Bytes read from the device in the last frame.
+  [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
+
+ private:
+  // A surface a tip can puncture: its triangles (device slots), the
+  // opposite vertex of each one's tet (tet bodies; kNone for tri bodies,
+  // which are two-sided).
+  struct Surface {
+    BodyKind kind = BodyKind::tet;
+    std::uint32_t body = 0;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::uint32_t> opposite;
+  };
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+  struct Row {
+    std::array<std::uint32_t, 8> words{};  // rows binding: (kind, needle, a, b), (c, first slot, vertices, segment)
+    std::array<float, 4> weights{};        // (wa, wb, wc, s)
+    std::uint32_t surface = kNone, triangle = 0;
+    bool exit = false;
+  };
+  struct Needle {
+    NeedleDesc desc;
+    math::Vec3 position_start{}, position_end{};
+    math::Quat rotation_start{1, 0, 0, 0}, rotation_end{1, 0, 0, 0};
+    std::uint32_t thread_first = 0, thread_vertices = 0;  // into the slots binding (0 vertices: no thread)
+    std::vector<Row> rows;                                // tie first, then the tip contact and punctures
+    double tip_force = 0.0;
+    std::uint32_t refused_degenerate = 0, refused_inverted = 0, refused_angle = 0;
+  };
+  // The needle's points in the world at its start (end = false) or end pose.
+  std::vector<math::Vec3> curve_at(const Needle& n, bool end) const;
+  math::Vec3 position_of(std::uint32_t slot) const;
+  math::Vec3 point_of(const Row& row) const;
+  // Where the segment a -> b first crosses a surface triangle in direction
+  // `entering` (true: from outside, false: from inside; tri bodies either
+  // way), skipping triangles the needle holds already. [out] row: its
+  // triangle and weights. Counts the triangles refused on `needle`.
+  bool first_crossing(const math::Vec3& a, const math::Vec3& b, bool entering, Needle& needle, Row& row);
+  Status upload(Device& device);
+
+  std::vector<Surface> surfaces_;
+  std::vector<Needle> needles_;
+  std::vector<std::uint32_t> slots_;  // the threads' vertices' device slots
+  std::vector<float> positions_;      // device order, xyzw, the last read
+  SutureBuffers buffers_;
+  std::uint32_t rows_capacity_ = 0, curve_points_ = 0;
+  std::uint64_t read_back_bytes_ = 0;
+};
+
+}  // namespace sinew

@@ -1,0 +1,73 @@
+// suture_scenes.h — the scenes of the needle and suture tests (issue 13,
+// part 4; tests/suture_test.cpp), shared with their benchmark
+// (benchmarks/suture_benchmark.cpp): two tissue pads either side of a cut
+// and a curved needle, with its thread, driven through both.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "sinew/mesh.h"
+#include "sinew/simulation.h"
+
+namespace sinew::test {
+
+// Two soft pads (neo-Hookean, E = 30 kPa, nu = 0.45; 12 x 10 x 12 mm of
+// 2 mm cells, 1,080 tets each) either side of a cut `gap` wide along the
+// z axis (pad A at x < -gap / 2, pad B at x > gap / 2; tops at y = 0),
+// each pinned at its far end (x = -/+ (gap / 2 + 12 mm)). Gravity on, 60
+// frames per second of 8 substeps with 10 sweeps.
+// The needle: a half circle of radius R = 8 mm (17 points), its centre
+// 2 mm above the cut, in the z = 0 plane. needle_pose(a) turns it by `a`
+// about its centre (the z axis): at 0 its tip, at (-R, 2 mm) and pointing
+// down, sits 2 mm over pad A; turning by pi drives it down through A, out of
+// A's cut face, across the cut, into B's and up out of B's top at
+// (R, 2 mm); by 2 pi its tail has followed. Its thread: 60 mm of 1 mm
+// segments from the needle's tail, straight up, its last vertex the knot.
+struct SuturePads {
+  static constexpr double radius = 0.008, centre_height = 0.002, cell = 0.002;
+  static constexpr int thread_segments = 60;
+  static SceneDesc scene(double gap = 0.004) {
+    SceneDesc scene;
+    scene.solver.time_step = 1.0 / 60.0;
+    scene.solver.substeps = 8;
+    scene.solver.iterations = 10;
+    for (int side = 0; side < 2; ++side) {
+      const double x0 = side == 0 ? -gap / 2 - 6 * cell : gap / 2;
+      auto mesh = make_tet_grid({.nx = 6, .ny = 5, .nz = 6, .origin = {x0, -5 * cell, -3 * cell},
+                                 .cell_size = {cell, cell, cell}});
+      TetBodyDesc pad;
+      pad.mesh = *mesh;
+      (void)pad.set_material(TetMaterial::neo_hookean, 3e4, 0.45);
+      pad.velocity_damping = 5.0;
+      const int far = side == 0 ? 0 : 6;
+      for (int k = 0; k <= 6; ++k)
+        for (int j = 0; j <= 5; ++j) pad.pinned.push_back(static_cast<std::uint32_t>(far + 7 * (j + 6 * k)));
+      scene.tet_bodies.push_back(pad);
+    }
+    NeedleDesc needle;
+    for (int i = 0; i <= 16; ++i) {
+      const double phi = M_PI * i / 16;  // tail at phi = 0, tip at pi
+      needle.curve.push_back({radius * std::cos(phi), radius * std::sin(phi), 0.0});
+    }
+    needle.position = {0.0, centre_height, 0.0};
+    needle.puncture_force = 0.01;
+    LineBodyDesc thread;
+    for (int i = 0; i <= thread_segments; ++i) {
+      thread.vertices.push_back({radius, centre_height + 0.001 * i, 0.0});
+      thread.masses.push_back(1e-5);
+      if (i < thread_segments)
+        thread.segments.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)});
+    }
+    thread.bending_compliance = 10.0;
+    thread.velocity_damping = 5.0;
+    scene.line_bodies.push_back(thread);
+    needle.thread = 0;
+    scene.needles.push_back(needle);
+    return scene;
+  }
+  // The needle turned by a [rad] about its centre (the z axis).
+  static std::array<double, 4> needle_rotation(double a) { return {std::cos(a / 2), 0.0, 0.0, std::sin(a / 2)}; }
+};
+
+}  // namespace sinew::test
