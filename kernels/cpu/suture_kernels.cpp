@@ -188,6 +188,21 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       lambda_n = lambda_n + dl;
     }
     float4 tangent = zero;
+    if (r[0].x == SINEW_SUTURE_TIP && lambda_n > 0.0f) {
+      // A pushing tip holds the tissue point on its axis (it catches the
+      // tissue rather than slide over it): the point's offset across the
+      // tip's direction goes to 0.
+      const float4 tip = curve_point(b, n, points - 1, t);
+      const float4 ahead = tissue_point(b.x, v, w) - tip;
+      const float4 across = ahead - dot3(dir, ahead) * dir;
+      const float offset = std::sqrt(dot3(across, across));
+      if (offset > 0.0f) {
+        tangent = (1.0f / offset) * across;
+        const float dl = (-offset - alpha * lambda_t) / (weight + alpha);
+        apply(b, v, c, count, tangent, dl);
+        lambda_t = lambda_t + dl;
+      }
+    }
     if (r[0].x == SINEW_SUTURE_THREAD) {
       // Friction: the tissue point's slide along the thread relative to the
       // thread's point, since the substep's start.

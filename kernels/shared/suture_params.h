@@ -25,8 +25,10 @@
  *                  tail q: C = |x_a - q| = 0;
  *   2 tip contact  the tip pushing a surface before it punctures it:
  *                  C = d_tip . (p - tip) >= 0, the tissue kept ahead of
- *                  the tip (the host turns it into a puncture when its
- *                  force passes NeedleDesc::puncture_force);
+ *                  the tip; while it pushes (lambda > 0) the tip also
+ *                  catches the tissue: C_t = |(p - tip) across d_tip| = 0
+ *                  (multiplier lambda_t). The host turns it into a
+ *                  puncture when its force passes puncture_force;
  *   3 puncture     the tissue point held on the needle's curve: q its
  *                  closest point on the polyline, C = |p - q| = 0, gradient
  *                  (p - q) / |p - q| (the iMSTK paper's); the needle slides
