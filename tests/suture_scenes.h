@@ -4,6 +4,7 @@
 // and a curved needle, with its thread, driven through both.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -69,6 +70,64 @@ struct SuturePads {
   }
   // The needle turned by a [rad] about its centre (the z axis).
   static std::array<double, 4> needle_rotation(double a) { return {std::cos(a / 2), 0.0, 0.0, std::sin(a / 2)}; }
+
+  // The stitch, frame by frame: the needle turns to 2 pi - 0.2 (its tail
+  // just out of B's top) over `turn_frames`, then is pulled away from the
+  // cut (up and towards +x, 2:1) at `pull_speed` [m per frame] up to
+  // `pulled_most` [m], then tugged: 3 mm back and forth every 2 s.
+  static constexpr int turn_frames = 110;
+  static constexpr double last_angle = 2.0 * M_PI - 0.2, pull_speed = 5e-4, pulled_most = 0.06;
+  static double pulled(int f) {
+    if (f < turn_frames) return 0.0;
+    const double straight = pull_speed * (f - turn_frames);
+    if (straight <= pulled_most) return straight;
+    const int tug = f - turn_frames - static_cast<int>(pulled_most / pull_speed);
+    return pulled_most - 0.0015 * (1.0 - std::cos(2.0 * M_PI * tug / 120.0));
+  }
+  static Status drive(Simulation& sim, int f) {
+    const double a = std::min(last_angle, last_angle * (f + 1) / turn_frames);
+    const double d = pulled(f);
+    return sim.set_needle_pose(0, {0.5 * d, centre_height + d, 0.0}, needle_rotation(a));
+  }
 };
+
+// A puncture's tissue point (xyzw positions in the user's order).
+inline std::array<double, 3> puncture_point(const SceneDesc& scene, const Simulation& sim,
+                                            const Simulation::Puncture& p, const std::vector<float>& x) {
+  std::array<std::uint32_t, 3> tri{};
+  std::uint32_t first = 0;
+  if (p.body_kind == BodyKind::tet) {
+    tri = extract_boundary_surface(scene.tet_bodies[p.body].mesh).triangles[p.triangle];
+    first = sim.info().tet_body_first_particle[p.body];
+  } else {
+    tri = scene.tri_bodies[p.body].mesh.triangles[p.triangle];
+    first = sim.info().tri_body_first_particle[p.body];
+  }
+  std::array<double, 3> q{0.0, 0.0, 0.0};
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) q[a] += p.weights[k] * x[4 * std::size_t{first + tri[k]} + a];
+  return q;
+}
+
+// The distance [m] from q to line body `body`'s polyline.
+inline double distance_to_thread(const std::array<double, 3>& q, const Simulation& sim, std::uint32_t body,
+                                 std::size_t vertices, const std::vector<float>& x) {
+  const std::uint32_t first = sim.info().line_body_first_particle[body];
+  double best = INFINITY;
+  for (std::size_t i = 0; i + 1 < vertices; ++i) {
+    std::array<double, 3> a{}, e{};
+    for (int k = 0; k < 3; ++k) {
+      a[k] = x[4 * (first + i) + k];
+      e[k] = x[4 * (first + i + 1) + k] - a[k];
+    }
+    const double ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    double s = ee > 0.0 ? ((q[0] - a[0]) * e[0] + (q[1] - a[1]) * e[1] + (q[2] - a[2]) * e[2]) / ee : 0.0;
+    s = std::clamp(s, 0.0, 1.0);
+    double d2 = 0.0;
+    for (int k = 0; k < 3; ++k) d2 += (q[k] - a[k] - s * e[k]) * (q[k] - a[k] - s * e[k]);
+    best = std::min(best, std::sqrt(d2));
+  }
+  return best;
+}
 
 }  // namespace sinew::test

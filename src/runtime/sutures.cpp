@@ -178,17 +178,16 @@ bool Sutures::first_crossing(const Vec3& a, const Vec3& b, bool entering, Needle
       const Vec3 e1 = math::sub(B, A), e2 = math::sub(C, A);
       const Vec3 n = math::cross(e1, e2);  // outward on a tet body's surface
       const double longest = std::max({math::dot(e1, e1), math::dot(e2, e2), math::dot(math::sub(C, B), math::sub(C, B))});
-      const double along = math::dot(dir, n);
-      if (surface.kind == BodyKind::tet && (entering ? along >= 0.0 : along <= 0.0)) continue;
-      if (along == 0.0) continue;
-      const double u = math::dot(math::sub(A, a), n) / along;
-      if (!(u >= 0.0 && u <= 1.0) || u >= best) continue;
-      // The segment meets the triangle's plane within its box: a triangle
-      // with no area or turned inside out cannot be punctured.
+      // A triangle with (next to) no area, within the path's box, has no
+      // side and no barycentric point to hold: refused.
       if (!(math::norm(n) > 1e-6 * longest)) {
         ++needle.refused_degenerate;
         continue;
       }
+      const double along = math::dot(dir, n);
+      if (along == 0.0) continue;
+      const double u = math::dot(math::sub(A, a), n) / along;
+      if (!(u >= 0.0 && u <= 1.0)) continue;
       const Vec3 x = math::add(a, math::mul(dir, u));
       const Vec3 v2 = math::sub(x, A);
       const double d00 = math::dot(e1, e1), d01 = math::dot(e1, e2), d11 = math::dot(e2, e2);
@@ -197,10 +196,15 @@ bool Sutures::first_crossing(const Vec3& a, const Vec3& b, bool entering, Needle
       const double wb = (d11 * d20 - d01 * d21) / denominator, wc = (d00 * d21 - d01 * d20) / denominator;
       const double wa = 1.0 - wb - wc;
       if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
+      // The path crosses it. A tet body's triangle whose tet is turned
+      // inside out (its fourth vertex on the outer side) has no inside to
+      // hold the point in: refused. Else it counts from its side.
       if (surface.opposite[t] != kNone && math::dot(n, math::sub(position_of(surface.opposite[t]), A)) >= 0.0) {
         ++needle.refused_inverted;
         continue;
       }
+      if (surface.kind == BodyKind::tet && (entering ? along > 0.0 : along < 0.0)) continue;
+      if (u >= best) continue;
       best = u;
       row.surface = s;
       row.triangle = t;
