@@ -182,6 +182,27 @@ TEST(Vtu, WritesPointsCellsAndFieldsThatReadBackExactly) {
   EXPECT_TRUE(std::all_of(types.begin(), types.end(), [](int t) { return t == 10; }));  // VTK_TETRA
 }
 
+// A thread or needle: line cells (VTK_LINE, 2 vertices each); a segment
+// past the vertices is named.
+TEST(Vtu, WritesLineCells) {
+  const std::vector<float> xyzw{0.0f, 0.0f, 0.0f, 1.0f, 0.001f, 0.0f, 0.0f, 1.0f, 0.002f, 0.5f, 0.0f, 1.0f};
+  const std::vector<std::array<std::uint32_t, 2>> segments{{0, 1}, {1, 2}};
+  const fs::path p = tmp_dir() / "thread.vtu";
+  const sinew::Status s = sinew::write_vtu_lines(p, xyzw, 4, segments);
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  const std::string xml = read_text(p);
+  EXPECT_NE(xml.find("NumberOfPoints=\"3\" NumberOfCells=\"2\""), std::string::npos);
+  EXPECT_EQ(numbers<float>(array_body(xml, "<Points>")),
+            (std::vector<float>{0.0f, 0.0f, 0.0f, 0.001f, 0.0f, 0.0f, 0.002f, 0.5f, 0.0f}));
+  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"connectivity\"")), (std::vector<std::int64_t>{0, 1, 1, 2}));
+  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"offsets\"")), (std::vector<std::int64_t>{2, 4}));
+  EXPECT_EQ(numbers<int>(array_body(xml, "Name=\"types\"")), (std::vector<int>{3, 3}));  // VTK_LINE
+  const std::vector<std::array<std::uint32_t, 2>> past{{0, 1}, {2, 3}};
+  const sinew::Status bad = sinew::write_vtu_lines(p, xyzw, 4, past);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message().find("segment 1 refers to vertex 3"), std::string::npos) << bad.error().message();
+}
+
 TEST(Vtu, StrideFourSkipsW) {
   const GridData g = grid_data();
   std::vector<float> xyzw;

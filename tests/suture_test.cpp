@@ -93,6 +93,24 @@ TEST_P(SutureTest, TheNeedlePassesThroughBothPadsAndTheThreadFollows) {
   }
   EXPECT_GE(run.push_at_puncture, scene.needles[0].puncture_force);
   EXPECT_LT(run.worst_off_thread, 3e-4);
+  if (GetParam() == "cpu") return;
+  // The same stitch on the CPU reference: the same punctures, the same positions.
+  auto reference = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  SINEW_ASSERT_OK(reference);
+  const StitchRun expected = stitch(*reference, scene, SuturePads::turn_frames + 10);
+  ASSERT_EQ(expected.punctures.size(), run.punctures.size());
+  for (std::size_t k = 0; k < run.punctures.size(); ++k) {
+    EXPECT_EQ(run.punctures[k].triangle, expected.punctures[k].triangle) << k;
+    EXPECT_EQ(run.punctures[k].thread_segment, expected.punctures[k].thread_segment) << k;
+  }
+  std::vector<float> x, y;
+  SINEW_ASSERT_OK(sim->read_positions(x));
+  SINEW_ASSERT_OK(reference->read_positions(y));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) worst = std::max(worst, std::abs(double(x[i]) - double(y[i])));
+  std::printf("[%s] largest difference from the CPU reference after %d frames: %.3g m\n", GetParam().c_str(),
+              SuturePads::turn_frames + 10, worst);
+  EXPECT_LT(worst, 1e-6);
 }
 
 // Then the thread is pulled 60 mm and tugged back and forth for the rest of

@@ -104,6 +104,12 @@ Status write_vtu(const std::filesystem::path& path, std::span<const float> posit
                  std::span<const std::array<std::uint32_t, 4>> tets,
                  std::span<const VertexField> fields = {});
 
+/// Writes a VTU of line cells (VTK_LINE), one per segment: a thread, a
+/// needle. [in] positions as for write_vtu. Errors name the file or the
+/// segment that refers to a missing vertex.
+Status write_vtu_lines(const std::filesystem::path& path, std::span<const float> positions, int stride,
+                       std::span<const std::array<std::uint32_t, 2>> segments);
+
 /// Writes a ParaView collection (.pvd) that lists a series of VTU files with
 /// their times [s]; file names are written relative to the .pvd's folder.
 Status write_pvd(const std::filesystem::path& path,

@@ -27,6 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int kVtkTetra = 10;
+constexpr int kVtkLine = 3;
 
 void append_float(std::string& out, float v) {
   char buf[32];
@@ -90,9 +91,10 @@ Status write_text_file(const fs::path& path, const std::string& text) {
   return {};
 }
 
+template <std::size_t N>
 Status check_vtu_input(const fs::path& path, std::span<const float> positions, int stride,
-                       std::span<const std::array<std::uint32_t, 4>> tets,
-                       std::span<const VertexField> fields) {
+                       std::span<const std::array<std::uint32_t, N>> tets,
+                       std::span<const VertexField> fields, const char* cell = "tet") {
   const std::string where = path.string() + ": ";
   if (stride != 3 && stride != 4) {
     return Error(ErrorCode::bad_parameter, where + "stride must be 3 or 4 (got " + std::to_string(stride) + ")");
@@ -108,7 +110,7 @@ Status check_vtu_input(const fs::path& path, std::span<const float> positions, i
     for (std::uint32_t v : tets[t]) {
       if (v >= n) {
         return Error(ErrorCode::bad_parameter,
-                     where + "tet " + std::to_string(t) + " refers to vertex " + std::to_string(v) +
+                     where + cell + " " + std::to_string(t) + " refers to vertex " + std::to_string(v) +
                      ", but there are only " + std::to_string(n) + " vertices");
       }
     }
@@ -161,28 +163,56 @@ void append_points(std::string& out, std::span<const float> positions, std::size
   out += "        </DataArray>\n      </Points>\n";
 }
 
-void append_cells(std::string& out, std::span<const std::array<std::uint32_t, 4>> tets) {
+// Cells of N vertices each, all of VTK type `type`.
+template <std::size_t N>
+void append_cells(std::string& out, std::span<const std::array<std::uint32_t, N>> cells, int type) {
   out += "      <Cells>\n";
   out += "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& t : tets) {
+  for (const auto& t : cells) {
     out += "          ";
-    for (int k = 0; k < 4; ++k) {
+    for (std::size_t k = 0; k < N; ++k) {
       if (k) out += ' ';
-      append_uint(out, t[static_cast<std::size_t>(k)]);
+      append_uint(out, t[k]);
     }
     out += '\n';
   }
   out += "        </DataArray>\n";
   out += "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < tets.size(); ++t) {
+  for (std::size_t t = 0; t < cells.size(); ++t) {
     out += "          ";
-    append_uint(out, 4 * (t + 1));
+    append_uint(out, N * (t + 1));
     out += '\n';
   }
   out += "        </DataArray>\n";
   out += "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < tets.size(); ++t) out += "          " + std::to_string(kVtkTetra) + "\n";
+  for (std::size_t t = 0; t < cells.size(); ++t) out += "          " + std::to_string(type) + "\n";
   out += "        </DataArray>\n      </Cells>\n";
+}
+
+// The whole file: points, their fields and the cells.
+template <std::size_t N>
+Status write_cells(const fs::path& path, std::span<const float> positions, int stride,
+                   std::span<const std::array<std::uint32_t, N>> cells, std::span<const VertexField> fields, int type,
+                   const char* cell) {
+  if (Status s = check_vtu_input<N>(path, positions, stride, cells, fields, cell); !s) return s;
+  const auto s = static_cast<std::size_t>(stride);
+  std::string out;
+  // About 12 bytes per number keeps reallocation out of the formatting loop.
+  out.reserve(64 + 12 * (positions.size() + cells.size() * (N + 2)) + 12 * positions.size() / s * fields.size() * 3);
+  out += "<?xml version=\"1.0\"?>\n";
+  out +=
+      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n";
+  out += "  <UnstructuredGrid>\n";
+  out += "    <Piece NumberOfPoints=\"" + std::to_string(positions.size() / s) + "\" NumberOfCells=\"" +
+         std::to_string(cells.size()) + "\">\n";
+  out += "      <PointData>\n";
+  for (const VertexField& f : fields) append_field(out, f);
+  out += "      </PointData>\n";
+  append_points(out, positions, s);
+  append_cells<N>(out, cells, type);
+  out += "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  return write_text_file(path, out);
 }
 
 // The name to write for `file` in a .pvd in `folder`: relative when possible.
@@ -201,25 +231,12 @@ std::string relative_name(const fs::path& file, const fs::path& folder) {
 
 Status write_vtu(const std::filesystem::path& path, std::span<const float> positions, int stride,
                  std::span<const std::array<std::uint32_t, 4>> tets, std::span<const VertexField> fields) {
-  if (Status s = check_vtu_input(path, positions, stride, tets, fields); !s) return s;
-  const auto s = static_cast<std::size_t>(stride);
-  std::string out;
-  // About 12 bytes per number keeps reallocation out of the formatting loop.
-  out.reserve(64 + 12 * (positions.size() + tets.size() * 6) + 12 * positions.size() / s * fields.size() * 3);
-  out += "<?xml version=\"1.0\"?>\n";
-  out +=
-      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-      "header_type=\"UInt64\">\n";
-  out += "  <UnstructuredGrid>\n";
-  out += "    <Piece NumberOfPoints=\"" + std::to_string(positions.size() / s) + "\" NumberOfCells=\"" +
-         std::to_string(tets.size()) + "\">\n";
-  out += "      <PointData>\n";
-  for (const VertexField& f : fields) append_field(out, f);
-  out += "      </PointData>\n";
-  append_points(out, positions, s);
-  append_cells(out, tets);
-  out += "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
-  return write_text_file(path, out);
+  return write_cells<4>(path, positions, stride, tets, fields, kVtkTetra, "tet");
+}
+
+Status write_vtu_lines(const std::filesystem::path& path, std::span<const float> positions, int stride,
+                       std::span<const std::array<std::uint32_t, 2>> segments) {
+  return write_cells<2>(path, positions, stride, segments, {}, kVtkLine, "segment");
 }
 
 Status write_pvd(const std::filesystem::path& path, std::span<const std::filesystem::path> vtu_files,
