@@ -66,7 +66,8 @@ struct FrameStats {
                                       ///< (with mesh collision: the positions too, 16 per particle,
                                       ///< and 32 per contact when a tool has face contacts; with
                                       ///< continuous collision, 32 per particle per substep and 16 per
-                                      ///< particle per repair round more)
+                                      ///< particle per repair round more; with needles,
+                                      ///< 32 per particle and 96 per suture row)
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,
   /// rest volume, ...): 0 when the xPBD system is solved exactly. Contact
@@ -114,6 +115,11 @@ struct FrameStats {
   /// scenes.
   std::uint32_t ccd_forced = 0;
   double ccd_ms = 0.0;
+  /// Needles (SceneDesc::needles), 0 without: the wall time [ms] of their
+  /// host side, before the frame (reading the positions back, testing the
+  /// tips' paths against the surfaces, uploading the rows) and after it
+  /// (reading the rows back, making and ending punctures); part of wall_ms.
+  double suture_ms = 0.0;
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;

@@ -163,10 +163,12 @@ Status Simulation::step() {
     impl_->stats.mesh_contact_colors = impl_->mesh_collision->colors();
     impl_->stats.collision_margin = impl_->mesh_collision->margin();
   }
-  if (impl_->sutures)
-    if (Status s = impl_->sutures->before_frame(*impl_->device, impl_->buffers); !s) return s;
   const auto collided = std::chrono::steady_clock::now();
   impl_->stats.collision_ms = std::chrono::duration<double, std::milli>(collided - start).count();
+  if (impl_->sutures)
+    if (Status s = impl_->sutures->before_frame(*impl_->device, impl_->buffers); !s) return s;
+  const auto sutured = std::chrono::steady_clock::now();
+  impl_->stats.suture_ms = std::chrono::duration<double, std::milli>(sutured - collided).count();
   if (impl_->stepper) {
     if (impl_->continuous) impl_->continuous->begin_frame(impl_->frame_capsules());
     if (Status s = impl_->stepper->run_frame(*impl_->device, impl_->stats, impl_->continuous.get()); !s) return s;
@@ -187,11 +189,15 @@ Status Simulation::step() {
     if (Status s = impl_->mesh_collision->after_frame(*impl_->device, impl_->buffers); !s) return s;
     impl_->stats.contact_violation = impl_->mesh_collision->violation();
   }
-  if (impl_->sutures)
+  if (impl_->sutures) {
+    const auto solved = std::chrono::steady_clock::now();
     if (Status s = impl_->sutures->after_frame(*impl_->device, impl_->buffers, impl_->time_step / impl_->substeps,
                                                impl_->time_step);
         !s)
       return s;
+    impl_->stats.suture_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - solved).count();
+  }
   const auto ran = std::chrono::steady_clock::now();
   if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
   impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4 +
