@@ -109,11 +109,16 @@ inline std::array<double, 3> puncture_point(const SceneDesc& scene, const Simula
   return q;
 }
 
-// The distance [m] from q to line body `body`'s polyline.
-inline double distance_to_thread(const std::array<double, 3>& q, const Simulation& sim, std::uint32_t body,
-                                 std::size_t vertices, const std::vector<float>& x) {
+// How far [m] a puncture on line body `body` is from its own point on the
+// thread (its segment and s, as the row holds it), and from the thread's
+// closest point to it: the row must hold the point where the thread is.
+struct OnThread {
+  double from_row = 0.0, from_closest = 0.0;
+};
+inline OnThread on_thread(const std::array<double, 3>& q, const Simulation::Puncture& p, const Simulation& sim,
+                          std::uint32_t body, std::size_t vertices, const std::vector<float>& x) {
   const std::uint32_t first = sim.info().line_body_first_particle[body];
-  double best = INFINITY;
+  OnThread out{INFINITY, INFINITY};
   for (std::size_t i = 0; i + 1 < vertices; ++i) {
     std::array<double, 3> a{}, e{};
     for (int k = 0; k < 3; ++k) {
@@ -123,11 +128,13 @@ inline double distance_to_thread(const std::array<double, 3>& q, const Simulatio
     const double ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
     double s = ee > 0.0 ? ((q[0] - a[0]) * e[0] + (q[1] - a[1]) * e[1] + (q[2] - a[2]) * e[2]) / ee : 0.0;
     s = std::clamp(s, 0.0, 1.0);
+    if (i == p.thread_segment) s = p.thread_s;
     double d2 = 0.0;
     for (int k = 0; k < 3; ++k) d2 += (q[k] - a[k] - s * e[k]) * (q[k] - a[k] - s * e[k]);
-    best = std::min(best, std::sqrt(d2));
+    if (i == p.thread_segment) out.from_row = std::sqrt(d2);
+    out.from_closest = std::min(out.from_closest, std::sqrt(d2));
   }
-  return best;
+  return out;
 }
 
 }  // namespace sinew::test

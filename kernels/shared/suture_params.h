@@ -27,18 +27,26 @@
  *                  C = d_tip . (p - tip) >= 0, the tissue kept ahead of
  *                  the tip; while it pushes (lambda > 0) the tip also
  *                  catches the tissue: C_t = |(p - tip) across d_tip| = 0
- *                  (multiplier lambda_t). The host turns it into a
- *                  puncture when its force passes puncture_force;
+ *                  with |lambda_t| <= tan(max_puncture_angle) lambda
+ *                  (beyond, the point slides at that bound). The host
+ *                  turns it into a puncture when its force passes
+ *                  puncture_force;
  *   3 puncture     the tissue point held on the needle's curve: q its
  *                  closest point on the polyline, C = |p - q| = 0, gradient
  *                  (p - q) / |p - q| (the iMSTK paper's); the needle slides
- *                  through it freely. When q is the tail and p lies behind
+ *                  through it freely. When q is the tip and p lies ahead
+ *                  of it, only p's offset across d_tip counts (a needle
+ *                  pulled back leaves the point; the host ends the row
+ *                  once it is 0.5 mm ahead). When q is the tail and p lies behind
  *                  it (d_tail . (p - tail) < 0) the needle has passed: with
  *                  a thread the row becomes a thread puncture on the
  *                  thread's first segment, without one it ends (kind 0);
  *   4 thread       the tissue point held on the thread: q = (1 - s) x_i +
  *                  s x_{i+1} on segment i (s its closest point, the
- *                  segment followed to a neighbour when s leaves [0, 1]),
+ *                  segment followed to a neighbour when s leaves [0, 1],
+ *                  at most SINEW_SUTURE_MAX_MOVES segments per solve;
+ *                  lambda_t carries over: neighbouring tangents are
+ *                  nearly parallel),
  *                  C = |p - q| = 0, with friction along the segment's
  *                  tangent: the relative slide over the substep is held
  *                  while its multiplier stays within mu_s |lambda|, else
@@ -58,7 +66,8 @@
  *   0 position float4 (xyz, w = inverse mass) [in/out]
  *   1 previous position float4 (the substep's start) [in]
  *   2 table uint [in]: word 0 the rows; then per needle (first point, points)
- *   3 needles float4 [in]: per needle (compliance, mu_s, mu_k, 0)
+ *   3 needles float4 [in]: per needle (compliance, mu_s, mu_k,
+ *     tan(max_puncture_angle), at most 1e6)
  *   4 curve float4 [in]: per needle point, its world position at the
  *     frame's start and at its end (2 per point)
  *   5 thread slots uint [in]: the device slots of the threads' vertices

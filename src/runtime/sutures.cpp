@@ -110,7 +110,8 @@ Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const C
   std::vector<float> params;
   for (const Needle& n : out->needles_)
     params.insert(params.end(), {float(n.desc.compliance), float(n.desc.thread_static_friction),
-                                 float(n.desc.thread_dynamic_friction), 0.0f});
+                                 float(n.desc.thread_dynamic_friction),
+                                 float(std::min(std::tan(n.desc.max_puncture_angle), 1e6))});
   if (Status s = device.write_buffer(b.needles, 0, params.data(), params.size() * 4); !s) return s.error();
   return out;
 }
@@ -125,6 +126,13 @@ Status Sutures::set_pose(std::size_t index, const Vec3& position, const math::Qu
   if (std::abs(math::qnorm(rotation) - 1.0) > 1e-6)
     return Error(ErrorCode::bad_parameter, name + ": the rotation must be a unit quaternion (its norm is " +
                                                std::to_string(math::qnorm(rotation)) + ")");
+  // Its points move along straight lines within a frame (suture_params.h):
+  // a turn of more than a quarter circle would fold the needle.
+  const double turn = 2.0 * std::acos(std::min(1.0, std::abs(math::qdot(needles_[index].rotation_start, rotation))));
+  if (turn > M_PI / 2)
+    return Error(ErrorCode::bad_parameter, name + " would turn by " + std::to_string(turn) +
+                                               " rad in one frame; at most pi/2 (its points move along chords "
+                                               "within a frame: turn it over several)");
   needles_[index].position_end = position;
   needles_[index].rotation_end = rotation;
   return {};
@@ -165,10 +173,12 @@ bool Sutures::first_crossing(const Vec3& a, const Vec3& b, bool entering, Needle
       for (int k = 0; k < 3; ++k)
         apart |= std::max({A[k], B[k], C[k]}) < lo[k] || std::min({A[k], B[k], C[k]}) > hi[k];
       if (apart) continue;
-      // The hole a puncture made: its triangle and those sharing a vertex
-      // with it (the tip leaves through them just after puncturing).
+      // The hole of a puncture the needle is in: its triangle and those
+      // sharing a vertex with it (the tip leaves through them just after
+      // puncturing). Holes on the thread no longer count: a later stitch
+      // may pass close by.
       const bool held = std::any_of(needle.rows.begin(), needle.rows.end(), [&](const Row& r) {
-        if (r.surface != s || r.words[0] == SINEW_SUTURE_TIP || r.words[0] == SINEW_SUTURE_TIE) return false;
+        if (r.surface != s || r.words[0] != SINEW_SUTURE_PUNCTURE) return false;
         const auto& h = surface.triangles[r.triangle];
         for (std::uint32_t v : tri)
           if (v == h[0] || v == h[1] || v == h[2]) return true;
@@ -316,6 +326,8 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
       }
     }
     std::erase_if(n.rows, [](const Row& r) { return r.words[0] == SINEW_SUTURE_DEAD; });
+    n.position_start = n.position_end;  // the next frame starts where this one ended
+    n.rotation_start = n.rotation_end;
     // Leaving a tet body: its surface crossed from inside by the tip's path.
     Row exit;
     if (first_crossing(start.back(), end.back(), false, n, exit)) {
@@ -328,8 +340,6 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
       exit.exit = true;
       n.rows.push_back(exit);
     }
-    n.position_start = n.position_end;
-    n.rotation_start = n.rotation_end;
   }
   return {};
 }

@@ -15,7 +15,8 @@
 // the same tissue point; a tip path that left a tet body through its
 // surface makes an exit puncture where it crossed. The kernel itself turns
 // a puncture the needle's tail has passed into a thread puncture (kind 4).
-// Punctures the needle was pulled back out of end.
+// Punctures the needle was pulled back out of (their tissue point 0.5 mm
+// ahead of the tip) end.
 //
 // Why the detection is on the host: a needle is one polyline and its tip
 // path one segment per frame, tested against the surfaces' triangles in a
@@ -38,7 +39,9 @@ namespace sinew {
 class Sutures {
  public:
   /// Most rows a needle may hold (its tie, tip contact and punctures).
-  static constexpr std::uint32_t kRowsPerNeedle = 32;
+  /// (Rows on the thread never end: a running suture of about 15 stitches
+  /// fills it; then step() fails naming the needle.)
+  static constexpr std::uint32_t kRowsPerNeedle = 64;
 
   /// [in] scene: its needles (checked), surfaces and threads; compiled: the
   /// particles' device order. Creates the buffers on `device`.
