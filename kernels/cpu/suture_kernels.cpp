@@ -132,8 +132,12 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       c[0] = 1.0f;
       count = 1;
     } else if (r[0].x == SINEW_SUTURE_TIP) {
+      // Along the triangle's normal, turned the way the tip goes (into the
+      // tissue): the surface, not the tip's axis, says which way it gives.
       const float4 tip = curve_point(b, n, points - 1, t);
-      dir = unit(tip - curve_point(b, n, points - 2, t));
+      const float4 d_tip = unit(tip - curve_point(b, n, points - 2, t));
+      dir = unit(cross3(b.x[v[1]] - b.x[v[0]], b.x[v[2]] - b.x[v[0]]));
+      if (dot3(dir, d_tip) < 0.0f) dir = float4{-dir.x, -dir.y, -dir.z, 0.0f};
       constraint = dot3(dir, p_now - tip);
       unilateral = true;
     } else if (r[0].x == SINEW_SUTURE_PUNCTURE) {

@@ -24,9 +24,11 @@
  *   1 tie          the thread's first vertex x_a held at the needle's
  *                  tail q: C = |x_a - q| = 0;
  *   2 tip contact  the tip pushing a surface before it punctures it:
- *                  C = d_tip . (p - tip) >= 0, the tissue kept ahead of
- *                  the tip; while it pushes (lambda > 0) the tip also
- *                  catches the tissue: C_t = |(p - tip) across d_tip| = 0
+ *                  C = m . (p - tip) >= 0 with m the triangle's unit
+ *                  normal turned the way the tip goes (d_tip . m > 0):
+ *                  the tissue kept ahead of the tip across the surface;
+ *                  while it pushes (lambda > 0) the tip also catches the
+ *                  tissue: C_t = |(p - tip) across m| = 0
  *                  with |lambda_t| <= tan(max_puncture_angle) lambda
  *                  (beyond, the point slides at that bound). The host
  *                  turns it into a puncture when its force passes

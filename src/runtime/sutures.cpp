@@ -301,13 +301,15 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
       const float* l = &lambda[at * 12];
       ++at;
       if (r.words[0] == SINEW_SUTURE_TIP) {
-        // The frame's impulse on the tissue, (sum + last) / h [N s], averaged over the frame.
-        const Vec3 impulse{double(l[8]) + l[4], double(l[9]) + l[5], double(l[10]) + l[6]};
-        n.tip_force = math::dot(impulse, d) / (h * frame);
-        if (n.tip_force < n.desc.puncture_force) continue;
         const auto& tri = surfaces_[r.surface].triangles[r.triangle];
         const Vec3 A = position_of(tri[0]);
         const Vec3 normal = unit(math::cross(math::sub(position_of(tri[1]), A), math::sub(position_of(tri[2]), A)));
+        // The frame's impulse on the tissue, (sum + last) / h [N s], averaged
+        // over the frame, into the surface (the kernel pushes along the
+        // normal turned the way the tip goes).
+        const Vec3 impulse{double(l[8]) + l[4], double(l[9]) + l[5], double(l[10]) + l[6]};
+        n.tip_force = std::abs(math::dot(impulse, normal)) / (h * frame);
+        if (n.tip_force < n.desc.puncture_force) continue;
         // The angle to the inward normal (a membrane's: the side the tip is on).
         const double cosine = surfaces_[r.surface].kind == BodyKind::tet ? -math::dot(d, normal)
                                                                          : std::abs(math::dot(d, normal));
