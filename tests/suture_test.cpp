@@ -401,6 +401,34 @@ TEST(Suture, AGrazingTipSlidesInsteadOfDraggingTheSurface) {
   EXPECT_LT(dragged, 3e-3);  // measured 1.7 mm; 5 mm when the tip pushed along its own axis
 }
 
+// The stitch with mesh collision and continuous collision detection on:
+// the thread runs through the tissue at its punctures, so neither may push
+// it out there (suture_exemption.h). Without that exemption the thread's
+// CCD fought the punctures (thousands of touches a frame, the rows jumping
+// along the thread) and the knot never reached the first puncture.
+TEST(Suture, TheStitchHoldsWithMeshCollisionAndContinuousCollisionOn) {
+  SceneDesc scene = SuturePads::scene();
+  scene.mesh_collision.enabled = true;
+  scene.mesh_collision.thickness = 5e-4;
+  scene.mesh_collision.self_collision = false;
+  scene.mesh_collision.continuous = true;
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  SINEW_ASSERT_OK(sim);
+  std::uint32_t forced = 0;
+  for (int f = 0; f < 300; ++f) {
+    SINEW_ASSERT_OK(SuturePads::drive(*sim, f));
+    SINEW_ASSERT_OK(sim->step());
+    forced += sim->last_frame().ccd_forced;
+  }
+  auto state = sim->needle_state(0);
+  SINEW_ASSERT_OK(state);
+  ASSERT_EQ(state->punctures.size(), 4u);
+  for (const auto& p : state->punctures) EXPECT_TRUE(p.on_thread);
+  EXPECT_EQ(state->punctures[0].thread_segment + 1, std::uint32_t{SuturePads::thread_segments})
+      << "the knot must reach the first puncture";
+  EXPECT_EQ(forced, 0u);
+}
+
 // Bad settings and calls are named.
 TEST(Suture, BadSettingsAreNamed) {
   const auto error_of = [](const SceneDesc& scene) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "math/proximity_math.h"
+#include "runtime/suture_exemption.h"
 #include "sinew/ccd.h"
 
 namespace sinew {
@@ -251,6 +252,8 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
       for (int i = 0; i < 2; ++i)
         for (int j = 0; j < 3; ++j) shared |= s[i] == t[j];
       if (shared) continue;
+      const std::uint32_t joined[5] = {s[0], s[1], t[0], t[1], t[2]};
+      if (suture_exempt(exempt_, joined)) continue;  // the thread runs through a puncture here
       for (int i = 0; i < 2; ++i) {
         const std::uint32_t p[4] = {s[i], t[0], t[1], t[2]};
         if (!moves(start, end, p)) continue;

@@ -103,6 +103,10 @@ class ContinuousSearch {
   /// Queries run by the last find().
   [[nodiscard]] std::uint64_t queries() const { return queries_; }
 
+  /// [in] mask: per particle, what sutures exempt (suture_exemption.h):
+  /// segment-triangle pairs joining a thread and a hole are not tested.
+  void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }
+
  private:
   std::vector<std::uint32_t> segments_, triangles_;
   std::vector<std::uint32_t> triangle_vertices_;  // sorted, unique
@@ -115,6 +119,7 @@ class ContinuousSearch {
   double drift(std::span<const float> start, std::span<const float> end) const;
   std::vector<collision::Pair> pairs_;
   std::uint64_t queries_ = 0;
+  const std::vector<std::uint8_t>* exempt_ = nullptr;
   void fit(std::span<const float> start, std::span<const float> end, std::span<const std::uint32_t> indices,
            int arity, collision::Bvh& tree);
 };
@@ -140,6 +145,9 @@ class ContinuousCollision final : public SubstepHook {
                       int substeps);
 
   Status after_sweeps(Device& device, int substep, int round, bool& repair) override;
+
+  /// See ContinuousSearch::set_suture_exemption.
+  void set_suture_exemption(const std::vector<std::uint8_t>* mask) { search_.set_suture_exemption(mask); }
 
   /// Before each frame: zeroes the frame's counters; [in] capsules: the
   /// tools and capsule colliders over the frame (interpolated per substep

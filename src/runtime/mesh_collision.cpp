@@ -4,6 +4,7 @@
 // find the candidate pairs and the contacts closer than the reach, colour
 // them (greedy, coloring/greedy_coloring.h) and upload them colour-sorted.
 #include "runtime/mesh_collision.h"
+#include "runtime/suture_exemption.h"
 
 #include "collision/shape_distance.h"
 
@@ -677,6 +678,7 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
   // The contacts kept: facing, across air, within their pair's own reach
   // (given to the narrow phase, which drops the rest as it finds them).
   const collision::ContactFilter wanted = [&](const Contact& c) {
+    if (suture_exempt(exempt_, c.v)) return false;  // a thread where it runs through a puncture
     if (!collision::facing(c, positions_) || !across_air(c)) return false;
     const bool vertex_triangle = c.kind == Contact::Kind::vertex_triangle;
     const float coefficient[4] = {c.w[0], vertex_triangle ? -c.w[1] : c.w[1], -c.w[2], -c.w[3]};

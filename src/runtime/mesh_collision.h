@@ -71,6 +71,10 @@ class MeshCollision {
   /// frame keeps more room; the caller's next round finds their touches
   /// again, or its fail-safe acts on them).
   Result<std::uint32_t> append_contacts(Device& device, std::span<const collision::Contact> contacts);
+
+  /// [in] mask: per particle, what sutures exempt (suture_exemption.h);
+  /// outlives this, read every frame.
+  void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }
   /// Particles of the scene (device order).
   [[nodiscard]] std::size_t particles() const { return movable_.size(); }
   /// The collidable primitives (device particles): every line body's
@@ -122,6 +126,7 @@ class MeshCollision {
   std::vector<std::uint32_t> triangles_, triangle_body_;  // device particles, 3 per triangle; body per triangle
   collision::TriangleOwnership ownership_;                // of triangles_: each vertex and edge tested once
   std::vector<std::uint32_t> segments_, segment_body_;    // 2 per segment
+  const std::vector<std::uint8_t>* exempt_ = nullptr;     // sutures' exemption mask (or none)
   std::vector<std::uint32_t> collidable_;                 // particles of any primitive
   // A BVH per body over its primitives [first, first + count).
   struct BodyTree {

@@ -89,6 +89,10 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->continuous = std::make_unique<ContinuousCollision>(
         impl->mesh_collision->segments(), impl->mesh_collision->triangles(), *impl->mesh_collision, impl->buffers,
         scene.mesh_collision, scene.solver.substeps);
+  if (impl->sutures) {  // a thread runs through its punctures: no contacts may push it out there
+    if (impl->mesh_collision) impl->mesh_collision->set_suture_exemption(impl->sutures->exemption());
+    if (impl->continuous) impl->continuous->set_suture_exemption(impl->sutures->exemption());
+  }
   if (SolveStepper::needed(scene.solver, continuous)) {
     impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
     append_stats(impl->program, impl->stats_plan, impl->buffers);

@@ -10,6 +10,7 @@
 #include <string>
 #include <tuple>
 
+#include "runtime/suture_exemption.h"
 #include "suture_params.h"
 
 namespace sinew {
@@ -343,7 +344,30 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
       n.rows.push_back(exit);
     }
   }
+  mark_exemption();
   return {};
+}
+
+void Sutures::mark_exemption() {
+  exempt_.assign(positions_.size() / 4, 0);
+  for (const Needle& n : needles_) {
+    bool holds = false;
+    for (const Row& r : n.rows) {
+      if (r.words[0] != SINEW_SUTURE_PUNCTURE && r.words[0] != SINEW_SUTURE_THREAD) continue;
+      holds = true;
+      // The hole: every triangle of the surface sharing a vertex with the punctured one.
+      const Surface& surface = surfaces_[r.surface];
+      const auto& hole = surface.triangles[r.triangle];
+      for (const auto& t : surface.triangles)
+        for (std::uint32_t v : t)
+          if (v == hole[0] || v == hole[1] || v == hole[2]) {
+            for (std::uint32_t u : t) exempt_[u] |= kSutureHole;
+            break;
+          }
+    }
+    if (holds)
+      for (std::uint32_t k = 0; k < n.thread_vertices; ++k) exempt_[slots_[n.thread_first + k]] |= kSutureThread;
+  }
 }
 
 Simulation::NeedleState Sutures::state(std::size_t index) const {

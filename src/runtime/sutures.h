@@ -60,6 +60,9 @@ class Sutures {
   Status after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame);
 
   [[nodiscard]] Simulation::NeedleState state(std::size_t index) const;
+  /// Per particle (device order), what the sutures exempt from mesh
+  /// collision and CCD (suture_exemption.h); updated after every frame.
+  [[nodiscard]] const std::vector<std::uint8_t>* exemption() const { return &exempt_; }
   [[nodiscard]] std::size_t needles() const { return needles_.size(); }
   /// Bytes read from the device in the last frame.
   [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
@@ -105,6 +108,8 @@ class Sutures {
   std::vector<Needle> needles_;
   std::vector<std::uint32_t> slots_;  // the threads' vertices' device slots
   std::vector<float> positions_;      // device order, xyzw, the last read
+  std::vector<std::uint8_t> exempt_;  // per particle: kSutureThread, kSutureHole (suture_exemption.h)
+  void mark_exemption();
   SutureBuffers buffers_;
   std::uint32_t rows_capacity_ = 0, curve_points_ = 0;
   std::uint64_t read_back_bytes_ = 0;
