@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "sinew/simulation.h"
 #include "thread_scenes.h"
 
@@ -29,16 +30,8 @@ namespace {
 
 using namespace sinew;
 
-std::string backend() {
-  const char* v = std::getenv("SINEW_BACKEND");
-  return v ? v : "auto";
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using bench::backend;
+using bench::median;
 
 void BM_ContinuousCollision(benchmark::State& state) {
   const int which = static_cast<int>(state.range(0));

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "mesh_contact_support.h"
 #include "sinew/simulation.h"
 
@@ -26,10 +27,7 @@ namespace {
 
 using namespace sinew;
 
-std::string backend() {
-  const char* v = std::getenv("SINEW_BACKEND");
-  return v ? v : "auto";
-}
+using bench::backend;
 
 void BM_MeshContacts(benchmark::State& state) {
   const bool fold = state.range(0) == 1;
@@ -76,10 +74,7 @@ void BM_MeshContacts(benchmark::State& state) {
       state.ResumeTiming();
     }
   }
-  const auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
-  };
+  using bench::median;
   state.counters["frame_ms"] = median(wall);
   state.counters["collision_ms"] = median(collision);
   state.counters["penetration"] = penetration;  // blocks: [mm]; fold: intersecting triangle pairs

@@ -116,7 +116,8 @@ TEST_P(SutureTest, TheNeedlePassesThroughBothPadsAndTheThreadFollows) {
 
 // Then the thread is pulled 60 mm and tugged back and forth for the rest of
 // 1,000 frames: its knot (last vertex) stops at the first puncture, every
-// puncture stays on the thread, within 0.3 mm of it, every frame.
+// puncture stays on the thread, within 0.75 mm of it, every frame, each
+// row holding the thread's closest point (not a segment off).
 TEST(Suture, TheThreadStaysThreadedThroughAThousandFramesOfPulling) {
   const SceneDesc scene = SuturePads::scene();
   auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
@@ -466,12 +467,17 @@ TEST(Suture, BadSettingsAreNamed) {
   const Status bad_rotation = sim->set_needle_pose(0, {0.0, 0.0, 0.0}, {2.0, 0.0, 0.0, 0.0});
   ASSERT_FALSE(bad_rotation.ok());
   EXPECT_NE(bad_rotation.error().message().find("unit quaternion"), std::string::npos);
+  const Status nan_position = sim->set_needle_pose(0, {0.0, NAN, 0.0}, {1.0, 0.0, 0.0, 0.0});
+  ASSERT_FALSE(nan_position.ok());
+  EXPECT_NE(nan_position.error().message().find("set_needle_pose: position"), std::string::npos)
+      << nan_position.error().message();
   const Status half_turn = sim->set_needle_pose(0, {0.0, 0.0, 0.0}, SuturePads::needle_rotation(M_PI));
   ASSERT_FALSE(half_turn.ok());
   EXPECT_NE(half_turn.error().message().find("at most pi/2"), std::string::npos) << half_turn.error().message();
   const Status bad_index = sim->set_needle_pose(1, {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0, 0.0});
   ASSERT_FALSE(bad_index.ok());
-  EXPECT_NE(bad_index.error().message().find("needle 1 does not exist"), std::string::npos);
+  EXPECT_NE(bad_index.error().message().find("set_needle_pose: index 1 is not a needle"), std::string::npos)
+      << bad_index.error().message();
   EXPECT_FALSE(sim->needle_state(1).ok());
 }
 

@@ -312,21 +312,18 @@ Result<Simulation::ToolState> Simulation::tool_state(std::size_t index) const {
   return state;
 }
 
-}  // namespace sinew
-
-namespace sinew {
-
 Status Simulation::set_needle_pose(std::size_t index, const std::array<double, 3>& position,
                                    const std::array<double, 4>& rotation) {
-  if (!impl_->sutures) return Error(ErrorCode::bad_parameter, "set_needle_pose: the scene has no needles");
+  constexpr const char* call = "set_needle_pose";
+  if (Status s = check_index(call, "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s) return s;
+  if (Status s = check_finite(call, "position", position); !s) return s;
+  if (Status s = check_rotation(call, rotation); !s) return s;
   return impl_->sutures->set_pose(index, position, rotation);
 }
 
 Result<Simulation::NeedleState> Simulation::needle_state(std::size_t index) const {
-  const std::size_t count = impl_->sutures ? impl_->sutures->needles() : 0;
-  if (index >= count)
-    return Error(ErrorCode::bad_parameter, "needle_state: needle " + std::to_string(index) +
-                                               " does not exist (the scene has " + std::to_string(count) + ")");
+  if (Status s = check_index("needle_state", "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s)
+    return s.error();
   return impl_->sutures->state(index);
 }
 

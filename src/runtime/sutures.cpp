@@ -118,20 +118,12 @@ Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const C
 }
 
 Status Sutures::set_pose(std::size_t index, const Vec3& position, const math::Quat& rotation) {
-  const std::string name = "needle " + std::to_string(index);
-  if (index >= needles_.size())
-    return Error(ErrorCode::bad_parameter,
-                 name + " does not exist (the scene has " + std::to_string(needles_.size()) + ")");
-  if (!math::finite(position) || !math::finite(rotation))
-    return Error(ErrorCode::bad_parameter, name + ": the pose must be finite");
-  if (std::abs(math::qnorm(rotation) - 1.0) > 1e-6)
-    return Error(ErrorCode::bad_parameter, name + ": the rotation must be a unit quaternion (its norm is " +
-                                               std::to_string(math::qnorm(rotation)) + ")");
   // Its points move along straight lines within a frame (suture_params.h):
   // a turn of more than a quarter circle would fold the needle.
   const double turn = 2.0 * std::acos(std::min(1.0, std::abs(math::qdot(needles_[index].rotation_start, rotation))));
   if (turn > M_PI / 2)
-    return Error(ErrorCode::bad_parameter, name + " would turn by " + std::to_string(turn) +
+    return Error(ErrorCode::bad_parameter, "set_needle_pose: needle " + std::to_string(index) + " would turn by " +
+                                               std::to_string(turn) +
                                                " rad in one frame; at most pi/2 (its points move along chords "
                                                "within a frame: turn it over several)");
   needles_[index].position_end = position;

@@ -50,6 +50,9 @@ class Sutures {
   [[nodiscard]] const SutureBuffers& buffers() const { return buffers_; }
 
   /// The pose needle `index` reaches at the end of the next frame.
+  /// [pre] index < needles(), the pose finite, the rotation a unit
+  /// quaternion (Simulation::set_needle_pose checks). Errors: a turn of
+  /// more than pi/2 from the frame's start.
   Status set_pose(std::size_t index, const math::Vec3& position, const math::Quat& rotation);
 
   /// Before a frame: reads the positions, finds the tips' contacts,
