@@ -239,10 +239,26 @@ struct ToolDesc {
   double compliance = 0.0;                              ///< of its contacts [m/N]
 };
 
+/// How a needle moves (NeedleDesc::drive).
+enum class NeedleDrive {
+  /// Posed by the user every frame (Simulation::set_needle_pose); it feels
+  /// the tissue's reaction (NeedleState::reaction_force) but is not moved by it.
+  kinematic,
+  /// A rigid body with mass and inertia, driven by a force and torque
+  /// (Simulation::apply_needle_force) and pushed back by the tissue and
+  /// pulled by its thread, coupled as a rigid tool is (ToolDesc): the
+  /// reaction of one frame acts on it in the next. Drive it through a
+  /// virtual coupling that also holds its orientation (a needle pushed
+  /// along its axis balances on its tip like a pencil); the gains' bounds
+  /// are in the README, "Needles and sutures".
+  force,
+};
+
 /// A suture needle (issue 13, part 4): a rigid curve, a polyline in its own
 /// frame from its tail (curve.front()) to its tip (curve.back()), moved
-/// kinematically (Simulation::set_needle_pose; its substeps interpolate
-/// each point linearly) and optionally pulling a thread tied to its tail.
+/// kinematically (Simulation::set_needle_pose) or by force
+/// (Simulation::apply_needle_force; `drive`), its substeps interpolating
+/// each point linearly, and optionally pulling a thread tied to its tail.
 ///
 /// The tip punctures the surfaces of the tet bodies (their boundary) and
 /// the tri bodies: when its path in a frame meets a surface triangle from
@@ -272,6 +288,14 @@ struct NeedleDesc {
   int thread = -1;
   double thread_static_friction = 0.3;   ///< of the thread sliding through a puncture, >= 0
   double thread_dynamic_friction = 0.2;  ///< >= 0, <= thread_static_friction
+  NeedleDrive drive = NeedleDrive::kinematic;
+  // ---- A force-driven needle's body (drive = force; ignored otherwise).
+  // The needle's frame has its origin at the centre of mass and its axes
+  // along the principal axes of inertia; the defaults are those of a needle
+  // held in its needle holder (the hand moves both).
+  double mass = 0.02;                                ///< [kg], > 0
+  std::array<double, 3> inertia{4e-5, 4e-5, 4e-6};   ///< principal moments in the needle frame [kg m^2], > 0
+  bool gravity = true;                               ///< whether gravity acts on it
 };
 
 /// How each frame is solved: a frame of length time_step is split into

@@ -165,11 +165,17 @@ class Simulation {
   };
   Result<ToolState> tool_state(std::size_t index) const;
 
-  /// Moves needle `index` to this pose [m, unit quaternion (w, x, y, z)]
-  /// by the end of the next frame (NeedleDesc); its substeps interpolate
-  /// each of its points linearly.
+  /// Moves kinematic needle `index` to this pose [m, unit quaternion (w, x,
+  /// y, z)] by the end of the next frame (NeedleDesc); its substeps
+  /// interpolate each of its points linearly. Errors: a force-driven needle.
   Status set_needle_pose(std::size_t index, const std::array<double, 3>& position,
                          const std::array<double, 4>& rotation);
+  /// Force [N] and torque [N m] (world frame, about the needle's origin, its
+  /// centre of mass) acting on force-driven needle `index` during the next
+  /// frame (then reset to zero); calls before one step add up. Errors: a
+  /// kinematic needle.
+  Status apply_needle_force(std::size_t index, const std::array<double, 3>& force,
+                            const std::array<double, 3>& torque);
 
   /// A tissue point held on a needle or its thread (NeedleDesc).
   struct Puncture {
@@ -188,6 +194,14 @@ class Simulation {
   struct NeedleState {
     std::array<double, 3> position{};            ///< [m]
     std::array<double, 4> rotation{1, 0, 0, 0};  ///< unit quaternion (w, x, y, z)
+    std::array<double, 3> velocity{};            ///< over the last frame [m/s]
+    std::array<double, 3> angular_velocity{};    ///< over the last frame, world frame [rad/s]
+    /// What the tissue and the thread did to the needle, averaged over the
+    /// last frame: the force [N] of its tip's push, its punctures and its
+    /// tie to the thread, and their torque about its origin [N m] (world
+    /// frame). Kinematic needles report it too: it is the force to render
+    /// on a haptic device.
+    std::array<double, 3> reaction_force{}, reaction_torque{};
     std::vector<Puncture> punctures;             ///< in the order they were made
     bool pushing = false;    ///< the tip pushes a surface it has not punctured
     double tip_force = 0.0;  ///< that push, along the tip, averaged over the frame [N]

@@ -198,6 +198,9 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
     for (std::uint32_t k = 0; k < count; ++k) weight = weight + b.x[v[k]].w * (c[k] * c[k]);
     if (!(weight > 0.0f)) continue;
     float lambda_n = l[0].x, lambda_t = l[0].y;
+    // The impulse given this substep, summed step by step: the directions
+    // turn between sweeps, so lambda times the last direction is not it.
+    float4 given = l[1];
     // A contact apart and not pushed in this substep does nothing; a
     // puncture or tie exactly met has no direction and needs nothing.
     const bool acts = unilateral ? (lambda_n > 0.0f || constraint < 0.0f) : constraint > 0.0f;
@@ -205,6 +208,7 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       float dl = (-constraint - alpha * lambda_n) / (weight + alpha);
       if (unilateral) dl = (lambda_n + dl > 0.0f ? lambda_n + dl : 0.0f) - lambda_n;
       apply(b, v, c, count, dir, dl);
+      given = given + dl * dir;
       lambda_n = lambda_n + dl;
     }
     float4 tangent = zero;
@@ -222,6 +226,7 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
         const float limit = needle.w * lambda_n;
         const float next = std::fabs(held) <= limit ? held : (held > 0.0f ? limit : -limit);
         apply(b, v, c, count, tangent, next - lambda_t);
+        given = given + (next - lambda_t) * tangent;
         lambda_t = next;
       }
     }
@@ -236,11 +241,11 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       const float kinetic = needle.z * std::fabs(lambda_n);
       const float next = std::fabs(held) <= limit ? held : held > 0.0f ? kinetic : -kinetic;
       apply(b, v, c, count, tangent, next - lambda_t);
+      given = given + (next - lambda_t) * tangent;
       lambda_t = next;
     }
     l[0] = float4{lambda_n, lambda_t, 0.0f, 0.0f};
-    const float4 impulse = lambda_n * dir + lambda_t * tangent;
-    l[1] = float4{impulse.x, impulse.y, impulse.z, 0.0f};
+    l[1] = float4{given.x, given.y, given.z, 0.0f};
   }
 }
 

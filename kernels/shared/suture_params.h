@@ -77,10 +77,12 @@
  *     thread slot, thread vertices, segment)
  *   7 weights float4 [in/out]: per row (wa, wb, wc, s)
  *   8 lambda float4 [in/out]: 3 per row: (lambda, lambda_t, 0, 0); the
- *     impulse vector lambda n + lambda_t t the row gave the tissue (or the
- *     tied thread vertex) in this substep [kg m]; the sum of the frame's
+ *     impulse vector the row gave the tissue (or the tied thread vertex)
+ *     in this substep [kg m], the sum of each sweep's steps dlambda n +
+ *     dlambda_t t (n and t turn between sweeps); the sum of the frame's
  *     earlier substeps' (reset like mesh_contact_params.h's lambda sum).
- *     (sum + last) / h is the frame's impulse [N s]. */
+ *     (sum + last) / h is the frame's impulse [N s]; the needle feels the
+ *     opposite (runtime/sutures.h). */
 #ifndef SINEW_SUTURE_PARAMS_H
 #define SINEW_SUTURE_PARAMS_H
 

@@ -275,6 +275,13 @@ Status check_needle(const SceneDesc& scene, const NeedleDesc& n, const std::stri
     return Error(ErrorCode::bad_parameter, name + ".thread = " + std::to_string(n.thread) +
                                                " is not a line body (the scene has " +
                                                std::to_string(scene.line_bodies.size()) + "; -1 for none)");
+  if (n.drive != NeedleDrive::kinematic && n.drive != NeedleDrive::force)
+    return Error(ErrorCode::bad_parameter, name + ".drive is neither kinematic nor force");
+  if (n.drive == NeedleDrive::force) {
+    if (Status s = positive(name + ".mass", n.mass); !s) return s;
+    for (int k = 0; k < 3; ++k)
+      if (Status s = positive(name + ".inertia[" + std::to_string(k) + "]", n.inertia[k]); !s) return s;
+  }
   for (std::size_t other = 0; n.thread >= 0 && &scene.needles[other] != &n; ++other)
     if (scene.needles[other].thread == n.thread)
       return Error(ErrorCode::bad_parameter, name + ".thread = " + std::to_string(n.thread) +

@@ -321,6 +321,15 @@ Status Simulation::set_needle_pose(std::size_t index, const std::array<double, 3
   return impl_->sutures->set_pose(index, position, rotation);
 }
 
+Status Simulation::apply_needle_force(std::size_t index, const std::array<double, 3>& force,
+                                      const std::array<double, 3>& torque) {
+  constexpr const char* call = "apply_needle_force";
+  if (Status s = check_index(call, "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s) return s;
+  if (Status s = check_finite(call, "force", force); !s) return s;
+  if (Status s = check_finite(call, "torque", torque); !s) return s;
+  return impl_->sutures->apply_force(index, force, torque);
+}
+
 Result<Simulation::NeedleState> Simulation::needle_state(std::size_t index) const {
   if (Status s = check_index("needle_state", "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s)
     return s.error();

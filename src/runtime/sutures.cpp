@@ -75,6 +75,13 @@ Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const C
     n.desc = scene.needles[i];
     n.position_start = n.position_end = n.desc.position;
     n.rotation_start = n.rotation_end = n.desc.rotation;
+    n.body.position = n.desc.position;
+    n.body.rotation = n.desc.rotation;
+    if (n.desc.drive == NeedleDrive::force) {
+      n.body.mass = n.desc.mass;
+      n.body.inertia = n.desc.inertia;
+      if (n.desc.gravity) n.body.gravity = scene.gravity;
+    }
     if (n.desc.thread >= 0) {
       const auto body = static_cast<std::size_t>(n.desc.thread);
       const std::uint32_t first = compiled.line_body_first_particle[body];
@@ -92,6 +99,8 @@ Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const C
     out->needles_.push_back(std::move(n));
   }
   out->positions_.resize(compiled.positions.size() * 4);
+  out->frame_ = scene.solver.time_step;
+  out->stiffness_ = double(scene.solver.iterations) * scene.solver.substeps * scene.solver.substeps;
   out->rows_capacity_ = static_cast<std::uint32_t>(out->needles_.size()) * kRowsPerNeedle;
   SutureBuffers& b = out->buffers_;
   const std::size_t needles = out->needles_.size();
@@ -117,10 +126,22 @@ Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const C
   return out;
 }
 
+namespace {
+
+// The angle [rad] between two unit quaternions' rotations.
+double turn_between(const math::Quat& a, const math::Quat& b) {
+  return 2.0 * std::acos(std::min(1.0, std::abs(math::qdot(a, b))));
+}
+
+}  // namespace
+
 Status Sutures::set_pose(std::size_t index, const Vec3& position, const math::Quat& rotation) {
+  if (needles_[index].desc.drive != NeedleDrive::kinematic)
+    return Error(ErrorCode::bad_parameter, "set_needle_pose: needle " + std::to_string(index) +
+                                               " is force-driven (NeedleDrive::force): use apply_needle_force");
   // Its points move along straight lines within a frame (suture_params.h):
   // a turn of more than a quarter circle would fold the needle.
-  const double turn = 2.0 * std::acos(std::min(1.0, std::abs(math::qdot(needles_[index].rotation_start, rotation))));
+  const double turn = turn_between(needles_[index].rotation_start, rotation);
   if (turn > M_PI / 2)
     return Error(ErrorCode::bad_parameter, "set_needle_pose: needle " + std::to_string(index) + " would turn by " +
                                                std::to_string(turn) +
@@ -128,6 +149,16 @@ Status Sutures::set_pose(std::size_t index, const Vec3& position, const math::Qu
                                                "within a frame: turn it over several)");
   needles_[index].position_end = position;
   needles_[index].rotation_end = rotation;
+  return {};
+}
+
+Status Sutures::apply_force(std::size_t index, const Vec3& force, const Vec3& torque) {
+  Needle& n = needles_[index];
+  if (n.desc.drive != NeedleDrive::force)
+    return Error(ErrorCode::bad_parameter, "apply_needle_force: needle " + std::to_string(index) +
+                                               " is kinematic (NeedleDrive::kinematic): use set_needle_pose");
+  n.body.force = math::add(n.body.force, force);  // calls before one frame add up
+  n.body.torque = math::add(n.body.torque, torque);
   return {};
 }
 
@@ -159,6 +190,15 @@ bool Sutures::first_crossing(const Vec3& a, const Vec3& b, bool entering, Needle
   for (std::uint32_t s = 0; s < surfaces_.size(); ++s) {
     const Surface& surface = surfaces_[s];
     if (!entering && surface.kind != BodyKind::tet) continue;  // a membrane has no inside
+    // Leaving needs the tip inside: it entered that body more often than it
+    // left (a tip pulled back out of a dent it pushed never entered).
+    if (!entering) {
+      int inside = 0;
+      for (const Row& r : needle.rows)
+        if (r.surface == s && (r.words[0] == SINEW_SUTURE_PUNCTURE || r.words[0] == SINEW_SUTURE_THREAD))
+          inside += r.exit ? -1 : 1;
+      if (inside <= 0) continue;
+    }
     for (std::uint32_t t = 0; t < surface.triangles.size(); ++t) {
       const auto& tri = surface.triangles[t];
       const Vec3 A = position_of(tri[0]), B = position_of(tri[1]), C = position_of(tri[2]);
@@ -224,6 +264,19 @@ Status Sutures::before_frame(Device& device, const XpbdBuffers& scene_buffers) {
   read_back_bytes_ += positions_.size() * 4;
   for (std::size_t i = 0; i < needles_.size(); ++i) {
     Needle& n = needles_[i];
+    if (n.desc.drive == NeedleDrive::force) {
+      // Its pose at the frame's end, from the force on it and the last
+      // frame's reaction (rigid_tool.h).
+      integrate_tool(n.body, frame_, stiffness_);
+      const double turn = turn_between(n.rotation_start, n.body.rotation);
+      if (!(turn <= M_PI / 2) || !std::isfinite(math::norm(n.body.position)))
+        return Error(ErrorCode::bad_parameter,
+                     "needle " + std::to_string(i) + " (force-driven) would turn by " + std::to_string(turn) +
+                         " rad in one frame; at most pi/2 (the torque on it is too large for its inertia and the "
+                         "time step)");
+      n.position_end = n.body.position;
+      n.rotation_end = n.body.rotation;
+    }
     std::erase_if(n.rows, [](const Row& r) { return r.words[0] == SINEW_SUTURE_TIP; });
     const std::vector<Vec3> start = curve_at(n, false), end = curve_at(n, true);
     const Vec3 d0 = unit(math::sub(start.back(), start[start.size() - 2]));
@@ -288,9 +341,18 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
     const std::vector<Vec3> start = curve_at(n, false), end = curve_at(n, true);
     const Vec3 tip = end.back(), d = unit(math::sub(end.back(), end[end.size() - 2]));
     n.tip_force = 0.0;
+    for (std::size_t k = 0; k < n.rows.size(); ++k) {
+      std::copy_n(&words[(at + k) * 8], 8, n.rows[k].words.begin());
+      std::copy_n(&weights[(at + k) * 4], 4, n.rows[k].weights.begin());
+    }
+    add_reactions(n, end, &lambda[at * 12], h, frame);
+    if (n.desc.drive == NeedleDrive::kinematic) {  // its motion over the frame, for NeedleState
+      n.body.velocity = math::mul(math::sub(n.position_end, n.position_start), 1.0 / frame);
+      n.body.angular_velocity = math::angular_velocity(n.rotation_start, n.rotation_end, frame);
+      n.body.position = n.position_end;
+      n.body.rotation = n.rotation_end;
+    }
     for (Row& r : n.rows) {
-      std::copy_n(&words[at * 8], 8, r.words.begin());
-      std::copy_n(&weights[at * 4], 4, r.weights.begin());
       const float* l = &lambda[at * 12];
       ++at;
       if (r.words[0] == SINEW_SUTURE_TIP) {
@@ -340,6 +402,63 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
   return {};
 }
 
+void Sutures::add_reactions(Needle& n, const std::vector<Vec3>& end, const float* lambda, double h, double frame) {
+  ToolBody& b = n.body;
+  n.reaction_force = n.reaction_torque = Vec3{0.0, 0.0, 0.0};
+  b.coupling_force = b.coupling_torque = Vec3{0.0, 0.0, 0.0};
+  b.touching_mass = 0.0;
+  b.touching_inertia = {};
+  const Vec3 origin = n.position_end;
+  for (std::size_t k = 0; k < n.rows.size(); ++k) {
+    const Row& r = n.rows[k];
+    const std::uint32_t kind = r.words[0];
+    if (kind != SINEW_SUTURE_TIE && kind != SINEW_SUTURE_TIP && kind != SINEW_SUTURE_PUNCTURE) continue;
+    const float* l = lambda + 12 * k;  // (lambda, lambda_t), the last substep's impulse, the earlier ones'
+    // Where the row pulls the needle: its tail (the tie), its tip, or the
+    // curve's closest point to the tissue point (a puncture).
+    Vec3 point = kind == SINEW_SUTURE_TIE ? end.front() : end.back();
+    if (kind == SINEW_SUTURE_PUNCTURE) {
+      const Vec3 p = point_of(r);
+      double best = INFINITY;
+      for (std::size_t j = 0; j + 1 < end.size(); ++j) {
+        const Vec3 e = math::sub(end[j + 1], end[j]);
+        const double u = std::clamp(math::dot(math::sub(p, end[j]), e) / math::dot(e, e), 0.0, 1.0);
+        const Vec3 q = math::add(end[j], math::mul(e, u));
+        const double d = math::norm(math::sub(p, q));
+        if (d < best) best = d, point = q;
+      }
+    }
+    const Vec3 arm = math::sub(point, origin);
+    // The tissue (or thread vertex) was moved by the impulse lambda; the
+    // needle takes the opposite: per substep lambda / h [N s].
+    const Vec3 last{l[4], l[5], l[6]};
+    const Vec3 all = math::add(last, Vec3{l[8], l[9], l[10]});
+    const Vec3 frame_impulse = math::mul(all, -1.0 / h), last_impulse = math::mul(last, -1.0 / h);
+    n.reaction_force = math::add(n.reaction_force, math::mul(frame_impulse, 1.0 / frame));
+    n.reaction_torque = math::add(n.reaction_torque, math::mul(math::cross(arm, frame_impulse), 1.0 / frame));
+    b.coupling_force = math::add(b.coupling_force, math::mul(last_impulse, 1.0 / h));
+    b.coupling_torque = math::add(b.coupling_torque, math::mul(math::cross(arm, last_impulse), 1.0 / h));
+    if (kind == SINEW_SUTURE_TIP && !(l[0] > 0.0f)) continue;  // not pushing at the frame's end
+    // The particles it holds stand in for a tool's touching particles
+    // (their mass c / w and its inertia about the needle's origin).
+    const std::uint32_t count = kind == SINEW_SUTURE_TIE ? 1 : 3;
+    for (std::uint32_t v = 0; v < count; ++v) {
+      const double c = kind == SINEW_SUTURE_TIE ? 1.0 : double(r.weights[v]);
+      const std::size_t at = std::size_t{r.words[2 + v]} * 4;
+      const double w = positions_[at + 3];
+      if (!(c > 0.0) || !(w > 0.0)) continue;
+      const double m = c / w;
+      const Vec3 rk = math::sub(position_of(r.words[2 + v]), origin);
+      b.touching_mass += m;
+      const double r2 = math::dot(rk, rk);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) b.touching_inertia[std::size_t(3 * i + j)] += m * ((i == j ? r2 : 0.0) - rk[i] * rk[j]);
+    }
+  }
+  b.contact_force = n.reaction_force;
+  b.contact_torque = n.reaction_torque;
+}
+
 void Sutures::mark_exemption() {
   exempt_.assign(positions_.size() / 4, 0);
   for (const Needle& n : needles_) {
@@ -367,6 +486,10 @@ Simulation::NeedleState Sutures::state(std::size_t index) const {
   Simulation::NeedleState out;
   out.position = n.position_start;
   out.rotation = n.rotation_start;
+  out.velocity = n.body.velocity;
+  out.angular_velocity = n.body.angular_velocity;
+  out.reaction_force = n.reaction_force;
+  out.reaction_torque = n.reaction_torque;
   out.tip_force = n.tip_force;
   out.refused_degenerate = n.refused_degenerate;
   out.refused_inverted = n.refused_inverted;

@@ -18,6 +18,16 @@
 // Punctures the needle was pulled back out of (their tissue point 0.5 mm
 // ahead of the tip) end.
 //
+// A needle's reaction: each row that joins the tissue or the thread to the
+// needle (tie, tip contact, puncture) gave the tissue an impulse (its
+// lambda records); the needle takes the opposite, at the row's point on the
+// needle at the frame's end, summed into a force and torque about its
+// origin. A force-driven needle (NeedleDrive::force) is a rigid body
+// integrated before each frame from the force applied to it and the last
+// substep's reaction, exactly as a rigid tool is (rigid_tool.h: the
+// coupling, its stability bound and its limits), the rows' particles
+// standing for the tool's touching particles.
+//
 // Why the detection is on the host: a needle is one polyline and its tip
 // path one segment per frame, tested against the surfaces' triangles in a
 // linear pass (60,000 triangles: a fraction of a millisecond); the read-back
@@ -32,6 +42,7 @@
 #include "compiler/scene_compiler.h"
 #include "math/vec3.h"
 #include "program/xpbd_program.h"
+#include "runtime/rigid_tool.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -51,9 +62,13 @@ class Sutures {
 
   /// The pose needle `index` reaches at the end of the next frame.
   /// [pre] index < needles(), the pose finite, the rotation a unit
-  /// quaternion (Simulation::set_needle_pose checks). Errors: a turn of
-  /// more than pi/2 from the frame's start.
+  /// quaternion (Simulation::set_needle_pose checks). Errors: a force-driven
+  /// needle; a turn of more than pi/2 from the frame's start.
   Status set_pose(std::size_t index, const math::Vec3& position, const math::Quat& rotation);
+  /// Adds a force [N] and torque [N m] (world frame, about its origin) on
+  /// force-driven needle `index` for the next frame. [pre] index <
+  /// needles(), both finite. Errors: a kinematic needle.
+  Status apply_force(std::size_t index, const math::Vec3& force, const math::Vec3& torque);
 
   /// Before a frame: reads the positions, finds the tips' contacts,
   /// uploads the needles and the rows.
@@ -93,6 +108,11 @@ class Sutures {
     math::Quat rotation_start{1, 0, 0, 0}, rotation_end{1, 0, 0, 0};
     std::uint32_t thread_first = 0, thread_vertices = 0;  // into the slots binding (0 vertices: no thread)
     std::vector<Row> rows;                                // tie first, then the tip contact and punctures
+    // A force-driven needle's rigid body (its position and rotation are
+    // position_start and rotation_start between frames); a kinematic one
+    // keeps only the last frame's motion here.
+    ToolBody body;
+    math::Vec3 reaction_force{}, reaction_torque{};  // the last frame's average [N], [N m]
     double tip_force = 0.0;
     std::uint32_t refused_degenerate = 0, refused_inverted = 0, refused_angle = 0;
   };
@@ -100,8 +120,14 @@ class Sutures {
   std::vector<math::Vec3> curve_at(const Needle& n, bool end) const;
   math::Vec3 position_of(std::uint32_t slot) const;
   math::Vec3 point_of(const Row& row) const;
+  // Sums each row's impulse on the needle (the opposite of the tissue's)
+  // into n's reaction and, for a force-driven needle, its coupling and
+  // touching mass (rigid_tool.h). [in] end: the needle at the frame's end;
+  // lambda: the rows' records as read back.
+  void add_reactions(Needle& n, const std::vector<math::Vec3>& end, const float* lambda, double h, double frame);
   // Where the segment a -> b first crosses a surface triangle in direction
-  // `entering` (true: from outside, false: from inside; tri bodies either
+  // `entering` (true: from outside, false: from inside a tet body the needle
+  // has entered and not left; tri bodies either
   // way), skipping triangles the needle holds already. [out] row: its
   // triangle and weights. Counts the triangles refused on `needle`.
   bool first_crossing(const math::Vec3& a, const math::Vec3& b, bool entering, Needle& needle, Row& row);
@@ -115,6 +141,8 @@ class Sutures {
   void mark_exemption();
   SutureBuffers buffers_;
   std::uint32_t rows_capacity_ = 0, curve_points_ = 0;
+  double frame_ = 0.0;      // the frame's length [s]
+  double stiffness_ = 0.0;  // iterations times substeps squared (integrate_tool)
   std::uint64_t read_back_bytes_ = 0;
 };
 
