@@ -5,15 +5,28 @@
 // turning (tip contacts, punctures in and out, the punctures passing to the
 // thread) and 190 of pulling and tugging (the thread sliding through four
 // punctures, then its knot holding).
-// Per run (the whole stitch = one iteration), medians over its frames [ms]:
-// wall time per frame; the needles' host side (suture_ms: reading the
-// positions back, testing the tip's path against the surfaces' 1,200
-// triangles, uploading the rows, reading them back); the rest (the frame's
-// program: the sweeps with the suture rows in each, and the statistics);
-// where the backend times its kernels, the device time of xpbd_sutures per
-// frame (all its dispatches: one per sweep). phase:0 times the turning
-// frames, phase:1 the pulling ones; needle:0 the same pads and thread
-// without the needle (what the scene costs without sutures).
+// Per run (the whole stitch = one iteration), medians over its frames [ms],
+// by stage:
+//   frame_ms        wall time per frame;
+//   broad_phase_ms  mesh collision (collision:1; FrameStats::collision_ms:
+//                   reading the positions back, the BVH broad phase and the
+//                   narrow phase, colouring and uploading the contacts);
+//   ccd_ms          continuous collision (collision:1; FrameStats::ccd_ms:
+//                   per substep, reading back, the swept-box broad phase and
+//                   the CCD queries, and the repairs' bookkeeping);
+//   suture_host_ms  the needles' host side (suture_ms: reading the
+//                   positions back, testing the tip's path against the
+//                   surfaces' 1,200 triangles, uploading the rows, reading
+//                   them back);
+//   solve_ms        the rest: the frame's program (the sweeps with the
+//                   suture rows and the mesh contacts in each, and the
+//                   statistics), and the repair sweeps CCD asks for;
+//   sutures_kernel_ms  where the backend times its kernels, the device time
+//                   of xpbd_sutures per frame (one dispatch per sweep).
+// phase:0 times the turning frames, phase:1 the pulling ones; needle:0 the
+// same pads and thread without the needle (what the scene costs without
+// sutures); collision:1 with mesh collision (0.5 mm thick, no
+// self-collision) and CCD on, as TheStitchHoldsWithMeshCollisionAndContinuousCollisionOn.
 //
 //   SINEW_BACKEND=cpu build/benchmarks/bench_suture --benchmark_repetitions=3
 //       --benchmark_format=csv > benchmarks/results/suture_<date>.csv
@@ -38,23 +51,29 @@ using bench::backend;
 using bench::median;
 
 void BM_Suture(benchmark::State& state) {
-  const bool pulling = state.range(0) == 1, needle = state.range(1) == 1;
+  const bool pulling = state.range(0) == 1, needle = state.range(1) == 1, collision = state.range(2) == 1;
   SceneDesc scene = test::SuturePads::scene();
   if (!needle) scene.needles.clear();
+  if (collision) {
+    scene.mesh_collision.enabled = true;
+    scene.mesh_collision.thickness = 5e-4;
+    scene.mesh_collision.self_collision = false;
+    scene.mesh_collision.continuous = true;
+  }
   constexpr int frames = 300;
   std::size_t sutures_kernel = 0;
   for (const auto name : kernel_names()) {
     if (name == "xpbd_sutures") break;
     ++sutures_kernel;
   }
-  std::vector<double> wall, suture, rest, kernel;
+  std::vector<double> wall, broad, ccd, suture, rest, kernel;
   for (auto _ : state) {
     auto sim = Simulation::create(scene, {.backend = backend(), .quiet = true});
     if (!sim) {
       state.SkipWithError(sim.error().message().c_str());
       return;
     }
-    wall.clear(), suture.clear(), rest.clear(), kernel.clear();
+    wall.clear(), broad.clear(), ccd.clear(), suture.clear(), rest.clear(), kernel.clear();
     for (int f = 0; f < frames; ++f) {
       if (Status s = needle ? test::SuturePads::drive(*sim, f) : Status{}; !s) {
         state.SkipWithError(s.error().message().c_str());
@@ -67,8 +86,10 @@ void BM_Suture(benchmark::State& state) {
       if ((f >= test::SuturePads::turn_frames) != pulling) continue;
       const FrameStats& st = sim->last_frame();
       wall.push_back(st.wall_ms);
+      broad.push_back(st.collision_ms);
+      ccd.push_back(st.ccd_ms);
       suture.push_back(st.suture_ms);
-      rest.push_back(st.wall_ms - st.suture_ms - st.collision_ms);
+      rest.push_back(st.wall_ms - st.suture_ms - st.collision_ms - st.ccd_ms);
       if (st.device.timed) kernel.push_back(st.device.kernel_ms[sutures_kernel]);
     }
     auto stitched = sim->needle_state(0);
@@ -78,10 +99,12 @@ void BM_Suture(benchmark::State& state) {
     }
   }
   state.counters["frame_ms"] = median(wall);
+  state.counters["broad_phase_ms"] = median(broad);
+  state.counters["ccd_ms"] = median(ccd);
   state.counters["suture_host_ms"] = median(suture);
-  state.counters["program_ms"] = median(rest);
+  state.counters["solve_ms"] = median(rest);
   state.counters["sutures_kernel_ms"] = kernel.empty() ? -1.0 : median(kernel);
-  state.SetLabel(backend() + (pulling ? "/pulling" : "/turning"));
+  state.SetLabel(backend() + (pulling ? "/pulling" : "/turning") + (collision ? "/collision" : ""));
 }
 
 // On the real liver (382,510 tets, the mesher's order, millimetres scaled to
@@ -153,10 +176,13 @@ void BM_SutureLiver(benchmark::State& state) {
 BENCHMARK(BM_SutureLiver)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_Suture)
-    ->ArgNames({"phase", "needle"})
-    ->Args({0, 1})
-    ->Args({1, 1})
-    ->Args({0, 0})
+    ->ArgNames({"phase", "needle", "collision"})
+    ->Args({0, 1, 0})
+    ->Args({1, 1, 0})
+    ->Args({0, 0, 0})
+    ->Args({0, 1, 1})
+    ->Args({1, 1, 1})
+    ->Args({0, 0, 1})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
 
