@@ -9,7 +9,8 @@
 // face and out through the right lip, at z = -3 mm and again at z = +3 mm
 // (a running suture: the thread crosses over the cut between them). Then it
 // is pulled up and away until the thread's knot (its last vertex) holds at
-// the first puncture and the stitches close the slit.
+// the first puncture, then 4 mm more (kTighten frames), and held there: the
+// stitches close the slit.
 //
 // Writes three VTU series (pad.pvd, thread.pvd and needle.pvd; the thread
 // and needle as line cells) and prints, per reported frame, the wall time,
@@ -34,8 +35,13 @@ constexpr double kCell = 0.002, kRadius = 0.008, kAbove = 0.002;  // [m]
 constexpr int kNx = 13, kNy = 5, kNz = 6, kSlit = 6;               // cells; the slit is column kSlit
 constexpr int kThreadSegments = 100;
 constexpr double kStitchZ[2] = {-0.003, 0.003};
-constexpr int kTurn = 110, kShift = 40, kPull = 200;  // frames of each phase
-constexpr double kLastAngle = 2.0 * M_PI - 0.2, kPulled = 0.085;
+constexpr int kTurn = 110, kShift = 40;  // frames of each phase
+// The pull: up and away from the cut at this speed [m per frame] until the
+// knot holds at the first puncture, then kTighten frames more, then held
+// for kHold frames; at most kMostPull frames to reach the knot.
+constexpr double kPullSpeed = 4.25e-4;
+constexpr int kTighten = 10, kHold = 60, kMostPull = 400;
+constexpr double kLastAngle = 2.0 * M_PI - 0.2;
 
 int fail(const std::string& message) {
   std::fprintf(stderr, "suturing: %s\n", message.c_str());
@@ -65,16 +71,18 @@ struct Pose {
   std::array<double, 3> position;
   double angle;
 };
-Pose script(int f) {
-  const int second = kTurn + kShift, pull = second + kTurn;
+// The stitches' frames: both turns, then the pull.
+constexpr int kStitched = 2 * kTurn + kShift;
+// The needle's pose in frame f < kStitched, or `pulled` [m] into the pull.
+Pose script(int f, double pulled) {
+  const int second = kTurn + kShift;
   if (f < kTurn) return {{0.0, kAbove, kStitchZ[0]}, kLastAngle * (f + 1) / kTurn};
   if (f < second) {  // over to the second stitch, the tip above the left lip
     const double u = double(f - kTurn + 1) / kShift;
     return {{0.0, kAbove, kStitchZ[0] + u * (kStitchZ[1] - kStitchZ[0])}, kLastAngle};
   }
-  if (f < pull) return {{0.0, kAbove, kStitchZ[1]}, kLastAngle + kLastAngle * (f - second + 1) / kTurn};
-  const double d = kPulled * std::min(1.0, double(f - pull + 1) / kPull);  // up and away from the cut
-  return {{0.5 * d, kAbove + d, kStitchZ[1]}, 2.0 * kLastAngle};
+  if (f < kStitched) return {{0.0, kAbove, kStitchZ[1]}, kLastAngle + kLastAngle * (f - second + 1) / kTurn};
+  return {{0.5 * pulled, kAbove + pulled, kStitchZ[1]}, 2.0 * kLastAngle};  // up and away from the cut
 }
 
 }  // namespace
@@ -123,8 +131,8 @@ int main(int argc, char** argv) {
 
   auto sim = sinew::Simulation::create(scene, {.backend = backend});
   if (!sim) return fail(sim.error().message());
-  std::printf("suturing on %s: %zu tets, a %d-segment thread, %d frames\n", sim->device_name().c_str(),
-              pad.mesh.tets.size(), kThreadSegments, 2 * kTurn + kShift + kPull + 60);
+  std::printf("suturing on %s: %zu tets, a %d-segment thread; %d frames of stitching, then the pull\n",
+              sim->device_name().c_str(), pad.mesh.tets.size(), kThreadSegments, kStitched);
 
   const std::uint32_t pad_first = sim->info().tet_body_first_particle[0];
   const std::uint32_t thread_first = sim->info().line_body_first_particle[0];
@@ -150,19 +158,30 @@ int main(int argc, char** argv) {
   for (std::uint32_t i = 0; i < kThreadSegments; ++i) thread_cells.push_back({i, i + 1});
   for (std::uint32_t i = 0; i + 1 < needle.curve.size(); ++i) needle_cells.push_back({i, i + 1});
   std::vector<float> x, ms;
-  const int frames = 2 * kTurn + kShift + kPull + 60;
-  double width_before = 0.0;
-  for (int f = 0; f < frames; ++f) {
-    const Pose p = script(f);
+  double width_before = 0.0, pulled = 0.0;
+  int knot_frame = -1, last = -1;  // when the knot first held; the last frame
+  for (int f = 0; last < 0 || f <= last; ++f) {
+    const Pose p = script(f, pulled);
     const std::array<double, 4> q{std::cos(p.angle / 2), 0.0, 0.0, std::sin(p.angle / 2)};
     if (auto s = sim->set_needle_pose(0, p.position, q); !s) return fail(s.error().message());
     if (auto s = sim->step(); !s) return fail("frame " + std::to_string(f) + ": " + s.error().message());
     ms.push_back(static_cast<float>(sim->last_frame().wall_ms));
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
     if (f == 0) width_before = slit_width(x);
-    if (f % every != 0 && f + 1 != frames) continue;
     auto state = sim->needle_state(0);
     if (!state) return fail(state.error().message());
+    if (f >= kStitched) {  // the pull: until the knot holds at the first puncture, then kTighten frames more
+      const bool knotted = !state->punctures.empty() && state->punctures[0].on_thread &&
+                           state->punctures[0].thread_segment + 1 == kThreadSegments;
+      if (knot_frame < 0 && knotted) {
+        knot_frame = f, last = f + kTighten + kHold;
+        std::printf("frame %3d  the knot holds at the first puncture, the needle %.1f mm up\n", f, pulled * 1e3);
+      }
+      if (knot_frame < 0 && f - kStitched >= kMostPull)
+        return fail("the knot never reached the first puncture in " + std::to_string(kMostPull) + " frames of pulling");
+      if (knot_frame < 0 || f < knot_frame + kTighten) pulled += kPullSpeed;
+    }
+    if (f % every != 0 && f != last) continue;
     std::string holes;
     for (const auto& h : state->punctures) holes += std::string(h.exit ? "out" : "in") + (h.on_thread ? "/thread " : "/needle ");
     std::printf("frame %3d  %6.2f ms  slit %.2f mm  %zu punctures: %s\n", f, ms.back(), slit_width(x) * 1e3,
