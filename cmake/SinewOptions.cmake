@@ -26,13 +26,15 @@ endif()
 
 if(SINEW_OPENVDB)
   # Debian's FindOpenVDB.cmake hard-fails when a Boost component is missing,
-  # so look for the header and library directly (the level-set code wires
-  # the imported target when it lands).
+  # so look for the headers and libraries directly.
   find_path(SINEW_OPENVDB_INCLUDE_DIR openvdb/openvdb.h)
   find_path(SINEW_NANOVDB_INCLUDE_DIR nanovdb/NanoVDB.h)
   find_library(SINEW_OPENVDB_LIBRARY openvdb)
+  # OpenVDB's headers convert halves inline through Imath (libimath-dev, a
+  # dependency of libopenvdb-dev), so the program links it too.
+  find_library(SINEW_IMATH_LIBRARY NAMES Imath Imath-3_1)
   set(_sinew_openvdb_ok FALSE)
-  if(SINEW_OPENVDB_INCLUDE_DIR AND SINEW_NANOVDB_INCLUDE_DIR AND SINEW_OPENVDB_LIBRARY)
+  if(SINEW_OPENVDB_INCLUDE_DIR AND SINEW_NANOVDB_INCLUDE_DIR AND SINEW_OPENVDB_LIBRARY AND SINEW_IMATH_LIBRARY)
     set(_sinew_openvdb_ok TRUE)
   endif()
   sinew_optional(SINEW_OPENVDB _sinew_openvdb_ok "OpenVDB + NanoVDB (apt-get install libopenvdb-dev libboost-dev)")

@@ -36,6 +36,34 @@ struct TriMesh {
   std::vector<std::array<std::uint32_t, 3>> triangles;
 };
 
+/// Reads a binary STL file: the triangles, with vertices at equal positions
+/// welded into one (bitwise equal coordinates, as STL writers repeat them).
+/// Units as in the file (../shared/data's are millimetres: scale them).
+/// Errors (bad_input_file, naming the file): missing or unreadable, an
+/// ASCII STL, a size that does not match its triangle count, a non-finite
+/// coordinate, no triangles.
+Result<TriMesh> read_stl(const std::filesystem::path& path);
+
+/// Why a closed surface is needed and what is checked (check_closed_surface).
+struct SurfaceReport {
+  std::uint64_t open_edges = 0;          ///< edges on one triangle only
+  std::uint64_t nonmanifold_edges = 0;   ///< edges on more than two triangles
+  std::uint64_t misoriented_edges = 0;   ///< edges both of whose triangles run the same way along them
+  std::uint64_t degenerate_triangles = 0;  ///< no area (or a repeated vertex)
+  /// Pairs of triangles that share no vertex and cross each other.
+  std::uint64_t intersecting_pairs = 0;
+  [[nodiscard]] bool closed() const {
+    return open_edges == 0 && nonmanifold_edges == 0 && misoriented_edges == 0 && degenerate_triangles == 0 &&
+           intersecting_pairs == 0;
+  }
+};
+
+/// Checks that `surface` bounds a solid: every edge on exactly two
+/// triangles running opposite ways along it, no triangle without area, no
+/// two triangles crossing (pairs sharing a vertex are not tested). [out]
+/// the counts. Errors: none (a non-finite vertex is counted as degenerate).
+SurfaceReport check_closed_surface(const TriMesh& surface);
+
 /// How a box cell of a tet grid is split.
 enum class TetsPerCell {
   five,  ///< 5 tets per cell, alternating mirrored cells so faces match
@@ -83,6 +111,7 @@ Status check_tet_mesh(const TetMesh& mesh, const std::string& origin = "mesh");
 
 /// Multiplies every position by `factor` (e.g. 1e-3 for millimetres to metres).
 void scale_mesh(TetMesh& mesh, double factor);
+void scale_mesh(TriMesh& mesh, double factor);
 
 /// The faces that belong to exactly one tet, wound outward; the returned
 /// mesh shares the tet mesh's vertex array and indices (unused vertices are

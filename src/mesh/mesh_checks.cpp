@@ -118,4 +118,10 @@ void scale_mesh(TetMesh& mesh, double factor) {
   }
 }
 
+void scale_mesh(TriMesh& mesh, double factor) {
+  for (Vec3d& p : mesh.vertices) {
+    for (double& x : p) x *= factor;
+  }
+}
+
 }  // namespace sinew
