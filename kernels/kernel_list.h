@@ -76,6 +76,8 @@
   /* the device narrow phase (kernels/shared/narrow_phase_params.h) */           \
   SINEW_KERNEL(narrow_triangle_pairs, 6, TrianglePairsParams, 0)                \
   /* continuous collision queries (kernels/shared/ccd_params.h) */              \
-  SINEW_KERNEL(ccd_queries, 3, CcdParams, 0)
+  SINEW_KERNEL(ccd_queries, 3, CcdParams, 0)                                     \
+  /* level sets (kernels/shared/level_set_params.h) */                          \
+  SINEW_KERNEL(level_set_sample, 3, LevelSetSampleParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */
