@@ -78,8 +78,9 @@ class LevelSet {
   /// its bytes, as uploaded to a device.
   [[nodiscard]] std::span<const std::byte> nanovdb_bytes() const;
 
-  struct Impl;  ///< (level_set.cpp)
+  struct Impl;  ///< opaque outside sinew (src/level_set/level_set_impl.h)
   explicit LevelSet(std::shared_ptr<Impl> impl);
+  [[nodiscard]] const Impl& internals() const { return *impl_; }
 
  private:
   std::shared_ptr<Impl> impl_;

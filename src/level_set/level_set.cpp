@@ -20,19 +20,13 @@
 #include <mutex>
 #include <string>
 
-#include <nanovdb/util/OpenToNanoVDB.h>
-#include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/SignedFloodFill.h>
 
-namespace sinew {
+#include "level_set/level_set_impl.h"
 
-struct LevelSet::Impl {
-  openvdb::FloatGrid::Ptr grid;
-  double voxel = 0.0, exterior = 0.0, interior = 0.0;
-  nanovdb::GridHandle<nanovdb::HostBuffer> nano;
-};
+namespace sinew {
 
 namespace {
 
