@@ -42,6 +42,34 @@ struct LevelSetSettings {
   double interior_band = 1.5e-3;
 };
 
+/// A cutting tool (LevelSet::cut), in its own frame: a burr (sphere of
+/// `radius` about the origin), a drill (capsule: the segment +-half_height
+/// along y swollen by `radius`) or a saw (box of `half_extents`).
+struct CutterShape {
+  enum class Kind { sphere, capsule, box };
+  Kind kind = Kind::sphere;
+  double radius = 1.5e-3;                               ///< sphere, capsule [m], > 0
+  double half_height = 0.0;                             ///< capsule [m], >= 0
+  std::array<double, 3> half_extents{1e-3, 1e-3, 1e-3};  ///< box [m], > 0
+};
+
+/// A rigid pose: the frame's origin [m] and its rotation, a unit quaternion
+/// (w, x, y, z), in the level set's frame.
+struct Pose {
+  std::array<double, 3> position{0.0, 0.0, 0.0};
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};
+};
+
+/// What one cut changed.
+struct CutReport {
+  double removed_volume = 0.0;      ///< [m^3], measured on the grid (see LevelSet::cut)
+  std::uint64_t changed_voxels = 0;
+  std::uint32_t changed_leaves = 0;  ///< 8^3-voxel blocks of the grid
+  /// Byte ranges (offset, size) of the NanoVDB grid that changed: what a
+  /// device's copy needs (update_level_set, src/level_set/device_level_set.h).
+  std::vector<std::array<std::uint64_t, 2>> changed_bytes;
+};
+
 /// A signed distance field on a sparse grid, in its own frame (the frame of
 /// the surface or shape it was built from). Copies share the grid (cheap).
 class LevelSet {
@@ -77,6 +105,30 @@ class LevelSet {
   /// The NanoVDB copy the kernels sample (a float grid, 32-byte aligned):
   /// its bytes, as uploaded to a device.
   [[nodiscard]] std::span<const std::byte> nanovdb_bytes() const;
+
+  /// Removes the material `shape` sweeps moving from pose `from` to `to`
+  /// (a CSG difference: every stored voxel becomes max(its value, minus
+  /// the swept tool's distance), at most exterior_band). The sweep is the
+  /// exact capsule for a sphere; a capsule or box is placed at poses along
+  /// the motion (positions lerped, rotations nlerped) no more than half a
+  /// voxel apart at its farthest point, so the union lies within h / 8 of
+  /// the true sweep. Voxels within exterior_band of the tool's reach are
+  /// updated (the solid's distances near the new face: a voxel deeper keeps
+  /// its old, larger depth, so the field is exact within the bands of every
+  /// surface, as a narrow band is). The host grid and its NanoVDB copy change in place
+  /// (for every copy of this LevelSet), neither's layout: only values.
+  /// removed_volume sums, over the changed voxels, h^3 times the drop of
+  /// clamp(1/2 - value / h, 0, 1) (the voxel's inside fraction, a linear
+  /// ramp across the surface). Errors (bad_parameter, nothing changed): a
+  /// level set whose inside is not all stored (interior_band must be
+  /// +infinity: a cut makes surface anywhere inside), a bad shape, a
+  /// non-finite pose or a rotation that is not a unit quaternion.
+  Result<CutReport> cut(const CutterShape& shape, const Pose& from, const Pose& to);
+
+  /// The zero level as triangles [m], counter-clockwise seen from outside
+  /// (OpenVDB's volume to mesh; quads split in two). For display: its cost
+  /// grows with the surface (measure it before calling it per frame).
+  [[nodiscard]] TriMesh surface() const;
 
   struct Impl;  ///< opaque outside sinew (src/level_set/level_set_impl.h)
   explicit LevelSet(std::shared_ptr<Impl> impl);

@@ -27,6 +27,24 @@ Result<DeviceLevelSet> upload_level_set(Device& device, const LevelSet& level_se
   return out;
 }
 
+Status update_level_set(Device& device, const DeviceLevelSet& grid, const LevelSet& level_set, const CutReport& cut,
+                        std::uint64_t* written) {
+  const std::span<const std::byte> bytes = level_set.nanovdb_bytes();
+  if (bytes.size() != grid.bytes)
+    return Error(ErrorCode::bad_parameter, "update_level_set: the device's grid (" + std::to_string(grid.bytes) +
+                                               " bytes) is not this level set's (" + std::to_string(bytes.size()) + ")");
+  std::uint64_t total = 0;
+  for (std::size_t r = 0; r < cut.changed_bytes.size();) {
+    std::uint64_t offset = cut.changed_bytes[r][0], end = offset + cut.changed_bytes[r][1];
+    for (++r; r < cut.changed_bytes.size() && cut.changed_bytes[r][0] == end; ++r) end += cut.changed_bytes[r][1];
+    if (end > bytes.size()) return Error(ErrorCode::bad_parameter, "update_level_set: a changed range past the grid");
+    if (Status s = device.write_buffer(grid.grid, offset, bytes.data() + offset, end - offset); !s) return s;
+    total += end - offset;
+  }
+  if (written) *written = total;
+  return {};
+}
+
 Result<std::vector<std::array<float, 4>>> sample_level_set(Device& device, const DeviceLevelSet& level_set,
                                                           std::span<const std::array<float, 3>> points) {
   std::vector<std::array<float, 4>> samples(points.size());

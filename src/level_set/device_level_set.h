@@ -30,6 +30,12 @@ struct DeviceLevelSet {
 /// (a build without OpenVDB), device errors.
 Result<DeviceLevelSet> upload_level_set(Device& device, const LevelSet& level_set);
 
+/// Brings a device's copy up to date after `level_set.cut` by writing only
+/// the byte ranges the cut changed (CutReport::changed_bytes, adjacent ones
+/// merged). [out] written: the bytes written, when not null.
+Status update_level_set(Device& device, const DeviceLevelSet& grid, const LevelSet& level_set, const CutReport& cut,
+                        std::uint64_t* written = nullptr);
+
 /// The value [m] and gradient at each point [m] (level set frame), as
 /// (value, gx, gy, gz), by one dispatch of level_set_sample. Errors (bad
 /// parameter): a non-finite point; device errors pass through.

@@ -23,8 +23,11 @@
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/SignedFloodFill.h>
+#include <openvdb/tools/VolumeToMesh.h>
+#include <unordered_set>
 
 #include "level_set/level_set_impl.h"
+#include "math/vec3.h"
 
 namespace sinew {
 
@@ -228,6 +231,174 @@ Point LevelSet::gradient(const Point& p) const {
 
 std::span<const std::byte> LevelSet::nanovdb_bytes() const {
   return {reinterpret_cast<const std::byte*>(impl_->nano.data()), impl_->nano.size()};
+}
+
+namespace {
+
+using math::Quat;
+using math::Vec3;
+
+// The tool's distance [m] at p (its own frame: local = R^T (p - position)).
+double shape_distance(const CutterShape& shape, const Vec3& local) {
+  switch (shape.kind) {
+    case CutterShape::Kind::sphere: return math::norm(local) - shape.radius;
+    case CutterShape::Kind::capsule: {
+      const double y = std::clamp(local[1], -shape.half_height, shape.half_height);
+      return math::norm(Vec3{local[0], local[1] - y, local[2]}) - shape.radius;
+    }
+    case CutterShape::Kind::box: {
+      double outside = 0.0, inside = -std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 3; ++k) {
+        const double q = std::abs(local[k]) - shape.half_extents[k];
+        outside += q > 0.0 ? q * q : 0.0;
+        inside = std::max(inside, q);
+      }
+      return outside > 0.0 ? std::sqrt(outside) : inside;
+    }
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+// How far the tool reaches from its origin [m].
+double shape_reach(const CutterShape& shape) {
+  switch (shape.kind) {
+    case CutterShape::Kind::sphere: return shape.radius;
+    case CutterShape::Kind::capsule: return shape.radius + shape.half_height;
+    case CutterShape::Kind::box: return math::norm(Vec3{shape.half_extents[0], shape.half_extents[1], shape.half_extents[2]});
+  }
+  return 0.0;
+}
+
+Status check_cut(const CutterShape& shape, const Pose& from, const Pose& to) {
+  const char* call = "LevelSet::cut";
+  const auto positive = [&](const char* what, double v) -> Status {
+    if (v > 0.0 && std::isfinite(v)) return {};
+    return Error(ErrorCode::bad_parameter, std::string(call) + ": " + what + " must be finite and > 0 [m] (got " +
+                                               str(v) + ")");
+  };
+  if (shape.kind == CutterShape::Kind::box) {
+    for (double e : shape.half_extents)
+      if (Status s = positive("the box's half_extents", e); !s) return s;
+  } else if (Status s = positive("the radius", shape.radius); !s) {
+    return s;
+  }
+  if (shape.kind == CutterShape::Kind::capsule && !(shape.half_height >= 0.0 && std::isfinite(shape.half_height)))
+    return Error(ErrorCode::bad_parameter, std::string(call) + ": half_height must be finite and >= 0 [m]");
+  for (const Pose* pose : {&from, &to}) {
+    const char* which = pose == &from ? "from" : "to";
+    for (double c : pose->position)
+      if (!std::isfinite(c))
+        return Error(ErrorCode::bad_parameter, std::string(call) + ": the " + which + " position is not finite");
+    const auto& q = pose->rotation;
+    const double n = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    if (!(std::abs(n - 1.0) <= 1e-6))
+      return Error(ErrorCode::bad_parameter,
+                   std::string(call) + ": the " + which + " rotation is not a unit quaternion (|q|^2 = " + str(n) + ")");
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<CutReport> LevelSet::cut(const CutterShape& shape, const Pose& from, const Pose& to) {
+  if (Status s = check_cut(shape, from, to); !s) return s.error();
+  if (std::isfinite(impl_->interior))
+    return Error(ErrorCode::bad_parameter,
+                 "LevelSet::cut: the level set stores its inside only " + str(impl_->interior) +
+                     " m deep; a cut makes surface anywhere inside, so build it with interior_band = +infinity");
+  const double h = impl_->voxel, reach = shape_reach(shape);
+  const Vec3 p0 = from.position, p1 = to.position;
+  // The poses the tool is placed at: a sphere's sweep is exact (the
+  // distance to the segment its centre travels); the others' farthest
+  // point moves at most h / 2 between two.
+  std::vector<std::pair<Vec3, Quat>> poses;
+  if (shape.kind != CutterShape::Kind::sphere) {
+    const double turn = 2.0 * std::acos(std::min(1.0, std::abs(math::qdot(from.rotation, to.rotation))));
+    const double travel = math::norm(math::sub(p1, p0)) + reach * turn;
+    const int n = std::max(1, static_cast<int>(std::ceil(travel / (0.5 * h))));
+    for (int k = 0; k <= n; ++k) {
+      const double u = double(k) / n;
+      poses.emplace_back(math::add(p0, math::mul(math::sub(p1, p0), u)), math::nlerp(from.rotation, to.rotation, u));
+    }
+  }
+  const auto tool_distance = [&](const Vec3& p) {
+    if (shape.kind == CutterShape::Kind::sphere) {
+      const Vec3 d = math::sub(p1, p0);
+      const double dd = math::dot(d, d);
+      const double u = dd > 0.0 ? std::clamp(math::dot(math::sub(p, p0), d) / dd, 0.0, 1.0) : 0.0;
+      return math::norm(math::sub(p, math::add(p0, math::mul(d, u)))) - shape.radius;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& [position, rotation] : poses)
+      best = std::min(best, shape_distance(shape, math::rotate(math::conj(rotation), math::sub(p, position))));
+    return best;
+  };
+  // Every voxel within the exterior band (and a voxel) of the tool's reach
+  // along its path: the solid's distances change up to there (a voxel
+  // deeper keeps its old depth, larger than its distance to the new face:
+  // exact within the bands of every surface, as a narrow band is).
+  openvdb::Coord first, last;
+  const double margin = reach + impl_->exterior + h;
+  for (int k = 0; k < 3; ++k) {
+    first[k] = static_cast<int>(std::floor((std::min(p0[k], p1[k]) - margin) / h));
+    last[k] = static_cast<int>(std::ceil((std::max(p0[k], p1[k]) + margin) / h));
+  }
+  auto* nano = impl_->nano.grid<float>();
+  auto nano_access = nano->getAccessor();
+  auto host_access = impl_->grid->getAccessor();
+  using Leaf = nanovdb::NanoLeaf<float>;
+  std::unordered_set<const Leaf*> leaves;
+  CutReport report;
+  const float ceiling = float(impl_->exterior);
+  const auto inside_fraction = [h](double value) { return std::clamp(0.5 - value / h, 0.0, 1.0); };
+  for (int i = first[0]; i <= last[0]; ++i)
+    for (int j = first[1]; j <= last[1]; ++j)
+      for (int k = first[2]; k <= last[2]; ++k) {
+        const nanovdb::Coord ijk(i, j, k);
+        const Leaf* leaf = nano_access.probeLeaf(ijk);
+        if (!leaf) continue;  // a tile: outside, beyond the band (the inside is all stored)
+        const float old_value = leaf->getValue(ijk);
+        const double cut = -tool_distance(Vec3{i * h, j * h, k * h});
+        if (!(cut > double(old_value))) continue;
+        const float value = std::min(float(cut), ceiling);
+        if (!(value > old_value)) continue;
+        const_cast<Leaf*>(leaf)->setValueOnly(ijk, value);
+        host_access.setValueOnly(openvdb::Coord(i, j, k), value);
+        leaves.insert(leaf);
+        ++report.changed_voxels;
+        report.removed_volume += (inside_fraction(old_value) - inside_fraction(value)) * h * h * h;
+      }
+  const auto* base = reinterpret_cast<const std::byte*>(impl_->nano.data());
+  for (const Leaf* leaf : leaves)
+    report.changed_bytes.push_back(
+        {std::uint64_t(reinterpret_cast<const std::byte*>(leaf) - base), std::uint64_t(sizeof(Leaf))});
+  std::sort(report.changed_bytes.begin(), report.changed_bytes.end());
+  report.changed_leaves = static_cast<std::uint32_t>(leaves.size());
+  return report;
+}
+
+TriMesh LevelSet::surface() const {
+  std::vector<openvdb::Vec3s> points;
+  std::vector<openvdb::Vec3I> triangles;
+  std::vector<openvdb::Vec4I> quads;
+  openvdb::tools::volumeToMesh(*impl_->grid, points, triangles, quads, 0.0);
+  TriMesh mesh;
+  mesh.vertices.reserve(points.size());
+  for (const auto& p : points) mesh.vertices.push_back({double(p[0]), double(p[1]), double(p[2])});
+  for (const auto& t : triangles) mesh.triangles.push_back({t[0], t[1], t[2]});
+  for (const auto& q : quads) {
+    mesh.triangles.push_back({q[0], q[1], q[2]});
+    mesh.triangles.push_back({q[0], q[2], q[3]});
+  }
+  // Counter-clockwise from outside: the enclosed volume comes out positive.
+  double volume = 0.0;
+  for (const auto& t : mesh.triangles) {
+    const auto &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    volume += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  if (volume < 0.0)
+    for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+  return mesh;
 }
 
 }  // namespace sinew

@@ -34,5 +34,7 @@ std::uint64_t LevelSet::voxels() const { return 0; }
 double LevelSet::value(const std::array<double, 3>&) const { return 0.0; }
 std::array<double, 3> LevelSet::gradient(const std::array<double, 3>&) const { return {}; }
 std::span<const std::byte> LevelSet::nanovdb_bytes() const { return {}; }
+Result<CutReport> LevelSet::cut(const CutterShape&, const Pose&, const Pose&) { return unavailable("LevelSet::cut"); }
+TriMesh LevelSet::surface() const { return {}; }
 
 }  // namespace sinew
