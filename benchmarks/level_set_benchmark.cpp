@@ -10,12 +10,15 @@
 // voxel (as a body's particles, stored in a memory-friendly order, sit near
 // their neighbours), which lets an accessor reuse its cached nodes.
 // Counters: samples_per_s (and per thread for the one-thread rows).
+// BM_CutTick: cutting the bone per haptic tick (below).
 //
 //   SINEW_BACKEND=cpu build/benchmarks/bench_level_set --benchmark_format=csv
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -154,6 +157,81 @@ void BM_KernelSample(benchmark::State& state) {
   state.SetLabel(bench::backend() + (bench::backend() == "cpu" ? " " + std::to_string(threads) + " thread(s)" : ""));
 }
 
+// A haptic tick of bone cutting (issue 14, part 4): a 3 mm burr (radius
+// 1.5 mm) plunging 1 mm per tick into the tibia's plateau, 20 mm deep,
+// cut from the level set (0.5 or 0.25 mm voxels, range(0) in um; its whole
+// inside stored) and the changed leaves written to the backend's copy.
+// Counters: the median tick [ms] (cut_ms + upload_ms), the bytes written
+// per tick, the voxels changed, the volume removed per tick [mm^3].
+void BM_CutTick(benchmark::State& state) {
+  const double voxel = double(state.range(0)) * 1e-6;
+  auto mesh = read_stl(std::string(SINEW_DATA_DIR) + "/meshes/surface/VHF_Left_Bone_Tibia_smooth.stl");
+  if (!mesh) {
+    state.SkipWithError(mesh.error().message().c_str());
+    return;
+  }
+  scale_mesh(*mesh, 1e-3);
+  auto bone = LevelSet::from_mesh(*mesh, {.voxel_size = voxel, .exterior_band = 3.0 * voxel,
+                                          .interior_band = std::numeric_limits<double>::infinity()});
+  if (!bone) {
+    state.SkipWithError(bone.error().message().c_str());
+    return;
+  }
+  auto device = create_device({.backend = bench::backend(), .quiet = true});
+  if (!device) {
+    state.SkipWithError(device.error().message().c_str());
+    return;
+  }
+  auto grid = upload_level_set(**device, *bone);
+  if (!grid) {
+    state.SkipWithError(grid.error().message().c_str());
+    return;
+  }
+  // The top: the highest vertex (z is the bone's long axis), moved 5 mm
+  // towards the bone's middle (onto the plateau). Each pass of 20 ticks
+  // plunges the burr 1 mm per tick from where it first touches the bone;
+  // the next pass is 4 mm over in y, into fresh bone.
+  std::array<double, 3> top = mesh->vertices[0];
+  for (const auto& v : mesh->vertices)
+    if (v[2] > top[2]) top = v;
+  const auto b = bone->bounds();
+  for (int k = 0; k < 2; ++k) top[k] += top[k] < 0.5 * (b[k] + b[k + 3]) ? 5e-3 : -5e-3;
+  std::vector<double> cut_ms, upload_ms, bytes, voxels, removed;
+  int tick = 0;
+  double y = top[1], z = top[2];
+  for (auto _ : state) {
+    if (tick % 20 == 0) {  // a new pass: the burr's centre where it first touches
+      y = top[1] + 4e-3 * (tick / 20);
+      for (z = top[2] + 3e-3; bone->value({top[0], y, z}) > 1.5e-3 && z > b[2]; z -= 1e-4) {
+      }
+    }
+    ++tick;
+    const Pose from{.position = {top[0], y, z}}, to{.position = {top[0], y, z - 1e-3}};
+    z -= 1e-3;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto report = bone->cut({.kind = CutterShape::Kind::sphere, .radius = 1.5e-3}, from, to);
+    const auto t1 = std::chrono::steady_clock::now();
+    std::uint64_t written = 0;
+    if (!report || !update_level_set(**device, *grid, *bone, *report, &written)) {
+      state.SkipWithError("cut");
+      return;
+    }
+    const auto t2 = std::chrono::steady_clock::now();
+    cut_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    upload_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    bytes.push_back(double(written));
+    voxels.push_back(double(report->changed_voxels));
+    removed.push_back(report->removed_volume * 1e9);
+  }
+  state.counters["cut_ms"] = bench::median(cut_ms);
+  state.counters["upload_ms"] = bench::median(upload_ms);
+  state.counters["bytes"] = bench::median(bytes);
+  state.counters["voxels"] = bench::median(voxels);
+  state.counters["removed_mm3"] = bench::median(removed);
+  state.counters["grid_mb"] = double(grid->bytes) / 1e6;
+  state.SetLabel(bench::backend());
+}
+
 BENCHMARK(BM_OpenVdbBoxSampler)->ArgName("order")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_KernelSample)
     ->ArgNames({"order", "threads"})
@@ -163,6 +241,7 @@ BENCHMARK(BM_KernelSample)
     ->Args({1, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_CutTick)->ArgName("voxel_um")->Arg(500)->Arg(250)->Iterations(40)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
