@@ -42,9 +42,9 @@
   SINEW_KERNEL(xpbd_solve_dihedral, 5, SolveParams, 0)                           \
   SINEW_KERNEL(xpbd_solve_line_bending, 5, SolveParams, 0)                       \
   /* contacts (kernels/shared/contact_params.h): + targets; + previous position, \
-   * colliders, contact impulses */                                              \
+   * colliders, contact impulses, level-set grids */                             \
   SINEW_KERNEL(xpbd_solve_attachment, 6, SolveParams, 0)                         \
-  SINEW_KERNEL(xpbd_solve_contacts, 8, SolveParams, 0)                           \
+  SINEW_KERNEL(xpbd_solve_contacts, 9, SolveParams, 0)                           \
   /* contacts between meshes (kernels/shared/mesh_contact_params.h) */           \
   SINEW_KERNEL(xpbd_solve_mesh_contacts, 9, MeshContactParams, 0)                \
   SINEW_KERNEL(xpbd_mesh_contacts_jacobi, 10, MeshContactParams, 0)              \

@@ -257,6 +257,7 @@ KernelCase contact_case(const ContactSetup& c, float substep_end, bool reset, bo
   k.bindings.push_back({c.prev, false, 4});
   k.bindings.push_back({c.colliders, false});
   k.bindings.push_back({c.impulses, false, 4});
+  k.bindings.push_back({std::vector<float>(4, 0.0f), false});  // no level-set grids (level_set_contact_test.cpp)
   const float h = 1.0f / 240.0f;
   k.params = bytes_of(SolveParams{first, count, 1.0f / (h * h), reset ? 1u : 0u, h, substep_end, measure ? 1u : 0u, 0});
   return k;

@@ -6,9 +6,11 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <vector>
 
+#include "sinew/level_set.h"
 #include "sinew/mesh.h"
 #include "sinew/result.h"
 
@@ -152,7 +154,7 @@ struct TriBodyDesc {
 /// box has `half_extents`; a cylinder has flat caps at y = +-half_height and
 /// `radius` about the y axis; an implicit shape is the signed distance
 /// function its `implicit` nodes compute (ImplicitNode).
-enum class ColliderShape { plane, sphere, capsule, box, cylinder, implicit };
+enum class ColliderShape { plane, sphere, capsule, box, cylinder, implicit, level_set };
 
 /// One node of an implicit shape (ColliderShape::implicit), an analytic
 /// signed distance function written as a CSG expression in postfix order:
@@ -201,6 +203,12 @@ struct ColliderDesc {
   double dynamic_friction = 0.4;                        ///< >= 0, <= static_friction
   double compliance = 0.0;                              ///< [m/N], >= 0
   std::vector<ImplicitNode> implicit;                   ///< implicit shape's nodes (only with ColliderShape::implicit)
+  /// ColliderShape::level_set: the signed distance field (sinew/level_set.h)
+  /// in the collider's frame. Particles are pushed out along its gradient;
+  /// one deeper inside than its interior band (where the gradient is zero)
+  /// is not (build it with the inside filled for a solid). The simulation
+  /// shares the grid: Simulation::cut_collider cuts it.
+  std::optional<LevelSet> level_set;
 };
 
 /// Which body a vertex belongs to.

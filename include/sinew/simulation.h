@@ -154,6 +154,14 @@ class Simulation {
   /// calls before one step add up.
   Status apply_tool_force(std::size_t index, const std::array<double, 3>& force, const std::array<double, 3>& torque);
 
+  /// Cuts level-set collider `index` (ColliderShape::level_set, built with
+  /// its whole inside stored): LevelSet::cut with the tool's poses in the
+  /// collider's frame. The collider's grid changes (and every LevelSet
+  /// sharing it), and so does the device's copy, by the changed leaves,
+  /// before this returns: the next step collides with the cut shape.
+  /// Errors: not a level-set collider; LevelSet::cut's.
+  Result<CutReport> cut_collider(std::size_t index, const CutterShape& shape, const Pose& from, const Pose& to);
+
   /// A tool's state at the end of the last frame.
   struct ToolState {
     std::array<double, 3> position{};          ///< [m]

@@ -22,6 +22,10 @@
 
 #include "xpbd_params.h"
 
+#if SINEW_HAS_OPENVDB
+#include "cpu/level_set_sampling.h"
+#endif
+
 namespace sinew::kernels {
 namespace {
 
@@ -158,8 +162,20 @@ SignedDistance implicit_distance(const ImplicitEntry* nodes, std::uint32_t count
   return stack[0];
 }
 
-SignedDistance collider_distance(const ColliderEntry& e, float4 local, const ImplicitEntry* nodes) {
+SignedDistance collider_distance(const ColliderEntry& e, float4 local, const ImplicitEntry* nodes,
+                                 std::uint32_t* grids) {
   if (e.shape == SINEW_SHAPE_IMPLICIT) return implicit_distance(nodes + e.implicit_first, e.implicit_count, local);
+#if SINEW_HAS_OPENVDB
+  if (e.shape == SINEW_SHAPE_LEVEL_SET) {
+    // Its trilinear value; its gradient, normalised (zero beyond the bands).
+    const float4 s = sample_level_set_grid(grids, e.implicit_first, e.half_x, e.half_y, local);
+    const float4 g{s.y, s.z, s.w, 0.0f};
+    const float length = length3(g);
+    return {s.x, length > 0.0f ? (1.0f / length) * g : float4{0.0f, 0.0f, 0.0f, 0.0f}};
+  }
+#else
+  (void)grids;
+#endif
   return shape_distance(e, local);
 }
 
@@ -209,6 +225,7 @@ void xpbd_solve_contacts(const void* params, std::byte* const* bindings, std::ui
   const auto* colliders = reinterpret_cast<const ColliderEntry*>(bindings[6] + sizeof(ColliderHeader));
   const auto* nodes = reinterpret_cast<const ImplicitEntry*>(colliders + header.colliders + header.tools);
   auto* impulses = reinterpret_cast<float4*>(bindings[7]);
+  auto* grids = reinterpret_cast<std::uint32_t*>(bindings[8]);
 
   const std::uint32_t count = header.colliders + header.tools;
   const float t1 = p.substep_end;                                  // the substep's end, as a frame fraction
@@ -240,7 +257,7 @@ void xpbd_solve_contacts(const void* params, std::byte* const* bindings, std::ui
       float4 lambda_t = p.reset_lambda ? float4{0, 0, 0, 0} : float4{lk[1], lk[2], lk[3], 0.0f};
 
       const Pose pose = collider_pose(e, t1);
-      const SignedDistance sd = collider_distance(e, rotate_inverse(pose.q, xi - pose.p), nodes);
+      const SignedDistance sd = collider_distance(e, rotate_inverse(pose.q, xi - pose.p), nodes, grids);
       const float c = sd.distance - margin[i];
       const float4 n = rotate(pose.q, sd.normal);
       const float alpha_t = e.compliance * p.inv_h2;

@@ -45,8 +45,10 @@ struct SignedDistance {
   float4 normal;
 };
 /// `nodes`: the collider buffer's ImplicitEntry array (after the last
-/// ColliderEntry), read only by implicit colliders.
-SignedDistance collider_distance(const ColliderEntry& e, float4 local, const ImplicitEntry* nodes);
+/// ColliderEntry), read only by implicit colliders; `grids`: the level-set
+/// grids buffer, read only by level-set colliders.
+SignedDistance collider_distance(const ColliderEntry& e, float4 local, const ImplicitEntry* nodes,
+                                 std::uint32_t* grids);
 
 /// The signed distance and normal of an implicit shape's `count` nodes
 /// (postfix CSG, kernels/shared/contact_params.h) at a point in the

@@ -32,7 +32,13 @@
  *            min(a, b) (unite), max(a, b) (intersect) or max(a, -b)
  *            (subtract, b's normal negated), keeping the normal of the
  *            value chosen (a on ties). At most SINEW_IMPLICIT_STACK values
- *            and SINEW_IMPLICIT_MAX_NODES nodes (checked on the host).
+ *            and SINEW_IMPLICIT_MAX_NODES nodes (checked on the host);
+ *   level set a LevelSet's NanoVDB grid (sinew/level_set.h) in binding 8, at
+ *            byte `implicit_first` of it; half_x = 1 / h, half_y = 1 / 2h
+ *            (h its voxel). The distance is its trilinear value, the normal
+ *            its gradient (kernels/shared/level_set_params.h) normalised; a
+ *            zero gradient (beyond the grid's bands) gives a zero normal,
+ *            along which nothing moves.
  *
  * ------------------------------------------------------------ xpbd_solve_contacts
  * arity 1: one constraint per movable particle, all in one colour (a particle
@@ -57,6 +63,8 @@
  *     pose, its rotation stabilised by the inertia of the particles it
  *     touches, and reports the frame average; see
  *     src/runtime/simulation_contacts.cpp.)
+ *   8 level-set grids uint [in]: every level-set collider's grid, each at
+ *     its byte offset (a placeholder when the scene has none).
  * data: SINEW_CONTACT_DATA_STRIDE floats per constraint: [0] margin [m], a
  *   distance the particle keeps from every surface (0 for mesh vertices).
  * lambda: SINEW_CONTACT_LAMBDA_PER_COLLIDER floats per (constraint,
@@ -100,6 +108,7 @@
 #define SINEW_SHAPE_BOX 3u
 #define SINEW_SHAPE_CYLINDER 4u
 #define SINEW_SHAPE_IMPLICIT 5u
+#define SINEW_SHAPE_LEVEL_SET 6u
 
 /* ImplicitEntry::op: primitives (their shape in the node's frame), then operations. */
 #define SINEW_IMPLICIT_HALF_SPACE 0u

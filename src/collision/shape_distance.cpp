@@ -110,6 +110,13 @@ ShapeDistance local_distance(const ColliderDesc& c, const Vec3& l) {
     case ColliderShape::box: return box(c.half_extents, l);
     case ColliderShape::cylinder: return cylinder(c.radius, c.half_height, l);
     case ColliderShape::implicit: return implicit(c.implicit, l);
+    case ColliderShape::level_set: {
+      // Its trilinear value and gradient, normalised (zero beyond its bands).
+      if (!c.level_set) return {};
+      const Vec3 g = c.level_set->gradient(l);
+      const double n = math::norm(g);
+      return {c.level_set->value(l), n > 0.0 ? math::mul(g, 1.0 / n) : Vec3{0.0, 0.0, 0.0}};
+    }
   }
   return {};
 }
@@ -141,7 +148,8 @@ CapsuleContact capsule_against(const ColliderDesc& shape, const Vec3& position, 
   auto at = [&](double t) { return math::add(a, math::mul(ab, t)); };
   auto f = [&](double t) { return shape_distance(shape, position, rotation, at(t)).distance; };
   double lo = 0.0, hi = 1.0;
-  if (shape.shape == ColliderShape::implicit) {  // not convex: bracket the best of 33 samples
+  if (shape.shape == ColliderShape::implicit || shape.shape == ColliderShape::level_set) {
+    // not convex: bracket the best of 33 samples
     constexpr int samples = 32;
     int best = 0;
     double best_f = f(0.0);

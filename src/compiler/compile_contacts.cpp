@@ -3,6 +3,7 @@
 // (kernels/shared/contact_params.h), one contact constraint per movable
 // particle and one attachment constraint per attached vertex.
 // Called after every body has been added, so the particle layout is final.
+#include <cstring>
 #include <array>
 #include <limits>
 #include <string>
@@ -41,6 +42,7 @@ std::uint32_t shape_code(ColliderShape shape) {
     case ColliderShape::box: return SINEW_SHAPE_BOX;
     case ColliderShape::cylinder: return SINEW_SHAPE_CYLINDER;
     case ColliderShape::implicit: return SINEW_SHAPE_IMPLICIT;
+    case ColliderShape::level_set: return SINEW_SHAPE_LEVEL_SET;
   }
   return SINEW_SHAPE_PLANE;
 }
@@ -104,7 +106,10 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
   out.colliders.clear();
   append_words(out.colliders, header);
   std::vector<ImplicitEntry> nodes;  // every implicit collider's nodes, after the entries
-  for (const ColliderDesc& c : scene.colliders) {
+  out.level_set_grids.clear();
+  out.level_set_offsets.assign(scene.colliders.size(), 0);
+  for (std::size_t k = 0; k < scene.colliders.size(); ++k) {
+    const ColliderDesc& c = scene.colliders[k];
     ColliderEntry e = entry(shape_code(c.shape), c.position, c.rotation);
     if (c.shape == ColliderShape::implicit) {
       e.implicit_first = static_cast<std::uint32_t>(nodes.size());
@@ -116,6 +121,22 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     e.half_x = static_cast<float>(c.half_extents[0]);
     e.half_y = static_cast<float>(c.half_extents[1]);
     e.half_z = static_cast<float>(c.half_extents[2]);
+    if (c.shape == ColliderShape::level_set) {
+      // Its grid at the next 32-byte boundary of the grids buffer (NanoVDB's
+      // alignment); the kernels address it by byte offset in 32 bits.
+      const std::span<const std::byte> bytes = c.level_set->nanovdb_bytes();
+      const std::uint64_t offset = (std::uint64_t{out.level_set_grids.size()} * 4 + 31) / 32 * 32;
+      if (offset + bytes.size() > std::uint64_t{UINT32_MAX})
+        return Error(ErrorCode::bad_parameter, "colliders: the level-set grids take more than 4 GiB (" +
+                                                   std::to_string(offset + bytes.size()) + " bytes)");
+      out.level_set_grids.resize(offset / 4 + bytes.size() / 4, 0u);
+      std::memcpy(out.level_set_grids.data() + offset / 4, bytes.data(), bytes.size());
+      out.level_set_offsets[k] = offset;
+      e.implicit_first = static_cast<std::uint32_t>(offset);
+      e.half_x = static_cast<float>(1.0 / c.level_set->voxel_size());
+      e.half_y = static_cast<float>(0.5 / c.level_set->voxel_size());
+      e.half_z = 0.0f;
+    }
     e.static_friction = static_cast<float>(c.static_friction);
     e.dynamic_friction = static_cast<float>(c.dynamic_friction);
     e.compliance = static_cast<float>(c.compliance);
@@ -153,7 +174,8 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     RawConstraints& contacts =
         b.constraints(Kernel::xpbd_solve_contacts, 1, SINEW_CONTACT_DATA_STRIDE,
                       SINEW_CONTACT_LAMBDA_PER_COLLIDER * surfaces,
-                      {SceneBuffer::previous_position, SceneBuffer::colliders, SceneBuffer::contact_impulses});
+                      {SceneBuffer::previous_position, SceneBuffer::colliders, SceneBuffer::contact_impulses,
+                       SceneBuffer::level_set_grids});
     for (std::uint32_t p = 0; p < particles; ++p) {
       if (!(b.mass[p] > 0.0)) continue;  // pinned: never moves, never collides
       contacts.particles.push_back(p);

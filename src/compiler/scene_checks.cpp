@@ -237,6 +237,14 @@ Status check_collider(const ColliderDesc& c, const std::string& name) {
     if (Status s = check_implicit(c.implicit, name + ".implicit"); !s) return s;
   } else if (!c.implicit.empty())
     return Error(ErrorCode::bad_parameter, name + ".implicit has nodes but the shape is not ColliderShape::implicit");
+  if (c.shape == ColliderShape::level_set) {
+    if (!c.level_set)
+      return Error(ErrorCode::bad_parameter, name + ".level_set is missing (ColliderShape::level_set needs one)");
+    if (c.level_set->nanovdb_bytes().empty())
+      return Error(ErrorCode::backend_unavailable, name + ".level_set has no grid (sinew was built without OpenVDB)");
+  } else if (c.level_set) {
+    return Error(ErrorCode::bad_parameter, name + ".level_set is set but the shape is not ColliderShape::level_set");
+  }
   if (Status s = check_friction(name, c.static_friction, c.dynamic_friction); !s) return s;
   return non_negative(name + ".compliance", c.compliance);
 }

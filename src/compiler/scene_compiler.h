@@ -24,6 +24,7 @@ enum class SceneBuffer {
   colliders,          ///< CompiledScene::colliders (kernels/shared/contact_params.h)
   targets,            ///< CompiledScene::targets (kernels/shared/contact_params.h)
   contact_impulses,   ///< SINEW_CONTACT_IMPULSE_FLOAT4S float4 per particle and tool (see contact_params.h)
+  level_set_grids,    ///< CompiledScene::level_set_grids (contact_params.h, binding 8 of the contacts)
 };
 
 struct ConstraintBlock {
@@ -63,6 +64,11 @@ struct CompiledScene {
   /// Simulation rewrites colliders and targets between frames.
   std::vector<float> colliders;
   std::vector<float> targets;
+  /// Every level-set collider's NanoVDB grid, each at a 32-byte aligned
+  /// offset (level_set_offsets, in SceneDesc::colliders order; 0 for the
+  /// other shapes), as 32-bit words.
+  std::vector<std::uint32_t> level_set_grids;
+  std::vector<std::uint64_t> level_set_offsets;
   std::uint32_t contact_impulse_slots = 0;  ///< float4s in the contact_impulses buffer
   /// Per particle (device order), the factor its velocity is multiplied by
   /// each substep, exp(-k h) for its body's velocity_damping k (1: none);

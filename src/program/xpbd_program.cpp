@@ -43,6 +43,7 @@ void sweep(FrameProgram& program, const ConstraintBlock& block, std::span<const 
       case SceneBuffer::colliders: bindings.push_back(scene_buffers.colliders); break;
       case SceneBuffer::targets: bindings.push_back(scene_buffers.targets); break;
       case SceneBuffer::contact_impulses: bindings.push_back(scene_buffers.contact_impulses); break;
+      case SceneBuffer::level_set_grids: bindings.push_back(scene_buffers.level_set_grids); break;
     }
   }
   for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
@@ -79,6 +80,9 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
   auto contact_impulses = make_buffer(device, impulses, "contact impulses");
   if (!contact_impulses) return contact_impulses.error();
   b.contact_impulses = *contact_impulses;
+  auto grids = make_buffer(device, scene.level_set_grids, "level-set grids");
+  if (!grids) return grids.error();
+  b.level_set_grids = *grids;
   for (const ConstraintBlock& block : scene.blocks) {
     const std::string name(kernel_name(block.kernel));
     auto particles = make_buffer(device, block.particles, name + " particles");

@@ -18,6 +18,7 @@ struct BlockBuffers {
 struct XpbdBuffers {
   BufferHandle position, previous, velocity;
   BufferHandle colliders, targets, contact_impulses;  ///< SceneBuffer (small placeholders when unused)
+  BufferHandle level_set_grids;                      ///< SceneBuffer::level_set_grids (a placeholder when none)
   std::vector<BlockBuffers> blocks;  ///< one per CompiledScene::blocks entry
 };
 

@@ -19,6 +19,9 @@ struct ContactState {
   bool targets_dirty = false;    ///< the target buffer changed since its last upload
   std::vector<ToolBody> tools;
   std::vector<ColliderDesc> shapes;  ///< the scene's colliders (the tools meet them on the host, tool_contacts.h)
+  /// Per scene collider, where its level set's grid starts in the level-set
+  /// grids buffer [bytes] (0 for other shapes; CompiledScene::level_set_offsets).
+  std::vector<std::uint64_t> level_set_offsets;
   std::vector<ColliderDesc> tool_shapes;  ///< each tool's capsule, for the meshes' faces (mesh_collision.h)
 };
 

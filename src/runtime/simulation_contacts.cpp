@@ -155,6 +155,7 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
     contacts.tool_shapes.push_back(tool_capsule(b));
   }
   contacts.shapes = scene.colliders;
+  contacts.level_set_offsets = compiled.level_set_offsets;
   return {};
 }
 
@@ -334,6 +335,29 @@ Result<Simulation::NeedleState> Simulation::needle_state(std::size_t index) cons
   if (Status s = check_index("needle_state", "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s)
     return s.error();
   return impl_->sutures->state(index);
+}
+
+Result<CutReport> Simulation::cut_collider(std::size_t index, const CutterShape& shape, const Pose& from,
+                                           const Pose& to) {
+  constexpr const char* call = "cut_collider";
+  ContactState& c = impl_->contacts;
+  if (Status s = check_index(call, "collider", index, c.shapes.size()); !s) return s.error();
+  ColliderDesc& collider = c.shapes[index];
+  if (collider.shape != ColliderShape::level_set || !collider.level_set)
+    return Error(ErrorCode::bad_parameter,
+                 std::string(call) + ": collider " + std::to_string(index) + " is not a level set");
+  auto report = collider.level_set->cut(shape, from, to);
+  if (!report) return report.error();
+  // The device's copy: the changed leaves, at the grid's place in the
+  // grids buffer, before the next frame reads them.
+  const std::span<const std::byte> bytes = collider.level_set->nanovdb_bytes();
+  const std::uint64_t base = c.level_set_offsets[index];
+  for (const auto& [offset, size] : report->changed_bytes)
+    if (Status s = impl_->device->write_buffer(impl_->buffers.level_set_grids, base + offset, bytes.data() + offset,
+                                               size);
+        !s)
+      return s.error();
+  return report;
 }
 
 }  // namespace sinew
