@@ -136,6 +136,40 @@ TEST(LevelSetContactCut, ACutHoleLetsTheClothThrough) {
   EXPECT_FALSE(bad.ok());
 }
 
+// A burr (a level-set sphere's surface points) pressed into a bone's flat
+// face (a level-set block): the penalty force is stiffness * pi R delta^2
+// along the face's normal, no torque about the burr's centre; tilted
+// contact pushes along the face's normal still; after a cut under the burr
+// it feels nothing.
+TEST(LevelSetPenalty, ABurrPressedIntoAFaceFeelsThePressureOfItsDepth) {
+  const double radius = 2e-3, voxel = 5e-5, stiffness = 1e9;  // N/m^3
+  auto burr = LevelSet::sphere({0, 0, 0}, radius, {.voxel_size = voxel, .exterior_band = 2e-4, .interior_band = 2e-4});
+  ASSERT_TRUE(burr.ok());
+  const SurfacePoints points = surface_points(burr->surface());
+  auto bone = LevelSet::box({-0.01, -0.01, -0.01}, {0.01, 0.0, 0.01},
+                            {.voxel_size = 1e-4, .exterior_band = 3e-4, .interior_band = INFINITY});
+  ASSERT_TRUE(bone.ok());
+  for (double delta : {2e-4, 4e-4, 8e-4}) {
+    auto contact = penalty_contact(*bone, points, {.position = {1.23e-4, radius - delta, -0.77e-4}}, stiffness);
+    ASSERT_TRUE(contact.ok()) << contact.error().message();
+    const double expected = stiffness * M_PI * radius * delta * delta;
+    std::printf("burr %.1f mm deep: force (%.4f, %.4f, %.4f) N, expected %.4f; torque %.2e N m; %u points in\n",
+                delta * 1e3, contact->force[0], contact->force[1], contact->force[2], expected,
+                std::hypot(contact->torque[0], contact->torque[1], contact->torque[2]), contact->touching);
+    EXPECT_NEAR(contact->force[1], expected, 0.03 * expected);
+    EXPECT_LT(std::hypot(contact->force[0], contact->force[2]), 0.01 * expected);
+    EXPECT_LT(std::hypot(contact->torque[0], contact->torque[1], contact->torque[2]), 0.01 * expected * radius);
+    EXPECT_NEAR(contact->deepest, delta, 1e-5);
+  }
+  // Cut a hole where the burr presses: nothing left to push it.
+  ASSERT_TRUE(bone->cut({.radius = 3e-3}, {.position = {0.0, 0.0, 0.0}}, {.position = {0.0, -2e-3, 0.0}}).ok());
+  auto freed = penalty_contact(*bone, points, {.position = {0.0, radius - 4e-4, 0.0}}, stiffness);
+  ASSERT_TRUE(freed.ok());
+  EXPECT_EQ(freed->touching, 0u);
+  EXPECT_FALSE(penalty_contact(*bone, points, {}, 0.0).ok());
+  EXPECT_FALSE(penalty_contact(*bone, points, {.position = {NAN, 0, 0}}, stiffness).ok());
+}
+
 TEST(LevelSetContactCut, BadLevelSetCollidersAreNamed) {
   ColliderDesc missing;
   missing.shape = ColliderShape::level_set;

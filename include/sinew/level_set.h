@@ -138,4 +138,36 @@ class LevelSet {
   std::shared_ptr<Impl> impl_;
 };
 
+/// Points spread over a surface, each with the area it stands for: a
+/// triangle mesh's vertices, each given a third of its triangles' areas.
+struct SurfacePoints {
+  std::vector<std::array<double, 3>> points;  ///< [m]
+  std::vector<double> areas;                  ///< [m^2]
+};
+/// [in] mesh, e.g. LevelSet::surface() of a tool. Unused vertices get no area.
+SurfacePoints surface_points(const TriMesh& mesh);
+
+/// What a solid level set does to a tool's surface points pressed into it,
+/// as a penalty (the voxmap-pointshell idea of McNeely, Neff and Troy,
+/// "Six degree-of-freedom haptic rendering using voxel sampling", SIGGRAPH
+/// 1999): a point at depth d = -value > 0 is pushed along the solid's
+/// normalised gradient with stiffness * d * its area, a pressure growing
+/// with depth. A sphere of radius R pressed delta deep into a flat face
+/// feels stiffness * pi * R * delta^2. Points where the gradient is zero
+/// (beyond the solid's interior band) push nothing: keep the band deeper
+/// than the tool goes.
+struct PenaltyContact {
+  std::array<double, 3> force{};   ///< on the tool [N], in the solid's frame
+  std::array<double, 3> torque{};  ///< on the tool about its origin [N m], in the solid's frame
+  double deepest = 0.0;            ///< the deepest point's depth [m]
+  std::uint32_t touching = 0;      ///< points inside the solid
+};
+/// [in] tool: its surface points in its own frame; tool_pose: that frame in
+/// the solid's; stiffness: pressure per depth [N/m^3], > 0. Errors
+/// (bad_parameter): a stiffness not finite and > 0, a non-finite pose or a
+/// rotation that is not a unit quaternion, points and areas of different
+/// counts.
+Result<PenaltyContact> penalty_contact(const LevelSet& solid, const SurfacePoints& tool, const Pose& tool_pose,
+                                       double stiffness);
+
 }  // namespace sinew
