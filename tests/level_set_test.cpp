@@ -15,6 +15,8 @@
 namespace sinew {
 namespace {
 
+#if SINEW_HAS_OPENVDB
+
 using P = std::array<double, 3>;
 
 double norm(const P& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
@@ -37,8 +39,6 @@ BoxDistance box_distance(const P& lo, const P& hi, const P& p) {
   if (outside > 0.0) return {std::sqrt(outside), -q[1]};  // one face nearest while the other two q < 0
   return {q[2], q[2] - q[1]};
 }
-
-#if SINEW_HAS_OPENVDB
 
 constexpr double kVoxel = 2.5e-4;  // 0.25 mm
 

@@ -138,7 +138,7 @@ pnanovdb_coord_t pnanovdb_coord_add(pnanovdb_coord_t a, pnanovdb_coord_t b) {
 #pragma clang diagnostic push
 #pragma clang diagnostic ignored "-Wreturn-type"
 #endif
-#include "PNanoVDB.h"
+#include "sinew_pnanovdb.h" /* PNanoVDB.h (generated: see CMakeLists.txt) */
 #ifdef __clang__
 #pragma clang diagnostic pop
 #endif
@@ -154,7 +154,7 @@ pnanovdb_coord_t pnanovdb_coord_add(pnanovdb_coord_t a, pnanovdb_coord_t b) {
 #endif
 #define PNANOVDB_GLSL
 layout(std430, binding = SINEW_NANOVDB_BINDING) readonly buffer NanoVdbGrid { uint pnanovdb_buf_data[]; };
-#include "PNanoVDB.h"
+#include "sinew_pnanovdb.h" /* PNanoVDB.h (generated: see CMakeLists.txt) */
 #define SINEW_NANOVDB_GRID_ARG(X, index, name)
 #define SINEW_NANOVDB_BUF(name) pnanovdb_buf_t(0u)
 #endif
