@@ -123,6 +123,9 @@ class LevelSet {
   /// level set whose inside is not all stored (interior_band must be
   /// +infinity: a cut makes surface anywhere inside), a bad shape, a
   /// non-finite pose or a rotation that is not a unit quaternion.
+  /// The NanoVDB leaves' statistics (their minimum, maximum, average) are
+  /// not updated: the kernels never read them. Not safe against sampling
+  /// the same grid on another thread at the same time.
   Result<CutReport> cut(const CutterShape& shape, const Pose& from, const Pose& to);
 
   /// The zero level as triangles [m], counter-clockwise seen from outside
