@@ -26,6 +26,7 @@
 #include <openvdb/tools/VolumeToMesh.h>
 #include <unordered_set>
 
+#include "collision/shape_distance.h"
 #include "level_set/level_set_impl.h"
 #include "math/vec3.h"
 
@@ -169,16 +170,13 @@ Result<LevelSet> LevelSet::box(const Point& lo, const Point& hi, const LevelSetS
       return Error(ErrorCode::bad_parameter, std::string(call) + ": hi must exceed lo on every axis (axis " +
                                                  std::to_string(k) + ": " + str(lo[k]) + " .. " + str(hi[k]) + ")");
   initialize_openvdb();
+  // The box's exact distance (collision/shape_distance.h), centred between lo and hi.
+  ColliderDesc box;
+  box.shape = ColliderShape::box;
+  for (int k = 0; k < 3; ++k) box.half_extents[k] = 0.5 * (hi[k] - lo[k]);
+  const math::Vec3 centre{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
   return from_function(lo, hi, settings, [&](const Point& p) {
-    // The box's exact distance: outside, the length of the excess over
-    // the half extents; inside, minus the distance to the nearest face.
-    double outside = 0.0, inside = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 3; ++k) {
-      const double q = std::abs(p[k] - 0.5 * (lo[k] + hi[k])) - 0.5 * (hi[k] - lo[k]);
-      outside += q > 0.0 ? q * q : 0.0;
-      inside = std::max(inside, q);
-    }
-    return outside > 0.0 ? std::sqrt(outside) : inside;
+    return collision::shape_distance(box, centre, {1.0, 0.0, 0.0, 0.0}, p).distance;
   });
 }
 
@@ -238,25 +236,17 @@ namespace {
 using math::Quat;
 using math::Vec3;
 
-// The tool's distance [m] at p (its own frame: local = R^T (p - position)).
-double shape_distance(const CutterShape& shape, const Vec3& local) {
-  switch (shape.kind) {
-    case CutterShape::Kind::sphere: return math::norm(local) - shape.radius;
-    case CutterShape::Kind::capsule: {
-      const double y = std::clamp(local[1], -shape.half_height, shape.half_height);
-      return math::norm(Vec3{local[0], local[1] - y, local[2]}) - shape.radius;
-    }
-    case CutterShape::Kind::box: {
-      double outside = 0.0, inside = -std::numeric_limits<double>::infinity();
-      for (int k = 0; k < 3; ++k) {
-        const double q = std::abs(local[k]) - shape.half_extents[k];
-        outside += q > 0.0 ? q * q : 0.0;
-        inside = std::max(inside, q);
-      }
-      return outside > 0.0 ? std::sqrt(outside) : inside;
-    }
-  }
-  return std::numeric_limits<double>::infinity();
+// The tool as the collider shape of the same dimensions, whose distances
+// collision/shape_distance.h already gives.
+ColliderDesc cutter_collider(const CutterShape& shape) {
+  ColliderDesc c;
+  c.shape = shape.kind == CutterShape::Kind::sphere    ? ColliderShape::sphere
+            : shape.kind == CutterShape::Kind::capsule ? ColliderShape::capsule
+                                                       : ColliderShape::box;
+  c.radius = shape.radius;
+  c.half_height = shape.half_height;
+  c.half_extents = shape.half_extents;
+  return c;
 }
 
 // How far the tool reaches from its origin [m].
@@ -321,6 +311,7 @@ Result<CutReport> LevelSet::cut(const CutterShape& shape, const Pose& from, cons
       poses.emplace_back(math::add(p0, math::mul(math::sub(p1, p0), u)), math::nlerp(from.rotation, to.rotation, u));
     }
   }
+  const ColliderDesc tool = cutter_collider(shape);
   const auto tool_distance = [&](const Vec3& p) {
     if (shape.kind == CutterShape::Kind::sphere) {
       const Vec3 d = math::sub(p1, p0);
@@ -330,7 +321,7 @@ Result<CutReport> LevelSet::cut(const CutterShape& shape, const Pose& from, cons
     }
     double best = std::numeric_limits<double>::infinity();
     for (const auto& [position, rotation] : poses)
-      best = std::min(best, shape_distance(shape, math::rotate(math::conj(rotation), math::sub(p, position))));
+      best = std::min(best, collision::shape_distance(tool, position, rotation, p).distance);
     return best;
   };
   // Every voxel within the exterior band (and a voxel) of the tool's reach
