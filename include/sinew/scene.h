@@ -229,14 +229,48 @@ struct AttachmentDesc {
   double compliance = 0.0;    ///< [m/N], >= 0
 };
 
-/// A rigid tool: a capsule (in its frame, the segment +-half_height along y
-/// swollen by radius) with mass and inertia, driven by a force and torque
-/// (Simulation::apply_tool_force) and pushed back by the tissue it touches.
-/// Its contacts with particles are solved like a collider's; the reaction of
-/// the tissue acts on the tool at the end of each frame.
+/// A rigid tool's shape (ToolDesc::shape).
+enum class ToolShape {
+  /// The segment +-half_height along its y swollen by `radius`: meets the
+  /// colliders and the other tools as a rigid body (positional contacts,
+  /// tool_contacts.h).
+  capsule,
+  /// ToolDesc::level_set in its frame (a burr, a drill bit, any closed
+  /// surface): meets the colliders and the other tools by a penalty on its
+  /// surface points (penalty_stiffness).
+  level_set,
+};
+
+/// A rigid tool with mass and inertia, driven by a force and torque
+/// (Simulation::apply_tool_force) and pushed back by what it touches. Its
+/// contacts with particles are solved like a collider's of its shape; the
+/// reaction of the tissue acts on the tool at the end of each frame.
+///
+/// A level-set tool (shape = level_set) against a collider or another tool
+/// feels a penalty (voxmap-pointshell; McNeely, Neff and Troy, SIGGRAPH
+/// 1999): each point of its surface (LevelSet::surface(), a third of its
+/// triangles' area each) at depth d > 0 inside the other shape is pushed
+/// along that shape's normal by area * (penalty_stiffness d +
+/// penalty_damping d'), never pulled (d' is the point's speed into the
+/// shape). A sphere of radius R pressed delta into a flat face feels
+/// penalty_stiffness pi R delta^2. The penalty at the start of a frame
+/// drives the frame (explicit): stable while sqrt(k / M) time_step < 2 for
+/// the contact's stiffness k = dF/d delta (2 penalty_stiffness pi R delta
+/// for that sphere) and the tool's mass M; README, "Level sets", sizes it.
+/// Particles deeper in the tool than its level set's interior band (zero
+/// gradient) are not pushed out: build a tool's level set with the inside
+/// filled. Continuous collision (MeshCollisionDesc::continuous) sweeps
+/// capsule tools only: a level-set tool meets particles and faces at the
+/// substeps' poses.
 struct ToolDesc {
-  double radius = 0.005;                                ///< [m], > 0
-  double half_height = 0.05;                            ///< [m], >= 0
+  ToolShape shape = ToolShape::capsule;
+  double radius = 0.005;                                ///< capsule [m], > 0
+  double half_height = 0.05;                            ///< capsule [m], >= 0
+  /// ToolShape::level_set: the signed distance field in the tool's frame
+  /// (its origin is the tool's centre of mass). Shared with the caller.
+  std::optional<LevelSet> level_set;
+  double penalty_stiffness = 0.0;  ///< level_set: pressure per depth [N/m^3], > 0 (no default: it depends on M and dt)
+  double penalty_damping = 0.0;    ///< level_set: pressure per speed into the shape [N s/m^3], >= 0
   double mass = 0.1;                                    ///< [kg], > 0
   std::array<double, 3> inertia{1e-4, 1e-5, 1e-4};      ///< principal moments in the tool frame [kg m^2], > 0
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< initial [m]

@@ -170,6 +170,13 @@ class Simulation {
     std::array<double, 3> angular_velocity{};  ///< world frame [rad/s]
     std::array<double, 3> contact_force{};     ///< what the tissue pushed the tool with, frame average [N]
     std::array<double, 3> contact_torque{};    ///< about the tool's centre [N m]
+    /// A level-set tool's penalty from the colliders and the other tools
+    /// (or a capsule tool's from level-set tools), at the start of the last
+    /// frame, which it drove (ToolDesc) [N], about its centre [N m].
+    std::array<double, 3> penalty_force{};
+    std::array<double, 3> penalty_torque{};
+    std::uint32_t penalty_points = 0;  ///< a level-set tool's surface points inside other shapes then
+    double penalty_depth = 0.0;        ///< the deepest one's depth [m]
   };
   Result<ToolState> tool_state(std::size_t index) const;
 

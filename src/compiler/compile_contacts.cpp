@@ -91,6 +91,26 @@ std::uint32_t first_particle(const CompiledScene& out, const VertexRef& v) {
   return 0;
 }
 
+// Appends a level set's NanoVDB grid to the grids buffer at the next
+// 32-byte boundary (NanoVDB's alignment), for collider entry `index`
+// (scene colliders, then tools): the kernels address it by byte offset in
+// 32 bits (implicit_first) and need 1/h and 1/2h (half_x, half_y).
+Status add_level_set(const LevelSet& level_set, std::size_t index, ColliderEntry& e, CompiledScene& out) {
+  const std::span<const std::byte> bytes = level_set.nanovdb_bytes();
+  const std::uint64_t offset = (std::uint64_t{out.level_set_grids.size()} * 4 + 31) / 32 * 32;
+  if (offset + bytes.size() > std::uint64_t{UINT32_MAX})
+    return Error(ErrorCode::bad_parameter, "colliders and tools: the level-set grids take more than 4 GiB (" +
+                                               std::to_string(offset + bytes.size()) + " bytes)");
+  out.level_set_grids.resize(offset / 4 + bytes.size() / 4, 0u);
+  std::memcpy(out.level_set_grids.data() + offset / 4, bytes.data(), bytes.size());
+  out.level_set_offsets[index] = offset;
+  e.implicit_first = static_cast<std::uint32_t>(offset);
+  e.half_x = static_cast<float>(1.0 / level_set.voxel_size());
+  e.half_y = static_cast<float>(0.5 / level_set.voxel_size());
+  e.half_z = 0.0f;
+  return {};
+}
+
 }  // namespace
 
 Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out) {
@@ -98,7 +118,7 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
   const auto tools = static_cast<std::uint32_t>(scene.tools.size());
   const auto particles = static_cast<std::uint32_t>(b.positions.size());
 
-  // The collider buffer: header, scene colliders, then tools as capsules.
+  // The collider buffer: header, scene colliders, then tools (capsules or level sets).
   ColliderHeader header{};
   header.colliders = colliders;
   header.tools = tools;
@@ -107,7 +127,7 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
   append_words(out.colliders, header);
   std::vector<ImplicitEntry> nodes;  // every implicit collider's nodes, after the entries
   out.level_set_grids.clear();
-  out.level_set_offsets.assign(scene.colliders.size(), 0);
+  out.level_set_offsets.assign(scene.colliders.size() + scene.tools.size(), 0);
   for (std::size_t k = 0; k < scene.colliders.size(); ++k) {
     const ColliderDesc& c = scene.colliders[k];
     ColliderEntry e = entry(shape_code(c.shape), c.position, c.rotation);
@@ -122,30 +142,22 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     e.half_y = static_cast<float>(c.half_extents[1]);
     e.half_z = static_cast<float>(c.half_extents[2]);
     if (c.shape == ColliderShape::level_set) {
-      // Its grid at the next 32-byte boundary of the grids buffer (NanoVDB's
-      // alignment); the kernels address it by byte offset in 32 bits.
-      const std::span<const std::byte> bytes = c.level_set->nanovdb_bytes();
-      const std::uint64_t offset = (std::uint64_t{out.level_set_grids.size()} * 4 + 31) / 32 * 32;
-      if (offset + bytes.size() > std::uint64_t{UINT32_MAX})
-        return Error(ErrorCode::bad_parameter, "colliders: the level-set grids take more than 4 GiB (" +
-                                                   std::to_string(offset + bytes.size()) + " bytes)");
-      out.level_set_grids.resize(offset / 4 + bytes.size() / 4, 0u);
-      std::memcpy(out.level_set_grids.data() + offset / 4, bytes.data(), bytes.size());
-      out.level_set_offsets[k] = offset;
-      e.implicit_first = static_cast<std::uint32_t>(offset);
-      e.half_x = static_cast<float>(1.0 / c.level_set->voxel_size());
-      e.half_y = static_cast<float>(0.5 / c.level_set->voxel_size());
-      e.half_z = 0.0f;
+      if (Status s = add_level_set(*c.level_set, k, e, out); !s) return s;
     }
     e.static_friction = static_cast<float>(c.static_friction);
     e.dynamic_friction = static_cast<float>(c.dynamic_friction);
     e.compliance = static_cast<float>(c.compliance);
     append_words(out.colliders, e);
   }
-  for (const ToolDesc& t : scene.tools) {
+  for (std::size_t k = 0; k < scene.tools.size(); ++k) {
+    const ToolDesc& t = scene.tools[k];
     ColliderEntry e = entry(SINEW_SHAPE_CAPSULE, t.position, t.rotation);
     e.radius = static_cast<float>(t.radius);
     e.half_height = static_cast<float>(t.half_height);
+    if (t.shape == ToolShape::level_set) {
+      e = entry(SINEW_SHAPE_LEVEL_SET, t.position, t.rotation);
+      if (Status s = add_level_set(*t.level_set, scene.colliders.size() + k, e, out); !s) return s;
+    }
     e.static_friction = static_cast<float>(t.static_friction);
     e.dynamic_friction = static_cast<float>(t.dynamic_friction);
     e.compliance = static_cast<float>(t.compliance);

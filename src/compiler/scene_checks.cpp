@@ -250,8 +250,19 @@ Status check_collider(const ColliderDesc& c, const std::string& name) {
 }
 
 Status check_tool(const ToolDesc& t, const std::string& name) {
-  if (Status s = positive(name + ".radius", t.radius); !s) return s;
-  if (Status s = non_negative(name + ".half_height", t.half_height); !s) return s;
+  if (t.shape == ToolShape::capsule) {
+    if (Status s = positive(name + ".radius", t.radius); !s) return s;
+    if (Status s = non_negative(name + ".half_height", t.half_height); !s) return s;
+    if (t.level_set)
+      return Error(ErrorCode::bad_parameter, name + ".level_set is set but the shape is not ToolShape::level_set");
+  } else {
+    if (!t.level_set)
+      return Error(ErrorCode::bad_parameter, name + ".level_set is missing (ToolShape::level_set needs one)");
+    if (t.level_set->nanovdb_bytes().empty())
+      return Error(ErrorCode::backend_unavailable, name + ".level_set has no grid (sinew was built without OpenVDB)");
+    if (Status s = positive(name + ".penalty_stiffness", t.penalty_stiffness); !s) return s;
+    if (Status s = non_negative(name + ".penalty_damping", t.penalty_damping); !s) return s;
+  }
   if (Status s = positive(name + ".mass", t.mass); !s) return s;
   for (int k = 0; k < 3; ++k)
     if (Status s = positive(name + ".inertia[" + std::to_string(k) + "]", t.inertia[k]); !s) return s;
@@ -352,7 +363,8 @@ Status check_mesh_collision(const SceneDesc& scene) {
     return Error(ErrorCode::bad_parameter,
                  "mesh_collision.continuous needs mesh_collision.schedule = ContactSchedule::colored");
   // What is tested: threads against anything, tools' and capsule colliders' axes against surfaces.
-  bool capsules = !scene.tools.empty();
+  bool capsules = false;
+  for (const ToolDesc& tool : scene.tools) capsules |= tool.shape == ToolShape::capsule;
   for (const ColliderDesc& collider : scene.colliders) capsules |= collider.shape == ColliderShape::capsule;
   const bool surfaces = !scene.tet_bodies.empty() || !scene.tri_bodies.empty();
   if (scene.line_bodies.empty() && !(capsules && surfaces))

@@ -64,9 +64,10 @@ struct CompiledScene {
   /// Simulation rewrites colliders and targets between frames.
   std::vector<float> colliders;
   std::vector<float> targets;
-  /// Every level-set collider's NanoVDB grid, each at a 32-byte aligned
-  /// offset (level_set_offsets, in SceneDesc::colliders order; 0 for the
-  /// other shapes), as 32-bit words.
+  /// Every level-set collider's and level-set tool's NanoVDB grid, each at
+  /// a 32-byte aligned offset (level_set_offsets [bytes], in
+  /// SceneDesc::colliders order, then SceneDesc::tools; 0 for the other
+  /// shapes), as 32-bit words.
   std::vector<std::uint32_t> level_set_grids;
   std::vector<std::uint64_t> level_set_offsets;
   std::uint32_t contact_impulse_slots = 0;  ///< float4s in the contact_impulses buffer

@@ -444,6 +444,11 @@ std::array<math::Vec3, 2> capsule_ends(const PosedShape& s) {
   return {math::sub(s.position, axis), math::add(s.position, axis)};
 }
 
+// A point of a shape's frame [m] at the shape's pose.
+math::Vec3 carried(const PosedShape& s, const math::Vec3& local) {
+  return math::add(s.position, math::rotate(s.rotation, local));
+}
+
 }  // namespace
 
 void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<const PosedShape> ends, double common) {
@@ -458,15 +463,41 @@ void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<co
     // the offset of the plane that touches it where it ends, on the face's
     // side (n points from the tool to the face): thickness - the largest
     // n . p over the capsule.
+    // A level-set tool: the bound from its box's corners (a rigid motion's
+    // displacement is affine in the point, so its length is convex and
+    // largest at a corner), and the plane through the contact's surface
+    // point carried along with the tool (its surface there, to first order).
+    const bool level_set = tools && shape.shape->shape == ColliderShape::level_set;
     double moved = 0.0;
     std::array<math::Vec3, 2> first{}, last{};
-    if (tools) {
+    if (level_set) {
+      const std::array<double, 6> box = shape.shape->level_set->bounds();
+      for (int corner = 0; corner < 8; ++corner) {
+        const math::Vec3 local{box[corner & 1 ? 3 : 0], box[corner & 2 ? 4 : 1], box[corner & 4 ? 5 : 2]};
+        moved = std::max(moved, math::norm(math::sub(carried(ends[index], local), carried(shape, local))));
+      }
+    } else if (tools) {
       first = capsule_ends(shape);
       last = capsule_ends(ends[index]);
       for (int k = 0; k < 2; ++k) moved = std::max(moved, math::norm(math::sub(last[k], first[k])));
     }
     const auto offset_at = [&](const std::array<math::Vec3, 2>& ends_at, const math::Vec3& n) {
       return desc_.thickness - (std::max(math::dot(n, ends_at[0]), math::dot(n, ends_at[1])) + shape.shape->radius);
+    };
+    // The contact plane's offset at the frame's end and its motion over the
+    // frame, for a tool (c.offset, c.motion) given its surface point at the
+    // start, or for a collider (at rest over the frame).
+    const auto plane = [&](Contact& c, const math::Vec3& normal, const math::Vec3& surface) {
+      if (level_set) {
+        const math::Vec3 local = math::rotate(math::conj(shape.rotation), math::sub(surface, shape.position));
+        c.offset = float(desc_.thickness - math::dot(normal, carried(ends[index], local)));
+        c.motion = float(desc_.thickness - math::dot(normal, surface)) - c.offset;
+      } else if (tools) {
+        c.offset = float(offset_at(last, normal));
+        c.motion = float(offset_at(first, normal)) - c.offset;
+      } else {
+        c.offset = float(desc_.thickness - math::dot(normal, surface));
+      }
     };
     if (shape.shape->shape == ColliderShape::plane) continue;
     // Triangles in parallel (one evaluation each for most), joined in
@@ -494,8 +525,7 @@ void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<co
         c.w = {0.0f, float(hit.weights[0]), float(hit.weights[1]), float(hit.weights[2])};
         c.normal = {float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2])};
         c.distance = float(hit.distance);
-        c.offset = float(tools ? offset_at(last, hit.normal) : desc_.thickness - math::dot(hit.normal, hit.surface));
-        if (tools) c.motion = float(offset_at(first, hit.normal)) - c.offset;
+        plane(c, hit.normal, hit.surface);
         c.shape = which;
         face_hit_[t] = 1;
       }
@@ -526,9 +556,8 @@ void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<co
       c.w = {0.0f, float(1.0 - along), 0.0f, float(along)};
       c.normal = {float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2])};
       c.distance = float(-hit.depth);
-      c.offset = float(tools ? offset_at(last, hit.normal)
-                             : desc_.thickness - math::dot(hit.normal, hit.point) - hit.depth);
-      if (tools) c.motion = float(offset_at(first, hit.normal)) - c.offset;
+      // The shape's surface under the segment's deepest point.
+      plane(c, hit.normal, math::add(hit.point, math::mul(hit.normal, hit.depth)));
       c.shape = which;
       all_.push_back(c);
     }

@@ -1,9 +1,11 @@
 // rigid_tool.h — the rigid tools' state and their integration from the
 // tissue's reaction, in double precision on the host.
 //
-// A tool is a capsule collider whose motion the host integrates, here; the
-// tissue's side (its collider entry, the contact impulses and their
-// reduction to the tool's reaction) is in simulation_contacts.cpp. The
+// A tool is a capsule or level-set collider whose motion the host
+// integrates, here; the tissue's side (its collider entry, the contact
+// impulses and their reduction to the tool's reaction) is in
+// simulation_contacts.cpp, a level-set tool's penalty against colliders and
+// tools in tool_penalty.h. The
 // coupling with the tissue is explicit and one frame long:
 //  1. before frame n (Simulation::Impl::before_frame calls integrate_tool):
 //     semi-implicit Euler over the frame with the applied force and torque
@@ -59,6 +61,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <vector>
 
 #include "math/vec3.h"
 
@@ -82,6 +86,16 @@ struct ToolBody {
   double mass = 0.0;  ///< [kg]
   double radius = 0.0, half_height = 0.0;  ///< its capsule [m] (the segment +-half_height along its y)
   double dynamic_friction = 0.0;          ///< against colliders and other tools (tool_contacts.h)
+
+  // A level-set tool (ToolShape::level_set): its penalty against the
+  // colliders and the other tools (tool_penalty.h).
+  bool level_set = false;
+  std::vector<V3> points;      ///< its surface points in its frame [m]
+  std::vector<double> areas;   ///< the area each stands for [m^2]
+  double penalty_stiffness = 0.0, penalty_damping = 0.0;  ///< [N/m^3], [N s/m^3]
+  V3 penalty_force{}, penalty_torque{};  ///< at the start of the last frame [N], about its centre [N m]
+  std::uint32_t penalty_points = 0;      ///< its points inside another shape then
+  double penalty_depth = 0.0;            ///< the deepest one's depth [m]
 };
 
 /// One semi-implicit Euler step of the tool over dt [s] from the applied

@@ -9,9 +9,10 @@
 // that end pose. The buffers are uploaded before a frame only when something
 // changed, so static colliders cost no transfer.
 //
-// Tools: a tool is a capsule collider whose motion the host integrates
-// (rigid_tool.h: the coupling with the tissue, its stabilisation and its
-// limits). Here is the tissue's side: before each frame (before_frame) each
+// Tools: a tool is a capsule or level-set collider whose motion the host
+// integrates (rigid_tool.h: the coupling with the tissue, its stabilisation
+// and its limits; tool_penalty.h: a level-set tool against colliders and
+// tools). Here is the tissue's side: before each frame (before_frame) each
 // tool is integrated over the frame and its collider entry moves from the
 // old pose to the new one across the frame's substeps; during the frame
 // the contact kernel sums each correction's impulse, and its moment about
@@ -35,6 +36,7 @@
 #include "math/vec3.h"
 #include "runtime/simulation_impl.h"
 #include "runtime/tool_contacts.h"
+#include "runtime/tool_penalty.h"
 
 namespace sinew {
 namespace {
@@ -152,7 +154,30 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
     b.radius = d.radius;
     b.half_height = d.half_height;
     b.dynamic_friction = d.dynamic_friction;
-    contacts.tool_shapes.push_back(tool_capsule(b));
+    if (d.shape == ToolShape::level_set) {
+      // Its point shell: the level set's zero surface, a third of each
+      // triangle's area to each corner (tool_penalty.h).
+      const SurfacePoints shell = surface_points(d.level_set->surface());
+      for (std::size_t i = 0; i < shell.points.size(); ++i) {
+        if (!(shell.areas[i] > 0.0)) continue;  // a vertex of no triangle
+        b.points.push_back(shell.points[i]);
+        b.areas.push_back(shell.areas[i]);
+      }
+      if (b.points.empty())
+        return Error(ErrorCode::bad_parameter, "tools[" + std::to_string(contacts.tools.size() - 1) +
+                                                   "].level_set has no surface (no zero crossing in its grid)");
+      b.level_set = true;
+      b.penalty_stiffness = d.penalty_stiffness;
+      b.penalty_damping = d.penalty_damping;
+      ColliderDesc shape;
+      shape.shape = ColliderShape::level_set;
+      shape.level_set = d.level_set;
+      shape.static_friction = d.static_friction;
+      shape.dynamic_friction = d.dynamic_friction;
+      contacts.tool_shapes.push_back(std::move(shape));
+    } else {
+      contacts.tool_shapes.push_back(tool_capsule(b));
+    }
   }
   contacts.shapes = scene.colliders;
   contacts.level_set_offsets = compiled.level_set_offsets;
@@ -179,6 +204,7 @@ std::vector<FrameCapsule> Simulation::Impl::frame_capsules() const {
       capsules.push_back({posed(contacts.shapes[k], colliders, k, true), posed(contacts.shapes[k], colliders, k, false),
                           collision::Contact::kNoShape});
   for (std::size_t t = 0; t < contacts.tools.size(); ++t) {
+    if (contacts.tools[t].level_set) continue;  // not swept (scene.h, ToolDesc)
     const std::size_t k = contacts.colliders + t;
     capsules.push_back({posed(contacts.tool_shapes[t], colliders, k, true),
                         posed(contacts.tool_shapes[t], colliders, k, false), static_cast<std::uint32_t>(t)});
@@ -188,6 +214,15 @@ std::vector<FrameCapsule> Simulation::Impl::frame_capsules() const {
 
 Status Simulation::Impl::before_frame() {
   ContactState& c = contacts;
+  // Level-set tools: the penalty where everything is at the frame's start
+  // (the colliders where the last frame left them) drives this frame.
+  for (const ToolBody& b : c.tools)
+    if (b.level_set) {
+      std::vector<PosedShape> starts;
+      for (std::uint32_t k = 0; k < c.colliders; ++k) starts.push_back(posed(c.shapes[k], colliders, k, true));
+      add_tool_penalties(c.tools, c.tool_shapes, starts);
+      break;
+    }
   for (ToolBody& b : c.tools) integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);
   // The tools against the colliders where those end this frame, and each other.
   if (!c.tools.empty()) resolve_tool_contacts(c.tools, collider_shapes(), time_step);
@@ -310,6 +345,10 @@ Result<Simulation::ToolState> Simulation::tool_state(std::size_t index) const {
   state.angular_velocity = b.angular_velocity;
   state.contact_force = b.contact_force;
   state.contact_torque = b.contact_torque;
+  state.penalty_force = b.penalty_force;
+  state.penalty_torque = b.penalty_torque;
+  state.penalty_points = b.penalty_points;
+  state.penalty_depth = b.penalty_depth;
   return state;
 }
 

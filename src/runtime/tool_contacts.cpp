@@ -110,10 +110,12 @@ void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<Posed
   std::vector<Contact> contacts;
   for (std::size_t i = 0; i < tools.size(); ++i) {
     ToolBody& a = tools[i];
+    if (a.level_set) continue;  // a penalty instead (tool_penalty.h)
     for (const PosedShape& s : colliders)
       contacts_against(a, nullptr, *s.shape, s.position, s.rotation, std::min(s.shape->dynamic_friction, a.dynamic_friction), contacts);
     for (std::size_t j = i + 1; j < tools.size(); ++j)
-      contacts_against(a, &tools[j], tool_capsule(tools[j]), tools[j].position, tools[j].rotation,
+      if (!tools[j].level_set)
+        contacts_against(a, &tools[j], tool_capsule(tools[j]), tools[j].position, tools[j].rotation,
                        std::min(a.dynamic_friction, tools[j].dynamic_friction), contacts);
   }
   if (contacts.empty()) return;

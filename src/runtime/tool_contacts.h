@@ -29,7 +29,7 @@ struct PosedShape {
   math::Quat rotation{1.0, 0.0, 0.0, 0.0};
 };
 
-/// A tool's capsule as a collider shape (its pose is the tool's).
+/// A capsule tool's capsule as a collider shape (its pose is the tool's).
 ColliderDesc tool_capsule(const ToolBody& b);
 
 /// Moves the tools out of the colliders and out of each other and removes
@@ -40,6 +40,7 @@ ColliderDesc tool_capsule(const ToolBody& b);
 /// with the tool's radius. A collider is infinitely heavy; two tools share
 /// a correction by their generalised inverse masses. Friction: the lesser
 /// of the two dynamic coefficients.
+/// Level-set tools take no part (their penalty: tool_penalty.h).
 void resolve_tool_contacts(std::vector<ToolBody>& tools, const std::vector<PosedShape>& colliders, double dt);
 
 }  // namespace sinew
