@@ -167,6 +167,41 @@ TEST(LevelSetCut, TheSurfaceIsTheZeroLevelAndFollowsTheCut) {
   EXPECT_GT(on_burr, 100u);
 }
 
+TEST(LevelSetCut, APartOfTheSolidIsAClosedSurfaceCappedByTheBox) {
+  // The half of a 3 mm sphere with x >= 0 (a box reaching past it on the
+  // other sides): closed and oriented, its vertices within a voxel of the
+  // box, its volume half the sphere's and at most the slab of a voxel
+  // more (1% for the sphere's own discretisation); a bad box is named.
+  const double r = 3e-3;
+  auto sphere = LevelSet::sphere({0.0, 0.0, 0.0}, r, {.voxel_size = kVoxel, .exterior_band = 4e-4, .interior_band = INFINITY});
+  ASSERT_TRUE(sphere.ok());
+  auto half = sphere->surface_in({0.0, -0.01, -0.01, 0.01, 0.01, 0.01});
+  ASSERT_TRUE(half.ok()) << half.error().message();
+  const SurfaceReport closed = check_closed_surface(*half);
+  double volume = 0.0, lowest_x = 1.0;
+  for (const auto& t : half->triangles) {
+    const auto &a = half->vertices[t[0]], &b = half->vertices[t[1]], &c = half->vertices[t[2]];
+    volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+               a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+  }
+  for (const auto& v : half->vertices) lowest_x = std::min(lowest_x, v[0]);
+  const double expected = 2.0 / 3.0 * M_PI * r * r * r;
+  std::printf("half sphere: %zu triangles, %llu open and %llu misoriented edges, volume %.4f of the half, lowest x "
+              "%.3f voxels\n",
+              half->triangles.size(), (unsigned long long)closed.open_edges,
+              (unsigned long long)closed.misoriented_edges, volume / expected, lowest_x / kVoxel);
+  EXPECT_EQ(closed.open_edges, 0u);
+  EXPECT_EQ(closed.misoriented_edges, 0u);
+  // The caps stand on the voxels: within a voxel outside the box's face.
+  EXPECT_GT(volume, 0.99 * expected);
+  EXPECT_LT(volume, 1.01 * expected + M_PI * r * r * kVoxel);
+  EXPECT_GT(lowest_x, -kVoxel);
+  auto bad = sphere->surface_in({0.0, 0.0, 0.0, 0.0, 1.0, 1.0});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message().find("lo < hi"), std::string::npos) << bad.error().message();
+  EXPECT_FALSE(sphere->surface_in({NAN, 0.0, 0.0, 1.0, 1.0, 1.0}).ok());
+}
+
 TEST(LevelSetCut, BadCutsAreNamed) {
   LevelSet cube = solid_cube();
   const auto message = [&](const CutterShape& shape, const Pose& from, const Pose& to) {

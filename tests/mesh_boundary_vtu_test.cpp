@@ -203,6 +203,26 @@ TEST(Vtu, WritesLineCells) {
   EXPECT_NE(bad.error().message().find("segment 1 refers to vertex 3"), std::string::npos) << bad.error().message();
 }
 
+// A surface (a level set's, for display): triangle cells (VTK_TRIANGLE, 3
+// vertices each) from 3-float positions; a triangle past the vertices is named.
+TEST(Vtu, WritesTriangleCells) {
+  const std::vector<float> xyz{0.0f, 0.0f, 0.0f, 0.001f, 0.0f, 0.0f, 0.0f, 0.001f, 0.0f, 0.0f, 0.0f, 0.001f};
+  const std::vector<std::array<std::uint32_t, 3>> triangles{{0, 2, 1}, {0, 1, 3}};
+  const fs::path p = tmp_dir() / "surface.vtu";
+  const sinew::Status s = sinew::write_vtu_triangles(p, xyz, 3, triangles);
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  const std::string xml = read_text(p);
+  EXPECT_NE(xml.find("NumberOfPoints=\"4\" NumberOfCells=\"2\""), std::string::npos);
+  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"connectivity\"")),
+            (std::vector<std::int64_t>{0, 2, 1, 0, 1, 3}));
+  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"offsets\"")), (std::vector<std::int64_t>{3, 6}));
+  EXPECT_EQ(numbers<int>(array_body(xml, "Name=\"types\"")), (std::vector<int>{5, 5}));  // VTK_TRIANGLE
+  const std::vector<std::array<std::uint32_t, 3>> past{{0, 1, 2}, {1, 2, 4}};
+  const sinew::Status bad = sinew::write_vtu_triangles(p, xyz, 3, past);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message().find("triangle 1 refers to vertex 4"), std::string::npos) << bad.error().message();
+}
+
 TEST(Vtu, StrideFourSkipsW) {
   const GridData g = grid_data();
   std::vector<float> xyzw;

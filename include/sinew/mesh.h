@@ -139,6 +139,12 @@ Status write_vtu(const std::filesystem::path& path, std::span<const float> posit
 Status write_vtu_lines(const std::filesystem::path& path, std::span<const float> positions, int stride,
                        std::span<const std::array<std::uint32_t, 2>> segments);
 
+/// Writes a VTU of triangle cells (VTK_TRIANGLE): a surface, e.g. a level
+/// set's (LevelSet::surface). [in] positions as for write_vtu. Errors name
+/// the file or the triangle that refers to a missing vertex.
+Status write_vtu_triangles(const std::filesystem::path& path, std::span<const float> positions, int stride,
+                           std::span<const std::array<std::uint32_t, 3>> triangles);
+
 /// Writes a ParaView collection (.pvd) that lists a series of VTU files with
 /// their times [s]; file names are written relative to the .pvd's folder.
 Status write_pvd(const std::filesystem::path& path,

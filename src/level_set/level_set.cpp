@@ -20,6 +20,7 @@
 #include <mutex>
 #include <string>
 
+#include <openvdb/tools/Clip.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/SignedFloodFill.h>
@@ -368,11 +369,14 @@ Result<CutReport> LevelSet::cut(const CutterShape& shape, const Pose& from, cons
   return report;
 }
 
-TriMesh LevelSet::surface() const {
+namespace {
+
+// OpenVDB's mesher's output as a TriMesh [m], counter-clockwise from outside.
+TriMesh mesh_of(const openvdb::FloatGrid& grid) {
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;
-  openvdb::tools::volumeToMesh(*impl_->grid, points, triangles, quads, 0.0);
+  openvdb::tools::volumeToMesh(grid, points, triangles, quads, 0.0);
   TriMesh mesh;
   mesh.vertices.reserve(points.size());
   for (const auto& p : points) mesh.vertices.push_back({double(p[0]), double(p[1]), double(p[2])});
@@ -390,6 +394,23 @@ TriMesh LevelSet::surface() const {
   if (volume < 0.0)
     for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
   return mesh;
+}
+
+}  // namespace
+
+TriMesh LevelSet::surface() const { return mesh_of(*impl_->grid); }
+
+Result<TriMesh> LevelSet::surface_in(const std::array<double, 6>& box) const {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(box[k]) || !std::isfinite(box[k + 3]) || !(box[k] < box[k + 3]))
+      return Error(ErrorCode::bad_parameter, "surface_in: the box must be finite with lo < hi on every axis (axis " +
+                                                 std::to_string(k) + ": " + std::to_string(box[k]) + " .. " +
+                                                 std::to_string(box[k + 3]) + ")");
+  // The voxels outside become the background (outside the surface), so the
+  // solid cut by the box is closed by caps on its faces.
+  const openvdb::BBoxd world({box[0], box[1], box[2]}, {box[3], box[4], box[5]});
+  const openvdb::FloatGrid::Ptr part = openvdb::tools::clip(*impl_->grid, world);
+  return mesh_of(*part);
 }
 
 }  // namespace sinew

@@ -36,5 +36,6 @@ std::array<double, 3> LevelSet::gradient(const std::array<double, 3>&) const { r
 std::span<const std::byte> LevelSet::nanovdb_bytes() const { return {}; }
 Result<CutReport> LevelSet::cut(const CutterShape&, const Pose&, const Pose&) { return unavailable("LevelSet::cut"); }
 TriMesh LevelSet::surface() const { return {}; }
+Result<TriMesh> LevelSet::surface_in(const std::array<double, 6>&) const { return unavailable("LevelSet::surface_in"); }
 
 }  // namespace sinew

@@ -28,6 +28,7 @@ namespace fs = std::filesystem;
 
 constexpr int kVtkTetra = 10;
 constexpr int kVtkLine = 3;
+constexpr int kVtkTriangle = 5;
 
 void append_float(std::string& out, float v) {
   char buf[32];
@@ -237,6 +238,11 @@ Status write_vtu(const std::filesystem::path& path, std::span<const float> posit
 Status write_vtu_lines(const std::filesystem::path& path, std::span<const float> positions, int stride,
                        std::span<const std::array<std::uint32_t, 2>> segments) {
   return write_cells<2>(path, positions, stride, segments, {}, kVtkLine, "segment");
+}
+
+Status write_vtu_triangles(const std::filesystem::path& path, std::span<const float> positions, int stride,
+                           std::span<const std::array<std::uint32_t, 3>> triangles) {
+  return write_cells<3>(path, positions, stride, triangles, {}, kVtkTriangle, "triangle");
 }
 
 Status write_pvd(const std::filesystem::path& path, std::span<const std::filesystem::path> vtu_files,

@@ -27,6 +27,10 @@ Sum press(const ToolBody& a, const ToolBody* b, const ColliderDesc& shape, const
   for (std::size_t i = 0; i < a.points.size(); ++i) {
     const V3 r = math::rotate(a.rotation, a.points[i]);
     const V3 p = math::add(a.position, r);
+    // A level set: its value first (most points are outside), the gradient only inside.
+    if (shape.shape == ColliderShape::level_set &&
+        !(shape.level_set->value(math::rotate(math::conj(rotation), math::sub(p, position))) < 0.0))
+      continue;
     const collision::ShapeDistance d = collision::shape_distance(shape, position, rotation, p);
     if (!(d.distance < 0.0)) continue;
     const double depth = -d.distance;
