@@ -22,7 +22,7 @@ struct ContactState {
   /// Per scene collider, where its level set's grid starts in the level-set
   /// grids buffer [bytes] (0 for other shapes; CompiledScene::level_set_offsets).
   std::vector<std::uint64_t> level_set_offsets;
-  std::vector<ColliderDesc> tool_shapes;  ///< each tool's capsule, for the meshes' faces (mesh_collision.h)
+  std::vector<ColliderDesc> tool_shapes;  ///< each tool's capsule or level set, for the meshes' faces (mesh_collision.h) and the penalty (tool_penalty.h)
 };
 
 }  // namespace sinew

@@ -27,6 +27,7 @@
 // State: Impl::colliders and Impl::targets are host copies of the device
 // buffers; the tools' rigid state lives in Impl::contacts (contact_state.h),
 // all sized in init_contacts: nothing here allocates per frame.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -184,9 +185,9 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
   return {};
 }
 
-std::vector<PosedShape> Simulation::Impl::collider_shapes() const {
+std::vector<PosedShape> Simulation::Impl::collider_shapes(bool start) const {
   std::vector<PosedShape> shapes;
-  for (std::uint32_t k = 0; k < contacts.colliders; ++k) shapes.push_back(posed(contacts.shapes[k], colliders, k, false));
+  for (std::uint32_t k = 0; k < contacts.colliders; ++k) shapes.push_back(posed(contacts.shapes[k], colliders, k, start));
   return shapes;
 }
 
@@ -216,13 +217,8 @@ Status Simulation::Impl::before_frame() {
   ContactState& c = contacts;
   // Level-set tools: the penalty where everything is at the frame's start
   // (the colliders where the last frame left them) drives this frame.
-  for (const ToolBody& b : c.tools)
-    if (b.level_set) {
-      std::vector<PosedShape> starts;
-      for (std::uint32_t k = 0; k < c.colliders; ++k) starts.push_back(posed(c.shapes[k], colliders, k, true));
-      add_tool_penalties(c.tools, c.tool_shapes, starts);
-      break;
-    }
+  if (std::any_of(c.tools.begin(), c.tools.end(), [](const ToolBody& b) { return b.level_set; }))
+    add_tool_penalties(c.tools, c.tool_shapes, collider_shapes(true));
   for (ToolBody& b : c.tools) integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);
   // The tools against the colliders where those end this frame, and each other.
   if (!c.tools.empty()) resolve_tool_contacts(c.tools, collider_shapes(), time_step);

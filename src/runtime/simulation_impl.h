@@ -72,9 +72,10 @@ struct Simulation::Impl {
   ContactState contacts;
   Status init_contacts(const SceneDesc& scene, const CompiledScene& compiled);
   Status before_frame();  ///< integrates the tools (rigid_tool.h), uploads what moved
-  /// The scene's colliders at their poses at the end of the coming frame.
-  [[nodiscard]] std::vector<PosedShape> collider_shapes() const;
-  /// Each tool's capsule at its pose at the start or the end of the coming
+  /// The scene's colliders at their poses at the end of the coming frame
+  /// (or at its start: where the last frame left them).
+  [[nodiscard]] std::vector<PosedShape> collider_shapes(bool start = false) const;
+  /// Each tool's shape (a capsule or a level set) at its pose at the start or the end of the coming
   /// frame (after before_frame, which integrates the tools).
   [[nodiscard]] std::vector<PosedShape> tool_shapes(bool start) const;
   /// The tools and capsule colliders over the coming frame, for the
