@@ -22,6 +22,7 @@
 #include "level_set_params.h"
 #include "narrow_phase_params.h"
 #include "mesh_contact_params.h"
+#include "neighbour_params.h"
 #include "primitive_params.h"
 #include "stats_params.h"
 #include "suture_params.h"

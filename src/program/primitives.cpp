@@ -98,7 +98,8 @@ std::uint32_t radix_sort_scratch_words(std::uint32_t capacity) {
 }
 
 void append_radix_sort(FrameProgram& program, const DeviceCount& n, std::uint32_t key_bits, BufferHandle keys,
-                       BufferHandle payload, BufferHandle keys_tmp, BufferHandle payload_tmp, DeviceWords scratch) {
+                       BufferHandle payload, BufferHandle keys_tmp, BufferHandle payload_tmp, DeviceWords scratch,
+                       std::uint32_t significant_bits) {
   const std::uint32_t stride = std::max(blocks(n.capacity), 1u);
   const std::uint32_t hist_words = SINEW_RADIX_DIGITS * stride;
   // scratch: [count of histogram words][histograms][their scan's scratch]
@@ -114,7 +115,12 @@ void append_radix_sort(FrameProgram& program, const DeviceCount& n, std::uint32_
   p.block_stride = stride;
   p.hist_offset = hist.offset;
   BufferHandle from_keys = keys, from_payload = payload, to_keys = keys_tmp, to_payload = payload_tmp;
-  for (std::uint32_t shift = 0; shift < key_bits; shift += SINEW_RADIX_BITS) {
+  // Passes over the significant digits, an even number of them (the
+  // ping-pong ends in keys/payload again).
+  const std::uint32_t bits = significant_bits > 0 && significant_bits < key_bits ? significant_bits : key_bits;
+  std::uint32_t passes = (bits + SINEW_RADIX_BITS - 1) / SINEW_RADIX_BITS;
+  passes += passes % 2;
+  for (std::uint32_t shift = 0; shift < passes * SINEW_RADIX_BITS; shift += SINEW_RADIX_BITS) {
     p.shift = shift;
     program.dispatch(Kernel::radix_histogram, stride * kBlock, {n.buffer, from_keys, hist.buffer}, p);
     program.barrier();

@@ -64,8 +64,11 @@ std::uint32_t radix_sort_scratch_words(std::uint32_t capacity);
 /// keys/payload; keys_tmp and payload_tmp hold as many (ping-pong, even
 /// pass count so the result ends where it started). [in] scratch:
 /// radix_sort_scratch_words words; all offsets 0 (whole buffers).
+/// [in] significant_bits: keys below 2^significant_bits need only that
+/// many bits sorted (fewer passes); 0: all key_bits.
 void append_radix_sort(FrameProgram& program, const DeviceCount& n, std::uint32_t key_bits, BufferHandle keys,
-                       BufferHandle payload, BufferHandle keys_tmp, BufferHandle payload_tmp, DeviceWords scratch);
+                       BufferHandle payload, BufferHandle keys_tmp, BufferHandle payload_tmp, DeviceWords scratch,
+                       std::uint32_t significant_bits = 0);
 
 /// Reduction operators (SINEW_REDUCE_* in primitive_params.h).
 enum class ReduceOp : std::uint32_t {

@@ -1,0 +1,119 @@
+// neighbour_kernels.cpp — CPU reference of the fixed-radius neighbour
+// search (kernels/shared/neighbour_params.h: cells, buckets, the 27-cell
+// query; Green 2010, Hoetzlein 2014). The GPU twins are
+// kernels/gpu/nbr_*.gpu; every float operation here is one the twins do in
+// the same order, so the sets found are the same bits.
+#include <cmath>
+#include <cstdint>
+
+#include "cpu/cpu_kernels.h"
+#include "neighbour_params.h"
+
+namespace sinew::kernels {
+namespace {
+
+using u32 = std::uint32_t;
+
+u32 point_count(const NeighbourParams& p, const std::byte* counts) {
+  const u32 n = reinterpret_cast<const u32*>(counts)[p.count_word];
+  return n < p.capacity ? n : p.capacity;
+}
+
+// The low 10 bits of v spread to every third bit (bits 0, 3, ..., 27).
+u32 spread10(u32 v) {
+  v &= 0x3ffu;
+  v = (v * 0x00010001u) & 0xFF0000FFu;
+  v = (v * 0x00000101u) & 0x0F00F00Fu;
+  v = (v * 0x00000011u) & 0xC30C30C3u;
+  v = (v * 0x00000005u) & 0x49249249u;
+  return v;
+}
+
+u32 bucket_of(int cx, int cy, int cz, u32 mask) {
+  return ((spread10(u32(cx)) << 2) | (spread10(u32(cy)) << 1) | spread10(u32(cz))) & mask;
+}
+
+}  // namespace
+
+void nbr_cells(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const NeighbourParams*>(params);
+  const u32 n = point_count(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  auto* keys = reinterpret_cast<u32*>(bindings[2]);
+  auto* order = reinterpret_cast<u32*>(bindings[3]);
+  auto* cells = reinterpret_cast<int*>(bindings[4]);
+  for (u32 i = begin; i < end && i < n; ++i) {
+    int c[3];
+    for (int k = 0; k < 3; ++k) c[k] = int(std::floor(points[4 * std::size_t{i} + k] * p.inv_cell));
+    keys[i] = bucket_of(c[0], c[1], c[2], p.table_mask);
+    order[i] = i;
+    for (int k = 0; k < 3; ++k) cells[4 * std::size_t{i} + k] = c[k];
+    cells[4 * std::size_t{i} + 3] = 0;
+  }
+}
+
+void nbr_ranges(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const NeighbourParams*>(params);
+  const u32 n = point_count(p, bindings[0]);
+  const auto* keys = reinterpret_cast<const u32*>(bindings[1]);
+  auto* ranges = reinterpret_cast<u32*>(bindings[2]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const u32 b = keys[s];
+    if (s == 0 || keys[s - 1] != b) ranges[2 * std::size_t{b}] = s;
+    if (s + 1 == n || keys[s + 1] != b) ranges[2 * std::size_t{b} + 1] = s + 1;
+  }
+}
+
+void nbr_gather(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const NeighbourParams*>(params);
+  const u32 n = point_count(p, bindings[0]);
+  const auto* order = reinterpret_cast<const u32*>(bindings[1]);
+  const auto* points = reinterpret_cast<const float*>(bindings[2]);
+  const auto* cells = reinterpret_cast<const u32*>(bindings[3]);
+  auto* sorted_points = reinterpret_cast<float*>(bindings[4]);
+  auto* sorted_cells = reinterpret_cast<u32*>(bindings[5]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const std::size_t i = order[s];
+    for (int k = 0; k < 4; ++k) {
+      sorted_points[4 * std::size_t{s} + k] = points[4 * i + k];
+      sorted_cells[4 * std::size_t{s} + k] = cells[4 * i + k];
+    }
+  }
+}
+
+void nbr_query(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const NeighbourParams*>(params);
+  const u32 n = point_count(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
+  const auto* order = reinterpret_cast<const u32*>(bindings[4]);
+  auto* lists = reinterpret_cast<u32*>(bindings[5]);
+  auto* neighbours = reinterpret_cast<u32*>(bindings[6]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const float* x = points + 4 * std::size_t{s};
+    const int* c = cells + 4 * std::size_t{s};
+    const u32 i = order[s];
+    u32 found = 0;
+    const u32 first = p.mode == 0 ? 0u : lists[i];
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+          const u32 b = bucket_of(cx, cy, cz, p.table_mask);
+          for (u32 t = ranges[2 * std::size_t{b}]; t < ranges[2 * std::size_t{b} + 1]; ++t) {
+            const int* ct = cells + 4 * std::size_t{t};
+            if (t == s || ct[0] != cx || ct[1] != cy || ct[2] != cz) continue;  // itself, or another cell's
+            const float* y = points + 4 * std::size_t{t};
+            const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
+            const float d2 = ex * ex + ey * ey + ez * ez;
+            if (!(d2 < p.radius2)) continue;
+            if (p.mode == 1 && first + found < p.out_capacity) neighbours[first + found] = order[t];
+            ++found;
+          }
+        }
+    if (p.mode == 0) lists[i] = found;
+  }
+}
+
+}  // namespace sinew::kernels

@@ -1,0 +1,162 @@
+// neighbour_grid.cpp — the host side of the device neighbour search (see
+// neighbour_grid.h; the kernels' contract: kernels/shared/neighbour_params.h).
+#include "neighbours/neighbour_grid.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <string>
+
+#include "neighbour_params.h"
+#include "program/primitives.h"
+
+namespace sinew {
+namespace {
+
+// The cell is this much wider than the radius, so that two points closer
+// than the radius land in the same or adjacent cells whatever the float
+// products round to, up to 2^16 cells from the origin (neighbour_params.h):
+// their cell coordinates u = x / cell differ by at most (1 + 2^-23) / (1 +
+// 2^-6) plus the two products' rounding, 2 * 2^-24 * 2^16 = 2^-7, < 1.
+constexpr double kCellMargin = 1.0 + 1.0 / 64.0;
+constexpr double kMaxCells = 65536.0;
+
+std::string str(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", v);
+  return text;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<NeighbourGrid>> NeighbourGrid::create(Device& device, std::uint32_t capacity, double radius,
+                                                             std::uint32_t pair_capacity) {
+  if (capacity == 0 || capacity > (1u << 28))
+    return Error(ErrorCode::bad_parameter,
+                 "neighbour search: capacity must be 1 .. 2^28 points (got " + std::to_string(capacity) + ")");
+  if (!(radius > 0.0) || !std::isfinite(radius) || !std::isfinite(float(radius * radius)) ||
+      !(float(radius) * float(radius) > 0.0f))
+    return Error(ErrorCode::bad_parameter,
+                 "neighbour search: radius must be finite and > 0 [m], its square a normal float (got " + str(radius) + ")");
+  if (pair_capacity == 0)
+    return Error(ErrorCode::bad_parameter, "neighbour search: pair_capacity must be > 0");
+  std::unique_ptr<NeighbourGrid> g(new NeighbourGrid(device));
+  g->capacity_ = capacity;
+  g->pair_capacity_ = pair_capacity;
+  // Buckets: a power of two, at least twice the points (few runs share one).
+  g->buckets_ = std::max(64u, std::bit_ceil(std::min(2u * capacity, 1u << 29)));
+  g->table_bits_ = static_cast<std::uint32_t>(std::countr_zero(g->buckets_));
+  g->inv_cell_ = float(1.0 / (radius * kCellMargin));
+  g->radius2_ = float(radius) * float(radius);
+  const std::size_t n = capacity;
+  struct Made {
+    BufferHandle* handle;
+    std::size_t bytes;
+    const char* label;
+  };
+  NeighbourGridBuffers& b = g->b_;
+  const std::uint32_t scratch = std::max(radix_sort_scratch_words(capacity), scan_scratch_words(capacity));
+  for (const Made& m : {Made{&b.counts, 8, "neighbour counts"}, Made{&b.points, 16 * n, "neighbour points"},
+                        Made{&b.keys, 4 * n, "neighbour keys"}, Made{&b.keys_tmp, 4 * n, "neighbour keys (sort)"},
+                        Made{&b.order, 4 * n, "neighbour order"}, Made{&b.order_tmp, 4 * n, "neighbour order (sort)"},
+                        Made{&b.cells, 16 * n, "neighbour cells"}, Made{&b.sorted_points, 16 * n, "neighbour sorted points"},
+                        Made{&b.sorted_cells, 16 * n, "neighbour sorted cells"},
+                        Made{&b.ranges, 8 * std::size_t{g->buckets_}, "neighbour bucket ranges"},
+                        Made{&b.lists, 4 * n, "neighbour lists"},
+                        Made{&b.neighbours, 4 * std::size_t{pair_capacity}, "neighbours"},
+                        Made{&b.scratch, 4 * std::size_t{scratch}, "neighbour scratch"}}) {
+    auto made = device.create_buffer(m.bytes, m.label);
+    if (!made) return made.error();
+    *m.handle = *made;
+  }
+  if (Status s = g->build_program(); !s) return s.error();
+  return g;
+}
+
+NeighbourGrid::~NeighbourGrid() {
+  if (have_program_) (void)device_.destroy_program(program_);
+  for (BufferHandle h : {b_.counts, b_.points, b_.keys, b_.keys_tmp, b_.order, b_.order_tmp, b_.cells, b_.sorted_points,
+                         b_.sorted_cells, b_.ranges, b_.lists, b_.neighbours, b_.scratch})
+    if (h.valid()) (void)device_.destroy_buffer(h);
+}
+
+double NeighbourGrid::max_coordinate() const { return kMaxCells / double(inv_cell_); }
+
+Status NeighbourGrid::build_program() {
+  if (have_program_) {
+    if (Status s = device_.destroy_program(program_); !s) return s;
+    have_program_ = false;
+  }
+  const NeighbourGridBuffers& b = b_;
+  kernels::NeighbourParams p{};
+  p.count_word = 0;
+  p.capacity = capacity_;
+  p.table_mask = buckets_ - 1;
+  p.inv_cell = inv_cell_;
+  p.radius2 = radius2_;
+  p.out_capacity = pair_capacity_;
+  const DeviceCount n{b.counts, 0, capacity_};
+  FrameProgram program;
+  program.fill(b.ranges, 0, 2 * buckets_, 0u);
+  program.dispatch(Kernel::nbr_cells, capacity_, {b.counts, b.points, b.keys, b.order, b.cells}, p);
+  program.barrier();
+  // Only the bucket's bits are sorted (table_bits_ of 32: fewer passes).
+  append_radix_sort(program, n, 32, b.keys, b.order, b.keys_tmp, b.order_tmp, {b.scratch, 0}, table_bits_);
+  program.barrier();
+  program.dispatch(Kernel::nbr_ranges, capacity_, {b.counts, b.keys, b.ranges}, p);
+  program.dispatch(Kernel::nbr_gather, capacity_, {b.counts, b.order, b.points, b.cells, b.sorted_points, b.sorted_cells}, p);
+  program.barrier();
+  p.mode = 0;
+  program.dispatch(Kernel::nbr_query, capacity_,
+                   {b.counts, b.sorted_points, b.sorted_cells, b.ranges, b.order, b.lists, b.neighbours}, p);
+  program.barrier();
+  // The counts become each list's offset; the total is the pairs' counter.
+  const std::uint32_t total = append_exclusive_scan(program, n, {b.lists, 0}, {b.lists, 0}, {b.scratch, 0});
+  program.copy(b.scratch, total, b.counts, 1, 1);
+  program.barrier();
+  program.counter("neighbour pairs", b.counts, 1, pair_capacity_);
+  p.mode = 1;
+  program.dispatch(Kernel::nbr_query, capacity_,
+                   {b.counts, b.sorted_points, b.sorted_cells, b.ranges, b.order, b.lists, b.neighbours}, p);
+  program.barrier();
+  auto made = device_.create_program(program);
+  if (!made) return made.error();
+  program_ = *made;
+  have_program_ = true;
+  return {};
+}
+
+Status NeighbourGrid::upload(const float* xyzw, std::uint32_t n) {
+  if (n > capacity_)
+    return Error(ErrorCode::bad_parameter, "neighbour search: " + std::to_string(n) + " points, more than its capacity " +
+                                               std::to_string(capacity_));
+  const double limit = max_coordinate();
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const float x = xyzw[4 * std::size_t{i} + std::size_t(k)];
+      if (!std::isfinite(x) || std::abs(double(x)) >= limit)
+        return Error(ErrorCode::bad_parameter, "neighbour search: point " + std::to_string(i) + " has coordinate " +
+                                                   str(double(x)) + ": it must be finite and within " + str(limit) +
+                                                   " m of the origin (2^16 cells)");
+    }
+  if (n > 0)
+    if (Status s = device_.write_buffer(b_.points, 0, xyzw, 16 * std::size_t{n}); !s) return s;
+  const std::uint32_t counts[2] = {n, 0u};
+  return device_.write_buffer(b_.counts, 0, counts, sizeof counts);
+}
+
+Status NeighbourGrid::run() { return device_.run_program(program_); }
+
+std::uint32_t NeighbourGrid::pairs() const {
+  const std::span<const std::uint32_t> c = device_.counters();
+  return c.empty() ? 0u : c[0];
+}
+
+Status NeighbourGrid::grow_pairs(std::uint32_t pair_capacity) {
+  if (pair_capacity <= pair_capacity_) return {};
+  if (Status s = device_.resize_buffer(b_.neighbours, 4 * std::size_t{pair_capacity}); !s) return s;
+  pair_capacity_ = pair_capacity;
+  return build_program();
+}
+
+}  // namespace sinew
