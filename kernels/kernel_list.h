@@ -81,7 +81,7 @@
   SINEW_KERNEL(level_set_sample, 3, LevelSetSampleParams, 0)                    \
   /* the fixed-radius neighbour search (kernels/shared/neighbour_params.h) */   \
   SINEW_KERNEL(nbr_cells, 5, NeighbourParams, 0)                                 \
-  SINEW_KERNEL(nbr_ranges, 3, NeighbourParams, 0)                                \
+  SINEW_KERNEL(nbr_ranges, 5, NeighbourParams, 0)                                \
   SINEW_KERNEL(nbr_gather, 6, NeighbourParams, 0)                                \
   SINEW_KERNEL(nbr_query, 7, NeighbourParams, 0)
 

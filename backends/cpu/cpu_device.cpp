@@ -18,6 +18,7 @@
 #include "backends/kernel_table.h"
 #include "cpu/cpu_kernels.h"
 #include "cpu/fem_kernels.h"   // the AVX2 FEM solves
+#include "cpu/neighbour_kernels.h"  // the AVX2 neighbour query
 #include "cpu/xpbd_kernels.h"  // the AVX2 distance and volume solves
 
 namespace sinew {
@@ -56,6 +57,7 @@ kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
   if (simd && kernel == Kernel::xpbd_solve_neo_hookean) return solve_neo_hookean_simd;
   if (simd && kernel == Kernel::xpbd_solve_stvk) return solve_stvk_simd;
   if (simd && kernel == Kernel::xpbd_solve_corotational) return solve_corotational_simd;
+  if (simd && kernel == Kernel::nbr_query) return kernels::nbr_query_avx2;
   return kReference[static_cast<std::size_t>(kernel)];
 }
 

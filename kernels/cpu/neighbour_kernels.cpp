@@ -29,6 +29,8 @@ u32 spread10(u32 v) {
   return v;
 }
 
+bool same_cell(const int* c, int cx, int cy, int cz) { return c[0] == cx && c[1] == cy && c[2] == cz; }
+
 u32 bucket_of(int cx, int cy, int cz, u32 mask) {
   return ((spread10(u32(cx)) << 2) | (spread10(u32(cy)) << 1) | spread10(u32(cz))) & mask;
 }
@@ -56,11 +58,18 @@ void nbr_ranges(const void* params, std::byte* const* bindings, std::uint32_t be
   const auto& p = *static_cast<const NeighbourParams*>(params);
   const u32 n = point_count(p, bindings[0]);
   const auto* keys = reinterpret_cast<const u32*>(bindings[1]);
-  auto* ranges = reinterpret_cast<u32*>(bindings[2]);
+  const auto* order = reinterpret_cast<const u32*>(bindings[2]);
+  const auto* cells = reinterpret_cast<const u32*>(bindings[3]);
+  auto* ranges = reinterpret_cast<u32*>(bindings[4]);
   for (u32 s = begin; s < end && s < n; ++s) {
     const u32 b = keys[s];
-    if (s == 0 || keys[s - 1] != b) ranges[2 * std::size_t{b}] = s;
-    if (s + 1 == n || keys[s + 1] != b) ranges[2 * std::size_t{b} + 1] = s + 1;
+    if (s == 0 || keys[s - 1] != b) ranges[3 * std::size_t{b}] = s;
+    if (s + 1 == n || keys[s + 1] != b) ranges[3 * std::size_t{b} + 1] = s + 1;
+    if (s > 0 && keys[s - 1] == b) {
+      const u32* c = cells + 4 * std::size_t{order[s]};
+      const u32* d = cells + 4 * std::size_t{order[s - 1]};
+      if (c[0] != d[0] || c[1] != d[1] || c[2] != d[2]) ranges[3 * std::size_t{b} + 2] = 1;
+    }
   }
 }
 
@@ -96,22 +105,44 @@ void nbr_query(const void* params, std::byte* const* bindings, std::uint32_t beg
     const u32 i = order[s];
     u32 found = 0;
     const u32 first = p.mode == 0 ? 0u : lists[i];
+    // Fill: hits gather in a small batch, written out to the list when full
+    // and at the end (a branch-free write past the list would land in the next).
+    constexpr u32 kBatch = 64;
+    u32 batch[kBatch + 1];
+    u32 held = 0;
+    const auto flush = [&] {
+      for (u32 k = 0; k < held; ++k)
+        if (first + found + k < p.out_capacity) neighbours[first + found + k] = batch[k];
+      found += held;
+      held = 0;
+    };
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
           const u32 b = bucket_of(cx, cy, cz, p.table_mask);
-          for (u32 t = ranges[2 * std::size_t{b}]; t < ranges[2 * std::size_t{b} + 1]; ++t) {
-            const int* ct = cells + 4 * std::size_t{t};
-            if (t == s || ct[0] != cx || ct[1] != cy || ct[2] != cz) continue;  // itself, or another cell's
+          const u32 run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
+          const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
+          // A run of one cell: all of it or none of it is the visited cell's.
+          if (run == run_end || (!mixed && !same_cell(cells + 4 * std::size_t{run}, cx, cy, cz))) continue;
+          // Branch-free over a run (which candidates pass is unpredictable):
+          // itself and, in a mixed run, another cell's points are left out.
+          for (u32 t = run; t < run_end; ++t) {
             const float* y = points + 4 * std::size_t{t};
             const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
             const float d2 = ex * ex + ey * ey + ez * ez;
-            if (!(d2 < p.radius2)) continue;
-            if (p.mode == 1 && first + found < p.out_capacity) neighbours[first + found] = order[t];
-            ++found;
+            const u32 hit = u32(d2 < p.radius2) & u32(t != s) &
+                            u32(!mixed || same_cell(cells + 4 * std::size_t{t}, cx, cy, cz));
+            if (p.mode == 1) {
+              batch[held] = order[t];  // kept only when it hits
+              held += hit;
+              if (held == kBatch) flush();
+            } else {
+              found += hit;
+            }
           }
         }
+    if (p.mode == 1) flush();
     if (p.mode == 0) lists[i] = found;
   }
 }

@@ -35,11 +35,17 @@
  *           4 cells uint4 [out]: the cell (int bits), w unused
  * ------------------------------------------------------------ nbr_ranges
  * One item per sorted point s < n (after the keys are sorted): where each
- * bucket's run of points starts and ends, ranges[2 b] = first s, ranges[2 b
- * + 1] = last s + 1; the caller zeroes ranges first (empty buckets: 0, 0).
+ * bucket's run of points starts and ends, ranges[3 b] = first s, ranges[3 b
+ * + 1] = last s + 1, and whether it mixes cells, ranges[3 b + 2] = 1 when
+ * two neighbours in the run have different cells (buckets shared by cells
+ * far apart); the caller zeroes ranges first (empty buckets: 0, 0, 0). A
+ * query skips a run of one cell that is not the cell it visits at once, and
+ * checks the cell of each point only in mixed runs.
  * bindings: 0 counts uint [in]
  *           1 keys uint [in]: sorted
- *           2 ranges uint, 2 per bucket [out]
+ *           2 order uint [in]: sorted s -> point i
+ *           3 cells uint4 [in]: per point
+ *           4 ranges uint, 3 per bucket [out]
  * ------------------------------------------------------------ nbr_gather
  * One item per sorted point s < n: its point and cell, copied into sorted
  * order (a query then reads its candidates' runs from contiguous memory).

@@ -61,7 +61,7 @@ Result<std::unique_ptr<NeighbourGrid>> NeighbourGrid::create(Device& device, std
                         Made{&b.order, 4 * n, "neighbour order"}, Made{&b.order_tmp, 4 * n, "neighbour order (sort)"},
                         Made{&b.cells, 16 * n, "neighbour cells"}, Made{&b.sorted_points, 16 * n, "neighbour sorted points"},
                         Made{&b.sorted_cells, 16 * n, "neighbour sorted cells"},
-                        Made{&b.ranges, 8 * std::size_t{g->buckets_}, "neighbour bucket ranges"},
+                        Made{&b.ranges, 12 * std::size_t{g->buckets_}, "neighbour bucket ranges"},
                         Made{&b.lists, 4 * n, "neighbour lists"},
                         Made{&b.neighbours, 4 * std::size_t{pair_capacity}, "neighbours"},
                         Made{&b.scratch, 4 * std::size_t{scratch}, "neighbour scratch"}}) {
@@ -75,6 +75,7 @@ Result<std::unique_ptr<NeighbourGrid>> NeighbourGrid::create(Device& device, std
 
 NeighbourGrid::~NeighbourGrid() {
   if (have_program_) (void)device_.destroy_program(program_);
+  if (have_grid_program_) (void)device_.destroy_program(grid_program_);
   for (BufferHandle h : {b_.counts, b_.points, b_.keys, b_.keys_tmp, b_.order, b_.order_tmp, b_.cells, b_.sorted_points,
                          b_.sorted_cells, b_.ranges, b_.lists, b_.neighbours, b_.scratch})
     if (h.valid()) (void)device_.destroy_buffer(h);
@@ -82,12 +83,7 @@ NeighbourGrid::~NeighbourGrid() {
 
 double NeighbourGrid::max_coordinate() const { return kMaxCells / double(inv_cell_); }
 
-Status NeighbourGrid::build_program() {
-  if (have_program_) {
-    if (Status s = device_.destroy_program(program_); !s) return s;
-    have_program_ = false;
-  }
-  const NeighbourGridBuffers& b = b_;
+kernels::NeighbourParams NeighbourGrid::params() const {
   kernels::NeighbourParams p{};
   p.count_word = 0;
   p.capacity = capacity_;
@@ -95,23 +91,48 @@ Status NeighbourGrid::build_program() {
   p.inv_cell = inv_cell_;
   p.radius2 = radius2_;
   p.out_capacity = pair_capacity_;
-  const DeviceCount n{b.counts, 0, capacity_};
-  FrameProgram program;
-  program.fill(b.ranges, 0, 2 * buckets_, 0u);
+  return p;
+}
+
+void NeighbourGrid::append_grid(FrameProgram& program) const {
+  const NeighbourGridBuffers& b = b_;
+  const kernels::NeighbourParams p = params();
+  program.fill(b.ranges, 0, 3 * buckets_, 0u);
   program.dispatch(Kernel::nbr_cells, capacity_, {b.counts, b.points, b.keys, b.order, b.cells}, p);
   program.barrier();
   // Only the bucket's bits are sorted (table_bits_ of 32: fewer passes).
-  append_radix_sort(program, n, 32, b.keys, b.order, b.keys_tmp, b.order_tmp, {b.scratch, 0}, table_bits_);
+  append_radix_sort(program, {b.counts, 0, capacity_}, 32, b.keys, b.order, b.keys_tmp, b.order_tmp, {b.scratch, 0},
+                    table_bits_);
   program.barrier();
-  program.dispatch(Kernel::nbr_ranges, capacity_, {b.counts, b.keys, b.ranges}, p);
+  program.dispatch(Kernel::nbr_ranges, capacity_, {b.counts, b.keys, b.order, b.cells, b.ranges}, p);
   program.dispatch(Kernel::nbr_gather, capacity_, {b.counts, b.order, b.points, b.cells, b.sorted_points, b.sorted_cells}, p);
   program.barrier();
+}
+
+Status NeighbourGrid::build_program() {
+  for (bool* have : {&have_program_, &have_grid_program_})
+    if (*have) {
+      if (Status s = device_.destroy_program(have == &have_program_ ? program_ : grid_program_); !s) return s;
+      *have = false;
+    }
+  const NeighbourGridBuffers& b = b_;
+  kernels::NeighbourParams p = params();
+  FrameProgram grid;
+  append_grid(grid);
+  auto made_grid = device_.create_program(grid);
+  if (!made_grid) return made_grid.error();
+  grid_program_ = *made_grid;
+  have_grid_program_ = true;
+
+  FrameProgram program;
+  append_grid(program);
   p.mode = 0;
   program.dispatch(Kernel::nbr_query, capacity_,
                    {b.counts, b.sorted_points, b.sorted_cells, b.ranges, b.order, b.lists, b.neighbours}, p);
   program.barrier();
   // The counts become each list's offset; the total is the pairs' counter.
-  const std::uint32_t total = append_exclusive_scan(program, n, {b.lists, 0}, {b.lists, 0}, {b.scratch, 0});
+  const std::uint32_t total =
+      append_exclusive_scan(program, {b.counts, 0, capacity_}, {b.lists, 0}, {b.lists, 0}, {b.scratch, 0});
   program.copy(b.scratch, total, b.counts, 1, 1);
   program.barrier();
   program.counter("neighbour pairs", b.counts, 1, pair_capacity_);
@@ -146,6 +167,7 @@ Status NeighbourGrid::upload(const float* xyzw, std::uint32_t n) {
 }
 
 Status NeighbourGrid::run() { return device_.run_program(program_); }
+Status NeighbourGrid::run_grid() { return device_.run_program(grid_program_); }
 
 std::uint32_t NeighbourGrid::pairs() const {
   const std::span<const std::uint32_t> c = device_.counters();

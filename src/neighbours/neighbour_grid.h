@@ -21,6 +21,7 @@
 #include <memory>
 
 #include "backends/backend.h"
+#include "neighbour_params.h"
 
 namespace sinew {
 
@@ -32,7 +33,7 @@ struct NeighbourGridBuffers {
   BufferHandle cells;          ///< uint4 per point: its cell
   BufferHandle sorted_points;  ///< float4 per sorted point
   BufferHandle sorted_cells;   ///< uint4 per sorted point
-  BufferHandle ranges;         ///< uint, 2 per bucket: a bucket's run [start, end) in sorted order
+  BufferHandle ranges;         ///< uint, 3 per bucket: a bucket's run [start, end) in sorted order, mixed (0/1)
   BufferHandle lists;          ///< uint per point: its list's offset in `neighbours` (after the program)
   BufferHandle neighbours;     ///< uint per pair: the point indices of every list, list after list
   BufferHandle scratch;        ///< the sort's and the scan's
@@ -57,6 +58,9 @@ class NeighbourGrid {
   /// exceed pair_capacity returns capacity_exceeded; pairs() then holds
   /// how many there were: grow_pairs(pairs()) and run again.
   Status run();
+  /// Runs only the grid's part (up to nbr_gather): the sorted points and
+  /// cells and the bucket ranges, for a solver that visits the cells itself.
+  Status run_grid();
   /// The neighbour pairs the last run found (from its counter).
   [[nodiscard]] std::uint32_t pairs() const;
   /// Regrows the neighbour slots to `pair_capacity` and rebuilds the program.
@@ -74,13 +78,15 @@ class NeighbourGrid {
  private:
   NeighbourGrid(Device& device) : device_(device) {}
   Status build_program();
+  [[nodiscard]] kernels::NeighbourParams params() const;
+  void append_grid(FrameProgram& program) const;
 
   Device& device_;
   NeighbourGridBuffers b_{};
   std::uint32_t capacity_ = 0, pair_capacity_ = 0, buckets_ = 0, table_bits_ = 0;
   float inv_cell_ = 0.0f, radius2_ = 0.0f;
-  ProgramHandle program_{};
-  bool have_program_ = false;
+  ProgramHandle program_{}, grid_program_{};
+  bool have_program_ = false, have_grid_program_ = false;
 };
 
 }  // namespace sinew
