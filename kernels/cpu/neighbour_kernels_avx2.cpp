@@ -47,6 +47,18 @@ void nbr_query_avx2(const void* params, std::byte* const* bindings, std::uint32_
   auto* neighbours = reinterpret_cast<u32*>(bindings[6]);
   const __m256 radius2 = _mm256_set1_ps(p.radius2);
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  // The 27 cells' runs of the last point's cell: the points of a cell are
+  // next to each other in sorted order, so the next point usually shares
+  // them (about eight a cell in a fluid), and the bucket lookups, scattered
+  // in memory, are done once a cell instead of once a point. A run that
+  // cannot hold the cell (empty, or one other cell's) is kept empty.
+  struct Visit {
+    u32 run, run_end;
+    bool mixed;
+  };
+  Visit visits[27];
+  int cached[3] = {0, 0, 0};
+  bool have_cached = false;
   for (u32 s = begin; s < end && s < n; ++s) {
     const float* x = points + 4 * std::size_t{s};
     const int* c = cells + 4 * std::size_t{s};
@@ -65,18 +77,31 @@ void nbr_query_avx2(const void* params, std::byte* const* bindings, std::uint32_
       found += held;
       held = 0;
     };
+    if (!have_cached || c[0] != cached[0] || c[1] != cached[1] || c[2] != cached[2]) {
+      int v = 0;
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx, ++v) {
+            const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+            const u32 b = ((spread10_avx2(u32(cx)) << 2) | (spread10_avx2(u32(cy)) << 1) | spread10_avx2(u32(cz))) &
+                          p.table_mask;
+            Visit& w = visits[v];
+            w = {ranges[3 * std::size_t{b}], ranges[3 * std::size_t{b} + 1], ranges[3 * std::size_t{b} + 2] != 0};
+            // A run of one cell: all of it or none of it is the visited cell's.
+            const int* rc = cells + 4 * std::size_t{w.run};
+            if (w.run < w.run_end && !w.mixed && !(rc[0] == cx && rc[1] == cy && rc[2] == cz)) w.run_end = w.run;
+          }
+      for (int k = 0; k < 3; ++k) cached[k] = c[k];
+      have_cached = true;
+    }
+    int v = 0;
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
+        for (int dx = -1; dx <= 1; ++dx, ++v) {
           const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          const u32 b = ((spread10_avx2(u32(cx)) << 2) | (spread10_avx2(u32(cy)) << 1) | spread10_avx2(u32(cz))) &
-                        p.table_mask;
-          const u32 run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
-          const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
-          // A run of one cell: all of it or none of it is the visited cell's.
+          const u32 run = visits[v].run, run_end = visits[v].run_end;
+          const bool mixed = visits[v].mixed;
           if (run == run_end) continue;
-          const int* rc = cells + 4 * std::size_t{run};
-          if (!mixed && !(rc[0] == cx && rc[1] == cy && rc[2] == cz)) continue;
           u32 t = run;
           const __m256i ccx = _mm256_set1_epi32(cx), ccy = _mm256_set1_epi32(cy), ccz = _mm256_set1_epi32(cz);
           // Whole groups of eight; a run's last few too, as a group masked
