@@ -24,6 +24,7 @@
 #include "mesh_contact_params.h"
 #include "neighbour_params.h"
 #include "primitive_params.h"
+#include "sph_params.h"
 #include "stats_params.h"
 #include "suture_params.h"
 #include "xpbd_params.h"

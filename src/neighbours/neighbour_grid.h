@@ -66,6 +66,10 @@ class NeighbourGrid {
   /// Regrows the neighbour slots to `pair_capacity` and rebuilds the program.
   Status grow_pairs(std::uint32_t pair_capacity);
 
+  /// Appends the grid's part of the program (up to nbr_gather, ending with a
+  /// barrier) to another program: a solver's step that visits the cells.
+  void append_grid(FrameProgram& program) const;
+
   [[nodiscard]] const NeighbourGridBuffers& buffers() const { return b_; }
   [[nodiscard]] std::uint32_t capacity() const { return capacity_; }
   [[nodiscard]] std::uint32_t pair_capacity() const { return pair_capacity_; }
@@ -79,7 +83,6 @@ class NeighbourGrid {
   NeighbourGrid(Device& device) : device_(device) {}
   Status build_program();
   [[nodiscard]] kernels::NeighbourParams params() const;
-  void append_grid(FrameProgram& program) const;
 
   Device& device_;
   NeighbourGridBuffers b_{};

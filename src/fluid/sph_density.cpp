@@ -1,0 +1,27 @@
+// sph_density.cpp — see sph_density.h.
+#include "fluid/sph_density.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace sinew {
+
+kernels::SphParams sph_params(const NeighbourGrid& grid, double support) {
+  kernels::SphParams p{};
+  p.count_word = 0;
+  p.capacity = grid.capacity();
+  p.table_mask = grid.buckets() - 1;
+  p.h2 = float(support) * float(support);
+  p.poly6 = float(315.0 / (64.0 * std::numbers::pi * std::pow(support, 9)));
+  return p;
+}
+
+void append_sph_density(FrameProgram& program, const NeighbourGrid& grid, const kernels::SphParams& params,
+                        BufferHandle density) {
+  const NeighbourGridBuffers& b = grid.buffers();
+  program.dispatch(Kernel::sph_density, grid.capacity(), {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density},
+                   params);
+  program.barrier();
+}
+
+}  // namespace sinew
