@@ -7,32 +7,19 @@
 #include <cstdint>
 
 #include "cpu/cpu_kernels.h"
+#include "cpu/neighbour_cells.h"
 #include "neighbour_params.h"
 
 namespace sinew::kernels {
 namespace {
 
 using u32 = std::uint32_t;
+using cells::bucket_of;
+using cells::same_cell;
 
 u32 point_count(const NeighbourParams& p, const std::byte* counts) {
   const u32 n = reinterpret_cast<const u32*>(counts)[p.count_word];
   return n < p.capacity ? n : p.capacity;
-}
-
-// The low 10 bits of v spread to every third bit (bits 0, 3, ..., 27).
-u32 spread10(u32 v) {
-  v &= 0x3ffu;
-  v = (v * 0x00010001u) & 0xFF0000FFu;
-  v = (v * 0x00000101u) & 0x0F00F00Fu;
-  v = (v * 0x00000011u) & 0xC30C30C3u;
-  v = (v * 0x00000005u) & 0x49249249u;
-  return v;
-}
-
-bool same_cell(const int* c, int cx, int cy, int cz) { return c[0] == cx && c[1] == cy && c[2] == cz; }
-
-u32 bucket_of(int cx, int cy, int cz, u32 mask) {
-  return ((spread10(u32(cx)) << 2) | (spread10(u32(cy)) << 1) | spread10(u32(cz))) & mask;
 }
 
 }  // namespace

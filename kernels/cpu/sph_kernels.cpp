@@ -6,23 +6,15 @@
 #include <cstdint>
 
 #include "cpu/cpu_kernels.h"
+#include "cpu/neighbour_cells.h"
 #include "sph_params.h"
 
 namespace sinew::kernels {
 namespace {
 
 using u32 = std::uint32_t;
-
-u32 spread10(u32 v) {
-  v &= 0x3ffu;
-  v = (v * 0x00010001u) & 0xFF0000FFu;
-  v = (v * 0x00000101u) & 0x0F00F00Fu;
-  v = (v * 0x00000011u) & 0xC30C30C3u;
-  v = (v * 0x00000005u) & 0x49249249u;
-  return v;
-}
-
-bool same_cell(const int* c, int cx, int cy, int cz) { return c[0] == cx && c[1] == cy && c[2] == cz; }
+using cells::bucket_of;
+using cells::same_cell;
 
 }  // namespace
 
@@ -42,7 +34,7 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          const u32 b = ((spread10(u32(cx)) << 2) | (spread10(u32(cy)) << 1) | spread10(u32(cz))) & p.table_mask;
+          const u32 b = bucket_of(cx, cy, cz, p.table_mask);
           const u32 run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
           const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
           if (run == run_end || (!mixed && !same_cell(cells + 4 * std::size_t{run}, cx, cy, cz))) continue;
