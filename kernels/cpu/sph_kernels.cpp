@@ -3,7 +3,9 @@
 // the poly6 density). They visit the neighbour grid's cells in the order of
 // nbr_query (neighbour_kernels.cpp) and round every float operation in the
 // GPU twins' order (kernels/gpu/sph_*.gpu).
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "cpu/cpu_kernels.h"
 #include "cpu/neighbour_cells.h"
@@ -46,10 +48,115 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
             if (!(d2 < p.h2)) continue;
             const float q = p.h2 - d2;
             const float w = q * q * q;
-            sum = sum + y[3] * w;
+            sum = sum + std::fabs(y[3]) * w;
           }
         }
     density[s] = p.poly6 * sum;
+  }
+}
+
+void sph_gather(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphParams*>(params);
+  const u32 stored = reinterpret_cast<const u32*>(bindings[0])[p.count_word];
+  const u32 n = stored < p.capacity ? stored : p.capacity;
+  const auto* order = reinterpret_cast<const u32*>(bindings[1]);
+  const auto* velocity = reinterpret_cast<const float*>(bindings[2]);
+  auto* sorted_velocity = reinterpret_cast<float*>(bindings[3]);
+  for (u32 s = begin; s < end && s < n; ++s)
+    std::memcpy(sorted_velocity + 4 * std::size_t{s}, velocity + 4 * std::size_t{order[s]}, 16);
+}
+
+namespace {
+
+// Tait's equation, negative pressure taken as 0 (sph_params.h).
+float tait(const SphParams& p, float rho) {
+  const float r = rho / p.rho0;
+  const float r2 = r * r;
+  const float r4 = r2 * r2;
+  const float r7 = r4 * r2 * r;
+  const float pressure = p.stiffness * (r7 - 1.0f);
+  return pressure > 0.0f ? pressure : 0.0f;
+}
+
+}  // namespace
+
+void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphParams*>(params);
+  const u32 stored = reinterpret_cast<const u32*>(bindings[0])[p.count_word];
+  const u32 n = stored < p.capacity ? stored : p.capacity;
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
+  const auto* density = reinterpret_cast<const float*>(bindings[4]);
+  const auto* sorted_velocity = reinterpret_cast<const float*>(bindings[5]);
+  auto* next_points = reinterpret_cast<float*>(bindings[6]);
+  auto* next_velocity = reinterpret_cast<float*>(bindings[7]);
+  auto* pressure = reinterpret_cast<float*>(bindings[8]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const float* x = points + 4 * std::size_t{s};
+    const float* v = sorted_velocity + 4 * std::size_t{s};
+    const float rho = density[s];
+    const float pi = tait(p, rho);
+    pressure[s] = pi;
+    if (!(x[3] > 0.0f)) {  // a boundary particle stays
+      std::memcpy(next_points + 4 * std::size_t{s}, x, 16);
+      std::memcpy(next_velocity + 4 * std::size_t{s}, v, 16);
+      continue;
+    }
+    const float own = pi / (rho * rho);
+    const int* c = cells + 4 * std::size_t{s};
+    float ax = 0.0f, ay = 0.0f, az = 0.0f;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+          const u32 b = bucket_of(cx, cy, cz, p.table_mask);
+          const u32 run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
+          const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
+          if (run == run_end || (!mixed && !same_cell(cells + 4 * std::size_t{run}, cx, cy, cz))) continue;
+          for (u32 t = run; t < run_end; ++t) {
+            if (t == s || (mixed && !same_cell(cells + 4 * std::size_t{t}, cx, cy, cz))) continue;
+            const float* y = points + 4 * std::size_t{t};
+            const float ex = x[0] - y[0], ey = x[1] - y[1], ez = x[2] - y[2];
+            const float d2 = ex * ex + ey * ey + ez * ez;
+            if (!(d2 < p.h2) || !(d2 > 0.0f)) continue;  // beyond the support, or no direction
+            const float r = std::sqrt(d2);
+            const float q = p.h - r;
+            const float gw = p.spiky * q * q / r;  // grad W = gw (x_i - x_j)
+            const float* w = sorted_velocity + 4 * std::size_t{t};
+            const bool fluid = y[3] > 0.0f;
+            const float ux = v[0] - (fluid ? w[0] : 0.0f), uy = v[1] - (fluid ? w[1] : 0.0f),
+                        uz = v[2] - (fluid ? w[2] : 0.0f);
+            const float approach = ux * ex + uy * ey + uz * ez;
+            const float rho_j = density[t];
+            const float rho_avg = fluid ? 0.5f * (rho + rho_j) : rho;
+            const float visc = approach < 0.0f ? -p.viscosity * approach / (rho_avg * (d2 + p.eta2)) : 0.0f;
+            float factor;
+            if (fluid) {
+              const float pj = tait(p, rho_j);
+              factor = y[3] * (own + pj / (rho_j * rho_j) + visc);
+            } else {
+              factor = -y[3] * (own + visc);
+            }
+            const float f = factor * gw;
+            ax = ax - f * ex;
+            ay = ay - f * ey;
+            az = az - f * ez;
+          }
+        }
+    ax = ax + p.gx;
+    ay = ay + p.gy;
+    az = az + p.gz;
+    float* xn = next_points + 4 * std::size_t{s};
+    float* vn = next_velocity + 4 * std::size_t{s};
+    vn[0] = v[0] + p.dt * ax;
+    vn[1] = v[1] + p.dt * ay;
+    vn[2] = v[2] + p.dt * az;
+    vn[3] = v[3];  // the id's bits
+    xn[0] = x[0] + p.dt * vn[0];
+    xn[1] = x[1] + p.dt * vn[1];
+    xn[2] = x[2] + p.dt * vn[2];
+    xn[3] = x[3];
   }
 }
 

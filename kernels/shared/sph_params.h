@@ -9,8 +9,15 @@
  *   W(r) = 315 / (64 pi h^9) (h^2 - r^2)^3 for r < h, 0 beyond,
  * a function of r^2 only: no square root, so every backend rounds it alike.
  *
+ * Particles. Each is a float4 xyz [m] and w: its mass m > 0 [kg] for a
+ * fluid particle, minus its "mass" psi = rho0 V_b for a boundary particle
+ * (Akinci, Ihmsen, Akinci, Solenthaler, Teschner, "Versatile rigid-fluid
+ * coupling for incompressible SPH", TOG 31(4), 2012: V_b = 1 / sum_k W_bk
+ * over the boundary particles k around b, computed on the host). Boundary
+ * particles never move.
+ *
  * ------------------------------------------------------------ sph_density
- * One item per sorted particle s < n: rho_s = poly6 * sum_j m_j (h2 -
+ * One item per sorted particle s < n: rho_s = poly6 * sum_j |w_j| (h2 -
  * d2)^3 over the particles j (itself included, d2 = 0) with d2 < h2, d2 =
  * (dx dx + dy dy) + dz dz in float, (h2 - d2)^3 = ((h2 - d2)(h2 - d2))(h2 -
  * d2), summed in the query's order (27 cells, dz outermost, each run in
@@ -19,7 +26,38 @@
  *           1 sorted_points float4 [in]: xyz [m], w the mass [kg]
  *           2 sorted_cells uint4 [in]
  *           3 ranges uint, 3 per bucket [in]
- *           4 density float, per sorted particle [out] [kg/m^3] */
+ *           4 density float, per sorted particle [out] [kg/m^3]
+ * ------------------------------------------------------------ sph_gather
+ * One item per sorted particle s < n: its velocity (xyz [m/s], w its id as
+ * bits) copied from the particle order[s] into sorted order.
+ * bindings: 0 counts uint [in]
+ *           1 order uint [in]
+ *           2 velocity float4 [in]
+ *           3 sorted_velocity float4 [out]
+ * ------------------------------------------------------------ sph_step
+ * One item per sorted particle s < n: weakly compressible SPH (Becker and
+ * Teschner, "Weakly compressible SPH for free surface flows", SCA 2007).
+ * Pressure by Tait's equation, p = B ((rho / rho0)^7 - 1), negative values
+ * taken as 0 (no tension at the free surface). Acceleration of a fluid
+ * particle i:
+ *   g - sum_fluid j m_j (p_i / rho_i^2 + p_j / rho_j^2 + Pi_ij) grad W_ij
+ *     - sum_boundary b psi_b (p_i / rho_i^2 + Pi_ib) grad W_ib
+ * with the spiky gradient grad W = spiky (h - r)^2 x_ij / r (0 < r < h;
+ * Müller et al. 2003) and Monaghan's viscosity Pi_ij = -viscosity
+ * min(v_ij . x_ij, 0) / (rho_avg (r^2 + eta2)) (Monaghan, "Smoothed
+ * particle hydrodynamics", Rep. Prog. Phys. 68, 2005), rho_avg the mean of
+ * the two densities (the particle's own for a boundary one, whose velocity
+ * is 0). Then symplectic Euler: v += dt a, x += dt v, written in sorted
+ * order (the next step's input). Boundary particles are copied unchanged.
+ * bindings: 0 counts uint [in]
+ *           1 sorted_points float4 [in]
+ *           2 sorted_cells uint4 [in]
+ *           3 ranges uint [in]
+ *           4 density float [in]
+ *           5 sorted_velocity float4 [in]
+ *           6 points float4 [out]: the next step's positions
+ *           7 velocity float4 [out]: the next step's velocities (w the id)
+ *           8 pressure float [out] [Pa], per sorted particle */
 #ifndef SINEW_SPH_PARAMS_H
 #define SINEW_SPH_PARAMS_H
 
@@ -36,8 +74,16 @@ SINEW_STRUCT_BEGIN(SphParams)
   uint pad0;
   float h2;         /* the support radius squared [m^2], float(h) * float(h) */
   float poly6;      /* 315 / (64 pi h^9) [1/m^9] */
-  float pad1;
-  float pad2;
+  float h;          /* the support radius [m] */
+  float spiky;      /* -45 / (pi h^6) [1/m^6]: the spiky gradient's factor */
+  float rho0;       /* rest density [kg/m^3] */
+  float stiffness;  /* B = rho0 c0^2 / 7 [Pa] (Tait's equation) */
+  float viscosity;  /* alpha c0 h [m^2/s] (Monaghan's artificial viscosity) */
+  float eta2;       /* 0.01 h^2 [m^2] */
+  float gx;         /* gravity [m/s^2] */
+  float gy;
+  float gz;
+  float dt;         /* the step [s] */
 SINEW_STRUCT_END(SphParams)
 
 #ifdef __cplusplus
