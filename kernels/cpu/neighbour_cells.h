@@ -5,6 +5,7 @@
 // copies inside its target region (avx2_lanes.h says why).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace sinew::kernels::cells {
@@ -27,5 +28,25 @@ inline std::uint32_t bucket_of(int cx, int cy, int cz, std::uint32_t mask) {
 
 /// Whether cell c (3 ints) is (cx, cy, cz).
 inline bool same_cell(const int* c, int cx, int cy, int cz) { return c[0] == cx && c[1] == cy && c[2] == cz; }
+
+/// Calls visit(t) for every sorted point t in the 27 cells around cell c
+/// (3 ints), in the query's order: dz outermost, then dy, then dx, each
+/// bucket's run in sorted order, a run of one other cell skipped whole and
+/// a mixed run's points of other cells left out (neighbour_params.h).
+/// [in] cells: the sorted points' cells (4 ints each); ranges: 3 words per bucket.
+template <class Visit>
+void visit_cells(const int* cells, const std::uint32_t* ranges, std::uint32_t mask, const int* c, Visit&& visit) {
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+        const std::uint32_t b = bucket_of(cx, cy, cz, mask);
+        const std::uint32_t run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
+        const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
+        if (run == run_end || (!mixed && !same_cell(cells + 4 * std::size_t{run}, cx, cy, cz))) continue;
+        for (std::uint32_t t = run; t < run_end; ++t)
+          if (!mixed || same_cell(cells + 4 * std::size_t{t}, cx, cy, cz)) visit(t);
+      }
+}
 
 }  // namespace sinew::kernels::cells

@@ -15,7 +15,7 @@ namespace {
 
 using u32 = std::uint32_t;
 using cells::bucket_of;
-using cells::same_cell;
+using cells::visit_cells;
 
 u32 point_count(const NeighbourParams& p, const std::byte* counts) {
   const u32 n = reinterpret_cast<const u32*>(counts)[p.count_word];
@@ -103,32 +103,20 @@ void nbr_query(const void* params, std::byte* const* bindings, std::uint32_t beg
       found += held;
       held = 0;
     };
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          const u32 b = bucket_of(cx, cy, cz, p.table_mask);
-          const u32 run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
-          const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
-          // A run of one cell: all of it or none of it is the visited cell's.
-          if (run == run_end || (!mixed && !same_cell(cells + 4 * std::size_t{run}, cx, cy, cz))) continue;
-          // Branch-free over a run (which candidates pass is unpredictable):
-          // itself and, in a mixed run, another cell's points are left out.
-          for (u32 t = run; t < run_end; ++t) {
-            const float* y = points + 4 * std::size_t{t};
-            const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
-            const float d2 = ex * ex + ey * ey + ez * ez;
-            const u32 hit = u32(d2 < p.radius2) & u32(t != s) &
-                            u32(!mixed || same_cell(cells + 4 * std::size_t{t}, cx, cy, cz));
-            if (p.mode == 1) {
-              batch[held] = order[t];  // kept only when it hits
-              held += hit;
-              if (held == kBatch) flush();
-            } else {
-              found += hit;
-            }
-          }
-        }
+    // Branch-free over the candidates (which pass is unpredictable).
+    visit_cells(cells, ranges, p.table_mask, c, [&](u32 t) {
+      const float* y = points + 4 * std::size_t{t};
+      const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
+      const float d2 = ex * ex + ey * ey + ez * ez;
+      const u32 hit = u32(d2 < p.radius2) & u32(t != s);
+      if (p.mode == 1) {
+        batch[held] = order[t];  // kept only when it hits
+        held += hit;
+        if (held == kBatch) flush();
+      } else {
+        found += hit;
+      }
+    });
     if (p.mode == 1) flush();
     if (p.mode == 0) lists[i] = found;
   }

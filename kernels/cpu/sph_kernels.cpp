@@ -15,8 +15,7 @@ namespace sinew::kernels {
 namespace {
 
 using u32 = std::uint32_t;
-using cells::bucket_of;
-using cells::same_cell;
+using cells::visit_cells;
 
 }  // namespace
 
@@ -32,25 +31,15 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
     const float* x = points + 4 * std::size_t{s};
     const int* c = cells + 4 * std::size_t{s};
     float sum = 0.0f;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          const u32 b = bucket_of(cx, cy, cz, p.table_mask);
-          const u32 run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
-          const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
-          if (run == run_end || (!mixed && !same_cell(cells + 4 * std::size_t{run}, cx, cy, cz))) continue;
-          for (u32 t = run; t < run_end; ++t) {
-            if (mixed && !same_cell(cells + 4 * std::size_t{t}, cx, cy, cz)) continue;
-            const float* y = points + 4 * std::size_t{t};
-            const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
-            const float d2 = ex * ex + ey * ey + ez * ez;
-            if (!(d2 < p.h2)) continue;
-            const float q = p.h2 - d2;
-            const float w = q * q * q;
-            sum = sum + std::fabs(y[3]) * w;
-          }
-        }
+    visit_cells(cells, ranges, p.table_mask, c, [&](u32 t) {
+      const float* y = points + 4 * std::size_t{t};
+      const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
+      const float d2 = ex * ex + ey * ey + ez * ez;
+      if (!(d2 < p.h2)) return;
+      const float q = p.h2 - d2;
+      const float w = q * q * q;
+      sum = sum + std::fabs(y[3]) * w;
+    });
     density[s] = p.poly6 * sum;
   }
 }
@@ -106,44 +95,34 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
     const float own = pi / (rho * rho);
     const int* c = cells + 4 * std::size_t{s};
     float ax = 0.0f, ay = 0.0f, az = 0.0f;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          const u32 b = bucket_of(cx, cy, cz, p.table_mask);
-          const u32 run = ranges[3 * std::size_t{b}], run_end = ranges[3 * std::size_t{b} + 1];
-          const bool mixed = ranges[3 * std::size_t{b} + 2] != 0;
-          if (run == run_end || (!mixed && !same_cell(cells + 4 * std::size_t{run}, cx, cy, cz))) continue;
-          for (u32 t = run; t < run_end; ++t) {
-            if (t == s || (mixed && !same_cell(cells + 4 * std::size_t{t}, cx, cy, cz))) continue;
-            const float* y = points + 4 * std::size_t{t};
-            const float ex = x[0] - y[0], ey = x[1] - y[1], ez = x[2] - y[2];
-            const float d2 = ex * ex + ey * ey + ez * ez;
-            if (!(d2 < p.h2) || !(d2 > 0.0f)) continue;  // beyond the support, or no direction
-            const float r = std::sqrt(d2);
-            const float q = p.h - r;
-            const float gw = p.spiky * q * q / r;  // grad W = gw (x_i - x_j)
-            const float* w = sorted_velocity + 4 * std::size_t{t};
-            const bool fluid = y[3] > 0.0f;
-            const float ux = v[0] - (fluid ? w[0] : 0.0f), uy = v[1] - (fluid ? w[1] : 0.0f),
-                        uz = v[2] - (fluid ? w[2] : 0.0f);
-            const float approach = ux * ex + uy * ey + uz * ez;
-            const float rho_j = density[t];
-            const float rho_avg = fluid ? 0.5f * (rho + rho_j) : rho;
-            const float visc = approach < 0.0f ? -p.viscosity * approach / (rho_avg * (d2 + p.eta2)) : 0.0f;
-            float factor;
-            if (fluid) {
-              const float pj = tait(p, rho_j);
-              factor = y[3] * (own + pj / (rho_j * rho_j) + visc);
-            } else {
-              factor = -y[3] * (own + visc);
-            }
-            const float f = factor * gw;
-            ax = ax - f * ex;
-            ay = ay - f * ey;
-            az = az - f * ez;
-          }
-        }
+    visit_cells(cells, ranges, p.table_mask, c, [&](u32 t) {
+      if (t == s) return;
+      const float* y = points + 4 * std::size_t{t};
+      const float ex = x[0] - y[0], ey = x[1] - y[1], ez = x[2] - y[2];
+      const float d2 = ex * ex + ey * ey + ez * ez;
+      if (!(d2 < p.h2) || !(d2 > 0.0f)) return;  // beyond the support, or no direction
+      const float r = std::sqrt(d2);
+      const float q = p.h - r;
+      const float gw = p.spiky * q * q / r;  // grad W = gw (x_i - x_j)
+      const float* w = sorted_velocity + 4 * std::size_t{t};
+      const bool fluid = y[3] > 0.0f;
+      const float ux = v[0] - (fluid ? w[0] : 0.0f), uy = v[1] - (fluid ? w[1] : 0.0f), uz = v[2] - (fluid ? w[2] : 0.0f);
+      const float approach = ux * ex + uy * ey + uz * ez;
+      const float rho_j = density[t];
+      const float rho_avg = fluid ? 0.5f * (rho + rho_j) : rho;
+      const float visc = approach < 0.0f ? -p.viscosity * approach / (rho_avg * (d2 + p.eta2)) : 0.0f;
+      float factor;
+      if (fluid) {
+        const float pj = tait(p, rho_j);
+        factor = y[3] * (own + pj / (rho_j * rho_j) + visc);
+      } else {
+        factor = -y[3] * (own + visc);
+      }
+      const float f = factor * gw;
+      ax = ax - f * ex;
+      ay = ay - f * ey;
+      az = az - f * ez;
+    });
     ax = ax + p.gx;
     ay = ay + p.gy;
     az = az + p.gz;
