@@ -1,6 +1,6 @@
 // sph_kernels.cpp — CPU reference of the fluid's kernels
-// (kernels/shared/sph_params.h; Müller, Charypar and Gross, SCA 2003, for
-// the poly6 density). They visit the neighbour grid's cells in the order of
+// (kernels/shared/sph_params.h: Monaghan's cubic spline, Tait's equation,
+// Akinci's boundary particles). They visit the neighbour grid's cells in the order of
 // nbr_query (neighbour_kernels.cpp) and round every float operation in the
 // GPU twins' order (kernels/gpu/sph_*.gpu).
 #include <cmath>
@@ -16,6 +16,19 @@ namespace {
 
 using u32 = std::uint32_t;
 using cells::visit_cells;
+
+// The cubic spline's shape w(q) and slope w'(q), 0 <= q < 2, in the GPU
+// twins' order of operations (sph_params.h).
+float cubic(float q) {
+  if (q < 1.0f) return (1.0f - (1.5f * q) * q) + ((0.75f * q) * q) * q;
+  const float t = 2.0f - q;
+  return ((0.25f * t) * t) * t;
+}
+float cubic_slope(float q) {
+  if (q < 1.0f) return (2.25f * q) * q - 3.0f * q;
+  const float t = 2.0f - q;
+  return (-0.75f * t) * t;
+}
 
 }  // namespace
 
@@ -36,11 +49,9 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
       const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
       const float d2 = ex * ex + ey * ey + ez * ez;
       if (!(d2 < p.h2)) return;
-      const float q = p.h2 - d2;
-      const float w = q * q * q;
-      sum = sum + std::fabs(y[3]) * w;
+      sum = sum + std::fabs(y[3]) * cubic(std::sqrt(d2) * p.inv_l);
     });
-    density[s] = p.poly6 * sum;
+    density[s] = p.sigma * sum;
   }
 }
 
@@ -102,8 +113,7 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
       const float d2 = ex * ex + ey * ey + ez * ez;
       if (!(d2 < p.h2) || !(d2 > 0.0f)) return;  // beyond the support, or no direction
       const float r = std::sqrt(d2);
-      const float q = p.h - r;
-      const float gw = p.spiky * q * q / r;  // grad W = gw (x_i - x_j)
+      const float gw = p.grad_sigma * cubic_slope(r * p.inv_l) / r;  // grad W = gw (x_i - x_j)
       const float* w = sorted_velocity + 4 * std::size_t{t};
       const bool fluid = y[3] > 0.0f;
       const float ux = v[0] - (fluid ? w[0] : 0.0f), uy = v[1] - (fluid ? w[1] : 0.0f), uz = v[2] - (fluid ? w[2] : 0.0f);

@@ -4,12 +4,20 @@
  * sorted points, their cells, the bucket ranges with their mixed flags),
  * with the support radius h as the search radius.
  *
- * Density: the poly6 kernel of Müller, Charypar and Gross, "Particle-Based
- * Fluid Simulation for Interactive Applications", SCA 2003:
- *   W(r) = 315 / (64 pi h^9) (h^2 - r^2)^3 for r < h, 0 beyond,
- * a function of r^2 only: no square root, so every backend rounds it alike.
+ * The kernel: the cubic spline of Monaghan, "Smoothed particle
+ * hydrodynamics", Rep. Prog. Phys. 68, 2005 (as Becker and Teschner 2007
+ * use it), with smoothing length l = h / 2 (support h), q = r / l:
+ *   W = sigma w(q), sigma = 1 / (pi l^3),
+ *   w(q) = (1 - 1.5 q q) + 0.75 q q q for q < 1, 0.25 (2 - q)^3 for 1 <= q < 2,
+ *   dW/dr = (sigma / l) w'(q), w'(q) = -3 q + 2.25 q q, or -0.75 (2 - q)^2.
+ * On a lattice of spacing h / 2 it sums to 1.0000 / spacing^3 and its
+ * gradient's first moment to 1.020 (poly6 and spiky, Müller et al. 2003,
+ * which this replaced: 1.0098 and 0.956; README, "SPH"). Each is written
+ * in that order of operations in every language:
+ *   q < 1:  w = (1 - (1.5 q) q) + ((0.75 q) q) q,  w' = (2.25 q) q - 3 q
+ *   q < 2:  t = 2 - q, w = ((0.25 t) t) t,          w' = (-0.75 t) t
  *
- * Particles. Each is a float4 xyz [m] and w: its mass m > 0 [kg] for a
+  * Particles. Each is a float4 xyz [m] and w: its mass m > 0 [kg] for a
  * fluid particle, minus its "mass" psi = rho0 V_b for a boundary particle
  * (Akinci, Ihmsen, Akinci, Solenthaler, Teschner, "Versatile rigid-fluid
  * coupling for incompressible SPH", TOG 31(4), 2012: V_b = 1 / sum_k W_bk
@@ -17,11 +25,11 @@
  * particles never move.
  *
  * ------------------------------------------------------------ sph_density
- * One item per sorted particle s < n: rho_s = poly6 * sum_j |w_j| (h2 -
- * d2)^3 over the particles j (itself included, d2 = 0) with d2 < h2, d2 =
- * (dx dx + dy dy) + dz dz in float, (h2 - d2)^3 = ((h2 - d2)(h2 - d2))(h2 -
- * d2), summed in the query's order (27 cells, dz outermost, each run in
- * sorted order), then multiplied by poly6 once.
+ * One item per sorted particle s < n: rho_s = sigma * sum_j |w_j| w(q_j)
+ * over the particles j (itself included, d2 = 0) with d2 < h2, d2 = (dx dx
+ * + dy dy) + dz dz in float, q = sqrt(d2) inv_l, summed in the query's
+ * order (27 cells, dz outermost, each run in sorted order), then
+ * multiplied by sigma once.
  * bindings: 0 counts uint [in]
  *           1 sorted_points float4 [in]: xyz [m], w the mass [kg]
  *           2 sorted_cells uint4 [in]
@@ -42,8 +50,7 @@
  * particle i:
  *   g - sum_fluid j m_j (p_i / rho_i^2 + p_j / rho_j^2 + Pi_ij) grad W_ij
  *     - sum_boundary b psi_b (p_i / rho_i^2 + Pi_ib) grad W_ib
- * with the spiky gradient grad W = spiky (h - r)^2 x_ij / r (0 < r < h;
- * Müller et al. 2003) and Monaghan's viscosity Pi_ij = -viscosity
+ * with grad W = ((sigma / l) w'(q) / r) x_ij (0 < r < h) and Monaghan's viscosity Pi_ij = -viscosity
  * min(v_ij . x_ij, 0) / (rho_avg (r^2 + eta2)) (Monaghan, "Smoothed
  * particle hydrodynamics", Rep. Prog. Phys. 68, 2005), rho_avg the mean of
  * the two densities (the particle's own for a boundary one, whose velocity
@@ -73,9 +80,9 @@ SINEW_STRUCT_BEGIN(SphParams)
   uint table_mask;  /* the neighbour grid's buckets - 1 */
   uint pad0;
   float h2;         /* the support radius squared [m^2], float(h) * float(h) */
-  float poly6;      /* 315 / (64 pi h^9) [1/m^9] */
-  float h;          /* the support radius [m] */
-  float spiky;      /* -45 / (pi h^6) [1/m^6]: the spiky gradient's factor */
+  float inv_l;      /* 1 / l, l = h / 2 the smoothing length [1/m] */
+  float sigma;      /* 1 / (pi l^3) [1/m^3] */
+  float grad_sigma; /* sigma / l [1/m^4] */
   float rho0;       /* rest density [kg/m^3] */
   float stiffness;  /* B = rho0 c0^2 / 7 [Pa] (Tait's equation) */
   float viscosity;  /* alpha c0 h [m^2/s] (Monaghan's artificial viscosity) */

@@ -11,8 +11,11 @@ kernels::SphParams sph_params(const NeighbourGrid& grid, double support) {
   p.count_word = 0;
   p.capacity = grid.capacity();
   p.table_mask = grid.buckets() - 1;
+  const double l = 0.5 * support;  // the cubic spline's smoothing length
   p.h2 = float(support) * float(support);
-  p.poly6 = float(315.0 / (64.0 * std::numbers::pi * std::pow(support, 9)));
+  p.inv_l = float(1.0 / l);
+  p.sigma = float(1.0 / (std::numbers::pi * l * l * l));
+  p.grad_sigma = float(1.0 / (std::numbers::pi * l * l * l * l));
   return p;
 }
 

@@ -1,6 +1,6 @@
 // sph_density.h — the fluid's density on a device (issue 15, part 2): the
-// poly6 kernel summed over each particle's neighbours on the neighbour grid
-// (kernels/shared/sph_params.h; Müller, Charypar and Gross, SCA 2003).
+// cubic spline kernel summed over each particle's neighbours on the
+// neighbour grid (kernels/shared/sph_params.h; Monaghan 2005).
 #pragma once
 
 #include "backends/backend.h"
@@ -10,7 +10,8 @@
 namespace sinew {
 
 /// The density kernel's parameters for particles on `grid` with support
-/// radius `support` [m] (the grid's radius): h^2 in float and 315 / (64 pi h^9).
+/// radius `support` [m] (the grid's radius): h^2 in float, 1 / l, sigma and
+/// sigma / l of the cubic spline (l = support / 2).
 kernels::SphParams sph_params(const NeighbourGrid& grid, double support);
 
 /// Appends the density of every particle of `grid` (xyz and mass in the

@@ -76,8 +76,6 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const SphSe
   }
   kernels::SphParams p = sph_params(g, h);
   const float rho0 = float(settings.rest_density);
-  p.h = float(h);
-  p.spiky = float(-45.0 / (std::numbers::pi * std::pow(h, 6)));
   p.rho0 = rho0;
   p.stiffness = float(settings.rest_density * settings.speed_of_sound * settings.speed_of_sound / 7.0);
   p.viscosity = float(settings.viscosity * settings.speed_of_sound * h);
