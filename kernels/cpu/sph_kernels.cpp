@@ -114,18 +114,18 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
       if (!(d2 < p.h2) || !(d2 > 0.0f)) return;  // beyond the support, or no direction
       const float r = std::sqrt(d2);
       const float gw = p.grad_sigma * cubic_slope(r * p.inv_l) / r;  // grad W = gw (x_i - x_j)
-      const float* w = sorted_velocity + 4 * std::size_t{t};
-      const bool fluid = y[3] > 0.0f;
-      const float ux = v[0] - (fluid ? w[0] : 0.0f), uy = v[1] - (fluid ? w[1] : 0.0f), uz = v[2] - (fluid ? w[2] : 0.0f);
-      const float approach = ux * ex + uy * ey + uz * ez;
-      const float rho_j = density[t];
-      const float rho_avg = fluid ? 0.5f * (rho + rho_j) : rho;
-      const float visc = approach < 0.0f ? -p.viscosity * approach / (rho_avg * (d2 + p.eta2)) : 0.0f;
       float factor;
-      if (fluid) {
+      if (y[3] > 0.0f) {  // a fluid particle: pressure and viscosity
+        const float* w = sorted_velocity + 4 * std::size_t{t};
+        const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
+        const float approach = ux * ex + uy * ey + uz * ez;
+        const float rho_j = density[t];
+        const float visc = approach < 0.0f ? -p.viscosity * approach / ((0.5f * (rho + rho_j)) * (d2 + p.eta2)) : 0.0f;
         const float pj = tait(p, rho_j);
         factor = y[3] * (own + pj / (rho_j * rho_j) + visc);
-      } else {
+      } else {  // a boundary particle (at rest): its pressure mirrored, and its own viscosity
+        const float approach = v[0] * ex + v[1] * ey + v[2] * ez;
+        const float visc = approach < 0.0f ? -p.boundary_viscosity * approach / (rho * (d2 + p.eta2)) : 0.0f;
         factor = -y[3] * (own + visc);
       }
       const float f = factor * gw;

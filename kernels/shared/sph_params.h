@@ -53,8 +53,9 @@
  * with grad W = ((sigma / l) w'(q) / r) x_ij (0 < r < h) and Monaghan's viscosity Pi_ij = -viscosity
  * min(v_ij . x_ij, 0) / (rho_avg (r^2 + eta2)) (Monaghan, "Smoothed
  * particle hydrodynamics", Rep. Prog. Phys. 68, 2005), rho_avg the mean of
- * the two densities (the particle's own for a boundary one, whose velocity
- * is 0). Then symplectic Euler: v += dt a, x += dt v, written in sorted
+ * the two densities; against a boundary particle (at rest) Pi_ib takes
+ * boundary_viscosity and rho_i (0: a free-slip boundary; Akinci et al.
+ * 2012 give the boundary its own coefficient too). Then symplectic Euler: v += dt a, x += dt v, written in sorted
  * order (the next step's input). Boundary particles are copied unchanged.
  * bindings: 0 counts uint [in]
  *           1 sorted_points float4 [in]
@@ -78,7 +79,7 @@ SINEW_STRUCT_BEGIN(SphParams)
   uint count_word;  /* n = min(counts[count_word], capacity) */
   uint capacity;    /* particles */
   uint table_mask;  /* the neighbour grid's buckets - 1 */
-  uint pad0;
+  float boundary_viscosity; /* alpha_b c0 h [m^2/s]: the viscosity against boundary particles (0: free slip) */
   float h2;         /* the support radius squared [m^2], float(h) * float(h) */
   float inv_l;      /* 1 / l, l = h / 2 the smoothing length [1/m] */
   float sigma;      /* 1 / (pi l^3) [1/m^3] */

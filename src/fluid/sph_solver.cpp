@@ -38,8 +38,9 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const SphSe
   for (const auto& [name, value] : {std::pair{"spacing", settings.spacing}, {"rest_density", settings.rest_density},
                                     {"speed_of_sound", settings.speed_of_sound}, {"time_step", settings.time_step}})
     if (Status s = positive(name, value); !s) return s.error();
-  if (!(settings.viscosity >= 0.0) || !std::isfinite(settings.viscosity))
-    return Error(ErrorCode::bad_parameter, "sph: viscosity must be finite and >= 0 (got " + str(settings.viscosity) + ")");
+  for (const auto& [name, value] : {std::pair{"viscosity", settings.viscosity}, {"boundary_viscosity", settings.boundary_viscosity}})
+    if (!(value >= 0.0) || !std::isfinite(value))
+      return Error(ErrorCode::bad_parameter, std::string("sph: ") + name + " must be finite and >= 0 (got " + str(value) + ")");
   for (double g : settings.gravity)
     if (!std::isfinite(g)) return Error(ErrorCode::bad_parameter, "sph: gravity must be finite");
   if (!(settings.support >= 1.0) || !std::isfinite(settings.support))
@@ -79,6 +80,7 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const SphSe
   p.rho0 = rho0;
   p.stiffness = float(settings.rest_density * settings.speed_of_sound * settings.speed_of_sound / 7.0);
   p.viscosity = float(settings.viscosity * settings.speed_of_sound * h);
+  p.boundary_viscosity = float(settings.boundary_viscosity * settings.speed_of_sound * h);
   p.eta2 = float(0.01 * h * h);
   p.gx = float(settings.gravity[0]);
   p.gy = float(settings.gravity[1]);

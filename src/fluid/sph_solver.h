@@ -27,7 +27,8 @@ struct SphSettings {
   double support = 2.0;         ///< the kernels' support radius h in spacings, >= 1
   double rest_density = 1000.0; ///< rho0 [kg/m^3], > 0
   double speed_of_sound = 10.0; ///< c0 [m/s], > 0: about 10x the fastest flow keeps density within 1%
-  double viscosity = 0.1;       ///< Monaghan's alpha, >= 0
+  double viscosity = 0.1;       ///< Monaghan's alpha between fluid particles, >= 0
+  double boundary_viscosity = 0.1;  ///< ... against boundary particles, >= 0 (0: free-slip walls)
   double time_step = 5e-5;      ///< [s], > 0, at most 0.4 h / c0 (the CFL condition; an error beyond)
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
 };
