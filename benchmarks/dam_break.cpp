@@ -13,7 +13,7 @@
 // Writes: --out/dam_break.csv (T, Z every 100 steps), dam_break.png (with
 // the data, when gnuplot exists); prints the error and the run time.
 //
-//   build/benchmarks/dam_break [--backend cpu] [--cells 24] [--depth 4] [--wall-viscosity 0.1] [--out DIR]
+//   build/benchmarks/dam_break [--backend cpu] [--cells 24] [--depth 4] [--viscosity 0.1] [--wall-viscosity 0.1] [--out DIR]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -37,7 +37,8 @@ struct Options {
   std::string backend = "cpu";
   int cells = 24;  // particles across the column's width a
   int depth = 4;   // particles across the slab
-  double wall_alpha = 0.1;  // viscosity against the tank (0: free slip)
+  double alpha = 0.1;       // Monaghan's viscosity between fluid particles
+  double wall_alpha = 0.1;  // ... against the tank (0: free slip)
   std::string out = "dam_break_out";
 };
 
@@ -65,6 +66,7 @@ int main(int argc, char** argv) {
     else if (a == "--cells") o.cells = std::atoi(argv[i + 1]);
     else if (a == "--depth") o.depth = std::atoi(argv[i + 1]);
     else if (a == "--wall-viscosity") o.wall_alpha = std::atof(argv[i + 1]);
+    else if (a == "--viscosity") o.alpha = std::atof(argv[i + 1]);
     else if (a == "--out") o.out = argv[i + 1];
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
@@ -106,7 +108,7 @@ int main(int argc, char** argv) {
   settings.spacing = s;
   settings.speed_of_sound = 10.0 * 2.0 * std::sqrt(g * 2.0 * a);
   settings.time_step = 0.4 * 2.0 * s / settings.speed_of_sound;
-  settings.viscosity = 0.1;
+  settings.viscosity = o.alpha;
   settings.boundary_viscosity = o.wall_alpha;
   auto device = create_device({.backend = o.backend, .quiet = true});
   if (!device) {
