@@ -169,7 +169,22 @@ TEST(SphSolver, BadSettingsAreNamed) {
   EXPECT_NE(message(s).find("spacing must be finite and > 0"), std::string::npos);
   s = {};
   s.viscosity = -1.0;
-  EXPECT_NE(message(s).find("viscosity"), std::string::npos);
+  EXPECT_NE(message(s).find("viscosity must be finite and >= 0"), std::string::npos);
+  s = {};
+  s.boundary_viscosity = NAN;
+  EXPECT_NE(message(s).find("boundary_viscosity must be finite and >= 0"), std::string::npos);
+  s = {};
+  s.support = 0.5;
+  EXPECT_NE(message(s).find("support must be finite and >= 1 spacing"), std::string::npos);
+  s = {};
+  s.gravity = {0.0, NAN, 0.0};
+  EXPECT_NE(message(s).find("gravity must be finite"), std::string::npos);
+  Tank nan = t;
+  nan.fluid[1][2] = NAN;
+  auto bad = SphSolver::create(**device, {}, nan.fluid, nan.boundary);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message().find("fluid particle 1 has coordinate nan"), std::string::npos)
+      << bad.error().message();
   EXPECT_NE(SphSolver::create(**device, {}, {}, t.boundary).error().message().find("no fluid"), std::string::npos);
 }
 

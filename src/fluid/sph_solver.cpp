@@ -54,6 +54,12 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const SphSe
                                                " s (h = " + str(h) + " m, c0 = " + str(settings.speed_of_sound) +
                                                " m/s): shorten it or lower the speed of sound");
   if (fluid.empty()) return Error(ErrorCode::bad_parameter, "sph: no fluid particles");
+  for (const auto& [what, points] : {std::pair{"fluid", fluid}, {"boundary", boundary}})
+    for (std::size_t i = 0; i < points.size(); ++i)
+      for (double x : points[i])
+        if (!std::isfinite(x))
+          return Error(ErrorCode::bad_parameter, std::string("sph: ") + what + " particle " + std::to_string(i) +
+                                                     " has coordinate " + str(x) + ": it must be finite");
   const std::size_t total = fluid.size() + boundary.size();
   if (total > (1u << 24))
     return Error(ErrorCode::bad_parameter, "sph: " + std::to_string(total) + " particles, more than 2^24");
