@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
   SphSettings settings;
   settings.spacing = s;
   settings.speed_of_sound = 10.0 * 2.0 * std::sqrt(g * 2.0 * a);
-  settings.time_step = 0.4 * 2.0 * s / settings.speed_of_sound;
+  settings.time_step = 0.4 * 2.0 * s / (1.1 * settings.speed_of_sound);  // the CFL bound with v_max = c0 / 10
   settings.viscosity = o.alpha;
   settings.boundary_viscosity = o.wall_alpha;
   auto device = create_device({.backend = o.backend, .quiet = true});

@@ -87,6 +87,6 @@
   /* smoothed-particle hydrodynamics (kernels/shared/sph_params.h) */             \
   SINEW_KERNEL(sph_density, 5, SphParams, 0)                                    \
   SINEW_KERNEL(sph_gather, 4, SphParams, 0)                                     \
-  SINEW_KERNEL(sph_step, 9, SphParams, 0)
+  SINEW_KERNEL(sph_step, 10, SphParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

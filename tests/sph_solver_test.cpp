@@ -49,7 +49,7 @@ Tank tank(int nx, int ny, int nz, double s, int wall) {
 
 TEST(SphSolver, AColumnAtRestHoldsItsWeight) {
   // 8 x 20 x 8 particles of 1 mm (2 cm deep) in a tank of one boundary
-  // layer, c0 = 10 m/s, 8e-5 s steps (the CFL bound), 0.64 s, then 20
+  // layer, c0 = 10 m/s, 7.5e-5 s steps (the CFL bound at rest: 8e-5), 0.6 s, then 20
   // samples 50 steps apart (pressure in a weakly compressible fluid is
   // noisy: layers are averaged over space and time). The fluid comes to
   // rest inside the tank, and the mean pressure of each 1 mm layer of the
@@ -63,7 +63,7 @@ TEST(SphSolver, AColumnAtRestHoldsItsWeight) {
   ASSERT_TRUE(device.ok());
   SphSettings settings;
   settings.spacing = s;
-  settings.time_step = 8e-5;  // the CFL bound 0.4 h / c0
+  settings.time_step = 7.5e-5;  // below the CFL bound 0.4 h / (c0 + v_max), 8e-5 at rest
   auto solver = SphSolver::create(**device, settings, t.fluid, t.boundary);
   ASSERT_TRUE(solver.ok()) << solver.error().message();
   SINEW_ASSERT_OK((*solver)->step(8000));
@@ -152,6 +152,25 @@ TEST_P(SphAgreement, ABlockFallingInATankMatchesTheCpu) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, SphAgreement, ::testing::ValuesIn(backends()), backend_name);
+
+TEST(SphSolver, AStepAtTheSoundsBoundFailsOnceTheParticlesMove) {
+  // dt = 0.4 h / c0 passes at rest; once the block falls, dt > 0.4 h / (c0
+  // + v_max): step() says so, with the particle's speed, never clamps.
+  const double s = 1e-3;
+  const Tank t = tank(4, 4, 4, s, 8);
+  std::vector<P3> block;
+  for (const P3& p : t.fluid) block.push_back({p[0], p[1] + 2 * s, p[2]});
+  auto device = create_device({.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(device.ok());
+  auto solver = SphSolver::create(**device, {.spacing = s, .time_step = 8e-5}, block, t.boundary);
+  ASSERT_TRUE(solver.ok()) << solver.error().message();
+  const Status moved = (*solver)->step(20);
+  ASSERT_FALSE(moved.ok());
+  EXPECT_NE(moved.error().message().find("beyond the CFL bound 0.4 h / (c0 + v_max)"), std::string::npos)
+      << moved.error().message();
+  EXPECT_GT((*solver)->last_max_speed(), 0.0);
+  EXPECT_NEAR((*solver)->mach(), (*solver)->last_max_speed() / 10.0, 1e-12);
+}
 
 TEST(SphSolver, BadSettingsAreNamed) {
   auto device = create_device({.backend = "cpu", .quiet = true});

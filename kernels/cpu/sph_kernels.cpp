@@ -92,6 +92,7 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
   auto* next_points = reinterpret_cast<float*>(bindings[6]);
   auto* next_velocity = reinterpret_cast<float*>(bindings[7]);
   auto* pressure = reinterpret_cast<float*>(bindings[8]);
+  auto* speed2 = reinterpret_cast<float*>(bindings[9]);
   for (u32 s = begin; s < end && s < n; ++s) {
     const float* x = points + 4 * std::size_t{s};
     const float* v = sorted_velocity + 4 * std::size_t{s};
@@ -101,6 +102,7 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
     if (!(x[3] > 0.0f)) {  // a boundary particle stays
       std::memcpy(next_points + 4 * std::size_t{s}, x, 16);
       std::memcpy(next_velocity + 4 * std::size_t{s}, v, 16);
+      speed2[s] = 0.0f;
       continue;
     }
     const float own = pi / (rho * rho);
@@ -142,6 +144,7 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
     vn[1] = v[1] + p.dt * ay;
     vn[2] = v[2] + p.dt * az;
     vn[3] = v[3];  // the id's bits
+    speed2[s] = (vn[0] * vn[0] + vn[1] * vn[1]) + vn[2] * vn[2];
     xn[0] = x[0] + p.dt * vn[0];
     xn[1] = x[1] + p.dt * vn[1];
     xn[2] = x[2] + p.dt * vn[2];

@@ -65,7 +65,9 @@
  *           5 sorted_velocity float4 [in]
  *           6 points float4 [out]: the next step's positions
  *           7 velocity float4 [out]: the next step's velocities (w the id)
- *           8 pressure float [out] [Pa], per sorted particle */
+ *           8 pressure float [out] [Pa], per sorted particle
+ *           9 speed2 float [out]: |v|^2 after the step [m^2/s^2], 0 for a
+ *             boundary particle (the host's CFL check takes its maximum) */
 #ifndef SINEW_SPH_PARAMS_H
 #define SINEW_SPH_PARAMS_H
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fluid/sph_density.h"
+#include "program/primitives.h"
 
 namespace sinew {
 namespace {
@@ -27,7 +28,7 @@ Status positive(const char* name, double v) {
 
 SphSolver::~SphSolver() {
   if (have_program_) (void)device_.destroy_program(program_);
-  for (BufferHandle h : {velocity_, sorted_velocity_, density_, pressure_})
+  for (BufferHandle h : {velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_})
     if (h.valid()) (void)device_.destroy_buffer(h);
   grid_.reset();
 }
@@ -76,11 +77,17 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const SphSe
     if (!made) return made.error();
     *b = *made;
   }
-  for (BufferHandle* b : {&solver->density_, &solver->pressure_}) {
+  for (BufferHandle* b : {&solver->density_, &solver->pressure_, &solver->speed2_}) {
     auto made = device.create_buffer(4 * std::size_t{n}, "sph densities");
     if (!made) return made.error();
     *b = *made;
   }
+  auto scratch = device.create_buffer(4 * std::size_t{reduce_scratch_words(n)}, "sph scratch");
+  if (!scratch) return scratch.error();
+  solver->scratch_ = *scratch;
+  solver->speed_of_sound_ = settings.speed_of_sound;
+  solver->h_ = h;
+  solver->cfl_step_ = settings.time_step;
   kernels::SphParams p = sph_params(g, h);
   const float rho0 = float(settings.rest_density);
   p.rho0 = rho0;
@@ -140,9 +147,12 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const SphSe
   step.barrier();
   step.dispatch(Kernel::sph_step, n,
                 {b.counts, b.sorted_points, b.sorted_cells, b.ranges, solver->density_, solver->sorted_velocity_,
-                 b.points, solver->velocity_, solver->pressure_},
+                 b.points, solver->velocity_, solver->pressure_, solver->speed2_},
                 p);
   step.barrier();
+  // The fastest particle, for the CFL check after the steps.
+  solver->max_word_ =
+      append_reduce(step, {b.counts, 0, n}, ReduceOp::max_f32, {solver->speed2_, 0}, 1, {solver->scratch_, 0});
   auto program = device.create_program(step);
   if (!program) return program.error();
   solver->program_ = *program;
@@ -153,6 +163,15 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const SphSe
 Status SphSolver::step(int steps) {
   for (int k = 0; k < steps; ++k)
     if (Status s = device_.run_program(program_); !s) return s;
+  if (steps <= 0) return {};
+  float v2 = 0.0f;
+  if (Status s = device_.read_buffer(scratch_, 4 * std::size_t{max_word_}, &v2, 4); !s) return s;
+  max_speed_ = std::sqrt(double(v2));
+  const double bound = 0.4 * h_ / (speed_of_sound_ + max_speed_);
+  if (!(cfl_step_ <= bound))
+    return Error(ErrorCode::bad_parameter, "sph: time_step " + str(cfl_step_) + " s is beyond the CFL bound 0.4 h / (c0 + "
+                                               "v_max) = " + str(bound) + " s with a particle at " + str(max_speed_) +
+                                               " m/s (c0 = " + str(speed_of_sound_) + " m/s)");
   return {};
 }
 

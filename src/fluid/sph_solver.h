@@ -52,8 +52,16 @@ class SphSolver {
   SphSolver(const SphSolver&) = delete;
   SphSolver& operator=(const SphSolver&) = delete;
 
-  /// Advances `steps` time steps (one program run each).
+  /// Advances `steps` time steps (one program run each), then checks the
+  /// CFL condition with the particles' speed: an error (bad_parameter)
+  /// when dt > 0.4 h / (c0 + v_max), naming both (the steps were taken;
+  /// shorten the step or raise c0). last_max_speed() and mach() report it.
   Status step(int steps);
+  /// The fastest fluid particle after the last step() [m/s].
+  [[nodiscard]] double last_max_speed() const { return max_speed_; }
+  /// last_max_speed() / c0: above about 0.1 the density varies more than
+  /// about 1% (weak compressibility no longer holds).
+  [[nodiscard]] double mach() const { return max_speed_ / speed_of_sound_; }
   /// [out] the fluid particles by id (their index in create()'s `fluid`),
   /// as the last step left them (density and pressure from its start).
   Status read(std::vector<SphParticle>& fluid);
@@ -66,7 +74,9 @@ class SphSolver {
   explicit SphSolver(Device& device) : device_(device) {}
   Device& device_;
   std::unique_ptr<NeighbourGrid> grid_;
-  BufferHandle velocity_, sorted_velocity_, density_, pressure_;
+  BufferHandle velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_;
+  std::uint32_t max_word_ = 0;  // the scratch word that holds the maximum |v|^2 after a step
+  double max_speed_ = 0.0, speed_of_sound_ = 0.0, cfl_step_ = 0.0, h_ = 0.0;
   ProgramHandle program_{};
   bool have_program_ = false;
   kernels::SphParams params_{};
