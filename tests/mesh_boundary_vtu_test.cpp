@@ -223,6 +223,29 @@ TEST(Vtu, WritesTriangleCells) {
   EXPECT_NE(bad.error().message().find("triangle 1 refers to vertex 4"), std::string::npos) << bad.error().message();
 }
 
+// Particles: one vertex cell (VTK_VERTEX) each, with their fields; a field
+// of the wrong size is named.
+TEST(Vtu, WritesPointCellsWithFields) {
+  const std::vector<float> xyz{0.0f, 0.0f, 0.0f, 0.001f, 0.0f, 0.0f, 0.0f, 0.002f, 0.0f};
+  const std::vector<float> density{1000.0f, 1001.0f, 999.5f};
+  const std::vector<float> velocity{0.0f, -1.0f, 0.0f, 0.5f, 0.0f, 0.0f, 0.0f, 0.0f, 0.25f};
+  const sinew::VertexField fields[] = {{"density", 1, density}, {"velocity", 3, velocity}};
+  const fs::path p = tmp_dir() / "particles.vtu";
+  const sinew::Status s = sinew::write_vtu_points(p, xyz, 3, fields);
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  const std::string xml = read_text(p);
+  EXPECT_NE(xml.find("NumberOfPoints=\"3\" NumberOfCells=\"3\""), std::string::npos);
+  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"connectivity\"")), (std::vector<std::int64_t>{0, 1, 2}));
+  EXPECT_EQ(numbers<int>(array_body(xml, "Name=\"types\"")), (std::vector<int>{1, 1, 1}));  // VTK_VERTEX
+  EXPECT_EQ(numbers<float>(array_body(xml, "Name=\"density\"")), density);
+  EXPECT_EQ(numbers<float>(array_body(xml, "Name=\"velocity\"")), velocity);
+  const std::vector<float> short_density{1000.0f};
+  const sinew::VertexField bad[] = {{"density", 1, short_density}};
+  const sinew::Status wrong = sinew::write_vtu_points(p, xyz, 3, bad);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().message().find("density"), std::string::npos) << wrong.error().message();
+}
+
 TEST(Vtu, StrideFourSkipsW) {
   const GridData g = grid_data();
   std::vector<float> xyzw;

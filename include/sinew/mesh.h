@@ -145,6 +145,13 @@ Status write_vtu_lines(const std::filesystem::path& path, std::span<const float>
 Status write_vtu_triangles(const std::filesystem::path& path, std::span<const float> positions, int stride,
                            std::span<const std::array<std::uint32_t, 3>> triangles);
 
+/// Writes a VTU of points (one VTK_VERTEX cell each) with per-point fields:
+/// particles, e.g. a fluid's with density, pressure and velocity. [in]
+/// positions as for write_vtu. Errors name the file or the field whose size
+/// is wrong.
+Status write_vtu_points(const std::filesystem::path& path, std::span<const float> positions, int stride,
+                        std::span<const VertexField> fields = {});
+
 /// Writes a ParaView collection (.pvd) that lists a series of VTU files with
 /// their times [s]; file names are written relative to the .pvd's folder.
 Status write_pvd(const std::filesystem::path& path,

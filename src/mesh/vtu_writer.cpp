@@ -29,6 +29,7 @@ namespace fs = std::filesystem;
 constexpr int kVtkTetra = 10;
 constexpr int kVtkLine = 3;
 constexpr int kVtkTriangle = 5;
+constexpr int kVtkVertex = 1;
 
 void append_float(std::string& out, float v) {
   char buf[32];
@@ -243,6 +244,14 @@ Status write_vtu_lines(const std::filesystem::path& path, std::span<const float>
 Status write_vtu_triangles(const std::filesystem::path& path, std::span<const float> positions, int stride,
                            std::span<const std::array<std::uint32_t, 3>> triangles) {
   return write_cells<3>(path, positions, stride, triangles, {}, kVtkTriangle, "triangle");
+}
+
+Status write_vtu_points(const std::filesystem::path& path, std::span<const float> positions, int stride,
+                        std::span<const VertexField> fields) {
+  // One vertex cell per point, so ParaView shows and colours every point.
+  std::vector<std::array<std::uint32_t, 1>> points(stride > 0 ? positions.size() / std::size_t(stride) : 0);
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = {static_cast<std::uint32_t>(i)};
+  return write_cells<1>(path, positions, stride, points, fields, kVtkVertex, "point");
 }
 
 Status write_pvd(const std::filesystem::path& path, std::span<const std::filesystem::path> vtu_files,
