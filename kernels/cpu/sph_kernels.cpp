@@ -17,6 +17,12 @@ namespace {
 using u32 = std::uint32_t;
 using cells::visit_cells;
 
+// n = min(counts[count_word], capacity), read when the kernel runs (sph_params.h).
+u32 particle_count(const SphParams& p, const std::byte* counts) {
+  const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
+  return stored < p.capacity ? stored : p.capacity;
+}
+
 // The cubic spline's shape w(q) and slope w'(q), 0 <= q < 2, in the GPU
 // twins' order of operations (sph_params.h).
 float cubic(float q) {
@@ -34,8 +40,7 @@ float cubic_slope(float q) {
 
 void sph_density(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
-  const u32 stored = reinterpret_cast<const u32*>(bindings[0])[p.count_word];
-  const u32 n = stored < p.capacity ? stored : p.capacity;
+  const u32 n = particle_count(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
@@ -57,8 +62,7 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
 
 void sph_gather(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
-  const u32 stored = reinterpret_cast<const u32*>(bindings[0])[p.count_word];
-  const u32 n = stored < p.capacity ? stored : p.capacity;
+  const u32 n = particle_count(p, bindings[0]);
   const auto* order = reinterpret_cast<const u32*>(bindings[1]);
   const auto* velocity = reinterpret_cast<const float*>(bindings[2]);
   auto* sorted_velocity = reinterpret_cast<float*>(bindings[3]);
@@ -82,8 +86,7 @@ float tait(const SphParams& p, float rho) {
 
 void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
-  const u32 stored = reinterpret_cast<const u32*>(bindings[0])[p.count_word];
-  const u32 n = stored < p.capacity ? stored : p.capacity;
+  const u32 n = particle_count(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);

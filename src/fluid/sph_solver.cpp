@@ -4,7 +4,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 #include <string>
 
 #include "fluid/sph_density.h"
