@@ -25,6 +25,7 @@
 #include "neighbour_params.h"
 #include "primitive_params.h"
 #include "sph_params.h"
+#include "sph_flow_params.h"
 #include "stats_params.h"
 #include "suture_params.h"
 #include "xpbd_params.h"

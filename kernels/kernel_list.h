@@ -87,6 +87,13 @@
   /* smoothed-particle hydrodynamics (kernels/shared/sph_params.h) */             \
   SINEW_KERNEL(sph_density, 5, SphParams, 0)                                    \
   SINEW_KERNEL(sph_gather, 4, SphParams, 0)                                     \
-  SINEW_KERNEL(sph_step, 10, SphParams, 0)
+  SINEW_KERNEL(sph_step, 10, SphParams, 0)                                      \
+  SINEW_KERNEL(sph_boundary_force, 7, SphParams, 0)                             \
+  /* particles that come and go (kernels/shared/sph_flow_params.h) */          \
+  SINEW_KERNEL(sph_boundary_move, 5, SphFlowParams, 0)                          \
+  SINEW_KERNEL(sph_sink_flags, 4, SphFlowParams, 0)                             \
+  SINEW_KERNEL(sph_pack, 7, SphFlowParams, 0)                                   \
+  SINEW_KERNEL(sph_emit, 6, SphFlowParams, 0)                                   \
+  SINEW_KERNEL(sph_emit_commit, 3, SphFlowParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

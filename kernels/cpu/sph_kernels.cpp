@@ -3,6 +3,7 @@
 // Akinci's boundary particles). They visit the neighbour grid's cells in the order of
 // nbr_query (neighbour_kernels.cpp) and round every float operation in the
 // GPU twins' order (kernels/gpu/sph_*.gpu).
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -128,8 +129,10 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
         const float visc = approach < 0.0f ? -p.viscosity * approach / ((0.5f * (rho + rho_j)) * (d2 + p.eta2)) : 0.0f;
         const float pj = tait(p, rho_j);
         factor = y[3] * (own + pj / (rho_j * rho_j) + visc);
-      } else {  // a boundary particle (at rest): its pressure mirrored, and its own viscosity
-        const float approach = v[0] * ex + v[1] * ey + v[2] * ez;
+      } else {  // a boundary particle: its pressure mirrored, and its own viscosity
+        const float* w = sorted_velocity + 4 * std::size_t{t};
+        const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
+        const float approach = ux * ex + uy * ey + uz * ez;
         const float visc = approach < 0.0f ? -p.boundary_viscosity * approach / (rho * (d2 + p.eta2)) : 0.0f;
         factor = -y[3] * (own + visc);
       }
@@ -152,6 +155,50 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
     xn[1] = x[1] + p.dt * vn[1];
     xn[2] = x[2] + p.dt * vn[2];
     xn[3] = x[3];
+  }
+}
+
+void sph_boundary_force(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphParams*>(params);
+  const u32 n = particle_count(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
+  const auto* density = reinterpret_cast<const float*>(bindings[4]);
+  const auto* sorted_velocity = reinterpret_cast<const float*>(bindings[5]);
+  auto* impulse = reinterpret_cast<float*>(bindings[6]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const float* x = points + 4 * std::size_t{s};
+    if (x[3] > 0.0f) continue;  // a fluid particle
+    const float* w = sorted_velocity + 4 * std::size_t{s};
+    const float psi = -x[3];
+    const int* c = cells + 4 * std::size_t{s};
+    float fx = 0.0f, fy = 0.0f, fz = 0.0f;
+    visit_cells(cells, ranges, p.table_mask, c, [&](u32 t) {
+      const float* y = points + 4 * std::size_t{t};
+      if (!(y[3] > 0.0f)) return;  // boundary particles do not push each other
+      // sph_step's terms for fluid particle i = t against this one, in its order.
+      const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
+      const float d2 = ex * ex + ey * ey + ez * ez;
+      if (!(d2 < p.h2) || !(d2 > 0.0f)) return;
+      const float r = std::sqrt(d2);
+      const float gw = p.grad_sigma * cubic_slope(r * p.inv_l) / r;
+      const float* v = sorted_velocity + 4 * std::size_t{t};
+      const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
+      const float approach = ux * ex + uy * ey + uz * ez;
+      const float rho = density[t];
+      const float own = tait(p, rho) / (rho * rho);
+      const float visc = approach < 0.0f ? -p.boundary_viscosity * approach / (rho * (d2 + p.eta2)) : 0.0f;
+      const float f = y[3] * ((psi * (own + visc)) * gw);
+      fx = fx + f * ex;
+      fy = fy + f * ey;
+      fz = fz + f * ez;
+    });
+    const u32 id = std::bit_cast<u32>(w[3]) & 0x7fffffffu;
+    float* out = impulse + 4 * std::size_t{id};
+    out[0] = out[0] + p.dt * fx;
+    out[1] = out[1] + p.dt * fy;
+    out[2] = out[2] + p.dt * fz;
   }
 }
 

@@ -53,9 +53,10 @@
  * with grad W = ((sigma / l) w'(q) / r) x_ij (0 < r < h) and Monaghan's viscosity Pi_ij = -viscosity
  * min(v_ij . x_ij, 0) / (rho_avg (r^2 + eta2)) (Monaghan, "Smoothed
  * particle hydrodynamics", Rep. Prog. Phys. 68, 2005), rho_avg the mean of
- * the two densities; against a boundary particle (at rest) Pi_ib takes
- * boundary_viscosity and rho_i (0: a free-slip boundary; Akinci et al.
- * 2012 give the boundary its own coefficient too). Then symplectic Euler: v += dt a, x += dt v, written in sorted
+ * the two densities; against a boundary particle Pi_ib takes
+ * boundary_viscosity, rho_i and the velocity relative to the boundary
+ * particle's (0: a free-slip boundary; Akinci et al. 2012 give the
+ * boundary its own coefficient too). Then symplectic Euler: v += dt a, x += dt v, written in sorted
  * order (the next step's input). Boundary particles are copied unchanged.
  * bindings: 0 counts uint [in]
  *           1 sorted_points float4 [in]
@@ -67,7 +68,22 @@
  *           7 velocity float4 [out]: the next step's velocities (w the id)
  *           8 pressure float [out] [Pa], per sorted particle
  *           9 speed2 float [out]: |v|^2 after the step [m^2/s^2], 0 for a
- *             boundary particle (the host's CFL check takes its maximum) */
+ *             boundary particle (the host's CFL check takes its maximum)
+ * ------------------------------------------------------ sph_boundary_force
+ * One item per sorted boundary particle b (w < 0): the impulse the fluid
+ * gives it in this step, the reaction to its pull on every fluid particle
+ * i in sph_step (Akinci et al. 2012, eq. 11), so the pair's momentum is
+ * conserved:  F_b = sum_i m_i psi_b (p_i / rho_i^2 + Pi_ib) gradW_ib-factor
+ * (x_i - x_b), each term computed in sph_step's order of operations (e =
+ * x_i - x_b, gw, Pi_ib from (v_i - v_b) . e); then impulse[id & 0x7fffffff]
+ * += dt F_b (its own slot: no two items write one).
+ * bindings: 0 counts uint [in]
+ *           1 sorted_points float4 [in]
+ *           2 sorted_cells uint4 [in]
+ *           3 ranges uint [in]
+ *           4 density float [in]
+ *           5 sorted_velocity float4 [in]
+ *           6 impulse float4 per boundary particle [in/out] [N s] */
 #ifndef SINEW_SPH_PARAMS_H
 #define SINEW_SPH_PARAMS_H
 

@@ -1,0 +1,144 @@
+// sph_flow_kernels.cpp — CPU reference of the kernels that make, remove
+// and move a fluid's particles on the device (kernels/shared/
+// sph_flow_params.h), in the order of operations of their GPU twins
+// (kernels/gpu/sph_emit.gpu and the others).
+#include <bit>
+#include <cstdint>
+#include <cstring>
+
+#include "cpu/cpu_kernels.h"
+#include "sph_flow_params.h"
+
+namespace sinew::kernels {
+namespace {
+
+using u32 = std::uint32_t;
+
+u32 particle_count(const SphFlowParams& p, const std::byte* counts) {
+  const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
+  return stored < p.capacity ? stored : p.capacity;
+}
+
+// An emitter's record (sph_flow_params.h).
+struct EmitterView {
+  const float* f;
+  [[nodiscard]] float rate() const { return f[3]; }
+  [[nodiscard]] u32 first() const { return std::bit_cast<u32>(f[11]); }
+  [[nodiscard]] u32 points() const { return std::bit_cast<u32>(f[15]); }
+};
+
+float phase_of(const u32* state, u32 e) { return std::bit_cast<float>(state[SINEW_SPH_STATE_PHASES + e]); }
+bool fires(const float* emitters, const u32* state, u32 e) {
+  return phase_of(state, e) + emitters[SINEW_SPH_EMITTER_FLOATS * e + 3] >= 1.0f;
+}
+
+}  // namespace
+
+void sph_boundary_move(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphFlowParams*>(params);
+  const u32 n = particle_count(p, bindings[0]);
+  auto* points = reinterpret_cast<float*>(bindings[1]);
+  auto* velocity = reinterpret_cast<float*>(bindings[2]);
+  const auto* position = reinterpret_cast<const float*>(bindings[3]);
+  const auto* boundary_velocity = reinterpret_cast<const float*>(bindings[4]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    float* v = velocity + 4 * std::size_t{s};
+    const u32 id = std::bit_cast<u32>(v[3]);
+    if ((id & SINEW_SPH_BOUNDARY_ID) == 0u) continue;
+    const std::size_t b = id & ~SINEW_SPH_BOUNDARY_ID;
+    std::memcpy(points + 4 * std::size_t{s}, position + 4 * b, 12);
+    std::memcpy(v, boundary_velocity + 4 * b, 12);
+  }
+}
+
+void sph_sink_flags(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphFlowParams*>(params);
+  const u32 n = particle_count(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* sinks = reinterpret_cast<const float*>(bindings[2]);
+  auto* flags = reinterpret_cast<u32*>(bindings[3]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const float* x = points + 4 * std::size_t{s};
+    u32 keep = 1u;
+    if (x[3] > 0.0f) {
+      for (u32 k = 0; k < p.sinks; ++k) {
+        const float* c = sinks + 4 * std::size_t{k};
+        const float dx = x[0] - c[0], dy = x[1] - c[1], dz = x[2] - c[2];
+        if ((dx * dx + dy * dy) + dz * dz < c[3]) keep = 0u;
+      }
+    }
+    flags[s] = keep;
+  }
+}
+
+void sph_pack(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphFlowParams*>(params);
+  const auto* counts = reinterpret_cast<const u32*>(bindings[0]);
+  const u32 n = particle_count(p, bindings[0]);
+  const u32 kept_count = counts[p.kept_word] < n ? counts[p.kept_word] : n;
+  const auto* kept = reinterpret_cast<const u32*>(bindings[1]);
+  const auto* points = reinterpret_cast<const float*>(bindings[2]);
+  const auto* velocity = reinterpret_cast<const float*>(bindings[3]);
+  auto* packed_points = reinterpret_cast<float*>(bindings[4]);
+  auto* packed_velocity = reinterpret_cast<float*>(bindings[5]);
+  auto* state = reinterpret_cast<u32*>(bindings[6]);
+  if (begin == 0 && end > 0) state[2] += n - kept_count;
+  for (u32 k = begin; k < end && k < kept_count; ++k) {
+    std::memcpy(packed_points + 4 * std::size_t{k}, points + 4 * std::size_t{kept[k]}, 16);
+    std::memcpy(packed_velocity + 4 * std::size_t{k}, velocity + 4 * std::size_t{kept[k]}, 16);
+  }
+}
+
+void sph_emit(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphFlowParams*>(params);
+  const u32 n = particle_count(p, bindings[0]);
+  auto* points = reinterpret_cast<float*>(bindings[1]);
+  auto* velocity = reinterpret_cast<float*>(bindings[2]);
+  const auto* emitters = reinterpret_cast<const float*>(bindings[3]);
+  const auto* pattern = reinterpret_cast<const float*>(bindings[4]);
+  const auto* state = reinterpret_cast<const u32*>(bindings[5]);
+  for (u32 i = begin; i < end && i < p.pattern; ++i) {
+    const float* lattice = pattern + 4 * std::size_t{i};
+    const u32 e = std::bit_cast<u32>(lattice[2]);
+    if (!fires(emitters, state, e)) continue;
+    u32 before = 0;  // the lattice points of the firing emitters before e
+    for (u32 k = 0; k < e; ++k)
+      if (fires(emitters, state, k)) before += EmitterView{emitters + SINEW_SPH_EMITTER_FLOATS * k}.points();
+    const float* f = emitters + SINEW_SPH_EMITTER_FLOATS * e;
+    const u32 j = i - EmitterView{f}.first();
+    const u32 slot = n + before + j;
+    if (slot >= p.capacity) continue;  // counted by sph_emit_commit's counter
+    const float depth = ((phase_of(state, e) + f[3]) - 1.0f) * p.spacing;
+    const float u = lattice[0], v = lattice[1];
+    float* x = points + 4 * std::size_t{slot};
+    for (int a = 0; a < 3; ++a) x[a] = ((f[a] + u * f[8 + a]) + v * f[12 + a]) + depth * f[4 + a];
+    x[3] = p.rest_mass;
+    float* w = velocity + 4 * std::size_t{slot};
+    for (int a = 0; a < 3; ++a) w[a] = f[7] * f[4 + a];
+    w[3] = std::bit_cast<float>(state[0] + before + j);
+  }
+}
+
+void sph_emit_commit(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  if (begin != 0 || end == 0) return;
+  const auto& p = *static_cast<const SphFlowParams*>(params);
+  auto* counts = reinterpret_cast<u32*>(bindings[0]);
+  const u32 n = particle_count(p, bindings[0]);
+  const auto* emitters = reinterpret_cast<const float*>(bindings[1]);
+  auto* state = reinterpret_cast<u32*>(bindings[2]);
+  u32 total = 0;
+  for (u32 e = 0; e < p.emitters; ++e) {
+    const float* f = emitters + SINEW_SPH_EMITTER_FLOATS * e;
+    const float next = phase_of(state, e) + f[3];
+    if (next >= 1.0f) total += EmitterView{f}.points();
+    state[SINEW_SPH_STATE_PHASES + e] = std::bit_cast<u32>(next >= 1.0f ? next - 1.0f : next);
+  }
+  const u32 asked = n + total;
+  const u32 made = (asked < p.capacity ? asked : p.capacity) - n;
+  state[3] = asked;
+  counts[p.count_word] = n + made;
+  state[0] += total;
+  state[1] += made;
+}
+
+}  // namespace sinew::kernels

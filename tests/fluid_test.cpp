@@ -1,0 +1,344 @@
+// fluid_test.cpp — the public fluid (sinew/fluid.h; issue 15, parts 3 and
+// 4): emitters make their flow rate, sinks remove what enters them, the
+// count lives on the device and overflow is reported; mass is conserved
+// exactly without them; the fluid's push on the boundary balances its
+// momentum; a moving boundary carries the fluid; the backends agree on
+// a scene with a source and suction; bad input is named; the samplers
+// leave no gap wider than a spacing.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "sinew/fluid.h"
+#include "test_support.h"
+
+namespace sinew::test {
+namespace {
+
+using P3 = std::array<double, 3>;
+constexpr double kS = 1e-3;  // spacing [m]
+
+// nx x ny x nz particles at the centres of cells of kS from `lo`.
+std::vector<P3> block(int nx, int ny, int nz, P3 lo = {0, 0, 0}) {
+  std::vector<P3> out;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      for (int k = 0; k < nz; ++k) out.push_back({lo[0] + (i + 0.5) * kS, lo[1] + (j + 0.5) * kS, lo[2] + (k + 0.5) * kS});
+  return out;
+}
+
+// A tank of 8 x 8 mm floor, walls 12 mm high, two boundary layers.
+FluidDesc tank_desc(const std::string& backend = "cpu") {
+  FluidDesc d;
+  d.settings.spacing = kS;
+  d.boundary = sample_box_walls({-0.5 * kS, -0.5 * kS, -0.5 * kS}, {8.5 * kS, 12 * kS, 8.5 * kS}, kS, 2);
+  d.device = {.backend = backend, .quiet = true};
+  return d;
+}
+
+std::array<double, 3> momentum(const std::vector<FluidParticle>& q, double mass) {
+  std::array<double, 3> p{};
+  for (const auto& x : q)
+    for (int a = 0; a < 3; ++a) p[a] += mass * x.velocity[a];
+  return p;
+}
+
+TEST(Fluid, MassIsConservedExactlyWithoutEmittersAndSinks) {
+  FluidDesc d = tank_desc();
+  d.particles = block(6, 6, 6, {kS, 2 * kS, kS});
+  auto fluid = Fluid::create(d);
+  ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+  SINEW_ASSERT_OK(fluid->step(300));
+  std::vector<FluidParticle> q;
+  SINEW_ASSERT_OK(fluid->read(q));
+  ASSERT_EQ(q.size(), d.particles.size());
+  for (std::size_t i = 0; i < q.size(); ++i) ASSERT_EQ(q[i].id, i) << "every particle, once";
+  EXPECT_EQ(fluid->stats().particles, d.particles.size());
+  EXPECT_EQ(fluid->stats().emitted, 0u);
+  EXPECT_EQ(fluid->stats().removed, 0u);
+  EXPECT_DOUBLE_EQ(fluid->stats().mass, double(d.particles.size()) * 1000.0 * kS * kS * kS);
+  EXPECT_NEAR(fluid->stats().time, 300 * 5e-5, 1e-12);
+}
+
+TEST(Fluid, AnEmitterMakesItsFlowRate) {
+  // 2 ml/s through a disc of 3 mm radius (29 lattice points) into the
+  // tank for 0.1 s: the emitted volume is the flow's, within one layer
+  // (the layer on its way out); every particle has its own id.
+  FluidDesc d = tank_desc();
+  const FluidEmitter e{.centre = {4 * kS, 9 * kS, 4 * kS}, .direction = {0, -1, 0}, .radius = 3 * kS, .flow_rate = 2e-6};
+  d.emitters.push_back(e);
+  d.capacity = 4000;
+  auto fluid = Fluid::create(d);
+  ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+  SINEW_ASSERT_OK(fluid->step(2000));
+  const double volume = double(fluid->stats().emitted) * kS * kS * kS, expected = 2e-6 * 0.1, layer = 29 * kS * kS * kS;
+  std::printf("[ measured ] emitted %llu particles: %.4f ml against the flow's %.4f ml (a layer is %.4f ml)\n",
+              static_cast<unsigned long long>(fluid->stats().emitted), 1e6 * volume, 1e6 * expected, 1e6 * layer);
+  EXPECT_EQ(fluid->stats().emitted % 29, 0u) << "whole layers of the 29-point lattice";
+  EXPECT_LE(std::abs(volume - expected), layer);
+  std::vector<FluidParticle> q;
+  SINEW_ASSERT_OK(fluid->read(q));
+  ASSERT_EQ(q.size(), fluid->stats().emitted);
+  std::set<std::uint32_t> ids;
+  double lowest = 1.0;
+  for (const auto& p : q) {
+    ids.insert(p.id);
+    lowest = std::min(lowest, double(p.position[1]));
+  }
+  EXPECT_EQ(ids.size(), q.size());
+  EXPECT_EQ(*ids.rbegin(), q.size() - 1) << "ids count up from 0";
+  EXPECT_GT(lowest, -0.5 * kS) << "held by the floor";
+  EXPECT_LT(lowest, 2 * kS) << "it fell to the floor";
+}
+
+TEST(Fluid, ASinkRemovesWhatEntersItAndTheBooksBalance) {
+  // A block poured onto a sink on the floor (radius 2.5 mm) and an emitter
+  // above: after 0.15 s, no fluid particle is inside the sink, some were
+  // removed, and particles = initial + emitted - removed exactly.
+  FluidDesc d = tank_desc();
+  d.particles = block(6, 4, 6, {kS, 3 * kS, kS});
+  d.emitters.push_back({.centre = {4 * kS, 10 * kS, 4 * kS}, .direction = {0, -1, 0}, .radius = 2 * kS, .flow_rate = 1e-6});
+  d.sinks.push_back({.centre = {4 * kS, 0.0, 4 * kS}, .radius = 2.5 * kS});
+  d.capacity = 2000;
+  auto fluid = Fluid::create(d);
+  ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+  SINEW_ASSERT_OK(fluid->step(3000));
+  const FluidStats& st = fluid->stats();
+  std::printf("[ measured ] %zu initial + %llu emitted - %llu removed = %u particles\n", d.particles.size(),
+              static_cast<unsigned long long>(st.emitted), static_cast<unsigned long long>(st.removed), st.particles);
+  EXPECT_GT(st.removed, 50u);
+  EXPECT_GT(st.emitted, 50u);
+  EXPECT_EQ(std::uint64_t(st.particles), d.particles.size() + st.emitted - st.removed);
+  std::vector<FluidParticle> q;
+  SINEW_ASSERT_OK(fluid->read(q));
+  ASSERT_EQ(q.size(), st.particles);
+  std::set<std::uint32_t> ids;
+  for (const auto& p : q) ids.insert(p.id);
+  EXPECT_EQ(ids.size(), q.size());
+  // Inside the sink only what the last step moved in (removal is at a step's start).
+  const double reach = 2.5 * kS - 0.5 * 5e-5;  // 0.5 m/s for one step, far above these speeds
+  for (const auto& p : q) {
+    const double dx = p.position[0] - 4 * kS, dy = p.position[1], dz = p.position[2] - 4 * kS;
+    EXPECT_GE(std::sqrt(dx * dx + dy * dy + dz * dz), reach) << "particle " << p.id << " inside the sink";
+  }
+}
+
+TEST(Fluid, AnEmitterPastTheCapacityIsReported) {
+  FluidDesc d = tank_desc();
+  d.emitters.push_back({.centre = {4 * kS, 9 * kS, 4 * kS}, .direction = {0, -1, 0}, .radius = 3 * kS, .flow_rate = 2e-6});
+  d.capacity = 100;  // three layers of 29 fit, the fourth does not
+  auto fluid = Fluid::create(d);
+  ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+  Status s;
+  int steps = 0;
+  while (s && steps < 2000) {
+    s = fluid->step(1);
+    ++steps;
+  }
+  ASSERT_FALSE(s.ok()) << "overflow must be reported";
+  EXPECT_EQ(s.error().code(), ErrorCode::capacity_exceeded);
+  EXPECT_NE(s.error().message().find("sph particles"), std::string::npos) << s.error().message();
+  EXPECT_EQ(fluid->stats().particles, 100u) << "what fits was made";
+  EXPECT_EQ(fluid->stats().emitted, 100u);
+}
+
+TEST(Fluid, TheBoundarysImpulseBalancesTheFluidsMomentum) {
+  // A block falls, lands and splashes in the tank: over the run, the
+  // fluid's momentum change plus the impulse the boundary took equals
+  // gravity's impulse, M g T, within float rounding (1e-4 of it).
+  FluidDesc d = tank_desc();
+  d.particles = block(6, 6, 6, {kS, 3 * kS, kS});
+  d.boundary_forces = true;
+  auto fluid = Fluid::create(d);
+  ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+  const double m = fluid->particle_mass(), M = m * double(d.particles.size()), T = 1500 * 5e-5;
+  SINEW_ASSERT_OK(fluid->step(1500));
+  std::vector<FluidParticle> q;
+  SINEW_ASSERT_OK(fluid->read(q));
+  std::vector<std::array<float, 3>> impulses;
+  SINEW_ASSERT_OK(fluid->read_boundary_impulses(impulses));
+  ASSERT_EQ(impulses.size(), d.boundary.size());
+  std::array<double, 3> J{};
+  for (const auto& j : impulses)
+    for (int a = 0; a < 3; ++a) J[a] += j[a];
+  const auto P = momentum(q, m);
+  const double gravity = M * 9.81 * T;
+  std::printf("[ measured ] fluid momentum %.4e N s, boundary impulse %.4e N s, M g T %.4e N s: off by %.2e of it\n",
+              P[1], J[1], -gravity, std::abs(P[1] + J[1] + gravity) / gravity);
+  EXPECT_GT(-J[1], 0.5 * gravity) << "the floor held it up";
+  for (int a = 0; a < 3; ++a) EXPECT_LT(std::abs(P[a] + J[a] + (a == 1 ? gravity : 0.0)), 1e-4 * gravity) << "axis " << a;
+  // Read again: the impulses were reset.
+  SINEW_ASSERT_OK(fluid->read_boundary_impulses(impulses));
+  for (const auto& j : impulses) ASSERT_EQ(j[1], 0.0f);
+}
+
+TEST(Fluid, AMovingFloorCarriesTheFluid) {
+  // Without gravity, the tank moves up at 0.1 m/s from rest, its boundary
+  // set every step: the fluid is pushed along (its mean speed within 5%
+  // of the tank's after 0.05 s), and none leaks through the floor.
+  FluidDesc d = tank_desc();
+  d.settings.gravity = {0, 0, 0};
+  d.particles = block(6, 4, 6, {kS, 0, kS});
+  d.moving_boundary = true;
+  auto fluid = Fluid::create(d);
+  ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+  const float u = 0.1f;
+  std::vector<std::array<float, 3>> x(d.boundary.size()), v(d.boundary.size(), {0.0f, u, 0.0f});
+  for (int k = 1; k <= 1000; ++k) {
+    const double lift = u * 5e-5 * k;
+    for (std::size_t b = 0; b < x.size(); ++b) x[b] = {float(d.boundary[b][0]), float(d.boundary[b][1] + lift), float(d.boundary[b][2])};
+    SINEW_ASSERT_OK(fluid->set_boundary(x, v));
+    SINEW_ASSERT_OK(fluid->step(1));
+  }
+  std::vector<FluidParticle> q;
+  SINEW_ASSERT_OK(fluid->read(q));
+  double mean = 0.0, lowest = 1.0;
+  for (const auto& p : q) {
+    mean += p.velocity[1] / double(q.size());
+    lowest = std::min(lowest, double(p.position[1]));
+  }
+  const double floor = u * 5e-5 * 1000 - 0.5 * kS;
+  std::printf("[ measured ] mean fluid speed %.4f m/s against the tank's %.2f; lowest particle %.3f mm above the floor\n",
+              mean, u, 1e3 * (lowest - floor));
+  EXPECT_NEAR(mean, u, 0.05 * u);
+  EXPECT_GT(lowest, floor) << "nothing through the floor";
+}
+
+class FluidAgreement : public BackendTest {};
+
+TEST_P(FluidAgreement, ASourceAndASinkMatchTheCpu) {
+  // An emitter, a sink and a falling block for 300 steps: the counts are
+  // equal and every particle lies within 1e-4 m of the CPU's (GPU square
+  // roots and divisions may round differently).
+  if (GetParam() == "cpu") GTEST_SKIP() << "the reference itself";
+  std::vector<std::vector<FluidParticle>> out;
+  std::vector<FluidStats> stats;
+  for (const std::string& backend : {std::string("cpu"), GetParam()}) {
+    FluidDesc d = tank_desc(backend);
+    d.particles = block(5, 4, 5, {kS, 3 * kS, kS});
+    d.emitters.push_back({.centre = {4 * kS, 10 * kS, 4 * kS}, .direction = {0, -1, 0}, .radius = 2 * kS, .flow_rate = 2e-6});
+    d.sinks.push_back({.centre = {3 * kS, 2 * kS, 3 * kS}, .radius = 1.5 * kS});  // under the block: it falls in
+    d.capacity = 1000;
+    d.boundary_forces = true;
+    auto fluid = Fluid::create(d);
+    ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+    SINEW_ASSERT_OK(fluid->step(300));
+    SINEW_ASSERT_OK(fluid->read(out.emplace_back()));
+    stats.push_back(fluid->stats());
+  }
+  EXPECT_EQ(stats[0].emitted, stats[1].emitted);
+  EXPECT_EQ(stats[0].removed, stats[1].removed);
+  ASSERT_EQ(out[0].size(), out[1].size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < out[0].size(); ++i) {
+    ASSERT_EQ(out[0][i].id, out[1][i].id);
+    for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(double(out[1][i].position[k] - out[0][i].position[k])));
+  }
+  std::printf("[ measured ] %s: %zu particles (%llu emitted, %llu removed), every one within %.2e m of the CPU's\n",
+              GetParam().c_str(), out[0].size(), static_cast<unsigned long long>(stats[0].emitted),
+              static_cast<unsigned long long>(stats[0].removed), worst);
+  EXPECT_GT(stats[0].emitted, 0u);
+  EXPECT_GT(stats[0].removed, 0u);
+  EXPECT_LT(worst, 1e-4);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, FluidAgreement, ::testing::ValuesIn(backends()), backend_name);
+
+TEST(Fluid, BadInputIsNamed) {
+  const auto message = [](const FluidDesc& d) {
+    auto made = Fluid::create(d);
+    return made.ok() ? std::string("created") : made.error().message();
+  };
+  FluidDesc d = tank_desc();
+  EXPECT_NE(message(d).find("no fluid particles and no emitter"), std::string::npos) << message(d);
+  FluidEmitter e{.centre = {4 * kS, 9 * kS, 4 * kS}, .direction = {0, -1, 0}, .radius = 2 * kS, .flow_rate = 1e-6};
+  d.capacity = 100;
+  d.emitters = {e};
+  d.emitters[0].direction = {0, 0, 0};
+  EXPECT_NE(message(d).find("emitter 0 direction must not be zero"), std::string::npos) << message(d);
+  d.emitters = {e};
+  d.emitters[0].radius = 0.2 * kS;
+  EXPECT_NE(message(d).find("emitter 0 radius"), std::string::npos) << message(d);
+  d.emitters = {e};
+  d.emitters[0].flow_rate = 1.0;  // 1 m^3/s through 13 mm^2
+  EXPECT_NE(message(d).find("more than a spacing per step"), std::string::npos) << message(d);
+  d.emitters = {e};
+  d.emitters[0].centre = {3.5 * kS, -0.5 * kS, 3.5 * kS};  // on the floor's boundary particles
+  EXPECT_NE(message(d).find("emitter 0 lies inside the boundary"), std::string::npos) << message(d);
+  d.emitters = {e};
+  d.sinks = {{.centre = {0, 0, 0}, .radius = 0.0}};
+  EXPECT_NE(message(d).find("sink 0 radius must be finite and > 0"), std::string::npos) << message(d);
+  d.sinks.clear();
+  d.particles = block(11, 1, 11);
+  EXPECT_NE(message(d).find("121 particles, more than the capacity 100"), std::string::npos) << message(d);
+  d.particles.clear();
+  auto fluid = Fluid::create(d);
+  ASSERT_TRUE(fluid.ok()) << fluid.error().message();
+  FluidEmitter wider = e;
+  wider.radius = 3 * kS;
+  EXPECT_NE(fluid->set_emitter(0, wider).error().message().find("radius must stay"), std::string::npos);
+  EXPECT_NE(fluid->set_emitter(1, e).error().message().find("no emitter 1"), std::string::npos);
+  EXPECT_NE(fluid->set_sink(0, {}).error().message().find("no sink 0"), std::string::npos);
+  std::vector<std::array<float, 3>> none;
+  EXPECT_NE(fluid->set_boundary(none, none).error().message().find("moving_boundary"), std::string::npos);
+  EXPECT_NE(fluid->read_boundary_impulses(none).error().message().find("boundary_forces"), std::string::npos);
+  FluidEmitter off = e;
+  off.flow_rate = 0.0;
+  SINEW_ASSERT_OK(fluid->set_emitter(0, off));
+  SINEW_ASSERT_OK(fluid->step(400));
+  EXPECT_EQ(fluid->stats().emitted, 0u) << "a closed source makes nothing";
+}
+
+TEST(Fluid, SamplesCoverASurfaceAndFollowIt) {
+  // A closed 10 x 6 x 4 mm box of 12 triangles sampled at 1 mm: every
+  // point of the surface (2,000 random ones) is within 0.75 mm of a
+  // sample; the samples follow the vertices when the box moves, and a
+  // force spread to the vertices keeps its total.
+  const std::vector<P3> v{{0, 0, 0}, {0.01, 0, 0}, {0.01, 0.006, 0}, {0, 0.006, 0},
+                          {0, 0, 0.004}, {0.01, 0, 0.004}, {0.01, 0.006, 0.004}, {0, 0.006, 0.004}};
+  const std::vector<std::array<std::uint32_t, 3>> t{{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                                                    {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  auto samples = sample_surface(v, t, kS);
+  ASSERT_TRUE(samples.ok()) << samples.error().message();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  double worst = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const auto& tri = t[std::size_t(k) % t.size()];
+    double a = u01(rng), b = u01(rng);
+    if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;
+    P3 x;
+    for (int c = 0; c < 3; ++c) x[c] = v[tri[0]][c] + a * (v[tri[1]][c] - v[tri[0]][c]) + b * (v[tri[2]][c] - v[tri[0]][c]);
+    double nearest = 1.0;
+    for (const P3& s : samples->points) nearest = std::min(nearest, std::hypot(s[0] - x[0], s[1] - x[1], s[2] - x[2]));
+    worst = std::max(worst, nearest);
+  }
+  std::printf("[ measured ] %zu samples; the farthest surface point is %.3f mm from one\n", samples->points.size(), 1e3 * worst);
+  EXPECT_LT(worst, 0.75 * kS);
+  std::vector<float> moved;
+  for (const P3& x : v) moved.insert(moved.end(), {float(x[0] + 0.02), float(x[1]), float(x[2]), 1.0f});
+  std::vector<std::array<float, 3>> at;
+  samples->positions_on(moved, 4, at);
+  ASSERT_EQ(at.size(), samples->points.size());
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    EXPECT_NEAR(at[i][0], samples->points[i][0] + 0.02, 1e-6);
+    EXPECT_NEAR(at[i][1], samples->points[i][1], 1e-6);
+  }
+  std::vector<std::array<float, 3>> force(samples->points.size(), {0.0f, -1e-3f, 0.0f});
+  std::vector<float> per_vertex(4 * v.size(), 0.0f);
+  samples->spread_to_vertices(force, per_vertex, 4);
+  double total = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) total += per_vertex[4 * i + 1];
+  EXPECT_NEAR(total, -1e-3 * double(samples->points.size()), 1e-6);
+  EXPECT_FALSE(sample_surface(v, {{{0, 1, 9}}}, kS).ok());
+  EXPECT_FALSE(sample_surface(v, t, 0.0).ok());
+}
+
+}  // namespace
+}  // namespace sinew::test
