@@ -30,6 +30,7 @@
 #define SINEW_KERNELS(SINEW_KERNEL)                                              \
   /* xPBD solver (kernels/shared/xpbd_params.h) */                               \
   SINEW_KERNEL(xpbd_predict, 3, PredictParams, 0)                                \
+  SINEW_KERNEL(xpbd_external_force, 3, ExternalForceParams, 0)                   \
   SINEW_KERNEL(xpbd_update_velocity, 3, UpdateVelocityParams, 0)                 \
   SINEW_KERNEL(xpbd_solve_distance, 6, SolveParams, 0)                           \
   SINEW_KERNEL(xpbd_solve_volume, 6, SolveParams, 0)                             \

@@ -543,6 +543,12 @@ struct SceneDesc {
   std::vector<ToolDesc> tools;
   std::vector<NeedleDesc> needles;
   MeshCollisionDesc mesh_collision;  ///< contacts between the bodies' meshes (off by default)
+  /// Forces on single particles, set by the host before each frame
+  /// (Simulation::set_particle_forces; e.g. a fluid's pressure on tissue,
+  /// two-way coupling). A scene pays only for the stages it uses: without
+  /// this, the frame program has no force kernel and the device no force
+  /// buffer; with it, one dispatch per substep and 16 bytes per particle.
+  bool external_forces = false;
 };
 
 /// Checks every parameter of a scene; the first problem found is returned,

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -153,6 +154,21 @@ class Simulation {
   /// acting on tool `index` during the next frame (then reset to zero);
   /// calls before one step add up.
   Status apply_tool_force(std::size_t index, const std::array<double, 3>& force, const std::array<double, 3>& torque);
+
+  /// Forces [N] on the scene's particles (3 floats x, y, z per particle, in
+  /// the particle order of read_positions), acting during the next frame
+  /// (every substep), then reset to zero; calls before one step replace the
+  /// previous call's forces. Each substep adds the impulse h f / m to a
+  /// particle's velocity before predicting its position, so the impulse
+  /// passes through the substep's velocity damping (the bodies'
+  /// velocity_damping k: a factor exp(-k h)) like any velocity, unlike
+  /// gravity's; pinned and kinematic particles (mass 0) ignore their force.
+  /// Costs an upload of 16 bytes per particle per call, and one more in the
+  /// first frame without a call after one (resetting them).
+  /// Needs SceneDesc::external_forces (else an error naming it). Errors
+  /// (bad_parameter): a span whose size is not 3 x particles, a non-finite
+  /// value (naming the particle); the forces set before stay then.
+  Status set_particle_forces(std::span<const float> xyz);
 
   /// Cuts level-set collider `index` (ColliderShape::level_set, built with
   /// its whole inside stored): LevelSet::cut with the tool's poses in the

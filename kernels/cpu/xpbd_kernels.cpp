@@ -37,6 +37,24 @@ void xpbd_predict(const void* params, std::byte* const* bindings, std::uint32_t 
   }
 }
 
+void xpbd_external_force(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                         std::uint32_t end) {
+  const auto& p = *static_cast<const ExternalForceParams*>(params);
+  const auto* x = reinterpret_cast<const float4*>(bindings[0]);
+  const auto* f = reinterpret_cast<const float4*>(bindings[1]);
+  auto* v = reinterpret_cast<float4*>(bindings[2]);
+  for (std::uint32_t i = begin; i < end; ++i) {
+    // w > 0 rather than != 0: a pinned or kinematic particle (w == 0) is
+    // moved by the host alone, so a force on it does nothing.
+    if (!(x[i].w > 0.0f)) continue;
+    // The impulse h f / m = (h w) f, as the GPU twin rounds it; v.w (the
+    // damping factor) is kept, and xpbd_predict damps this impulse with
+    // the rest of the velocity.
+    const float s = p.h * x[i].w;
+    v[i] = add_scaled3(v[i], s, f[i]);
+  }
+}
+
 void xpbd_update_velocity(const void* params, std::byte* const* bindings, std::uint32_t begin,
                           std::uint32_t end) {
   const auto& p = *static_cast<const UpdateVelocityParams*>(params);

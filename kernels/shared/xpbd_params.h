@@ -33,6 +33,21 @@ SINEW_STRUCT_BEGIN(PredictParams)
   uint pad2;
 SINEW_STRUCT_END(PredictParams)
 
+/* xpbd_external_force: one item per particle, before each substep's
+ * xpbd_predict (only in scenes with SceneDesc::external_forces).
+ * bindings: 0 position float4 (w = inverse mass [1/kg]) [in]
+ *           1 force float4 (xyz [N], w unused) [in]
+ *           2 velocity float4 (xyz [m/s]) [in/out]
+ * v.xyz += (h w) f.xyz — for particles with w > 0 only (pinned and
+ * kinematic particles take no force). v.w (the damping factor) is kept;
+ * xpbd_predict then damps the impulse with the rest of the velocity. */
+SINEW_STRUCT_BEGIN(ExternalForceParams)
+  float h;     /* substep length [s], the very float xpbd_predict moves by */
+  uint count;  /* particles */
+  uint pad0;
+  uint pad1;
+SINEW_STRUCT_END(ExternalForceParams)
+
 /* xpbd_update_velocity: one item per particle.
  * bindings: 0 position float4 [in], 1 previous position float4 [in],
  *           2 velocity float4 [in/out]: the predicted velocity v_p in,

@@ -75,6 +75,9 @@ struct CompiledScene {
   /// each substep, exp(-k h) for its body's velocity_damping k (1: none);
   /// uploaded as the velocity buffer's w (xpbd_params.h, xpbd_predict).
   std::vector<float> velocity_damping;
+  /// SceneDesc::external_forces: the program applies a force buffer
+  /// (xpbd_external_force) before every substep's predict.
+  bool external_forces = false;
   std::vector<std::uint32_t> tet_body_first_particle;
   std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;

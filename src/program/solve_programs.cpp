@@ -97,8 +97,11 @@ SolvePrograms::SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buff
   enum class Phase { predict, first_sweep, sweep, measure, update } phase = Phase::predict;
   for (const auto& command : whole.commands()) {
     if (const auto* d = std::get_if<Dispatch>(&command)) {
-      if (d->kernel == Kernel::xpbd_predict) {
-        parts_.emplace_back();
+      if (d->kernel == Kernel::xpbd_external_force || d->kernel == Kernel::xpbd_predict) {
+        // A substep opens with its external forces (when the scene has
+        // them) or else its predict: the predict that follows the forces
+        // belongs to the same substep's part.
+        if (parts_.empty() || phase != Phase::predict) parts_.emplace_back();
         phase = Phase::predict;
       } else if (d->kernel == Kernel::xpbd_update_velocity) {
         phase = Phase::update;

@@ -68,7 +68,8 @@ class SolvePrograms {
   void declare_counters(FrameProgram& program) const;
 
   [[nodiscard]] int substeps() const { return static_cast<int>(parts_.size()); }
-  /// Predict of substep s (and whatever precedes its first sweep).
+  /// Predict of substep s (and whatever precedes its first sweep: the
+  /// external forces, xpbd_external_force, when the scene has them).
   void append_predict(FrameProgram& program, int s) const;
   /// Sweeps number first .. first + count - 1 (1-based within the
   /// substep) of substep s, each followed by its accelerator step. With

@@ -83,6 +83,11 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
   auto grids = make_buffer(device, scene.level_set_grids, "level-set grids");
   if (!grids) return grids.error();
   b.level_set_grids = *grids;
+  if (scene.external_forces) {  // only then: a scene pays for the stages it uses
+    auto forces = make_buffer(device, zeros, "external forces");
+    if (!forces) return forces.error();
+    b.external_force = *forces;
+  }
   for (const ConstraintBlock& block : scene.blocks) {
     const std::string name(kernel_name(block.kernel));
     auto particles = make_buffer(device, block.particles, name + " particles");
@@ -113,6 +118,9 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   predict.gravity_y = static_cast<float>(gravity[1]);
   predict.gravity_z = static_cast<float>(gravity[2]);
   predict.count = particles;
+  kernels::ExternalForceParams force{};
+  force.h = predict.h;  // the very float xpbd_predict moves by
+  force.count = particles;
   kernels::UpdateVelocityParams update{};
   update.inv_h = static_cast<float>(1.0 / h);
   update.h = predict.h;  // the very float xpbd_predict moves by
@@ -132,6 +140,13 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
                                                  mesh_contacts->table, k, mesh_contacts->capacity));
   }
   for (int s = 0; s < solver.substeps; ++s) {
+    if (scene.external_forces) {
+      // Into the velocity before predict, so the force acts in every
+      // substep as gravity does (its impulse then damped like any velocity).
+      program.dispatch(Kernel::xpbd_external_force, particles,
+                       {buffers.position, buffers.external_force, buffers.velocity}, force);
+      program.barrier();
+    }
     program.dispatch(Kernel::xpbd_predict, particles, {buffers.position, buffers.previous, buffers.velocity}, predict);
     program.barrier();
     for (int it = 0; it < solver.iterations; ++it) {

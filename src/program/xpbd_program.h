@@ -1,6 +1,6 @@
 // xpbd_program.h — the frame program of the xPBD solver: per substep,
-// predict, `iterations` colour-by-colour sweeps, update velocities. Only the
-// stages a scene has constraints for are emitted.
+// (external forces,) predict, `iterations` colour-by-colour sweeps, update
+// velocities. Only the stages a scene has constraints for are emitted.
 #pragma once
 
 #include "compiler/scene_compiler.h"
@@ -19,6 +19,10 @@ struct XpbdBuffers {
   BufferHandle position, previous, velocity;
   BufferHandle colliders, targets, contact_impulses;  ///< SceneBuffer (small placeholders when unused)
   BufferHandle level_set_grids;                      ///< SceneBuffer::level_set_grids (a placeholder when none)
+  /// Force [N] per particle, float4 (xyz, w unused) in device order, that
+  /// xpbd_external_force applies every substep; only with
+  /// CompiledScene::external_forces (else no buffer: an invalid handle).
+  BufferHandle external_force;
   std::vector<BlockBuffers> blocks;  ///< one per CompiledScene::blocks entry
 };
 
@@ -58,6 +62,8 @@ struct SweepExtras {
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
 
 /// The dispatches of one frame of `solver`, with `gravity` [m/s^2].
+/// With CompiledScene::external_forces, each substep starts with
+/// xpbd_external_force (and a barrier) before its predict.
 /// With mesh contacts, every sweep ends with one indirect dispatch per
 /// contact colour (counts from its table, declared as counters); with
 /// sutures, then one dispatch of one item for all their rows.

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <string>
 
 #include "compiler/scene_compiler.h"
 #include "math/xpbd_math.h"
@@ -40,6 +42,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   auto buffers = upload_scene(*impl->device, *compiled);
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
+  if (compiled->external_forces) impl->force_scratch.resize(compiled->positions.size());
   if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
   impl->order = compiled->order;
   impl->time_step = scene.solver.time_step;
@@ -143,6 +146,7 @@ Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
 
 Status Simulation::step() {
   const auto start = std::chrono::steady_clock::now();
+  if (Status s = impl_->begin_frame_forces(); !s) return s;
   if (Status s = impl_->before_frame(); !s) return s;
   if (impl_->mesh_collision) {
     bool grew = false;
@@ -216,6 +220,59 @@ Status Simulation::step() {
   impl_->stats.time = static_cast<double>(impl_->stats.frame) * impl_->time_step;
   impl_->stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
   impl_->stats.measure_ms = std::chrono::duration<double, std::milli>(end - ran).count();
+  return {};
+}
+
+Status Simulation::set_particle_forces(std::span<const float> xyz) {
+  constexpr const char* call = "set_particle_forces";
+  Impl& im = *impl_;
+  if (!im.buffers.external_force.valid())
+    return Error(ErrorCode::bad_parameter, std::string(call) +
+                                               ": the scene was created without SceneDesc::external_forces "
+                                               "(set it to true to apply forces to particles)");
+  const std::size_t n = im.order.device_of.size();
+  if (xyz.size() != 3 * n)
+    return Error(ErrorCode::bad_parameter, std::string(call) + ": xyz holds " + std::to_string(xyz.size()) +
+                                               " floats; the scene has " + std::to_string(n) +
+                                               " particles, so it needs " + std::to_string(3 * n) +
+                                               " (x, y, z per particle)");
+  // Checked and staged before anything is uploaded: on an error the forces
+  // set before stay.
+  for (std::size_t u = 0; u < n; ++u) {
+    const float* f = &xyz[3 * u];
+    if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2])) {
+      std::ostringstream message;
+      message << call << ": the force on particle " << u << " must be finite (got " << f[0] << ", " << f[1] << ", "
+              << f[2] << " N)";
+      return Error(ErrorCode::bad_parameter, message.str());
+    }
+    im.force_scratch[im.order.device_of[u]] = kernels::float4{f[0], f[1], f[2], 0.0f};
+  }
+  if (n == 0) return {};
+  if (Status s = im.device->write_buffer(im.buffers.external_force, 0, im.force_scratch.data(),
+                                         n * sizeof(kernels::float4));
+      !s)
+    return s;
+  im.forces_for_next_frame = true;
+  im.forces_on_device = true;
+  return {};
+}
+
+// Forces act for one frame. They are reset lazily, at the start of the
+// first frame without a call: a host that sets them every frame (two-way
+// coupling) pays one upload per frame, not two, one that stops pays one
+// upload of zeros, and one that never calls pays nothing. (A fill in the
+// frame program would cost every frame of every such scene.)
+Status Simulation::Impl::begin_frame_forces() {
+  const bool stale = forces_on_device && !forces_for_next_frame;
+  forces_for_next_frame = false;  // this frame consumes them
+  if (!stale) return {};
+  std::fill(force_scratch.begin(), force_scratch.end(), kernels::float4{0.0f, 0.0f, 0.0f, 0.0f});
+  if (Status s = device->write_buffer(buffers.external_force, 0, force_scratch.data(),
+                                      force_scratch.size() * sizeof(kernels::float4));
+      !s)
+    return s;
+  forces_on_device = false;
   return {};
 }
 

@@ -46,6 +46,16 @@ struct Simulation::Impl {
 
   void measure(FrameStats& stats) const;
 
+  // SceneDesc::external_forces: forces staged in device order (sized once,
+  // so a call allocates nothing); whether a call set the coming frame's,
+  // and whether the device buffer holds a call's (nonzero) forces.
+  std::vector<kernels::float4> force_scratch;
+  bool forces_for_next_frame = false;
+  bool forces_on_device = false;
+  /// Before a frame's program: the forces of the last frame's call, if no
+  /// call since set the coming frame's, are reset to zero.
+  Status begin_frame_forces();
+
   // Contacts between meshes (mesh_collision.h; null when the scene has
   // none). The program is rebuilt when they outgrow it, from the compiled
   // scene's shape (its blocks without their data) kept here for that.
