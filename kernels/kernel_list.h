@@ -94,7 +94,8 @@
   SINEW_KERNEL(sph_boundary_move, 5, SphFlowParams, 0)                          \
   SINEW_KERNEL(sph_sink_flags, 4, SphFlowParams, 0)                             \
   SINEW_KERNEL(sph_pack, 7, SphFlowParams, 0)                                   \
-  SINEW_KERNEL(sph_emit, 6, SphFlowParams, 0)                                   \
-  SINEW_KERNEL(sph_emit_commit, 3, SphFlowParams, 0)
+  SINEW_KERNEL(sph_emit_flags, 8, SphFlowParams, 0)                             \
+  SINEW_KERNEL(sph_emit, 7, SphFlowParams, 0)                                   \
+  SINEW_KERNEL(sph_emit_commit, 4, SphFlowParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

@@ -44,7 +44,10 @@ struct FluidSettings {
 
 /// A source: a disc that lets fluid through at a flow rate, layer after
 /// layer of particles on a square lattice of the spacing (those within
-/// the radius), each layer leaving one spacing behind the last.
+/// the radius), each layer leaving one spacing behind the last. A lattice
+/// point with a fluid particle within 0.75 spacing of its place makes
+/// nothing that layer (FluidStats::blocked): a source under the fluid's
+/// surface delivers less than its rate.
 struct FluidEmitter {
   std::array<double, 3> centre{};             ///< the disc's centre [m]
   std::array<double, 3> direction{0, -1, 0};  ///< the flow's direction (normalised; not zero)
@@ -64,7 +67,12 @@ struct FluidSink {
 
 struct FluidDesc {
   FluidSettings settings;
-  std::vector<std::array<double, 3>> particles;  ///< fluid at rest at the start [m]
+  /// Fluid at the start [m], about a spacing from the boundary particles:
+  /// closer, a single layer of them adds more than the missing fluid's
+  /// density (their volumes assume that gap) and the first steps push the
+  /// fluid away hard.
+  std::vector<std::array<double, 3>> particles;
+  std::vector<std::array<double, 3>> velocities; ///< their velocities [m/s] (empty: at rest)
   /// Boundary particles [m] (sample_surface, sample_box_walls): what holds
   /// the fluid. Each gets its volume from its neighbours at create().
   std::vector<std::array<double, 3>> boundary;
@@ -89,11 +97,16 @@ struct FluidParticle {
   float density = 0.0f, pressure = 0.0f;        ///< [kg/m^3], [Pa] from the last step's start
 };
 
-/// Counts after the last step() (read back with it: 6 words).
+/// Counts after the last step() (read back with it: 7 words).
 struct FluidStats {
   std::uint32_t particles = 0;  ///< fluid particles now
   std::uint64_t emitted = 0;    ///< made by emitters since create()
   std::uint64_t removed = 0;    ///< removed by sinks since create()
+  /// Emitter lattice points that made nothing because a fluid particle was
+  /// within 0.75 spacing of their place (a submerged source makes only what
+  /// it finds room for: a particle on top of another would blow the fluid
+  /// apart), since create().
+  std::uint64_t blocked = 0;
   std::uint64_t steps = 0;      ///< time steps since create()
   double time = 0.0;            ///< simulated time [s]
   double max_speed = 0.0;       ///< the fastest fluid particle after the last step() [m/s]

@@ -83,6 +83,11 @@ struct TetGridDesc {
 /// 5 or 6 positively oriented tets per cell, conforming across cells.
 Result<TetMesh> make_tet_grid(const TetGridDesc& desc);
 
+/// The mesh without the vertices no tet uses (e.g. after removing tets to
+/// carve a cavity out of a tet grid), the others renumbered in the order
+/// the tets first use them. [pre] every index < vertices.size().
+TetMesh drop_unused_vertices(const TetMesh& mesh);
+
 /// Reads a TetGen mesh: `path` is the .node file, the .ele file or their
 /// common stem; both files must exist. Handles 0- and 1-based numbering
 /// (detected from the first index in .node), attributes and boundary markers

@@ -2,11 +2,14 @@
 // and move a fluid's particles on the device (kernels/shared/
 // sph_flow_params.h), in the order of operations of their GPU twins
 // (kernels/gpu/sph_emit.gpu and the others).
+#include <atomic>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
 #include "cpu/cpu_kernels.h"
+#include "cpu/neighbour_cells.h"
 #include "sph_flow_params.h"
 
 namespace sinew::kernels {
@@ -19,17 +22,17 @@ u32 particle_count(const SphFlowParams& p, const std::byte* counts) {
   return stored < p.capacity ? stored : p.capacity;
 }
 
-// An emitter's record (sph_flow_params.h).
-struct EmitterView {
-  const float* f;
-  [[nodiscard]] float rate() const { return f[3]; }
-  [[nodiscard]] u32 first() const { return std::bit_cast<u32>(f[11]); }
-  [[nodiscard]] u32 points() const { return std::bit_cast<u32>(f[15]); }
-};
-
 float phase_of(const u32* state, u32 e) { return std::bit_cast<float>(state[SINEW_SPH_STATE_PHASES + e]); }
 bool fires(const float* emitters, const u32* state, u32 e) {
   return phase_of(state, e) + emitters[SINEW_SPH_EMITTER_FLOATS * e + 3] >= 1.0f;
+}
+
+// A lattice point's place this step: centre + u t1 + v t2 + depth d, in
+// the GPU twins' order (sph_flow_params.h, sph_emit).
+void place(const SphFlowParams& p, const float* f, float phase, const float* lattice, float* x) {
+  const float depth = ((phase + f[3]) - 1.0f) * p.spacing;
+  const float u = lattice[0], v = lattice[1];
+  for (int a = 0; a < 3; ++a) x[a] = ((f[a] + u * f[8 + a]) + v * f[12 + a]) + depth * f[4 + a];
 }
 
 }  // namespace
@@ -89,6 +92,38 @@ void sph_pack(const void* params, std::byte* const* bindings, std::uint32_t begi
   }
 }
 
+void sph_emit_flags(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphFlowParams*>(params);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
+  const auto* emitters = reinterpret_cast<const float*>(bindings[4]);
+  const auto* pattern = reinterpret_cast<const float*>(bindings[5]);
+  auto* state = reinterpret_cast<u32*>(bindings[6]);
+  auto* flags = reinterpret_cast<u32*>(bindings[7]);
+  for (u32 i = begin; i < end && i < p.pattern; ++i) {
+    const float* lattice = pattern + 4 * std::size_t{i};
+    const u32 e = std::bit_cast<u32>(lattice[2]);
+    flags[i] = 0u;
+    if (!fires(emitters, state, e)) continue;
+    float x[3];
+    place(p, emitters + SINEW_SPH_EMITTER_FLOATS * e, phase_of(state, e), lattice, x);
+    const int c[3] = {int(std::floor(x[0] * p.inv_cell)), int(std::floor(x[1] * p.inv_cell)),
+                      int(std::floor(x[2] * p.inv_cell))};
+    bool blocked = false;
+    cells::visit_cells(cells, ranges, p.table_mask, c, [&](u32 t) {
+      const float* y = points + 4 * std::size_t{t};
+      const float dx = y[0] - x[0], dy = y[1] - x[1], dz = y[2] - x[2];
+      if (y[3] > 0.0f && (dx * dx + dy * dy) + dz * dz < p.clear2) blocked = true;
+    });
+    if (blocked) {
+      std::atomic_ref<u32>(state[4]).fetch_add(1u);
+      continue;
+    }
+    flags[i] = 1u;
+  }
+}
+
 void sph_emit(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphFlowParams*>(params);
   const u32 n = particle_count(p, bindings[0]);
@@ -97,25 +132,22 @@ void sph_emit(const void* params, std::byte* const* bindings, std::uint32_t begi
   const auto* emitters = reinterpret_cast<const float*>(bindings[3]);
   const auto* pattern = reinterpret_cast<const float*>(bindings[4]);
   const auto* state = reinterpret_cast<const u32*>(bindings[5]);
+  const auto* flags = reinterpret_cast<const u32*>(bindings[6]);
   for (u32 i = begin; i < end && i < p.pattern; ++i) {
+    if (flags[i] == 0u) continue;
+    u32 before = 0;  // the points made before this one (a few hundred at most: a loop, not a scan)
+    for (u32 k = 0; k < i; ++k) before += flags[k];
+    const u32 slot = n + before;
+    if (slot >= p.capacity) continue;  // counted by sph_emit_commit's counter
     const float* lattice = pattern + 4 * std::size_t{i};
     const u32 e = std::bit_cast<u32>(lattice[2]);
-    if (!fires(emitters, state, e)) continue;
-    u32 before = 0;  // the lattice points of the firing emitters before e
-    for (u32 k = 0; k < e; ++k)
-      if (fires(emitters, state, k)) before += EmitterView{emitters + SINEW_SPH_EMITTER_FLOATS * k}.points();
     const float* f = emitters + SINEW_SPH_EMITTER_FLOATS * e;
-    const u32 j = i - EmitterView{f}.first();
-    const u32 slot = n + before + j;
-    if (slot >= p.capacity) continue;  // counted by sph_emit_commit's counter
-    const float depth = ((phase_of(state, e) + f[3]) - 1.0f) * p.spacing;
-    const float u = lattice[0], v = lattice[1];
     float* x = points + 4 * std::size_t{slot};
-    for (int a = 0; a < 3; ++a) x[a] = ((f[a] + u * f[8 + a]) + v * f[12 + a]) + depth * f[4 + a];
+    place(p, f, phase_of(state, e), lattice, x);
     x[3] = p.rest_mass;
     float* w = velocity + 4 * std::size_t{slot};
     for (int a = 0; a < 3; ++a) w[a] = f[7] * f[4 + a];
-    w[3] = std::bit_cast<float>(state[0] + before + j);
+    w[3] = std::bit_cast<float>(state[0] + before);
   }
 }
 
@@ -126,11 +158,11 @@ void sph_emit_commit(const void* params, std::byte* const* bindings, std::uint32
   const u32 n = particle_count(p, bindings[0]);
   const auto* emitters = reinterpret_cast<const float*>(bindings[1]);
   auto* state = reinterpret_cast<u32*>(bindings[2]);
+  const auto* flags = reinterpret_cast<const u32*>(bindings[3]);
   u32 total = 0;
+  for (u32 i = 0; i < p.pattern; ++i) total += flags[i];
   for (u32 e = 0; e < p.emitters; ++e) {
-    const float* f = emitters + SINEW_SPH_EMITTER_FLOATS * e;
-    const float next = phase_of(state, e) + f[3];
-    if (next >= 1.0f) total += EmitterView{f}.points();
+    const float next = phase_of(state, e) + emitters[SINEW_SPH_EMITTER_FLOATS * e + 3];
     state[SINEW_SPH_STATE_PHASES + e] = std::bit_cast<u32>(next >= 1.0f ? next - 1.0f : next);
   }
   const u32 asked = n + total;

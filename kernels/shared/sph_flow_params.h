@@ -13,7 +13,8 @@
  *   3 the particles the last step asked for, n + emitted (the counter
  *     "sph particles": above the capacity the step reports
  *     capacity_exceeded, and the particles past it were not made)
- *   4 unused                     5 .. 7 unused
+ *   4 lattice points blocked in all (sph_emit_flags)
+ *   5 .. 7 unused
  *   8 + e emitter e's phase (float bits): the fraction of a layer's
  *         spacing its flow has moved since its last layer, in [0, 1)
  *
@@ -50,28 +51,45 @@
  *           2 points float4 [in]      3 velocity float4 [in]
  *           4 packed_points float4 [out]   5 packed_velocity float4 [out]
  *           6 state uint [in/out]
+ * ------------------------------------------------------ sph_emit_flags
+ * One item per lattice point i < pattern: flags[i] = 1 when its emitter e
+ * fires this step (phase_e + rate_e >= 1) and no fluid particle (w > 0)
+ * lies within clear = 0.75 spacing of its place (below), else 0; a
+ * firing point that is blocked adds 1 to state word 4. Placing a particle
+ * on top of another would make a density spike that blows the fluid
+ * apart; a submerged source makes only what it finds room for. The
+ * particles are searched on the last step's grid: after sph_step, points
+ * are in that grid's sorted order, and none has moved a cell since (the
+ * CFL bound keeps them within 0.4 h per step), so the 27 cells around the
+ * place's cell, floor(x inv_cell), hold every particle within h of it.
+ * Test: d2 = (dx dx + dy dy) + dz dz < clear2 in float.
+ * bindings: 0 counts uint [in]
+ *           1 points float4 [in]     2 sorted_cells uint4 [in] (last grid's)
+ *           3 ranges uint [in] (last grid's, 3 per bucket)
+ *           4 emitters float [in]    5 pattern float4 [in]
+ *           6 state uint [in/out]    7 flags uint [out]
  * ------------------------------------------------------ sph_emit
- * One item per lattice point i < pattern: when its emitter e fires this
- * step (phase_e + rate_e >= 1), the particle of this point goes to slot
- * n + o_e + j (o_e: the lattice points of the firing emitters before e,
- * j: i - first_e) if that is below the capacity, at
+ * One item per lattice point i < pattern with flags[i] = 1: its particle
+ * goes to slot n + o (o: the flags set before i) if that is below the
+ * capacity, at
  *   centre + u t1 + v t2 + ((phase_e + rate_e) - 1) spacing d
  * (the layer has moved that far past the disc since it crossed it, so
  * layers stay one spacing apart), with velocity v d, mass rest_mass and
- * id state[0] + o_e + j. Written in that order of operations:
+ * id state[0] + o. Written in that order of operations:
  *   x = ((c.x + u t1.x) + v t2.x) + depth d.x.
  * bindings: 0 counts uint [in]
  *           1 points float4 [out]     2 velocity float4 [out]
  *           3 emitters float [in]     4 pattern float4 [in]
- *           5 state uint [in]
+ *           5 state uint [in]         6 flags uint [in]
  * ------------------------------------------------------ sph_emit_commit
- * One item: the step's emission made official. total = the firing
- * emitters' lattice points; state[3] = n + total (the counter);
- * counts[count_word] = min(n + total, capacity); state[0] += total;
- * state[1] += what was made; every phase += rate, less 1 when it fired.
+ * One item: the step's emission made official. total = the flags set;
+ * state[3] = n + total (the counter); counts[count_word] = min(n + total,
+ * capacity); state[0] += total; state[1] += what was made; every phase
+ * += rate, less 1 when it fired.
  * bindings: 0 counts uint [in/out]
  *           1 emitters float [in]
- *           2 state uint [in/out] */
+ *           2 state uint [in/out]
+ *           3 flags uint [in] */
 #ifndef SINEW_SPH_FLOW_PARAMS_H
 #define SINEW_SPH_FLOW_PARAMS_H
 
@@ -94,6 +112,10 @@ SINEW_STRUCT_BEGIN(SphFlowParams)
   uint sinks;       /* sink records */
   float spacing;    /* the fluid's particle spacing [m] */
   float rest_mass;  /* a fluid particle's mass [kg] */
+  float inv_cell;   /* sph_emit_flags: the neighbour grid's 1 / cell [1/m] */
+  uint table_mask;  /* ... its buckets - 1 */
+  float clear2;     /* ... (0.75 spacing)^2 in float [m^2] */
+  uint pad;
 SINEW_STRUCT_END(SphFlowParams)
 
 #ifdef __cplusplus

@@ -79,7 +79,7 @@ void frame_of(const std::array<double, 3>& d, std::array<double, 3>& t1, std::ar
 SphSolver::~SphSolver() {
   if (have_program_) (void)device_.destroy_program(program_);
   for (BufferHandle h : {velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_, state_, emitters_,
-                         pattern_, sinks_, flags_, kept_, compact_scratch_, boundary_position_, boundary_velocity_,
+                         emit_flags_, pattern_, sinks_, flags_, kept_, compact_scratch_, boundary_position_, boundary_velocity_,
                          impulse_})
     if (h.valid()) (void)device_.destroy_buffer(h);
   grid_.reset();
@@ -171,6 +171,11 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
         if (!std::isfinite(x))
           return Error(ErrorCode::bad_parameter, std::string("sph: ") + what + " particle " + std::to_string(i) +
                                                      " has coordinate " + str(x) + ": it must be finite");
+  if (!desc.velocities.empty() && desc.velocities.size() != desc.particles.size())
+    return Error(ErrorCode::bad_parameter, "sph: " + std::to_string(desc.velocities.size()) + " velocities for " +
+                                               std::to_string(desc.particles.size()) + " particles");
+  for (std::size_t i = 0; i < desc.velocities.size(); ++i)
+    if (Status s = finite3("velocity " + std::to_string(i), desc.velocities[i]); !s) return s.error();
   const std::size_t capacity = desc.capacity > 0 ? desc.capacity : desc.particles.size();
   if (desc.particles.size() > capacity)
     return Error(ErrorCode::bad_parameter, "sph: " + std::to_string(desc.particles.size()) +
@@ -215,7 +220,15 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
                          {&m.speed2_, 4 * std::size_t{n}, "sph speeds"},
                          {&m.scratch_, 4 * std::size_t{reduce_scratch_words(n)}, "sph scratch"},
                          {&m.state_, 4 * (SINEW_SPH_STATE_PHASES + desc.emitters.size()), "sph state"}};
-  if (!desc.emitters.empty()) made.push_back({&m.emitters_, 4 * SINEW_SPH_EMITTER_FLOATS * desc.emitters.size(), "sph emitters"});
+  std::uint32_t lattice_points = 0;
+  for (const FluidEmitter& e : desc.emitters) lattice_points += std::uint32_t(emitter_lattice(e.radius, m.spacing_).size());
+  if (lattice_points > 4096)  // sph_emit counts the points before each one in a loop
+    return Error(ErrorCode::bad_parameter, "sph: the emitters' discs hold " + std::to_string(lattice_points) +
+                                               " lattice points, more than 4096: make them smaller or fewer");
+  if (!desc.emitters.empty()) {
+    made.push_back({&m.emitters_, 4 * SINEW_SPH_EMITTER_FLOATS * desc.emitters.size(), "sph emitters"});
+    made.push_back({&m.emit_flags_, 4 * std::size_t{lattice_points}, "sph emitter flags"});
+  }
   if (!desc.sinks.empty()) {
     made.push_back({&m.sinks_, 16 * desc.sinks.size(), "sph sinks"});
     made.push_back({&m.flags_, 4 * std::size_t{n}, "sph sink flags"});
@@ -274,7 +287,8 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   for (std::size_t i = 0; i < desc.particles.size(); ++i) {
     const auto& x = desc.particles[i];
     xyzw.insert(xyzw.end(), {float(x[0]), float(x[1]), float(x[2]), mass});
-    velocity.insert(velocity.end(), {0.0f, 0.0f, 0.0f, std::bit_cast<float>(std::uint32_t(i))});
+    const std::array<double, 3> v = desc.velocities.empty() ? std::array<double, 3>{} : desc.velocities[i];
+    velocity.insert(velocity.end(), {float(v[0]), float(v[1]), float(v[2]), std::bit_cast<float>(std::uint32_t(i))});
   }
   for (std::size_t b = 0; b < boundary.size(); ++b) {
     xyzw.insert(xyzw.end(), {float(boundary[b][0]), float(boundary[b][1]), float(boundary[b][2]), -psi[b]});
@@ -302,6 +316,9 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   m.sinks_count_ = desc.sinks.size();
   for (std::size_t k = 0; k < desc.sinks.size(); ++k)
     if (Status s = m.set_sink(k, desc.sinks[k]); !s) return s.error();
+  // No grid yet: the emitters' first search must find no particle (sph_emit_flags).
+  const std::vector<std::uint32_t> empty(3 * std::size_t{g.buckets()}, 0u);
+  if (Status s = device.write_buffer(g.buffers().ranges, 0, empty.data(), 4 * empty.size()); !s) return s.error();
   if (m.boundary_position_.valid()) {
     std::vector<std::array<float, 3>> x(boundary.size()), v(boundary.size(), {0.0f, 0.0f, 0.0f});
     for (std::size_t b = 0; b < boundary.size(); ++b) x[b] = {float(boundary[b][0]), float(boundary[b][1]), float(boundary[b][2])};
@@ -329,11 +346,27 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
   flow.sinks = static_cast<std::uint32_t>(sinks_count_);
   flow.spacing = float(spacing_);
   flow.rest_mass = float(mass_);
+  flow.inv_cell = g.inv_cell();
+  flow.table_mask = g.buckets() - 1;
+  flow.clear2 = float(0.75 * spacing_) * float(0.75 * spacing_);
 
   FrameProgram step;
   if (moving) {
     step.dispatch(Kernel::sph_boundary_move, n, {b.counts, b.points, velocity_, boundary_position_, boundary_velocity_}, flow);
     step.barrier();
+  }
+  if (have_emitters) {
+    // Before the sinks: the points are still in the last grid's order, which
+    // sph_emit_flags searches for room.
+    step.dispatch(Kernel::sph_emit_flags, std::max(flow.pattern, 1u),
+                  {b.counts, b.points, b.sorted_cells, b.ranges, emitters_, pattern_, state_, emit_flags_}, flow);
+    step.barrier();
+    step.dispatch(Kernel::sph_emit, std::max(flow.pattern, 1u),
+                  {b.counts, b.points, velocity_, emitters_, pattern_, state_, emit_flags_}, flow);
+    step.barrier();
+    step.dispatch(Kernel::sph_emit_commit, 1, {b.counts, emitters_, state_, emit_flags_}, flow);
+    step.barrier();
+    step.counter("sph particles (fluid capacity + boundary particles)", state_, 3, n);
   }
   if (have_sinks) {
     // Flags, their compaction into the kept indices (count in counts[1]),
@@ -349,13 +382,6 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
     step.copy(sorted_velocity_, 0, velocity_, 0, 4 * n);
     step.copy(b.counts, 1, b.counts, 0, 1);
     step.barrier();
-  }
-  if (have_emitters) {
-    step.dispatch(Kernel::sph_emit, std::max(flow.pattern, 1u), {b.counts, b.points, velocity_, emitters_, pattern_, state_}, flow);
-    step.barrier();
-    step.dispatch(Kernel::sph_emit_commit, 1, {b.counts, emitters_, state_}, flow);
-    step.barrier();
-    step.counter("sph particles (fluid capacity + boundary particles)", state_, 3, n);
   }
   // The grid, the density, the velocities in the grid's order, the forces and the motion.
   g.append_grid(step);
@@ -380,12 +406,13 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
 }
 
 Status SphSolver::read_counts() {
-  std::uint32_t count = 0, state[4] = {};
+  std::uint32_t count = 0, state[5] = {};
   if (Status s = device_.read_buffer(grid_->buffers().counts, 0, &count, 4); !s) return s;
   if (Status s = device_.read_buffer(state_, 0, state, sizeof state); !s) return s;
   stats_.particles = std::min(count, slots_) - boundary_;
   stats_.emitted = state[1];
   stats_.removed = state[2];
+  stats_.blocked = state[4];
   stats_.mass = double(stats_.particles) * mass_;
   return {};
 }

@@ -2,10 +2,10 @@
 // fluid particles and boundary particles on the neighbour grid, one
 // program per step:
 //   sph_boundary_move      the boundary to the host's latest pose (moving_boundary)
+//   sph_emit_flags, sph_emit, sph_emit_commit
+//                          the emitters' layers appended where there is room (emitters)
 //   sph_sink_flags, compaction, sph_pack, copies
 //                          the particles inside sinks removed (sinks)
-//   sph_emit, sph_emit_commit
-//                          the emitters' layers appended (emitters)
 //   the grid               sorted by cell (neighbour_grid.h)
 //   sph_density, sph_gather, sph_step [+ sph_boundary_force]
 //   reduce                 the fastest particle, for the CFL check
@@ -83,7 +83,7 @@ class SphSolver {
   Device& device_;
   std::unique_ptr<NeighbourGrid> grid_;
   BufferHandle velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_;
-  BufferHandle state_, emitters_, pattern_, sinks_, flags_, kept_, compact_scratch_;
+  BufferHandle state_, emitters_, emit_flags_, pattern_, sinks_, flags_, kept_, compact_scratch_;
   BufferHandle boundary_position_, boundary_velocity_, impulse_;
   std::uint32_t max_word_ = 0;  // the scratch word that holds the maximum |v|^2 after a step
   double speed_of_sound_ = 0.0, time_step_ = 0.0, h_ = 0.0, spacing_ = 0.0, mass_ = 0.0;

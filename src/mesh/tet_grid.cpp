@@ -214,3 +214,26 @@ Result<TetMesh> make_tet_grid(const TetGridDesc& desc) {
 }
 
 }  // namespace sinew
+
+namespace sinew {
+
+TetMesh drop_unused_vertices(const TetMesh& mesh) {
+  TetMesh out;
+  std::vector<std::uint32_t> renumber(mesh.vertices.size(), ~0u);
+  out.tets.reserve(mesh.tets.size());
+  for (const auto& tet : mesh.tets) {
+    std::array<std::uint32_t, 4> kept{};
+    for (int k = 0; k < 4; ++k) {
+      std::uint32_t& to = renumber[tet[k]];
+      if (to == ~0u) {
+        to = static_cast<std::uint32_t>(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[tet[k]]);
+      }
+      kept[k] = to;
+    }
+    out.tets.push_back(kept);
+  }
+  return out;
+}
+
+}  // namespace sinew

@@ -304,5 +304,6 @@ std::string Simulation::device_name() const { return impl_->device->device_name(
 
 const Device& SimulationInternals::device(const Simulation& sim) { return *sim.impl_->device; }
 const FrameProgram& SimulationInternals::program(const Simulation& sim) { return sim.impl_->program; }
+double SimulationInternals::frame_length(const Simulation& sim) { return sim.impl_->solver.time_step; }
 
 }  // namespace sinew

@@ -11,6 +11,7 @@ namespace sinew {
 struct SimulationInternals {
   static const Device& device(const Simulation& sim);
   static const FrameProgram& program(const Simulation& sim);
+  static double frame_length(const Simulation& sim);  ///< SolverSettings::time_step [s]
 };
 
 }  // namespace sinew
