@@ -19,6 +19,7 @@
 #include "cpu/cpu_kernels.h"
 #include "cpu/fem_kernels.h"   // the AVX2 FEM solves
 #include "cpu/neighbour_kernels.h"  // the AVX2 neighbour query
+#include "cpu/sph_kernels.h"        // the AVX2 fluid density and step
 #include "cpu/xpbd_kernels.h"  // the AVX2 distance and volume solves
 
 namespace sinew {
@@ -58,6 +59,8 @@ kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
   if (simd && kernel == Kernel::xpbd_solve_stvk) return solve_stvk_simd;
   if (simd && kernel == Kernel::xpbd_solve_corotational) return solve_corotational_simd;
   if (simd && kernel == Kernel::nbr_query) return kernels::nbr_query_avx2;
+  if (simd && kernel == Kernel::sph_density) return kernels::sph_density_avx2;
+  if (simd && kernel == Kernel::sph_step) return kernels::sph_step_avx2;
   return kReference[static_cast<std::size_t>(kernel)];
 }
 

@@ -48,6 +48,10 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
   auto* density = reinterpret_cast<float*>(bindings[4]);
   for (u32 s = begin; s < end && s < n; ++s) {
     const float* x = points + 4 * std::size_t{s};
+    if (x[3] < 0.0f) {  // a boundary particle
+      density[s] = p.rho0;
+      continue;
+    }
     const int* c = cells + 4 * std::size_t{s};
     float sum = 0.0f;
     visit_cells(cells, ranges, p.table_mask, c, [&](u32 t) {

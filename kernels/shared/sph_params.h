@@ -25,7 +25,10 @@
  * particles never move.
  *
  * ------------------------------------------------------------ sph_density
- * One item per sorted particle s < n: rho_s = sigma * sum_j |w_j| w(q_j)
+ * One item per sorted particle s < n: a boundary particle (w < 0) gets
+ * rho0 at once (a step needs no boundary density; their volumes at
+ * create are summed with w = +1 instead); a fluid particle
+ * rho_s = sigma * sum_j |w_j| w(q_j)
  * over the particles j (itself included, d2 = 0) with d2 < h2, d2 = (dx dx
  * + dy dy) + dz dz in float, q = sqrt(d2) inv_l, summed in the query's
  * order (27 cells, dz outermost, each run in sorted order), then

@@ -257,11 +257,11 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   p.dt = float(settings.time_step);
   m.params_ = p;
 
-  // The boundary's volumes: its density with "mass" 1 each is sum_k W_bk.
+  // The boundary's volumes: its density with mass 1 each (as if fluid) is sum_k W_bk.
   const auto& boundary = desc.boundary;
   std::vector<float> xyzw;
   xyzw.reserve(4 * total);
-  for (const auto& b : boundary) xyzw.insert(xyzw.end(), {float(b[0]), float(b[1]), float(b[2]), -1.0f});
+  for (const auto& b : boundary) xyzw.insert(xyzw.end(), {float(b[0]), float(b[1]), float(b[2]), 1.0f});
   std::vector<float> psi(boundary.size());
   if (!boundary.empty()) {
     if (Status s = g.upload(xyzw.data(), m.boundary_); !s) return s.error();

@@ -1,0 +1,319 @@
+// sph_kernels_avx2.cpp — the fluid's density and step (sph_kernels.cpp,
+// kernels/shared/sph_params.h) with each neighbour's term computed eight
+// candidates at a time with AVX2, for the CPU backend's speed. Bitwise
+// equal to the scalar reference: the same cells in the same order, every
+// term rounded as the reference rounds it (no fused multiply-add, correctly
+// rounded square roots and divisions), and the terms summed one by one in
+// candidate order, so no sum is reassociated
+// (SphSolver.TheAvx2KernelsAreBitwiseTheReference compares them bit for bit).
+//
+// Tried and measured slower on this 2-core machine (README, "SPH fluid"):
+// packing the neighbours first and computing terms only for them, with the
+// candidates copied once per cell into arrays of each field.
+//
+// Only the functions in the target("avx2") region use AVX2; the CPU backend
+// calls these only where cpu_has_avx2().
+#include <immintrin.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#include "cpu/avx2_lanes.h"
+#include "cpu/sph_kernels.h"
+#include "sph_params.h"
+
+namespace sinew::kernels {
+
+#pragma GCC push_options
+#pragma GCC target("avx2")
+
+namespace {
+
+using u32 = std::uint32_t;
+
+u32 spread10_lanes(u32 v) {
+  v &= 0x3ffu;
+  v = (v * 0x00010001u) & 0xFF0000FFu;
+  v = (v * 0x00000101u) & 0x0F00F00Fu;
+  v = (v * 0x00000011u) & 0xC30C30C3u;
+  v = (v * 0x00000005u) & 0x49249249u;
+  return v;
+}
+
+u32 count_of(const SphParams& p, const std::byte* counts) {
+  const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
+  return stored < p.capacity ? stored : p.capacity;
+}
+
+// The 27 cells' runs around one cell (dz outermost, as the reference visits
+// them), looked up once per cell: the particles of a cell are next to each
+// other in sorted order, so the next particle usually shares them. A run
+// that cannot hold the cell (empty, or one other cell's) is kept empty.
+struct CellRuns {
+  struct Run {
+    u32 begin, end;
+    bool mixed;
+    int cx, cy, cz;
+  };
+  Run runs[27];
+  int at[3] = {0, 0, 0};
+  bool valid = false;
+
+  void look_up(const int* c, const int* cells, const u32* ranges, u32 mask) {
+    if (valid && c[0] == at[0] && c[1] == at[1] && c[2] == at[2]) return;
+    int v = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx, ++v) {
+          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+          const u32 b =
+              ((spread10_lanes(u32(cx)) << 2) | (spread10_lanes(u32(cy)) << 1) | spread10_lanes(u32(cz))) & mask;
+          Run& r = runs[v];
+          r = {ranges[3 * std::size_t{b}], ranges[3 * std::size_t{b} + 1], ranges[3 * std::size_t{b} + 2] != 0, cx, cy, cz};
+          const int* rc = cells + 4 * std::size_t{r.begin};
+          if (r.begin < r.end && !r.mixed && !(rc[0] == cx && rc[1] == cy && rc[2] == cz)) r.end = r.begin;
+        }
+    for (int k = 0; k < 3; ++k) at[k] = c[k];
+    valid = true;
+  }
+};
+
+// Which of the eight candidates t .. t + 7 belong to the run (and, in a
+// mixed bucket, to the visited cell): a lane mask.
+u32 run_lanes(const CellRuns::Run& r, u32 t, const int* cells, const u32 (&index)[8]) {
+  const u32 left = r.end - t;
+  u32 mask = left >= 8 ? 0xffu : (1u << left) - 1u;
+  if (r.mixed) {
+    const avx2::Lanes ct = avx2::load_particles(reinterpret_cast<const float*>(cells), index);
+    __m256i same = _mm256_cmpeq_epi32(_mm256_castps_si256(ct.x), _mm256_set1_epi32(r.cx));
+    same = _mm256_and_si256(same, _mm256_cmpeq_epi32(_mm256_castps_si256(ct.y), _mm256_set1_epi32(r.cy)));
+    same = _mm256_and_si256(same, _mm256_cmpeq_epi32(_mm256_castps_si256(ct.z), _mm256_set1_epi32(r.cz)));
+    mask &= u32(_mm256_movemask_ps(_mm256_castsi256_ps(same)));
+  }
+  return mask;
+}
+
+__m256 select(__m256 when, __m256 yes, __m256 no) { return _mm256_blendv_ps(no, yes, when); }
+
+// The cubic spline's w(q) and w'(q) (sph_params.h), lane by lane.
+__m256 cubic_lanes(__m256 q) {
+  using namespace avx2;
+  const __m256 near = sub(_mm256_set1_ps(1.0f), mul(mul(_mm256_set1_ps(1.5f), q), q));
+  const __m256 inner = add(near, mul(mul(mul(_mm256_set1_ps(0.75f), q), q), q));
+  const __m256 t = sub(_mm256_set1_ps(2.0f), q);
+  const __m256 outer = mul(mul(mul(_mm256_set1_ps(0.25f), t), t), t);
+  return select(_mm256_cmp_ps(q, _mm256_set1_ps(1.0f), _CMP_LT_OQ), inner, outer);
+}
+__m256 cubic_slope_lanes(__m256 q) {
+  using namespace avx2;
+  const __m256 inner = sub(mul(mul(_mm256_set1_ps(2.25f), q), q), mul(_mm256_set1_ps(3.0f), q));
+  const __m256 t = sub(_mm256_set1_ps(2.0f), q);
+  const __m256 outer = mul(mul(_mm256_set1_ps(-0.75f), t), t);
+  return select(_mm256_cmp_ps(q, _mm256_set1_ps(1.0f), _CMP_LT_OQ), inner, outer);
+}
+
+// Tait's equation, negative pressure taken as 0 (sph_params.h).
+float tait_one(const SphParams& p, float rho) {
+  const float r = rho / p.rho0;
+  const float r2 = r * r;
+  const float r4 = r2 * r2;
+  const float r7 = r4 * r2 * r;
+  const float pressure = p.stiffness * (r7 - 1.0f);
+  return pressure > 0.0f ? pressure : 0.0f;
+}
+__m256 tait_lanes(const SphParams& p, __m256 rho) {
+  using namespace avx2;
+  const __m256 r = _mm256_div_ps(rho, _mm256_set1_ps(p.rho0));
+  const __m256 r2 = mul(r, r);
+  const __m256 r4 = mul(r2, r2);
+  const __m256 r7 = mul(mul(r4, r2), r);
+  const __m256 pressure = mul(_mm256_set1_ps(p.stiffness), sub(r7, _mm256_set1_ps(1.0f)));
+  return select(_mm256_cmp_ps(pressure, _mm256_setzero_ps(), _CMP_GT_OQ), pressure, _mm256_setzero_ps());
+}
+
+// The reference's terms for one candidate, for the runs' last few at the
+// buffers' end (sph_kernels.cpp, in its order of operations).
+float cubic_one(float q) {
+  if (q < 1.0f) return (1.0f - (1.5f * q) * q) + ((0.75f * q) * q) * q;
+  const float t = 2.0f - q;
+  return ((0.25f * t) * t) * t;
+}
+float cubic_slope_one(float q) {
+  if (q < 1.0f) return (2.25f * q) * q - 3.0f * q;
+  const float t = 2.0f - q;
+  return (-0.75f * t) * t;
+}
+
+}  // namespace
+
+void sph_density_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  using namespace avx2;
+  const auto& p = *static_cast<const SphParams*>(params);
+  const u32 n = count_of(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
+  auto* density = reinterpret_cast<float*>(bindings[4]);
+  const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l);
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  CellRuns runs;
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const float* x = points + 4 * std::size_t{s};
+    if (x[3] < 0.0f) {  // a boundary particle
+      density[s] = p.rho0;
+      continue;
+    }
+    runs.look_up(cells + 4 * std::size_t{s}, cells, ranges, p.table_mask);
+    const __m256 px = _mm256_set1_ps(x[0]), py = _mm256_set1_ps(x[1]), pz = _mm256_set1_ps(x[2]);
+    float sum = 0.0f;
+    for (const CellRuns::Run& r : runs.runs) {
+      u32 t = r.begin;
+      for (; t < r.end && t + 8 <= p.capacity; t += 8) {
+        const u32 index[8] = {t, t + 1, t + 2, t + 3, t + 4, t + 5, t + 6, t + 7};
+        const Lanes y = load_particles(points, index);
+        const __m256 ex = sub(y.x, px), ey = sub(y.y, py), ez = sub(y.z, pz);
+        const __m256 d2 = add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez));
+        const u32 mask = u32(_mm256_movemask_ps(_mm256_cmp_ps(d2, h2, _CMP_LT_OQ))) & run_lanes(r, t, cells, index);
+        if (mask == 0) continue;
+        alignas(32) float term[8];
+        _mm256_store_ps(term, mul(_mm256_and_ps(y.w, abs_mask), cubic_lanes(mul(_mm256_sqrt_ps(d2), inv_l))));
+        for (u32 j = 0; j < 8; ++j)
+          if (mask >> j & 1u) sum = sum + term[j];
+      }
+      for (; t < r.end; ++t) {  // at the buffer's end, one by one as the reference
+        const int* ct = cells + 4 * std::size_t{t};
+        if (r.mixed && !(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
+        const float* y = points + 4 * std::size_t{t};
+        const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
+        const float d2 = ex * ex + ey * ey + ez * ez;
+        if (!(d2 < p.h2)) continue;
+        sum = sum + std::fabs(y[3]) * cubic_one(std::sqrt(d2) * p.inv_l);
+      }
+    }
+    density[s] = p.sigma * sum;
+  }
+}
+
+void sph_step_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  using namespace avx2;
+  const auto& p = *static_cast<const SphParams*>(params);
+  const u32 n = count_of(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
+  const auto* density = reinterpret_cast<const float*>(bindings[4]);
+  const auto* sorted_velocity = reinterpret_cast<const float*>(bindings[5]);
+  auto* next_points = reinterpret_cast<float*>(bindings[6]);
+  auto* next_velocity = reinterpret_cast<float*>(bindings[7]);
+  auto* pressure = reinterpret_cast<float*>(bindings[8]);
+  auto* speed2 = reinterpret_cast<float*>(bindings[9]);
+  const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l), zero = _mm256_setzero_ps();
+  const __m256 grad_sigma = _mm256_set1_ps(p.grad_sigma), eta2 = _mm256_set1_ps(p.eta2), half = _mm256_set1_ps(0.5f);
+  const __m256 minus_viscosity = _mm256_set1_ps(-p.viscosity), minus_boundary = _mm256_set1_ps(-p.boundary_viscosity);
+  CellRuns runs;
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const float* x = points + 4 * std::size_t{s};
+    const float* v = sorted_velocity + 4 * std::size_t{s};
+    const float rho = density[s];
+    const float pi = tait_one(p, rho);
+    pressure[s] = pi;
+    if (!(x[3] > 0.0f)) {  // a boundary particle stays
+      std::memcpy(next_points + 4 * std::size_t{s}, x, 16);
+      std::memcpy(next_velocity + 4 * std::size_t{s}, v, 16);
+      speed2[s] = 0.0f;
+      continue;
+    }
+    const float own = pi / (rho * rho);
+    runs.look_up(cells + 4 * std::size_t{s}, cells, ranges, p.table_mask);
+    const __m256 px = _mm256_set1_ps(x[0]), py = _mm256_set1_ps(x[1]), pz = _mm256_set1_ps(x[2]);
+    const __m256 vx = _mm256_set1_ps(v[0]), vy = _mm256_set1_ps(v[1]), vz = _mm256_set1_ps(v[2]);
+    const __m256 rho_i = _mm256_set1_ps(rho), own_i = _mm256_set1_ps(own);
+    float ax = 0.0f, ay = 0.0f, az = 0.0f;
+    for (const CellRuns::Run& r : runs.runs) {
+      u32 t = r.begin;
+      for (; t < r.end && t + 8 <= p.capacity; t += 8) {
+        const u32 index[8] = {t, t + 1, t + 2, t + 3, t + 4, t + 5, t + 6, t + 7};
+        const Lanes y = load_particles(points, index);
+        const __m256 ex = sub(px, y.x), ey = sub(py, y.y), ez = sub(pz, y.z);
+        const __m256 d2 = add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez));
+        const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(d2, h2, _CMP_LT_OQ), _mm256_cmp_ps(d2, zero, _CMP_GT_OQ));
+        const u32 mask = u32(_mm256_movemask_ps(inside)) & run_lanes(r, t, cells, index);
+        if (mask == 0) continue;
+        const __m256 dist = _mm256_sqrt_ps(d2);
+        const __m256 gw = _mm256_div_ps(mul(grad_sigma, cubic_slope_lanes(mul(dist, inv_l))), dist);
+        const Lanes w = load_particles(sorted_velocity, index);
+        const __m256 approach = add(add(mul(sub(vx, w.x), ex), mul(sub(vy, w.y), ey)), mul(sub(vz, w.z), ez));
+        const __m256 closing = _mm256_cmp_ps(approach, zero, _CMP_LT_OQ);
+        const __m256 d2_eta = add(d2, eta2);
+        // A fluid neighbour: both pressures and the viscosity.
+        const __m256 rho_j = _mm256_loadu_ps(density + t);
+        const __m256 visc_fluid = select(
+            closing, _mm256_div_ps(mul(minus_viscosity, approach), mul(mul(half, add(rho_i, rho_j)), d2_eta)), zero);
+        const __m256 pj = tait_lanes(p, rho_j);
+        const __m256 fluid_factor = mul(y.w, add(add(own_i, _mm256_div_ps(pj, mul(rho_j, rho_j))), visc_fluid));
+        // A boundary neighbour: its pressure mirrored, and its own viscosity.
+        const __m256 visc_boundary =
+            select(closing, _mm256_div_ps(mul(minus_boundary, approach), mul(rho_i, d2_eta)), zero);
+        const __m256 boundary_factor = mul(negate(y.w), add(own_i, visc_boundary));
+        const __m256 factor = select(_mm256_cmp_ps(y.w, zero, _CMP_GT_OQ), fluid_factor, boundary_factor);
+        const __m256 f = mul(factor, gw);
+        alignas(32) float fx[8], fy[8], fz[8];
+        _mm256_store_ps(fx, mul(f, ex));
+        _mm256_store_ps(fy, mul(f, ey));
+        _mm256_store_ps(fz, mul(f, ez));
+        for (u32 j = 0; j < 8; ++j)
+          if (mask >> j & 1u) {
+            ax = ax - fx[j];
+            ay = ay - fy[j];
+            az = az - fz[j];
+          }
+      }
+      for (; t < r.end; ++t) {  // at the buffer's end, one by one as the reference
+        const int* ct = cells + 4 * std::size_t{t};
+        if (r.mixed && !(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
+        if (t == s) continue;
+        const float* y = points + 4 * std::size_t{t};
+        const float ex = x[0] - y[0], ey = x[1] - y[1], ez = x[2] - y[2];
+        const float d2 = ex * ex + ey * ey + ez * ez;
+        if (!(d2 < p.h2) || !(d2 > 0.0f)) continue;
+        const float dist = std::sqrt(d2);
+        const float gw = p.grad_sigma * cubic_slope_one(dist * p.inv_l) / dist;
+        const float* w = sorted_velocity + 4 * std::size_t{t};
+        const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
+        const float approach = ux * ex + uy * ey + uz * ez;
+        float factor;
+        if (y[3] > 0.0f) {
+          const float rho_j = density[t];
+          const float visc = approach < 0.0f ? -p.viscosity * approach / ((0.5f * (rho + rho_j)) * (d2 + p.eta2)) : 0.0f;
+          factor = y[3] * (own + tait_one(p, rho_j) / (rho_j * rho_j) + visc);
+        } else {
+          const float visc = approach < 0.0f ? -p.boundary_viscosity * approach / (rho * (d2 + p.eta2)) : 0.0f;
+          factor = -y[3] * (own + visc);
+        }
+        const float f = factor * gw;
+        ax = ax - f * ex;
+        ay = ay - f * ey;
+        az = az - f * ez;
+      }
+    }
+    ax = ax + p.gx;
+    ay = ay + p.gy;
+    az = az + p.gz;
+    float* xn = next_points + 4 * std::size_t{s};
+    float* vn = next_velocity + 4 * std::size_t{s};
+    vn[0] = v[0] + p.dt * ax;
+    vn[1] = v[1] + p.dt * ay;
+    vn[2] = v[2] + p.dt * az;
+    vn[3] = v[3];  // the id's bits
+    speed2[s] = (vn[0] * vn[0] + vn[1] * vn[1]) + vn[2] * vn[2];
+    xn[0] = x[0] + p.dt * vn[0];
+    xn[1] = x[1] + p.dt * vn[1];
+    xn[2] = x[2] + p.dt * vn[2];
+    xn[3] = x[3];
+  }
+}
+
+#pragma GCC pop_options
+
+}  // namespace sinew::kernels
