@@ -12,7 +12,11 @@
 // candidates copied once per cell into arrays of each field.
 //
 // Only the functions in the target("avx2") region use AVX2; the CPU backend
-// calls these only where cpu_has_avx2().
+// calls these only where cpu_has_avx2(). The scalar helpers below (the
+// spline, Tait's equation, the bucket hash) are deliberate copies of the
+// reference's: an inline function shared with a file built without AVX2
+// could be emitted here with AVX2 instructions and picked by the linker
+// for every caller.
 #include <immintrin.h>
 
 #include <cmath>
