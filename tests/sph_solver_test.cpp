@@ -166,15 +166,22 @@ TEST(SphSolver, TheAvx2KernelsAreBitwiseTheReference) {
     for (int j = 0; j < 6; ++j)
       for (int k = 0; k < 6; ++k) block.push_back({(i + 1.5) * s, (j + 2.5) * s, (k + 1.5) * s});
   std::vector<std::vector<SphParticle>> out;
+  std::vector<std::vector<std::array<float, 3>>> impulses;
   std::vector<std::string> names;
   for (bool simd : {false, true}) {
     auto device = create_device({.backend = "cpu", .cpu_simd = simd, .quiet = true});
     ASSERT_TRUE(device.ok()) << device.error().message();
     names.push_back((*device)->device_name());
-    auto solver = SphSolver::create(**device, {.spacing = s}, block, t.boundary);
+    FluidDesc desc;
+    desc.settings.spacing = s;
+    desc.particles = block;
+    desc.boundary = t.boundary;
+    desc.boundary_forces = true;  // and sph_boundary_force_avx2
+    auto solver = SphSolver::create(**device, desc);
     ASSERT_TRUE(solver.ok()) << solver.error().message();
     SINEW_ASSERT_OK((*solver)->step(400));
     SINEW_ASSERT_OK((*solver)->read(out.emplace_back()));
+    SINEW_ASSERT_OK((*solver)->read_boundary_impulses(impulses.emplace_back()));
   }
   if (names[0] == names[1]) GTEST_SKIP() << "no AVX2 here: " << names[1];
   ASSERT_EQ(out[0].size(), out[1].size());
@@ -182,6 +189,11 @@ TEST(SphSolver, TheAvx2KernelsAreBitwiseTheReference) {
   for (std::size_t i = 0; i < out[0].size(); ++i)
     differ += std::memcmp(&out[0][i], &out[1][i], sizeof(SphParticle)) != 0;
   EXPECT_EQ(differ, 0) << "particles whose bits differ";
+  ASSERT_EQ(impulses[0].size(), t.boundary.size());
+  float pushed = 0.0f;
+  for (const auto& j : impulses[0]) pushed += std::abs(j[1]);
+  EXPECT_GT(pushed, 0.0f) << "the floor took an impulse";
+  EXPECT_EQ(std::memcmp(impulses[0].data(), impulses[1].data(), 12 * impulses[0].size()), 0) << "boundary impulses";
 }
 
 TEST(SphSolver, AStepAtTheSoundsBoundFailsOnceTheParticlesMove) {

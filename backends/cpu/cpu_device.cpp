@@ -61,6 +61,7 @@ kernels::CpuKernelFn cpu_kernel(Kernel kernel, bool simd) {
   if (simd && kernel == Kernel::nbr_query) return kernels::nbr_query_avx2;
   if (simd && kernel == Kernel::sph_density) return kernels::sph_density_avx2;
   if (simd && kernel == Kernel::sph_step) return kernels::sph_step_avx2;
+  if (simd && kernel == Kernel::sph_boundary_force) return kernels::sph_boundary_force_avx2;
   return kReference[static_cast<std::size_t>(kernel)];
 }
 

@@ -15,5 +15,7 @@ namespace sinew::kernels {
 void sph_density_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 /// sph_step likewise.
 void sph_step_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
+/// sph_boundary_force likewise.
+void sph_boundary_force_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end);
 
 }  // namespace sinew::kernels

@@ -318,6 +318,93 @@ void sph_step_avx2(const void* params, std::byte* const* bindings, std::uint32_t
   }
 }
 
+void sph_boundary_force_avx2(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                             std::uint32_t end) {
+  using namespace avx2;
+  const auto& p = *static_cast<const SphParams*>(params);
+  const u32 n = count_of(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
+  const auto* density = reinterpret_cast<const float*>(bindings[4]);
+  const auto* sorted_velocity = reinterpret_cast<const float*>(bindings[5]);
+  auto* impulse = reinterpret_cast<float*>(bindings[6]);
+  const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l), zero = _mm256_setzero_ps();
+  const __m256 grad_sigma = _mm256_set1_ps(p.grad_sigma), eta2 = _mm256_set1_ps(p.eta2);
+  const __m256 minus_boundary = _mm256_set1_ps(-p.boundary_viscosity);
+  CellRuns runs;
+  for (u32 s = begin; s < end && s < n; ++s) {
+    const float* x = points + 4 * std::size_t{s};
+    if (x[3] > 0.0f) continue;  // a fluid particle
+    const float* w = sorted_velocity + 4 * std::size_t{s};
+    const float psi = -x[3];
+    runs.look_up(cells + 4 * std::size_t{s}, cells, ranges, p.table_mask);
+    const __m256 px = _mm256_set1_ps(x[0]), py = _mm256_set1_ps(x[1]), pz = _mm256_set1_ps(x[2]);
+    const __m256 wx = _mm256_set1_ps(w[0]), wy = _mm256_set1_ps(w[1]), wz = _mm256_set1_ps(w[2]);
+    const __m256 psi_b = _mm256_set1_ps(psi);
+    float fx = 0.0f, fy = 0.0f, fz = 0.0f;
+    for (const CellRuns::Run& r : runs.runs) {
+      u32 t = r.begin;
+      for (; t < r.end && t + 8 <= p.capacity; t += 8) {
+        const u32 index[8] = {t, t + 1, t + 2, t + 3, t + 4, t + 5, t + 6, t + 7};
+        const Lanes y = load_particles(points, index);
+        const __m256 ex = sub(y.x, px), ey = sub(y.y, py), ez = sub(y.z, pz);
+        const __m256 d2 = add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez));
+        const __m256 inside = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(d2, h2, _CMP_LT_OQ), _mm256_cmp_ps(d2, zero, _CMP_GT_OQ)),
+                                            _mm256_cmp_ps(y.w, zero, _CMP_GT_OQ));  // fluid only
+        const u32 mask = u32(_mm256_movemask_ps(inside)) & run_lanes(r, t, cells, index);
+        if (mask == 0) continue;
+        const __m256 dist = _mm256_sqrt_ps(d2);
+        const __m256 gw = _mm256_div_ps(mul(grad_sigma, cubic_slope_lanes(mul(dist, inv_l))), dist);
+        const Lanes v = load_particles(sorted_velocity, index);
+        const __m256 approach = add(add(mul(sub(v.x, wx), ex), mul(sub(v.y, wy), ey)), mul(sub(v.z, wz), ez));
+        const __m256 rho = _mm256_loadu_ps(density + t);
+        const __m256 own = _mm256_div_ps(tait_lanes(p, rho), mul(rho, rho));
+        const __m256 visc = select(_mm256_cmp_ps(approach, zero, _CMP_LT_OQ),
+                                   _mm256_div_ps(mul(minus_boundary, approach), mul(rho, add(d2, eta2))), zero);
+        const __m256 f = mul(y.w, mul(mul(psi_b, add(own, visc)), gw));
+        alignas(32) float gx[8], gy[8], gz[8];
+        _mm256_store_ps(gx, mul(f, ex));
+        _mm256_store_ps(gy, mul(f, ey));
+        _mm256_store_ps(gz, mul(f, ez));
+        for (u32 j = 0; j < 8; ++j)
+          if (mask >> j & 1u) {
+            fx = fx + gx[j];
+            fy = fy + gy[j];
+            fz = fz + gz[j];
+          }
+      }
+      for (; t < r.end; ++t) {  // at the buffer's end, one by one as the reference
+        const int* ct = cells + 4 * std::size_t{t};
+        if (r.mixed && !(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
+        const float* y = points + 4 * std::size_t{t};
+        if (!(y[3] > 0.0f)) continue;
+        const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
+        const float d2 = ex * ex + ey * ey + ez * ez;
+        if (!(d2 < p.h2) || !(d2 > 0.0f)) continue;
+        const float dist = std::sqrt(d2);
+        const float gw = p.grad_sigma * cubic_slope_one(dist * p.inv_l) / dist;
+        const float* v = sorted_velocity + 4 * std::size_t{t};
+        const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
+        const float approach = ux * ex + uy * ey + uz * ez;
+        const float rho = density[t];
+        const float own = tait_one(p, rho) / (rho * rho);
+        const float visc = approach < 0.0f ? -p.boundary_viscosity * approach / (rho * (d2 + p.eta2)) : 0.0f;
+        const float f = y[3] * ((psi * (own + visc)) * gw);
+        fx = fx + f * ex;
+        fy = fy + f * ey;
+        fz = fz + f * ez;
+      }
+    }
+    u32 id;
+    std::memcpy(&id, w + 3, 4);
+    float* out = impulse + 4 * std::size_t{id & 0x7fffffffu};
+    out[0] = out[0] + p.dt * fx;
+    out[1] = out[1] + p.dt * fy;
+    out[2] = out[2] + p.dt * fz;
+  }
+}
+
 #pragma GCC pop_options
 
 }  // namespace sinew::kernels
