@@ -96,6 +96,11 @@
   SINEW_KERNEL(sph_pack, 7, SphFlowParams, 0)                                   \
   SINEW_KERNEL(sph_emit_flags, 8, SphFlowParams, 0)                             \
   SINEW_KERNEL(sph_emit, 7, SphFlowParams, 0)                                   \
-  SINEW_KERNEL(sph_emit_commit, 4, SphFlowParams, 0)
+  SINEW_KERNEL(sph_emit_commit, 4, SphFlowParams, 0)                            \
+  /* position-based fluids (kernels/shared/pbf_params.h) */                     \
+  SINEW_KERNEL(pbf_predict, 4, PbfParams, 0)                                    \
+  SINEW_KERNEL(pbf_lambda, 6, PbfParams, 0)                                     \
+  SINEW_KERNEL(pbf_delta, 6, PbfParams, 0)                                      \
+  SINEW_KERNEL(pbf_finish, 9, PbfParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

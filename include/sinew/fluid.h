@@ -31,15 +31,32 @@
 
 namespace sinew {
 
+/// The solver (README, "SPH fluid", has the measured comparison).
+enum class FluidMethod {
+  /// Weakly compressible SPH (Becker and Teschner 2007): pressure from
+  /// density by Tait's equation, explicit steps bound by the speed of sound.
+  wcsph,
+  /// Position-based fluids (Macklin and Müller 2013): density constraints
+  /// projected by pbf_iterations Jacobi sweeps a step, steps bound only by
+  /// the particles' speed (0.4 h per step). No boundary forces (no coupling
+  /// with tissue), no pressure, no viscosity yet.
+  pbf,
+};
+
 struct FluidSettings {
+  FluidMethod method = FluidMethod::wcsph;
   double spacing = 1e-3;        ///< the fluid's particle spacing [m], > 0; a particle's mass is rho0 spacing^3
   double support = 2.0;         ///< the kernels' support radius h in spacings, >= 1
   double rest_density = 1000.0; ///< rho0 [kg/m^3], > 0 (blood: about 1060)
-  double speed_of_sound = 10.0; ///< c0 [m/s], > 0: about 10x the fastest flow keeps density within 1%
+  double speed_of_sound = 10.0; ///< c0 [m/s], > 0: about 10x the fastest flow keeps density within 1% (wcsph)
   double viscosity = 0.1;       ///< Monaghan's alpha between fluid particles, >= 0
   double boundary_viscosity = 0.1;  ///< ... against boundary particles, >= 0 (0: free-slip walls)
-  double time_step = 5e-5;      ///< [s], > 0, at most 0.4 h / c0 (the CFL condition; an error beyond)
+  double time_step = 5e-5;      ///< [s], > 0; wcsph: at most 0.4 h / c0 (the CFL condition; an error beyond)
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
+  int pbf_iterations = 4;        ///< pbf: Jacobi sweeps of the density constraints per step, >= 1
+  /// pbf: epsilon, the softening of every constraint, as a fraction of a
+  /// particle's constraint stiffness inside a fluid at rest, > 0.
+  double pbf_relaxation = 0.01;
 };
 
 /// A source: a disc that lets fluid through at a flow rate, layer after

@@ -5,12 +5,14 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <numeric>
 #include <string>
 
 #include "fluid/sph_density.h"
 #include "program/primitives.h"
 #include "sph_flow_params.h"
+#include "pbf_params.h"
 
 namespace sinew {
 namespace {
@@ -42,6 +44,11 @@ Status check_settings(const FluidSettings& settings) {
   if (Status s = finite3("gravity", settings.gravity); !s) return s;
   if (!(settings.support >= 1.0) || !std::isfinite(settings.support))
     return Error(ErrorCode::bad_parameter, "sph: support must be finite and >= 1 spacing (got " + str(settings.support) + ")");
+  if (settings.method == FluidMethod::pbf) {
+    if (settings.pbf_iterations < 1)
+      return Error(ErrorCode::bad_parameter, "sph: pbf_iterations must be >= 1 (got " + std::to_string(settings.pbf_iterations) + ")");
+    return positive("pbf_relaxation", settings.pbf_relaxation);
+  }
   // The CFL condition for the speed of sound (Monaghan 2005): reported, never clamped.
   const double h = settings.support * settings.spacing;
   const double cfl = 0.4 * h / settings.speed_of_sound;
@@ -79,7 +86,7 @@ void frame_of(const std::array<double, 3>& d, std::array<double, 3>& t1, std::ar
 SphSolver::~SphSolver() {
   if (have_program_) (void)device_.destroy_program(program_);
   for (BufferHandle h : {velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_, state_, emitters_,
-                         emit_flags_, pattern_, sinks_, flags_, kept_, compact_scratch_, boundary_position_, boundary_velocity_,
+                         emit_flags_, previous_, lambda_, moved_, pattern_, sinks_, flags_, kept_, compact_scratch_, boundary_position_, boundary_velocity_,
                          impulse_})
     if (h.valid()) (void)device_.destroy_buffer(h);
   grid_.reset();
@@ -190,7 +197,12 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   m.boundary_ = static_cast<std::uint32_t>(desc.boundary.size());
   m.capacity_ = static_cast<std::uint32_t>(capacity);
   m.slots_ = static_cast<std::uint32_t>(total);
-  m.speed_of_sound_ = settings.speed_of_sound;
+  m.pbf_ = settings.method == FluidMethod::pbf;
+  m.speed_of_sound_ = m.pbf_ ? 0.0 : settings.speed_of_sound;  // PBF's steps are bound by the particles' speed alone
+  m.iterations_ = settings.pbf_iterations;
+  if (m.pbf_ && desc.boundary_forces)
+    return Error(ErrorCode::bad_parameter, "sph: boundary_forces (and coupling with tissue) need method wcsph: "
+                                           "PBF's reaction on the boundary is not built");
   m.h_ = h;
   m.spacing_ = settings.spacing;
   m.time_step_ = settings.time_step;
@@ -240,6 +252,11 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
     made.push_back({&m.boundary_velocity_, 16 * std::size_t{m.boundary_}, "sph boundary velocities"});
   }
   if (desc.boundary_forces && m.boundary_ > 0) made.push_back({&m.impulse_, 16 * std::size_t{m.boundary_}, "sph boundary impulses"});
+  if (m.pbf_) {
+    made.push_back({&m.previous_, 16 * std::size_t{n}, "pbf previous positions"});
+    made.push_back({&m.lambda_, 4 * std::size_t{n}, "pbf lambdas"});
+    made.push_back({&m.moved_, 16 * std::size_t{n}, "pbf moved positions"});
+  }
   for (const Made& b : made) {
     auto buffer = device.create_buffer(std::max<std::size_t>(b.bytes, 16), b.label);
     if (!buffer) return buffer.error();
@@ -256,6 +273,39 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   p.gz = float(settings.gravity[2]);
   p.dt = float(settings.time_step);
   m.params_ = p;
+  if (m.pbf_) {
+    kernels::PbfParams q{};
+    q.count_word = 0;
+    q.capacity = p.capacity;
+    q.table_mask = p.table_mask;
+    q.h2 = p.h2;
+    q.inv_l = p.inv_l;
+    q.sigma = p.sigma;
+    q.grad_sigma = p.grad_sigma;
+    q.rho0 = p.rho0;
+    q.inv_rho0 = float(1.0 / settings.rest_density);
+    q.dt = p.dt;
+    q.inv_dt = float(1.0 / settings.time_step);
+    q.gx = p.gx;
+    q.gy = p.gy;
+    q.gz = p.gz;
+    // epsilon: a fraction of sum_j |grad_j C_i|^2 / m_j inside a fluid at rest
+    // (a cubic lattice of the spacing), the constraint's stiffness there.
+    const double l = 0.5 * h, mass = settings.rest_density * std::pow(settings.spacing, 3);
+    double stiffness = 0.0;
+    const int reach = int(std::ceil(h / settings.spacing));
+    for (int i = -reach; i <= reach; ++i)
+      for (int j = -reach; j <= reach; ++j)
+        for (int k = -reach; k <= reach; ++k) {
+          const double r = settings.spacing * std::sqrt(double(i * i + j * j + k * k)), q2 = r / l;
+          if (r == 0.0 || r >= h) continue;
+          const double slope = q2 < 1.0 ? 2.25 * q2 * q2 - 3.0 * q2 : -0.75 * (2.0 - q2) * (2.0 - q2);
+          const double gradient = mass / settings.rest_density * slope / (std::numbers::pi * l * l * l * l);
+          stiffness += gradient * gradient / mass;
+        }
+    q.epsilon = float(settings.pbf_relaxation * stiffness);
+    m.pbf_params_ = q;
+  }
 
   // The boundary's volumes: its density with mass 1 each (as if fluid) is sum_k W_bk.
   const auto& boundary = desc.boundary;
@@ -383,6 +433,53 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
     step.copy(b.counts, 1, b.counts, 0, 1);
     step.barrier();
   }
+  if (pbf_) {
+    append_pbf(step);
+  } else {
+    append_wcsph(step, forces);
+  }
+  // The fastest particle, for the speed check after the steps.
+  max_word_ = append_reduce(step, {b.counts, 0, n}, ReduceOp::max_f32, {speed2_, 0}, 1, {scratch_, 0});
+  auto program = device_.create_program(step);
+  if (!program) return program.error();
+  program_ = *program;
+  have_program_ = true;
+  return {};
+}
+
+void SphSolver::append_pbf(FrameProgram& step) const {
+  // Predict, sort the predicted positions along the grid, project the
+  // density constraints (Jacobi: lambdas, then moves, copied back), then
+  // the velocities from the motion (pbf_params.h).
+  const NeighbourGrid& g = *grid_;
+  const NeighbourGridBuffers& b = g.buffers();
+  const std::uint32_t n = slots_;
+  step.dispatch(Kernel::pbf_predict, n, {b.counts, b.points, velocity_, previous_}, pbf_params_);
+  step.barrier();
+  g.append_grid(step);
+  step.dispatch(Kernel::sph_gather, n, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
+  step.barrier();
+  for (int it = 0; it < iterations_; ++it) {
+    step.dispatch(Kernel::pbf_lambda, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, lambda_},
+                  pbf_params_);
+    step.barrier();
+    step.dispatch(Kernel::pbf_delta, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, lambda_, moved_},
+                  pbf_params_);
+    step.barrier();
+    step.copy(moved_, 0, b.sorted_points, 0, 4 * n);
+    step.barrier();
+  }
+  step.dispatch(Kernel::pbf_finish, n,
+                {b.counts, b.sorted_points, b.order, previous_, sorted_velocity_, b.points, velocity_, speed2_,
+                 pressure_},
+                pbf_params_);
+  step.barrier();
+}
+
+void SphSolver::append_wcsph(FrameProgram& step, bool forces) const {
+  const NeighbourGrid& g = *grid_;
+  const NeighbourGridBuffers& b = g.buffers();
+  const std::uint32_t n = slots_;
   // The grid, the density, the velocities in the grid's order, the forces and the motion.
   g.append_grid(step);
   append_sph_density(step, g, params_, density_);
@@ -396,13 +493,6 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
     step.dispatch(Kernel::sph_boundary_force, n,
                   {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, impulse_}, params_);
   step.barrier();
-  // The fastest particle, for the CFL check after the steps.
-  max_word_ = append_reduce(step, {b.counts, 0, n}, ReduceOp::max_f32, {speed2_, 0}, 1, {scratch_, 0});
-  auto program = device_.create_program(step);
-  if (!program) return program.error();
-  program_ = *program;
-  have_program_ = true;
-  return {};
 }
 
 Status SphSolver::read_counts() {
@@ -434,6 +524,10 @@ Status SphSolver::step(int steps) {
   stats_.max_speed = std::sqrt(double(v2));
   if (!ran) return ran;
   const double bound = 0.4 * h_ / (speed_of_sound_ + stats_.max_speed);
+  if (pbf_ && !(time_step_ <= bound))
+    return Error(ErrorCode::bad_parameter, "sph: time_step " + str(time_step_) + " s moves the fastest particle (" +
+                                               str(stats_.max_speed) + " m/s) more than 0.4 h per step (bound " +
+                                               str(bound) + " s): shorten it");
   if (!(time_step_ <= bound))
     return Error(ErrorCode::bad_parameter, "sph: time_step " + str(time_step_) + " s is beyond the CFL bound 0.4 h / (c0 + "
                                                "v_max) = " + str(bound) + " s with a particle at " + str(stats_.max_speed) +

@@ -30,6 +30,7 @@
 #include "neighbours/neighbour_grid.h"
 #include "sinew/fluid.h"
 #include "sph_params.h"
+#include "pbf_params.h"
 
 namespace sinew {
 
@@ -75,6 +76,8 @@ class SphSolver {
  private:
   explicit SphSolver(Device& device) : device_(device) {}
   Status build_program(bool have_sinks, bool have_emitters, bool moving, bool forces);
+  void append_wcsph(FrameProgram& step, bool forces) const;
+  void append_pbf(FrameProgram& step) const;
   /// Emitter `index`'s record (sph_flow_params.h) and, at create, its lattice.
   Status write_emitter(std::size_t index, const FluidEmitter& emitter, std::vector<float>* pattern);
   Status check_emitter(std::size_t index, const FluidEmitter& emitter) const;
@@ -85,6 +88,10 @@ class SphSolver {
   BufferHandle velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_;
   BufferHandle state_, emitters_, emit_flags_, pattern_, sinks_, flags_, kept_, compact_scratch_;
   BufferHandle boundary_position_, boundary_velocity_, impulse_;
+  BufferHandle previous_, lambda_, moved_;  // pbf
+  kernels::PbfParams pbf_params_{};
+  bool pbf_ = false;
+  int iterations_ = 0;
   std::uint32_t max_word_ = 0;  // the scratch word that holds the maximum |v|^2 after a step
   double speed_of_sound_ = 0.0, time_step_ = 0.0, h_ = 0.0, spacing_ = 0.0, mass_ = 0.0;
   ProgramHandle program_{};
