@@ -7,9 +7,12 @@
 // candidate order, so no sum is reassociated
 // (SphSolver.TheAvx2KernelsAreBitwiseTheReference compares them bit for bit).
 //
-// Tried and measured slower on this 2-core machine (README, "SPH fluid"):
-// packing the neighbours first and computing terms only for them, with the
-// candidates copied once per cell into arrays of each field.
+// The density and step put up to eight particles of one cell in the lanes
+// and broadcast each shared candidate to them; the boundary force takes
+// eight candidates of one particle at a time. Tried and measured slower
+// (README, "SPH fluid"): candidates in the lanes for the density and step,
+// and packing the neighbours first to compute terms only for them, with
+// each cell's candidates copied into arrays of each field.
 //
 // Only the functions in the target("avx2") region use AVX2; the CPU backend
 // calls these only where cpu_has_avx2(). The scalar helpers below (the
@@ -136,13 +139,8 @@ __m256 tait_lanes(const SphParams& p, __m256 rho) {
   return select(_mm256_cmp_ps(pressure, _mm256_setzero_ps(), _CMP_GT_OQ), pressure, _mm256_setzero_ps());
 }
 
-// The reference's terms for one candidate, for the runs' last few at the
-// buffers' end (sph_kernels.cpp, in its order of operations).
-float cubic_one(float q) {
-  if (q < 1.0f) return (1.0f - (1.5f * q) * q) + ((0.75f * q) * q) * q;
-  const float t = 2.0f - q;
-  return ((0.25f * t) * t) * t;
-}
+// The reference's slope for one candidate, for sph_boundary_force_avx2's
+// runs' last few at the buffers' end (sph_kernels.cpp, in its order).
 float cubic_slope_one(float q) {
   if (q < 1.0f) return (2.25f * q) * q - 3.0f * q;
   const float t = 2.0f - q;
@@ -159,43 +157,44 @@ void sph_density_avx2(const void* params, std::byte* const* bindings, std::uint3
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
   auto* density = reinterpret_cast<float*>(bindings[4]);
-  const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l);
-  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l), zero = _mm256_setzero_ps();
+  const u32 last = end < n ? end : n;
   CellRuns runs;
-  for (u32 s = begin; s < end && s < n; ++s) {
-    const float* x = points + 4 * std::size_t{s};
-    if (x[3] < 0.0f) {  // a boundary particle
-      density[s] = p.rho0;
-      continue;
-    }
-    runs.look_up(cells + 4 * std::size_t{s}, cells, ranges, p.table_mask);
-    const __m256 px = _mm256_set1_ps(x[0]), py = _mm256_set1_ps(x[1]), pz = _mm256_set1_ps(x[2]);
-    float sum = 0.0f;
-    for (const CellRuns::Run& r : runs.runs) {
-      u32 t = r.begin;
-      for (; t < r.end && t + 8 <= p.capacity; t += 8) {
-        const u32 index[8] = {t, t + 1, t + 2, t + 3, t + 4, t + 5, t + 6, t + 7};
-        const Lanes y = load_particles(points, index);
-        const __m256 ex = sub(y.x, px), ey = sub(y.y, py), ez = sub(y.z, pz);
-        const __m256 d2 = add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez));
-        const u32 mask = u32(_mm256_movemask_ps(_mm256_cmp_ps(d2, h2, _CMP_LT_OQ))) & run_lanes(r, t, cells, index);
-        if (mask == 0) continue;
-        alignas(32) float term[8];
-        _mm256_store_ps(term, mul(_mm256_and_ps(y.w, abs_mask), cubic_lanes(mul(_mm256_sqrt_ps(d2), inv_l))));
-        for (u32 j = 0; j < 8; ++j)
-          if (mask >> j & 1u) sum = sum + term[j];
-      }
-      for (; t < r.end; ++t) {  // at the buffer's end, one by one as the reference
-        const int* ct = cells + 4 * std::size_t{t};
-        if (r.mixed && !(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
+  // Up to eight particles of one cell at a time, one a lane: they share
+  // their candidates, each read once and broadcast to every lane, and each
+  // lane sums its terms in candidate order. A lane a candidate is not
+  // within the support of adds +0, which leaves its sum (>= +0) bitwise as
+  // it was, so each particle's density is the reference's.
+  for (u32 s = begin; s < last;) {
+    const int* c = cells + 4 * std::size_t{s};
+    u32 k = 1;
+    while (k < 8 && s + k < last && cells[4 * std::size_t{s + k}] == c[0] && cells[4 * std::size_t{s + k} + 1] == c[1] &&
+           cells[4 * std::size_t{s + k} + 2] == c[2])
+      ++k;
+    u32 index[8];
+    for (u32 j = 0; j < 8; ++j) index[j] = s + (j < k ? j : 0);
+    const Lanes x = load_particles(points, index);
+    runs.look_up(c, cells, ranges, p.table_mask);
+    __m256 sum = zero;
+    for (const CellRuns::Run& r : runs.runs)
+      for (u32 t = r.begin; t < r.end; ++t) {
         const float* y = points + 4 * std::size_t{t};
-        const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
-        const float d2 = ex * ex + ey * ey + ez * ez;
-        if (!(d2 < p.h2)) continue;
-        sum = sum + std::fabs(y[3]) * cubic_one(std::sqrt(d2) * p.inv_l);
+        if (r.mixed) {
+          const int* ct = cells + 4 * std::size_t{t};
+          if (!(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
+        }
+        const __m256 ex = sub(_mm256_set1_ps(y[0]), x.x), ey = sub(_mm256_set1_ps(y[1]), x.y),
+                     ez = sub(_mm256_set1_ps(y[2]), x.z);
+        const __m256 d2 = add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez));
+        const __m256 inside = _mm256_cmp_ps(d2, h2, _CMP_LT_OQ);
+        if (_mm256_movemask_ps(inside) == 0) continue;
+        const __m256 term = mul(_mm256_set1_ps(std::fabs(y[3])), cubic_lanes(mul(_mm256_sqrt_ps(d2), inv_l)));
+        sum = add(sum, _mm256_and_ps(term, inside));
       }
-    }
-    density[s] = p.sigma * sum;
+    alignas(32) float rho[8];
+    _mm256_store_ps(rho, mul(_mm256_set1_ps(p.sigma), sum));
+    for (u32 j = 0; j < k; ++j) density[s + j] = points[4 * std::size_t{s + j} + 3] < 0.0f ? p.rho0 : rho[j];
+    s += k;
   }
 }
 
@@ -215,106 +214,96 @@ void sph_step_avx2(const void* params, std::byte* const* bindings, std::uint32_t
   const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l), zero = _mm256_setzero_ps();
   const __m256 grad_sigma = _mm256_set1_ps(p.grad_sigma), eta2 = _mm256_set1_ps(p.eta2), half = _mm256_set1_ps(0.5f);
   const __m256 minus_viscosity = _mm256_set1_ps(-p.viscosity), minus_boundary = _mm256_set1_ps(-p.boundary_viscosity);
+  const u32 last = end < n ? end : n;
   CellRuns runs;
-  for (u32 s = begin; s < end && s < n; ++s) {
-    const float* x = points + 4 * std::size_t{s};
-    const float* v = sorted_velocity + 4 * std::size_t{s};
-    const float rho = density[s];
-    const float pi = tait_one(p, rho);
-    pressure[s] = pi;
-    if (!(x[3] > 0.0f)) {  // a boundary particle stays
-      std::memcpy(next_points + 4 * std::size_t{s}, x, 16);
-      std::memcpy(next_velocity + 4 * std::size_t{s}, v, 16);
-      speed2[s] = 0.0f;
-      continue;
+  // As sph_density_avx2: up to eight particles of one cell in the lanes,
+  // each candidate read once and broadcast; a lane it is not a neighbour
+  // of subtracts +0, which leaves every float bitwise as it was.
+  for (u32 s = begin; s < last;) {
+    const int* c = cells + 4 * std::size_t{s};
+    u32 k = 1;
+    while (k < 8 && s + k < last && cells[4 * std::size_t{s + k}] == c[0] && cells[4 * std::size_t{s + k} + 1] == c[1] &&
+           cells[4 * std::size_t{s + k} + 2] == c[2])
+      ++k;
+    alignas(32) float rho_of[8], own_of[8];
+    u32 index[8];
+    for (u32 j = 0; j < 8; ++j) {
+      index[j] = s + (j < k ? j : 0);
+      const float rho = density[index[j]];
+      const float pi = tait_one(p, rho);
+      if (j < k) pressure[s + j] = pi;
+      rho_of[j] = rho;
+      own_of[j] = pi / (rho * rho);
     }
-    const float own = pi / (rho * rho);
-    runs.look_up(cells + 4 * std::size_t{s}, cells, ranges, p.table_mask);
-    const __m256 px = _mm256_set1_ps(x[0]), py = _mm256_set1_ps(x[1]), pz = _mm256_set1_ps(x[2]);
-    const __m256 vx = _mm256_set1_ps(v[0]), vy = _mm256_set1_ps(v[1]), vz = _mm256_set1_ps(v[2]);
-    const __m256 rho_i = _mm256_set1_ps(rho), own_i = _mm256_set1_ps(own);
-    float ax = 0.0f, ay = 0.0f, az = 0.0f;
-    for (const CellRuns::Run& r : runs.runs) {
-      u32 t = r.begin;
-      for (; t < r.end && t + 8 <= p.capacity; t += 8) {
-        const u32 index[8] = {t, t + 1, t + 2, t + 3, t + 4, t + 5, t + 6, t + 7};
-        const Lanes y = load_particles(points, index);
-        const __m256 ex = sub(px, y.x), ey = sub(py, y.y), ez = sub(pz, y.z);
+    const Lanes x = load_particles(points, index);
+    const Lanes v = load_particles(sorted_velocity, index);
+    const __m256 rho_i = _mm256_load_ps(rho_of), own_i = _mm256_load_ps(own_of);
+    runs.look_up(c, cells, ranges, p.table_mask);
+    __m256 ax = zero, ay = zero, az = zero;
+    for (const CellRuns::Run& r : runs.runs)
+      for (u32 t = r.begin; t < r.end; ++t) {
+        const float* y = points + 4 * std::size_t{t};
+        if (r.mixed) {
+          const int* ct = cells + 4 * std::size_t{t};
+          if (!(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
+        }
+        const __m256 ex = sub(x.x, _mm256_set1_ps(y[0])), ey = sub(x.y, _mm256_set1_ps(y[1])),
+                     ez = sub(x.z, _mm256_set1_ps(y[2]));
         const __m256 d2 = add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez));
         const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(d2, h2, _CMP_LT_OQ), _mm256_cmp_ps(d2, zero, _CMP_GT_OQ));
-        const u32 mask = u32(_mm256_movemask_ps(inside)) & run_lanes(r, t, cells, index);
-        if (mask == 0) continue;
+        if (_mm256_movemask_ps(inside) == 0) continue;
         const __m256 dist = _mm256_sqrt_ps(d2);
         const __m256 gw = _mm256_div_ps(mul(grad_sigma, cubic_slope_lanes(mul(dist, inv_l))), dist);
-        const Lanes w = load_particles(sorted_velocity, index);
-        const __m256 approach = add(add(mul(sub(vx, w.x), ex), mul(sub(vy, w.y), ey)), mul(sub(vz, w.z), ez));
+        const float* w = sorted_velocity + 4 * std::size_t{t};
+        const __m256 approach = add(add(mul(sub(v.x, _mm256_set1_ps(w[0])), ex), mul(sub(v.y, _mm256_set1_ps(w[1])), ey)),
+                                    mul(sub(v.z, _mm256_set1_ps(w[2])), ez));
         const __m256 closing = _mm256_cmp_ps(approach, zero, _CMP_LT_OQ);
         const __m256 d2_eta = add(d2, eta2);
-        // A fluid neighbour: both pressures and the viscosity.
-        const __m256 rho_j = _mm256_loadu_ps(density + t);
-        const __m256 visc_fluid = select(
-            closing, _mm256_div_ps(mul(minus_viscosity, approach), mul(mul(half, add(rho_i, rho_j)), d2_eta)), zero);
-        const __m256 pj = tait_lanes(p, rho_j);
-        const __m256 fluid_factor = mul(y.w, add(add(own_i, _mm256_div_ps(pj, mul(rho_j, rho_j))), visc_fluid));
-        // A boundary neighbour: its pressure mirrored, and its own viscosity.
-        const __m256 visc_boundary =
-            select(closing, _mm256_div_ps(mul(minus_boundary, approach), mul(rho_i, d2_eta)), zero);
-        const __m256 boundary_factor = mul(negate(y.w), add(own_i, visc_boundary));
-        const __m256 factor = select(_mm256_cmp_ps(y.w, zero, _CMP_GT_OQ), fluid_factor, boundary_factor);
-        const __m256 f = mul(factor, gw);
-        alignas(32) float fx[8], fy[8], fz[8];
-        _mm256_store_ps(fx, mul(f, ex));
-        _mm256_store_ps(fy, mul(f, ey));
-        _mm256_store_ps(fz, mul(f, ez));
-        for (u32 j = 0; j < 8; ++j)
-          if (mask >> j & 1u) {
-            ax = ax - fx[j];
-            ay = ay - fy[j];
-            az = az - fz[j];
-          }
-      }
-      for (; t < r.end; ++t) {  // at the buffer's end, one by one as the reference
-        const int* ct = cells + 4 * std::size_t{t};
-        if (r.mixed && !(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
-        if (t == s) continue;
-        const float* y = points + 4 * std::size_t{t};
-        const float ex = x[0] - y[0], ey = x[1] - y[1], ez = x[2] - y[2];
-        const float d2 = ex * ex + ey * ey + ez * ez;
-        if (!(d2 < p.h2) || !(d2 > 0.0f)) continue;
-        const float dist = std::sqrt(d2);
-        const float gw = p.grad_sigma * cubic_slope_one(dist * p.inv_l) / dist;
-        const float* w = sorted_velocity + 4 * std::size_t{t};
-        const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
-        const float approach = ux * ex + uy * ey + uz * ez;
-        float factor;
-        if (y[3] > 0.0f) {
+        __m256 factor;
+        if (y[3] > 0.0f) {  // a fluid neighbour: both pressures and the viscosity
           const float rho_j = density[t];
-          const float visc = approach < 0.0f ? -p.viscosity * approach / ((0.5f * (rho + rho_j)) * (d2 + p.eta2)) : 0.0f;
-          factor = y[3] * (own + tait_one(p, rho_j) / (rho_j * rho_j) + visc);
-        } else {
-          const float visc = approach < 0.0f ? -p.boundary_viscosity * approach / (rho * (d2 + p.eta2)) : 0.0f;
-          factor = -y[3] * (own + visc);
+          const __m256 rj = _mm256_set1_ps(rho_j);
+          const __m256 visc = select(
+              closing, _mm256_div_ps(mul(minus_viscosity, approach), mul(mul(half, add(rho_i, rj)), d2_eta)), zero);
+          const float pj = tait_one(p, rho_j) / (rho_j * rho_j);
+          factor = mul(_mm256_set1_ps(y[3]), add(add(own_i, _mm256_set1_ps(pj)), visc));
+        } else {  // a boundary neighbour: its pressure mirrored, and its own viscosity
+          const __m256 visc = select(closing, _mm256_div_ps(mul(minus_boundary, approach), mul(rho_i, d2_eta)), zero);
+          factor = mul(_mm256_set1_ps(-y[3]), add(own_i, visc));
         }
-        const float f = factor * gw;
-        ax = ax - f * ex;
-        ay = ay - f * ey;
-        az = az - f * ez;
+        const __m256 f = mul(factor, gw);
+        ax = sub(ax, _mm256_and_ps(mul(f, ex), inside));
+        ay = sub(ay, _mm256_and_ps(mul(f, ey), inside));
+        az = sub(az, _mm256_and_ps(mul(f, ez), inside));
       }
+    alignas(32) float fx[8], fy[8], fz[8];
+    _mm256_store_ps(fx, ax);
+    _mm256_store_ps(fy, ay);
+    _mm256_store_ps(fz, az);
+    for (u32 j = 0; j < k; ++j) {
+      const u32 i = s + j;
+      const float* xi = points + 4 * std::size_t{i};
+      const float* vi = sorted_velocity + 4 * std::size_t{i};
+      float* xn = next_points + 4 * std::size_t{i};
+      float* vn = next_velocity + 4 * std::size_t{i};
+      if (!(xi[3] > 0.0f)) {  // a boundary particle stays
+        std::memcpy(xn, xi, 16);
+        std::memcpy(vn, vi, 16);
+        speed2[i] = 0.0f;
+        continue;
+      }
+      const float gx = fx[j] + p.gx, gy = fy[j] + p.gy, gz = fz[j] + p.gz;
+      vn[0] = vi[0] + p.dt * gx;
+      vn[1] = vi[1] + p.dt * gy;
+      vn[2] = vi[2] + p.dt * gz;
+      vn[3] = vi[3];  // the id's bits
+      speed2[i] = (vn[0] * vn[0] + vn[1] * vn[1]) + vn[2] * vn[2];
+      xn[0] = xi[0] + p.dt * vn[0];
+      xn[1] = xi[1] + p.dt * vn[1];
+      xn[2] = xi[2] + p.dt * vn[2];
+      xn[3] = xi[3];
     }
-    ax = ax + p.gx;
-    ay = ay + p.gy;
-    az = az + p.gz;
-    float* xn = next_points + 4 * std::size_t{s};
-    float* vn = next_velocity + 4 * std::size_t{s};
-    vn[0] = v[0] + p.dt * ax;
-    vn[1] = v[1] + p.dt * ay;
-    vn[2] = v[2] + p.dt * az;
-    vn[3] = v[3];  // the id's bits
-    speed2[s] = (vn[0] * vn[0] + vn[1] * vn[1]) + vn[2] * vn[2];
-    xn[0] = x[0] + p.dt * vn[0];
-    xn[1] = x[1] + p.dt * vn[1];
-    xn[2] = x[2] + p.dt * vn[2];
-    xn[3] = x[3];
+    s += k;
   }
 }
 
