@@ -7,9 +7,8 @@
 // candidate order, so no sum is reassociated
 // (SphSolver.TheAvx2KernelsAreBitwiseTheReference compares them bit for bit).
 //
-// The density and step put up to eight particles of one cell in the lanes
-// and broadcast each shared candidate to them; the boundary force takes
-// eight candidates of one particle at a time. Tried and measured slower
+// Each kernel puts up to eight particles of one cell in the lanes and
+// broadcasts each shared candidate to them. Tried and measured slower
 // (README, "SPH fluid"): candidates in the lanes for the density and step,
 // and packing the neighbours first to compute terms only for them, with
 // each cell's candidates copied into arrays of each field.
@@ -86,21 +85,6 @@ struct CellRuns {
   }
 };
 
-// Which of the eight candidates t .. t + 7 belong to the run (and, in a
-// mixed bucket, to the visited cell): a lane mask.
-u32 run_lanes(const CellRuns::Run& r, u32 t, const int* cells, const u32 (&index)[8]) {
-  const u32 left = r.end - t;
-  u32 mask = left >= 8 ? 0xffu : (1u << left) - 1u;
-  if (r.mixed) {
-    const avx2::Lanes ct = avx2::load_particles(reinterpret_cast<const float*>(cells), index);
-    __m256i same = _mm256_cmpeq_epi32(_mm256_castps_si256(ct.x), _mm256_set1_epi32(r.cx));
-    same = _mm256_and_si256(same, _mm256_cmpeq_epi32(_mm256_castps_si256(ct.y), _mm256_set1_epi32(r.cy)));
-    same = _mm256_and_si256(same, _mm256_cmpeq_epi32(_mm256_castps_si256(ct.z), _mm256_set1_epi32(r.cz)));
-    mask &= u32(_mm256_movemask_ps(_mm256_castsi256_ps(same)));
-  }
-  return mask;
-}
-
 __m256 select(__m256 when, __m256 yes, __m256 no) { return _mm256_blendv_ps(no, yes, when); }
 
 // The cubic spline's w(q) and w'(q) (sph_params.h), lane by lane.
@@ -128,23 +112,6 @@ float tait_one(const SphParams& p, float rho) {
   const float r7 = r4 * r2 * r;
   const float pressure = p.stiffness * (r7 - 1.0f);
   return pressure > 0.0f ? pressure : 0.0f;
-}
-__m256 tait_lanes(const SphParams& p, __m256 rho) {
-  using namespace avx2;
-  const __m256 r = _mm256_div_ps(rho, _mm256_set1_ps(p.rho0));
-  const __m256 r2 = mul(r, r);
-  const __m256 r4 = mul(r2, r2);
-  const __m256 r7 = mul(mul(r4, r2), r);
-  const __m256 pressure = mul(_mm256_set1_ps(p.stiffness), sub(r7, _mm256_set1_ps(1.0f)));
-  return select(_mm256_cmp_ps(pressure, _mm256_setzero_ps(), _CMP_GT_OQ), pressure, _mm256_setzero_ps());
-}
-
-// The reference's slope for one candidate, for sph_boundary_force_avx2's
-// runs' last few at the buffers' end (sph_kernels.cpp, in its order).
-float cubic_slope_one(float q) {
-  if (q < 1.0f) return (2.25f * q) * q - 3.0f * q;
-  const float t = 2.0f - q;
-  return (-0.75f * t) * t;
 }
 
 }  // namespace
@@ -321,76 +288,75 @@ void sph_boundary_force_avx2(const void* params, std::byte* const* bindings, std
   const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l), zero = _mm256_setzero_ps();
   const __m256 grad_sigma = _mm256_set1_ps(p.grad_sigma), eta2 = _mm256_set1_ps(p.eta2);
   const __m256 minus_boundary = _mm256_set1_ps(-p.boundary_viscosity);
+  const u32 last = end < n ? end : n;
   CellRuns runs;
-  for (u32 s = begin; s < end && s < n; ++s) {
-    const float* x = points + 4 * std::size_t{s};
-    if (x[3] > 0.0f) continue;  // a fluid particle
-    const float* w = sorted_velocity + 4 * std::size_t{s};
-    const float psi = -x[3];
-    runs.look_up(cells + 4 * std::size_t{s}, cells, ranges, p.table_mask);
-    const __m256 px = _mm256_set1_ps(x[0]), py = _mm256_set1_ps(x[1]), pz = _mm256_set1_ps(x[2]);
-    const __m256 wx = _mm256_set1_ps(w[0]), wy = _mm256_set1_ps(w[1]), wz = _mm256_set1_ps(w[2]);
-    const __m256 psi_b = _mm256_set1_ps(psi);
-    float fx = 0.0f, fy = 0.0f, fz = 0.0f;
-    for (const CellRuns::Run& r : runs.runs) {
-      u32 t = r.begin;
-      for (; t < r.end && t + 8 <= p.capacity; t += 8) {
-        const u32 index[8] = {t, t + 1, t + 2, t + 3, t + 4, t + 5, t + 6, t + 7};
-        const Lanes y = load_particles(points, index);
-        const __m256 ex = sub(y.x, px), ey = sub(y.y, py), ez = sub(y.z, pz);
+  // As sph_step_avx2: up to eight particles of one cell in the lanes (the
+  // fluid ones among them are skipped at the end), each fluid candidate
+  // broadcast; a lane it is not a neighbour of adds +0, which leaves every
+  // float bitwise as it was.
+  for (u32 s = begin; s < last;) {
+    const int* c = cells + 4 * std::size_t{s};
+    u32 k = 1;
+    bool any_boundary = !(points[4 * std::size_t{s} + 3] > 0.0f);
+    while (k < 8 && s + k < last && cells[4 * std::size_t{s + k}] == c[0] && cells[4 * std::size_t{s + k} + 1] == c[1] &&
+           cells[4 * std::size_t{s + k} + 2] == c[2]) {
+      any_boundary = any_boundary || !(points[4 * std::size_t{s + k} + 3] > 0.0f);
+      ++k;
+    }
+    if (!any_boundary) {
+      s += k;
+      continue;
+    }
+    u32 index[8];
+    for (u32 j = 0; j < 8; ++j) index[j] = s + (j < k ? j : 0);
+    const Lanes x = load_particles(points, index);
+    const Lanes w = load_particles(sorted_velocity, index);
+    const __m256 psi = negate(x.w);
+    runs.look_up(c, cells, ranges, p.table_mask);
+    __m256 fx = zero, fy = zero, fz = zero;
+    for (const CellRuns::Run& r : runs.runs)
+      for (u32 t = r.begin; t < r.end; ++t) {
+        const float* y = points + 4 * std::size_t{t};
+        if (!(y[3] > 0.0f)) continue;  // boundary particles do not push each other
+        if (r.mixed) {
+          const int* ct = cells + 4 * std::size_t{t};
+          if (!(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
+        }
+        const __m256 ex = sub(_mm256_set1_ps(y[0]), x.x), ey = sub(_mm256_set1_ps(y[1]), x.y),
+                     ez = sub(_mm256_set1_ps(y[2]), x.z);
         const __m256 d2 = add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez));
-        const __m256 inside = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(d2, h2, _CMP_LT_OQ), _mm256_cmp_ps(d2, zero, _CMP_GT_OQ)),
-                                            _mm256_cmp_ps(y.w, zero, _CMP_GT_OQ));  // fluid only
-        const u32 mask = u32(_mm256_movemask_ps(inside)) & run_lanes(r, t, cells, index);
-        if (mask == 0) continue;
+        const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(d2, h2, _CMP_LT_OQ), _mm256_cmp_ps(d2, zero, _CMP_GT_OQ));
+        if (_mm256_movemask_ps(inside) == 0) continue;
         const __m256 dist = _mm256_sqrt_ps(d2);
         const __m256 gw = _mm256_div_ps(mul(grad_sigma, cubic_slope_lanes(mul(dist, inv_l))), dist);
-        const Lanes v = load_particles(sorted_velocity, index);
-        const __m256 approach = add(add(mul(sub(v.x, wx), ex), mul(sub(v.y, wy), ey)), mul(sub(v.z, wz), ez));
-        const __m256 rho = _mm256_loadu_ps(density + t);
-        const __m256 own = _mm256_div_ps(tait_lanes(p, rho), mul(rho, rho));
-        const __m256 visc = select(_mm256_cmp_ps(approach, zero, _CMP_LT_OQ),
-                                   _mm256_div_ps(mul(minus_boundary, approach), mul(rho, add(d2, eta2))), zero);
-        const __m256 f = mul(y.w, mul(mul(psi_b, add(own, visc)), gw));
-        alignas(32) float gx[8], gy[8], gz[8];
-        _mm256_store_ps(gx, mul(f, ex));
-        _mm256_store_ps(gy, mul(f, ey));
-        _mm256_store_ps(gz, mul(f, ez));
-        for (u32 j = 0; j < 8; ++j)
-          if (mask >> j & 1u) {
-            fx = fx + gx[j];
-            fy = fy + gy[j];
-            fz = fz + gz[j];
-          }
-      }
-      for (; t < r.end; ++t) {  // at the buffer's end, one by one as the reference
-        const int* ct = cells + 4 * std::size_t{t};
-        if (r.mixed && !(ct[0] == r.cx && ct[1] == r.cy && ct[2] == r.cz)) continue;
-        const float* y = points + 4 * std::size_t{t};
-        if (!(y[3] > 0.0f)) continue;
-        const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
-        const float d2 = ex * ex + ey * ey + ez * ez;
-        if (!(d2 < p.h2) || !(d2 > 0.0f)) continue;
-        const float dist = std::sqrt(d2);
-        const float gw = p.grad_sigma * cubic_slope_one(dist * p.inv_l) / dist;
         const float* v = sorted_velocity + 4 * std::size_t{t};
-        const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
-        const float approach = ux * ex + uy * ey + uz * ez;
+        const __m256 approach = add(add(mul(sub(_mm256_set1_ps(v[0]), w.x), ex), mul(sub(_mm256_set1_ps(v[1]), w.y), ey)),
+                                    mul(sub(_mm256_set1_ps(v[2]), w.z), ez));
         const float rho = density[t];
-        const float own = tait_one(p, rho) / (rho * rho);
-        const float visc = approach < 0.0f ? -p.boundary_viscosity * approach / (rho * (d2 + p.eta2)) : 0.0f;
-        const float f = y[3] * ((psi * (own + visc)) * gw);
-        fx = fx + f * ex;
-        fy = fy + f * ey;
-        fz = fz + f * ez;
+        const __m256 rho_j = _mm256_set1_ps(rho);
+        const __m256 own = _mm256_set1_ps(tait_one(p, rho) / (rho * rho));
+        const __m256 visc = select(_mm256_cmp_ps(approach, zero, _CMP_LT_OQ),
+                                   _mm256_div_ps(mul(minus_boundary, approach), mul(rho_j, add(d2, eta2))), zero);
+        const __m256 f = mul(_mm256_set1_ps(y[3]), mul(mul(psi, add(own, visc)), gw));
+        fx = add(fx, _mm256_and_ps(mul(f, ex), inside));
+        fy = add(fy, _mm256_and_ps(mul(f, ey), inside));
+        fz = add(fz, _mm256_and_ps(mul(f, ez), inside));
       }
+    alignas(32) float gx[8], gy[8], gz[8];
+    _mm256_store_ps(gx, fx);
+    _mm256_store_ps(gy, fy);
+    _mm256_store_ps(gz, fz);
+    for (u32 j = 0; j < k; ++j) {
+      const float* xi = points + 4 * std::size_t{s + j};
+      if (xi[3] > 0.0f) continue;  // a fluid particle
+      u32 id;
+      std::memcpy(&id, sorted_velocity + 4 * std::size_t{s + j} + 3, 4);
+      float* out = impulse + 4 * std::size_t{id & 0x7fffffffu};
+      out[0] = out[0] + p.dt * gx[j];
+      out[1] = out[1] + p.dt * gy[j];
+      out[2] = out[2] + p.dt * gz[j];
     }
-    u32 id;
-    std::memcpy(&id, w + 3, 4);
-    float* out = impulse + 4 * std::size_t{id & 0x7fffffffu};
-    out[0] = out[0] + p.dt * fx;
-    out[1] = out[1] + p.dt * fy;
-    out[2] = out[2] + p.dt * fz;
+    s += k;
   }
 }
 
