@@ -18,13 +18,14 @@
 // spline, Tait's equation, the bucket hash) are deliberate copies of the
 // reference's: an inline function shared with a file built without AVX2
 // could be emitted here with AVX2 instructions and picked by the linker
-// for every caller.
+// for every caller. (avx2_cells.h is shared only by AVX2 files.)
 #include <immintrin.h>
 
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 
+#include "cpu/avx2_cells.h"
 #include "cpu/avx2_lanes.h"
 #include "cpu/sph_kernels.h"
 #include "sph_params.h"
@@ -38,52 +39,10 @@ namespace {
 
 using u32 = std::uint32_t;
 
-u32 spread10_lanes(u32 v) {
-  v &= 0x3ffu;
-  v = (v * 0x00010001u) & 0xFF0000FFu;
-  v = (v * 0x00000101u) & 0x0F00F00Fu;
-  v = (v * 0x00000011u) & 0xC30C30C3u;
-  v = (v * 0x00000005u) & 0x49249249u;
-  return v;
-}
-
 u32 count_of(const SphParams& p, const std::byte* counts) {
   const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
   return stored < p.capacity ? stored : p.capacity;
 }
-
-// The 27 cells' runs around one cell (dz outermost, as the reference visits
-// them), looked up once per cell: the particles of a cell are next to each
-// other in sorted order, so the next particle usually shares them. A run
-// that cannot hold the cell (empty, or one other cell's) is kept empty.
-struct CellRuns {
-  struct Run {
-    u32 begin, end;
-    bool mixed;
-    int cx, cy, cz;
-  };
-  Run runs[27];
-  int at[3] = {0, 0, 0};
-  bool valid = false;
-
-  void look_up(const int* c, const int* cells, const u32* ranges, u32 mask) {
-    if (valid && c[0] == at[0] && c[1] == at[1] && c[2] == at[2]) return;
-    int v = 0;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx, ++v) {
-          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          const u32 b =
-              ((spread10_lanes(u32(cx)) << 2) | (spread10_lanes(u32(cy)) << 1) | spread10_lanes(u32(cz))) & mask;
-          Run& r = runs[v];
-          r = {ranges[3 * std::size_t{b}], ranges[3 * std::size_t{b} + 1], ranges[3 * std::size_t{b} + 2] != 0, cx, cy, cz};
-          const int* rc = cells + 4 * std::size_t{r.begin};
-          if (r.begin < r.end && !r.mixed && !(rc[0] == cx && rc[1] == cy && rc[2] == cz)) r.end = r.begin;
-        }
-    for (int k = 0; k < 3; ++k) at[k] = c[k];
-    valid = true;
-  }
-};
 
 __m256 select(__m256 when, __m256 yes, __m256 no) { return _mm256_blendv_ps(no, yes, when); }
 
@@ -126,7 +85,7 @@ void sph_density_avx2(const void* params, std::byte* const* bindings, std::uint3
   auto* density = reinterpret_cast<float*>(bindings[4]);
   const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l), zero = _mm256_setzero_ps();
   const u32 last = end < n ? end : n;
-  CellRuns runs;
+  avx2::CellRuns runs;
   // Up to eight particles of one cell at a time, one a lane: they share
   // their candidates, each read once and broadcast to every lane, and each
   // lane sums its terms in candidate order. A lane a candidate is not
@@ -134,16 +93,13 @@ void sph_density_avx2(const void* params, std::byte* const* bindings, std::uint3
   // it was, so each particle's density is the reference's.
   for (u32 s = begin; s < last;) {
     const int* c = cells + 4 * std::size_t{s};
-    u32 k = 1;
-    while (k < 8 && s + k < last && cells[4 * std::size_t{s + k}] == c[0] && cells[4 * std::size_t{s + k} + 1] == c[1] &&
-           cells[4 * std::size_t{s + k} + 2] == c[2])
-      ++k;
+    const u32 k = avx2::same_cell_run(cells, s, last);
     u32 index[8];
     for (u32 j = 0; j < 8; ++j) index[j] = s + (j < k ? j : 0);
     const Lanes x = load_particles(points, index);
     runs.look_up(c, cells, ranges, p.table_mask);
     __m256 sum = zero;
-    for (const CellRuns::Run& r : runs.runs)
+    for (const avx2::CellRuns::Run& r : runs.runs)
       for (u32 t = r.begin; t < r.end; ++t) {
         const float* y = points + 4 * std::size_t{t};
         if (r.mixed) {
@@ -182,16 +138,13 @@ void sph_step_avx2(const void* params, std::byte* const* bindings, std::uint32_t
   const __m256 grad_sigma = _mm256_set1_ps(p.grad_sigma), eta2 = _mm256_set1_ps(p.eta2), half = _mm256_set1_ps(0.5f);
   const __m256 minus_viscosity = _mm256_set1_ps(-p.viscosity), minus_boundary = _mm256_set1_ps(-p.boundary_viscosity);
   const u32 last = end < n ? end : n;
-  CellRuns runs;
+  avx2::CellRuns runs;
   // As sph_density_avx2: up to eight particles of one cell in the lanes,
   // each candidate read once and broadcast; a lane it is not a neighbour
   // of subtracts +0, which leaves every float bitwise as it was.
   for (u32 s = begin; s < last;) {
     const int* c = cells + 4 * std::size_t{s};
-    u32 k = 1;
-    while (k < 8 && s + k < last && cells[4 * std::size_t{s + k}] == c[0] && cells[4 * std::size_t{s + k} + 1] == c[1] &&
-           cells[4 * std::size_t{s + k} + 2] == c[2])
-      ++k;
+    const u32 k = avx2::same_cell_run(cells, s, last);
     alignas(32) float rho_of[8], own_of[8];
     u32 index[8];
     for (u32 j = 0; j < 8; ++j) {
@@ -207,7 +160,7 @@ void sph_step_avx2(const void* params, std::byte* const* bindings, std::uint32_t
     const __m256 rho_i = _mm256_load_ps(rho_of), own_i = _mm256_load_ps(own_of);
     runs.look_up(c, cells, ranges, p.table_mask);
     __m256 ax = zero, ay = zero, az = zero;
-    for (const CellRuns::Run& r : runs.runs)
+    for (const avx2::CellRuns::Run& r : runs.runs)
       for (u32 t = r.begin; t < r.end; ++t) {
         const float* y = points + 4 * std::size_t{t};
         if (r.mixed) {
@@ -289,7 +242,7 @@ void sph_boundary_force_avx2(const void* params, std::byte* const* bindings, std
   const __m256 grad_sigma = _mm256_set1_ps(p.grad_sigma), eta2 = _mm256_set1_ps(p.eta2);
   const __m256 minus_boundary = _mm256_set1_ps(-p.boundary_viscosity);
   const u32 last = end < n ? end : n;
-  CellRuns runs;
+  avx2::CellRuns runs;
   // As sph_step_avx2: up to eight particles of one cell in the lanes (the
   // fluid ones among them are skipped at the end), each fluid candidate
   // broadcast; a lane it is not a neighbour of adds +0, which leaves every
@@ -314,7 +267,7 @@ void sph_boundary_force_avx2(const void* params, std::byte* const* bindings, std
     const __m256 psi = negate(x.w);
     runs.look_up(c, cells, ranges, p.table_mask);
     __m256 fx = zero, fy = zero, fz = zero;
-    for (const CellRuns::Run& r : runs.runs)
+    for (const avx2::CellRuns::Run& r : runs.runs)
       for (u32 t = r.begin; t < r.end; ++t) {
         const float* y = points + 4 * std::size_t{t};
         if (!(y[3] > 0.0f)) continue;  // boundary particles do not push each other
