@@ -38,7 +38,7 @@ std::vector<P3> block(int nx, int ny, int nz, P3 lo = {0, 0, 0}) {
 FluidDesc tank_desc(const std::string& backend = "cpu") {
   FluidDesc d;
   d.settings.spacing = kS;
-  d.boundary = sample_box_walls({-0.5 * kS, -0.5 * kS, -0.5 * kS}, {8.5 * kS, 12 * kS, 8.5 * kS}, kS, 2);
+  d.boundary = *sample_box_walls({-0.5 * kS, -0.5 * kS, -0.5 * kS}, {8.5 * kS, 12 * kS, 8.5 * kS}, kS, 2);
   d.device = {.backend = backend, .quiet = true};
   return d;
 }
@@ -305,7 +305,11 @@ TEST(Fluid, BadInputIsNamed) {
   EXPECT_NE(message(d).find("sink 0 radius must be finite and > 0"), std::string::npos) << message(d);
   d.sinks.clear();
   d.particles = block(11, 1, 11);
+  EXPECT_NE(message(d).find("FluidDesc::capacity 100 leaves emitters no room: it must be more than the 121"),
+            std::string::npos) << message(d);
+  d.emitters.clear();
   EXPECT_NE(message(d).find("121 particles, more than the capacity 100"), std::string::npos) << message(d);
+  d.emitters = {e};
   d.particles.clear();
   auto fluid = Fluid::create(d);
   ASSERT_TRUE(fluid.ok()) << fluid.error().message();
@@ -322,6 +326,31 @@ TEST(Fluid, BadInputIsNamed) {
   SINEW_ASSERT_OK(fluid->set_emitter(0, off));
   SINEW_ASSERT_OK(fluid->step(400));
   EXPECT_EQ(fluid->stats().emitted, 0u) << "a closed source makes nothing";
+  // Nothing at all yet (no boundary, a source not fired): a step is fine and the speed 0.
+  FluidDesc lone;
+  lone.emitters = {e};
+  lone.capacity = 50;
+  lone.device = d.device;
+  auto empty = Fluid::create(lone);
+  ASSERT_TRUE(empty.ok()) << empty.error().message();
+  SINEW_ASSERT_OK(empty->step(1));
+  EXPECT_EQ(empty->stats().max_speed, 0.0);
+  lone.capacity = 0;  // no room for the emitter
+  EXPECT_NE(Fluid::create(lone).error().message().find("FluidDesc::capacity 0 leaves emitters no room"), std::string::npos);
+  lone.capacity = 50;
+  lone.settings.support = 1.1;
+  lone.settings.time_step = 4e-5;  // within the CFL bound of the shorter support
+  EXPECT_NE(Fluid::create(lone).error().message().find("emitters need support >= 1.25"), std::string::npos);
+  lone.settings.support = 2.0;
+  lone.settings.time_step = 5e-5;
+  lone.emitters[0].radius = 0.05;  // 50 spacings: thousands of lattice points
+  EXPECT_NE(Fluid::create(lone).error().message().find("more than 4096"), std::string::npos);
+  // The samplers name their faults.
+  EXPECT_NE(sample_box_walls({0, 0, 0}, {0, 1e-2, 1e-2}, kS).error().message().find("hi must be above lo on axis 0"),
+            std::string::npos);
+  EXPECT_FALSE(sample_box_walls({0, 0, 0}, {1e-2, 1e-2, 1e-2}, 0.0).ok());
+  EXPECT_FALSE(sample_box_walls({0, 0, 0}, {1e-2, 1e-2, 1e-2}, kS, 0).ok());
+  EXPECT_FALSE(sample_box_walls({0, 0, 0}, {1.0, 1.0, 1.0}, 1e-6).ok()) << "too many points";
 }
 
 TEST(Fluid, SamplesCoverASurfaceAndFollowIt) {
@@ -387,7 +416,7 @@ ColumnResult settle_column(const FluidSettings& settings, const std::string& bac
   FluidDesc d;
   d.settings = settings;
   d.particles = block(8, 20, 8);
-  d.boundary = sample_box_walls({-0.5 * kS, -0.5 * kS, -0.5 * kS}, {8.5 * kS, 24 * kS, 8.5 * kS}, kS, 2);
+  d.boundary = *sample_box_walls({-0.5 * kS, -0.5 * kS, -0.5 * kS}, {8.5 * kS, 24 * kS, 8.5 * kS}, kS, 2);
   d.device = {.backend = backend, .quiet = true};
   ColumnResult out;
   auto fluid = Fluid::create(d);

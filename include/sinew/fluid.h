@@ -5,7 +5,7 @@
 //
 //   sinew::FluidDesc desc;
 //   desc.settings.spacing = 1e-3;                         // 1 mm particles
-//   desc.boundary = sinew::sample_box_walls(...);         // or sample_surface
+//   desc.boundary = *sinew::sample_box_walls(...);        // or sample_surface
 //   desc.emitters.push_back({.centre = {0, 0.02, 0}, .direction = {0, -1, 0},
 //                            .radius = 2e-3, .flow_rate = 2e-6});  // 2 ml/s
 //   desc.sinks.push_back({.centre = {0, 0, 0}, .radius = 3e-3});
@@ -64,7 +64,9 @@ struct FluidSettings {
 /// the radius), each layer leaving one spacing behind the last. A lattice
 /// point with a fluid particle within 0.75 spacing of its place makes
 /// nothing that layer (FluidStats::blocked): a source under the fluid's
-/// surface delivers less than its rate.
+/// surface delivers less than its rate. Only fluid blocks it: a moving
+/// boundary that comes to cover a source is not checked after
+/// set_emitter. Emitters need support >= 1.25 spacings (the search's reach).
 struct FluidEmitter {
   std::array<double, 3> centre{};             ///< the disc's centre [m]
   std::array<double, 3> direction{0, -1, 0};  ///< the flow's direction (normalised; not zero)
@@ -75,8 +77,9 @@ struct FluidEmitter {
   double flow_rate = 0.0;
 };
 
-/// Suction: fluid particles strictly inside the ball are removed at the
-/// start of each step.
+/// Suction: fluid particles strictly inside the ball are removed each step,
+/// after the emitters' layers are made (a particle made inside a sink is
+/// counted as emitted and removed in the same step).
 struct FluidSink {
   std::array<double, 3> centre{};  ///< [m]
   double radius = 0.0;             ///< [m], > 0
@@ -101,20 +104,23 @@ struct FluidDesc {
   std::vector<FluidEmitter> emitters;  ///< their count is fixed; their poses and rates may change
   std::vector<FluidSink> sinks;        ///< likewise
   /// The most fluid particles there can be at once; 0: the initial
-  /// particles' count. An emitter that would pass it makes what fits and
-  /// the step reports capacity_exceeded (naming "sph particles").
+  /// particles' count (with emitters it must be more than that). An
+  /// emitter that would pass it makes what fits, and step() finishes its
+  /// steps and then reports capacity_exceeded (naming "sph particles").
   std::uint32_t capacity = 0;
   DeviceOptions device;  ///< the backend it runs on
 };
 
 /// One fluid particle as read back.
 struct FluidParticle {
-  std::uint32_t id = 0;  ///< its index in FluidDesc::particles, then counting on as emitters make more
+  /// Its index in FluidDesc::particles, then counting on as emitters make
+  /// more (a particle not made for lack of capacity uses up its id too).
+  std::uint32_t id = 0;
   std::array<float, 3> position{}, velocity{};  ///< [m], [m/s]
   float density = 0.0f, pressure = 0.0f;        ///< [kg/m^3], [Pa] from the last step's start
 };
 
-/// Counts after the last step() (read back with it: 7 words).
+/// Counts after the last step() (read back with it: 6 words).
 struct FluidStats {
   std::uint32_t particles = 0;  ///< fluid particles now
   std::uint64_t emitted = 0;    ///< made by emitters since create()
@@ -148,7 +154,8 @@ class Fluid {
   /// grid, density and forces, symplectic Euler. Then reads the counts and
   /// checks the CFL condition with the particles' speed: an error when dt >
   /// 0.4 h / (c0 + v_max), naming both (the steps were taken). Emitters
-  /// that outgrow the capacity: capacity_exceeded (what fits was made).
+  /// that outgrow the capacity: capacity_exceeded after all the steps (what
+  /// fits was made in each).
   Status step(int steps = 1);
   /// [out] the fluid particles, by increasing id.
   Status read(std::vector<FluidParticle>& particles) const;
@@ -215,8 +222,11 @@ Result<SurfaceSamples> sample_level_set(const LevelSet& level_set, double spacin
 
 /// The walls and floor of an open box [lo, hi] (no lid on the +y face),
 /// `layers` layers of points `spacing` apart outside it, the first on its
-/// faces: a tank for tests and examples.
-std::vector<std::array<double, 3>> sample_box_walls(const std::array<double, 3>& lo, const std::array<double, 3>& hi,
-                                                    double spacing, int layers = 2);
+/// faces: a tank for tests and examples. Errors (bad_parameter): hi not
+/// above lo on every axis, a spacing that is not finite and > 0 or gives
+/// more than 2^24 points, layers < 1.
+Result<std::vector<std::array<double, 3>>> sample_box_walls(const std::array<double, 3>& lo,
+                                                            const std::array<double, 3>& hi, double spacing,
+                                                            int layers = 2);
 
 }  // namespace sinew

@@ -12,7 +12,8 @@
 // force J / frame on the vertices (Simulation::set_particle_forces) for
 // the tissue's frame, which then runs. So the tissue gains in its frame
 // exactly the momentum the fluid lost to it (up to float rounding): total
-// momentum is conserved. The coupling is explicit, one frame apart: it is
+// momentum is conserved, but for what lands on pinned or kinematic
+// vertices (they take no force: the fixed world takes it). The coupling is explicit, one frame apart: it is
 // stable while the fluid's push moves the tissue's surface by much less
 // than a spacing per frame.
 //
@@ -52,14 +53,17 @@ class FluidCoupling {
   /// SceneDesc::external_forces; it must outlive the coupling. Errors: the
   /// simulation's frame not a whole number of fluid steps (naming both), a
   /// surface's vertex beyond the simulation's particles, no surface;
-  /// sample_surface's and Fluid::create's.
+  /// surfaces that give no boundary particle, a simulation without
+  /// SceneDesc::external_forces; sample_surface's and Fluid::create's.
   static Result<FluidCoupling> create(Simulation& simulation, FluidDesc desc,
                                       std::span<const CoupledSurface> surfaces);
   FluidCoupling(FluidCoupling&&) noexcept;
   FluidCoupling& operator=(FluidCoupling&&) noexcept;
   ~FluidCoupling();
 
-  /// One coupled frame (above). Errors: the fluid's and the simulation's.
+  /// One coupled frame (above). Errors: the fluid's and the simulation's;
+  /// an emitter past the fluid's capacity finishes the frame (both sides)
+  /// and then returns capacity_exceeded.
   Status step();
 
   [[nodiscard]] Fluid& fluid();

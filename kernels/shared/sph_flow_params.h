@@ -59,9 +59,13 @@
  * on top of another would make a density spike that blows the fluid
  * apart; a submerged source makes only what it finds room for. The
  * particles are searched on the last step's grid: after sph_step, points
- * are in that grid's sorted order, and none has moved a cell since (the
- * CFL bound keeps them within 0.4 h per step), so the 27 cells around the
- * place's cell, floor(x inv_cell), hold every particle within h of it.
+ * are in that grid's sorted order, and the 27 cells around the place's
+ * cell, floor(x inv_cell), held every particle then within h of it. The
+ * CFL bound keeps a step's motion within 0.4 h, so a particle within
+ * 0.75 spacing now is found when 0.75 spacing + 0.4 h <= h, that is
+ * support >= 1.25 spacings (checked at create). The first step searches
+ * no grid (its ranges are zeroed): initial particles on an emitter's
+ * lattice are the caller's to avoid.
  * Test: d2 = (dx dx + dy dy) + dz dz < clear2 in float.
  * bindings: 0 counts uint [in]
  *           1 points float4 [in]     2 sorted_cells uint4 [in] (last grid's)

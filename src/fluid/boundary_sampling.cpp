@@ -50,6 +50,15 @@ Result<SurfaceSamples> sample_surface(std::span<const std::array<double, 3>> ver
     for (double x : vertices[v])
       if (!std::isfinite(x))
         return Error(ErrorCode::bad_parameter, "sample_surface: vertex " + std::to_string(v) + " is not finite");
+  double area = 0.0;  // a bound on the points: every edge and face at the spacing
+  for (const auto& t : triangles) {
+    const double e = std::max({distance(vertices[t[0]], vertices[t[1]]), distance(vertices[t[1]], vertices[t[2]]),
+                               distance(vertices[t[2]], vertices[t[0]])}) / spacing + 1.0;
+    area += e * e;
+  }
+  if (area > double(1 << 26))
+    return Error(ErrorCode::bad_parameter, "sample_surface: the spacing makes too many points (about " +
+                                               std::to_string(static_cast<long long>(area)) + ")");
   SurfaceSamples out;
   const auto add = [&](std::size_t t, std::array<float, 3> w) {
     const auto& tri = triangles[t];
@@ -105,8 +114,20 @@ Result<SurfaceSamples> sample_level_set(const LevelSet& level_set, double spacin
   return sample_surface(surface.vertices, surface.triangles, spacing);
 }
 
-std::vector<std::array<double, 3>> sample_box_walls(const std::array<double, 3>& lo, const std::array<double, 3>& hi,
-                                                    double spacing, int layers) {
+Result<std::vector<std::array<double, 3>>> sample_box_walls(const std::array<double, 3>& lo,
+                                                            const std::array<double, 3>& hi, double spacing,
+                                                            int layers) {
+  if (!(spacing > 0.0) || !std::isfinite(spacing))
+    return Error(ErrorCode::bad_parameter, "sample_box_walls: spacing must be finite and > 0");
+  if (layers < 1) return Error(ErrorCode::bad_parameter, "sample_box_walls: layers must be >= 1");
+  double cells = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    if (!(hi[a] > lo[a]) || !std::isfinite(hi[a] - lo[a]))
+      return Error(ErrorCode::bad_parameter, "sample_box_walls: hi must be above lo on axis " + std::to_string(a));
+    cells *= (hi[a] - lo[a]) / spacing + 2.0 * layers + 1.0;
+  }
+  if (cells > double(1 << 24))
+    return Error(ErrorCode::bad_parameter, "sample_box_walls: the spacing makes too many points (more than 2^24)");
   std::vector<std::array<double, 3>> points;
   const auto count = [&](int a) { return int(std::ceil((hi[a] - lo[a]) / spacing - 1e-9)); };
   const int nx = count(0), ny = count(1), nz = count(2);

@@ -60,6 +60,12 @@ Result<FluidCoupling> FluidCoupling::create(Simulation& simulation, FluidDesc de
     m->first_particle.push_back(c.first_particle);
   }
   m->coupled = static_cast<std::uint32_t>(desc.boundary.size()) - m->fixed;
+  if (m->coupled == 0)
+    return Error(ErrorCode::bad_parameter, "fluid coupling: the surfaces gave no boundary particles (no triangles?)");
+  // Forces of zero for the next frame: the simulation's error names
+  // SceneDesc::external_forces now, before the fluid steps.
+  if (Status s = simulation.set_particle_forces(std::vector<float>(3 * std::size_t{particles}, 0.0f)); !s)
+    return s.error();
   desc.moving_boundary = true;
   desc.boundary_forces = true;
   auto fluid = Fluid::create(desc);
@@ -91,8 +97,11 @@ Status FluidCoupling::step() {
     next += at.size();
   }
   if (Status s = m.fluid->set_boundary(m.position, m.velocity); !s) return s;
-  // The fluid's frame, then its push on the tissue as constant forces over the tissue's frame.
-  if (Status s = m.fluid->step(m.steps); !s) return s;
+  // The fluid's frame, then its push on the tissue as constant forces over
+  // the tissue's frame. An emitter past the capacity still leaves a whole
+  // frame (what fits was made): finish it, then report it.
+  Status fluid_status = m.fluid->step(m.steps);
+  if (!fluid_status && fluid_status.error().code() != ErrorCode::capacity_exceeded) return fluid_status;
   if (Status s = m.fluid->read_boundary_impulses(m.impulse); !s) return s;
   m.last = m.last_fixed = {};
   for (std::size_t b = 0; b < m.impulse.size(); ++b)
@@ -110,7 +119,8 @@ Status FluidCoupling::step() {
     next += count;
   }
   if (Status s = m.simulation->set_particle_forces(m.force); !s) return s;
-  return m.simulation->step();
+  if (Status s = m.simulation->step(); !s) return s;
+  return fluid_status;
 }
 
 Fluid& FluidCoupling::fluid() { return *impl_->fluid; }

@@ -111,6 +111,10 @@ Status SphSolver::check_emitter(std::size_t index, const FluidEmitter& e) const 
   if (!(e.radius >= 0.5 * spacing_) || !std::isfinite(e.radius))
     return Error(ErrorCode::bad_parameter, "sph: " + name + " radius " + str(e.radius) +
                                                " m must be finite and >= half the spacing (" + str(0.5 * spacing_) + " m)");
+  if (e.radius / spacing_ > 36.0)  // pi 36^2 is about 4,000 lattice points (the limit is 4,096 in all)
+    return Error(ErrorCode::bad_parameter, "sph: " + name + " radius " + str(e.radius) + " m holds about " +
+                                               str(3.14159 * (e.radius / spacing_) * (e.radius / spacing_)) +
+                                               " lattice points, more than 4096");
   if (!(e.flow_rate >= 0.0) || !std::isfinite(e.flow_rate))
     return Error(ErrorCode::bad_parameter, "sph: " + name + " flow_rate must be finite and >= 0 (got " + str(e.flow_rate) + ")");
   const double points = double(emitter_lattice(e.radius, spacing_).size());
@@ -184,6 +188,13 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   for (std::size_t i = 0; i < desc.velocities.size(); ++i)
     if (Status s = finite3("velocity " + std::to_string(i), desc.velocities[i]); !s) return s.error();
   const std::size_t capacity = desc.capacity > 0 ? desc.capacity : desc.particles.size();
+  if (!desc.emitters.empty() && capacity <= desc.particles.size())
+    return Error(ErrorCode::bad_parameter, "sph: FluidDesc::capacity " + std::to_string(capacity) +
+                                               " leaves emitters no room: it must be more than the " +
+                                               std::to_string(desc.particles.size()) + " initial particles");
+  if (!desc.emitters.empty() && !(settings.support >= 1.25))
+    return Error(ErrorCode::bad_parameter, "sph: emitters need support >= 1.25 spacings (got " + str(settings.support) +
+                                               "): their search for room reaches 0.75 spacing + a step's motion");
   if (desc.particles.size() > capacity)
     return Error(ErrorCode::bad_parameter, "sph: " + std::to_string(desc.particles.size()) +
                                                " particles, more than the capacity " + std::to_string(capacity));
@@ -509,19 +520,25 @@ Status SphSolver::read_counts() {
 
 Status SphSolver::step(int steps) {
   Status ran;
-  for (int k = 0; k < steps && ran; ++k) {
-    ran = device_.run_program(program_);
-    // A capacity error leaves a consistent step (what fits was made): count it.
-    if (ran || ran.error().code() == ErrorCode::capacity_exceeded) {
-      ++stats_.steps;
-      stats_.time += time_step_;
+  for (int k = 0; k < steps; ++k) {
+    Status one = device_.run_program(program_);
+    // A capacity error leaves a consistent step (what fits was made): count
+    // it, go on with the steps asked for, and report it after them.
+    const bool overflow = !one && one.error().code() == ErrorCode::capacity_exceeded;
+    if (!one && !overflow) {
+      ran = one;
+      break;
     }
+    ++stats_.steps;
+    stats_.time += time_step_;
+    if (overflow && ran) ran = one;
   }
   if (steps <= 0) return {};
   if (Status s = read_counts(); !s) return s;
   float v2 = 0.0f;
   if (Status s = device_.read_buffer(scratch_, 4 * std::size_t{max_word_}, &v2, 4); !s) return s;
-  stats_.max_speed = std::sqrt(double(v2));
+  // No particle at all leaves the reduction's identity: speed 0.
+  stats_.max_speed = v2 > 0.0f && std::isfinite(v2) ? std::sqrt(double(v2)) : 0.0;
   if (!ran) return ran;
   const double bound = 0.4 * h_ / (speed_of_sound_ + stats_.max_speed);
   if (pbf_ && !(time_step_ <= bound))
