@@ -115,6 +115,8 @@ struct FluidDesc {
 struct FluidParticle {
   /// Its index in FluidDesc::particles, then counting on as emitters make
   /// more (a particle not made for lack of capacity uses up its id too).
+  /// Ids are 31 bits: a step() that could pass 2^31 is refused
+  /// (capacity_exceeded) before it runs.
   std::uint32_t id = 0;
   std::array<float, 3> position{}, velocity{};  ///< [m], [m/s]
   float density = 0.0f, pressure = 0.0f;        ///< [kg/m^3], [Pa] from the last step's start

@@ -245,6 +245,8 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
                          {&m.state_, 4 * (SINEW_SPH_STATE_PHASES + desc.emitters.size()), "sph state"}};
   std::uint32_t lattice_points = 0;
   for (const FluidEmitter& e : desc.emitters) lattice_points += std::uint32_t(emitter_lattice(e.radius, m.spacing_).size());
+  m.lattice_points_ = lattice_points;
+  m.next_id_ = static_cast<std::uint32_t>(desc.particles.size());
   if (lattice_points > 4096)  // sph_emit counts the points before each one in a loop
     return Error(ErrorCode::bad_parameter, "sph: the emitters' discs hold " + std::to_string(lattice_points) +
                                                " lattice points, more than 4096: make them smaller or fewer");
@@ -514,11 +516,17 @@ Status SphSolver::read_counts() {
   stats_.emitted = state[1];
   stats_.removed = state[2];
   stats_.blocked = state[4];
+  next_id_ = state[0];
   stats_.mass = double(stats_.particles) * mass_;
   return {};
 }
 
 Status SphSolver::step(int steps) {
+  // Fluid ids are 31 bits (bit 31 marks the boundary's): a step must not
+  // make one past that. The counts read after the last step bound it.
+  if (std::uint64_t{next_id_} + std::uint64_t{lattice_points_} * std::uint64_t(std::max(steps, 0)) >= 0x80000000ull)
+    return Error(ErrorCode::capacity_exceeded, "sph: fluid ids would pass 2^31 in these steps (" +
+                                                   std::to_string(next_id_) + " made since create)");
   Status ran;
   for (int k = 0; k < steps; ++k) {
     Status one = device_.run_program(program_);

@@ -102,6 +102,7 @@ class SphSolver {
   std::vector<std::uint32_t> emitter_points_;  // lattice points per emitter
   std::vector<std::array<double, 3>> boundary_at_;  // the boundary's latest positions (the emitters' check)
   std::size_t sinks_count_ = 0;
+  std::uint32_t lattice_points_ = 0, next_id_ = 0;  // the emitters' points; the next fluid id
   FluidStats stats_;
 };
 
