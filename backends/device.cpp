@@ -27,6 +27,7 @@
 #include "sph_params.h"
 #include "sph_flow_params.h"
 #include "pbf_params.h"
+#include "sph_tension_params.h"
 #include "stats_params.h"
 #include "suture_params.h"
 #include "xpbd_params.h"

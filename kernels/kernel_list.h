@@ -90,6 +90,9 @@
   SINEW_KERNEL(sph_gather, 4, SphParams, 0)                                     \
   SINEW_KERNEL(sph_step, 10, SphParams, 0)                                      \
   SINEW_KERNEL(sph_boundary_force, 7, SphParams, 0)                             \
+  /* surface tension (kernels/shared/sph_tension_params.h) */                   \
+  SINEW_KERNEL(sph_normals, 6, TensionParams, 0)                                \
+  SINEW_KERNEL(sph_tension, 8, TensionParams, 0)                                \
   /* particles that come and go (kernels/shared/sph_flow_params.h) */          \
   SINEW_KERNEL(sph_boundary_move, 5, SphFlowParams, 0)                          \
   SINEW_KERNEL(sph_sink_flags, 4, SphFlowParams, 0)                             \

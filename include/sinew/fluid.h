@@ -53,6 +53,11 @@ struct FluidSettings {
   double boundary_viscosity = 0.1;  ///< ... against boundary particles, >= 0 (0: free-slip walls)
   double time_step = 5e-5;      ///< [s], > 0; wcsph: at most 0.4 h / c0 (the CFL condition; an error beyond)
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
+  /// wcsph: Akinci et al.'s (2013) surface tension coefficient gamma, >= 0
+  /// (0: none, and no kernels for it): cohesion between fluid particles and
+  /// a curvature term that rounds the surface (kernels/shared/
+  /// sph_tension_params.h). Water at 1 mm particles: about 0.05-0.5.
+  double surface_tension = 0.0;
   int pbf_iterations = 4;        ///< pbf: Jacobi sweeps of the density constraints per step, >= 1
   /// pbf: epsilon, the softening of every constraint, as a fraction of a
   /// particle's constraint stiffness inside a fluid at rest, > 0.

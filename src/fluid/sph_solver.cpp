@@ -13,6 +13,7 @@
 #include "program/primitives.h"
 #include "sph_flow_params.h"
 #include "pbf_params.h"
+#include "sph_tension_params.h"
 
 namespace sinew {
 namespace {
@@ -44,6 +45,11 @@ Status check_settings(const FluidSettings& settings) {
   if (Status s = finite3("gravity", settings.gravity); !s) return s;
   if (!(settings.support >= 1.0) || !std::isfinite(settings.support))
     return Error(ErrorCode::bad_parameter, "sph: support must be finite and >= 1 spacing (got " + str(settings.support) + ")");
+  if (!(settings.surface_tension >= 0.0) || !std::isfinite(settings.surface_tension))
+    return Error(ErrorCode::bad_parameter, "sph: surface_tension must be finite and >= 0 (got " +
+                                               str(settings.surface_tension) + ")");
+  if (settings.method == FluidMethod::pbf && settings.surface_tension > 0.0)
+    return Error(ErrorCode::bad_parameter, "sph: surface_tension needs method wcsph (PBF's is not built)");
   if (settings.method == FluidMethod::pbf) {
     if (settings.pbf_iterations < 1)
       return Error(ErrorCode::bad_parameter, "sph: pbf_iterations must be >= 1 (got " + std::to_string(settings.pbf_iterations) + ")");
@@ -86,7 +92,7 @@ void frame_of(const std::array<double, 3>& d, std::array<double, 3>& t1, std::ar
 SphSolver::~SphSolver() {
   if (have_program_) (void)device_.destroy_program(program_);
   for (BufferHandle h : {velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_, state_, emitters_,
-                         emit_flags_, previous_, lambda_, moved_, pattern_, sinks_, flags_, kept_, compact_scratch_, boundary_position_, boundary_velocity_,
+                         emit_flags_, previous_, lambda_, moved_, normals_, pattern_, sinks_, flags_, kept_, compact_scratch_, boundary_position_, boundary_velocity_,
                          impulse_})
     if (h.valid()) (void)device_.destroy_buffer(h);
   grid_.reset();
@@ -265,6 +271,8 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
     made.push_back({&m.boundary_velocity_, 16 * std::size_t{m.boundary_}, "sph boundary velocities"});
   }
   if (desc.boundary_forces && m.boundary_ > 0) made.push_back({&m.impulse_, 16 * std::size_t{m.boundary_}, "sph boundary impulses"});
+  m.tension_ = settings.surface_tension > 0.0;
+  if (m.tension_) made.push_back({&m.normals_, 16 * std::size_t{n}, "sph surface normals"});
   if (m.pbf_) {
     made.push_back({&m.previous_, 16 * std::size_t{n}, "pbf previous positions"});
     made.push_back({&m.lambda_, 4 * std::size_t{n}, "pbf lambdas"});
@@ -286,6 +294,23 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   p.gz = float(settings.gravity[2]);
   p.dt = float(settings.time_step);
   m.params_ = p;
+  if (m.tension_) {
+    kernels::TensionParams t{};
+    t.count_word = 0;
+    t.capacity = p.capacity;
+    t.table_mask = p.table_mask;
+    t.h2 = p.h2;
+    t.h = float(h);
+    t.inv_l = p.inv_l;
+    t.grad_sigma = p.grad_sigma;
+    t.gamma = float(settings.surface_tension);
+    t.cohesion = float(32.0 / (std::numbers::pi * std::pow(h, 9)));
+    t.h6_64 = float(std::pow(h, 6) / 64.0);
+    t.rho0 = p.rho0;
+    t.dt = p.dt;
+    t.dt2 = float(settings.time_step * settings.time_step);
+    m.tension_params_ = t;
+  }
   if (m.pbf_) {
     kernels::PbfParams q{};
     q.count_word = 0;
@@ -497,6 +522,9 @@ void SphSolver::append_wcsph(FrameProgram& step, bool forces) const {
   g.append_grid(step);
   append_sph_density(step, g, params_, density_);
   step.dispatch(Kernel::sph_gather, n, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
+  if (tension_)  // reads the densities and sorted points, as the gather does not write them
+    step.dispatch(Kernel::sph_normals, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_},
+                  tension_params_);
   step.barrier();
   step.dispatch(Kernel::sph_step, n,
                 {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, b.points, velocity_,
@@ -506,6 +534,12 @@ void SphSolver::append_wcsph(FrameProgram& step, bool forces) const {
     step.dispatch(Kernel::sph_boundary_force, n,
                   {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, impulse_}, params_);
   step.barrier();
+  if (tension_) {  // a further acceleration over the step, added to sph_step's results
+    step.dispatch(Kernel::sph_tension, n,
+                  {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_, b.points, velocity_},
+                  tension_params_);
+    step.barrier();
+  }
 }
 
 Status SphSolver::read_counts() {

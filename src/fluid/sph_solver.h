@@ -31,6 +31,7 @@
 #include "sinew/fluid.h"
 #include "sph_params.h"
 #include "pbf_params.h"
+#include "sph_tension_params.h"
 
 namespace sinew {
 
@@ -89,6 +90,9 @@ class SphSolver {
   BufferHandle state_, emitters_, emit_flags_, pattern_, sinks_, flags_, kept_, compact_scratch_;
   BufferHandle boundary_position_, boundary_velocity_, impulse_;
   BufferHandle previous_, lambda_, moved_;  // pbf
+  BufferHandle normals_;                    // surface tension
+  kernels::TensionParams tension_params_{};
+  bool tension_ = false;
   kernels::PbfParams pbf_params_{};
   bool pbf_ = false;
   int iterations_ = 0;
