@@ -118,6 +118,16 @@ TEST(SphSolver, AColumnAtRestHoldsItsWeight) {
   EXPECT_GT(lowest, -0.5 * s) << "nothing through the boundary";
 }
 
+// 6 x 6 x 6 particles `s` apart, 2 spacings above the tank's floor, one
+// in from its walls.
+std::vector<P3> falling_block(double s) {
+  std::vector<P3> block;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      for (int k = 0; k < 6; ++k) block.push_back({(i + 1.5) * s, (j + 2.5) * s, (k + 1.5) * s});
+  return block;
+}
+
 class SphAgreement : public BackendTest {};
 
 TEST_P(SphAgreement, ABlockFallingInATankMatchesTheCpu) {
@@ -128,10 +138,7 @@ TEST_P(SphAgreement, ABlockFallingInATankMatchesTheCpu) {
   if (GetParam() == "cpu") GTEST_SKIP() << "the reference itself";
   const double s = 1e-3;
   Tank t = tank(8, 8, 8, s, 12);
-  std::vector<P3> block;
-  for (int i = 0; i < 6; ++i)
-    for (int j = 0; j < 6; ++j)
-      for (int k = 0; k < 6; ++k) block.push_back({(i + 1.5) * s, (j + 2.5) * s, (k + 1.5) * s});
+  const std::vector<P3> block = falling_block(s);
   std::vector<std::vector<SphParticle>> out;
   for (const std::string& backend : {std::string("cpu"), GetParam()}) {
     auto device = create_device({.backend = backend, .quiet = true});
@@ -161,10 +168,7 @@ TEST(SphSolver, TheAvx2KernelsAreBitwiseTheReference) {
   // bit for bit. Skipped where the CPU has no AVX2 (both runs would be scalar).
   const double s = 1e-3;
   Tank t = tank(8, 8, 8, s, 12);
-  std::vector<P3> block;
-  for (int i = 0; i < 6; ++i)
-    for (int j = 0; j < 6; ++j)
-      for (int k = 0; k < 6; ++k) block.push_back({(i + 1.5) * s, (j + 2.5) * s, (k + 1.5) * s});
+  const std::vector<P3> block = falling_block(s);
   std::vector<std::vector<SphParticle>> out;
   std::vector<std::vector<std::array<float, 3>>> impulses;
   std::vector<std::string> names;

@@ -29,6 +29,14 @@ inline std::uint32_t bucket_of(int cx, int cy, int cz, std::uint32_t mask) {
 /// Whether cell c (3 ints) is (cx, cy, cz).
 inline bool same_cell(const int* c, int cx, int cy, int cz) { return c[0] == cx && c[1] == cy && c[2] == cz; }
 
+/// n = min(counts[p.count_word], p.capacity): a kernel's item count, read
+/// from its device word when it runs (any params struct with those fields).
+template <class Params>
+std::uint32_t count_of(const Params& p, const std::byte* counts) {
+  const std::uint32_t stored = reinterpret_cast<const std::uint32_t*>(counts)[p.count_word];
+  return stored < p.capacity ? stored : p.capacity;
+}
+
 /// Calls visit(t) for every sorted point t in the 27 cells around cell c
 /// (3 ints), in the query's order: dz outermost, then dy, then dx, each
 /// bucket's run in sorted order, a run of one other cell skipped whole and

@@ -11,6 +11,7 @@
 
 #include "cpu/cpu_kernels.h"
 #include "cpu/neighbour_cells.h"
+#include "cpu/sph_spline.h"
 #include "pbf_params.h"
 
 namespace sinew::kernels {
@@ -19,28 +20,11 @@ namespace {
 using u32 = std::uint32_t;
 using cells::visit_cells;
 
-u32 particle_count(const PbfParams& p, const std::byte* counts) {
-  const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
-  return stored < p.capacity ? stored : p.capacity;
-}
-
-// The cubic spline's shape and slope (sph_params.h).
-float spline(float q) {
-  if (q < 1.0f) return (1.0f - (1.5f * q) * q) + ((0.75f * q) * q) * q;
-  const float t = 2.0f - q;
-  return ((0.25f * t) * t) * t;
-}
-float spline_slope(float q) {
-  if (q < 1.0f) return (2.25f * q) * q - 3.0f * q;
-  const float t = 2.0f - q;
-  return (-0.75f * t) * t;
-}
-
 }  // namespace
 
 void pbf_predict(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const PbfParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   auto* points = reinterpret_cast<float*>(bindings[1]);
   auto* velocity = reinterpret_cast<float*>(bindings[2]);
   auto* previous = reinterpret_cast<float*>(bindings[3]);
@@ -60,7 +44,7 @@ void pbf_predict(const void* params, std::byte* const* bindings, std::uint32_t b
 
 void pbf_lambda(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const PbfParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
@@ -81,9 +65,9 @@ void pbf_lambda(const void* params, std::byte* const* bindings, std::uint32_t be
       if (!(d2 < p.h2)) return;
       const float r = std::sqrt(d2);
       const float mass = std::fabs(y[3]);
-      sum = sum + mass * spline(r * p.inv_l);
+      sum = sum + mass * spline::shape(r * p.inv_l);
       if (!(d2 > 0.0f)) return;  // itself: no direction
-      const float c = ((mass * p.inv_rho0) * p.grad_sigma) * spline_slope(r * p.inv_l) / r;  // grad_j C_i = -c e
+      const float c = ((mass * p.inv_rho0) * p.grad_sigma) * spline::slope(r * p.inv_l) / r;  // grad_j C_i = -c e
       gx = gx + c * ex;
       gy = gy + c * ey;
       gz = gz + c * ez;
@@ -100,7 +84,7 @@ void pbf_lambda(const void* params, std::byte* const* bindings, std::uint32_t be
 
 void pbf_delta(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const PbfParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
@@ -119,7 +103,7 @@ void pbf_delta(const void* params, std::byte* const* bindings, std::uint32_t beg
       const float d2 = ex * ex + ey * ey + ez * ez;
       if (!(d2 < p.h2) || !(d2 > 0.0f)) return;
       const float r = std::sqrt(d2);
-      const float gw = p.grad_sigma * spline_slope(r * p.inv_l) / r;
+      const float gw = p.grad_sigma * spline::slope(r * p.inv_l) / r;
       const float k = (std::fabs(y[3]) * own) / x[3] + lambda[t];  // a boundary particle's lambda is 0
       const float c = (k * p.inv_rho0) * gw;
       dx = dx + c * ex;
@@ -134,7 +118,7 @@ void pbf_delta(const void* params, std::byte* const* bindings, std::uint32_t beg
 
 void pbf_finish(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const PbfParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* sorted_points = reinterpret_cast<const float*>(bindings[1]);
   const auto* order = reinterpret_cast<const u32*>(bindings[2]);
   const auto* previous = reinterpret_cast<const float*>(bindings[3]);

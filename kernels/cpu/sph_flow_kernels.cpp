@@ -17,11 +17,6 @@ namespace {
 
 using u32 = std::uint32_t;
 
-u32 particle_count(const SphFlowParams& p, const std::byte* counts) {
-  const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
-  return stored < p.capacity ? stored : p.capacity;
-}
-
 float phase_of(const u32* state, u32 e) { return std::bit_cast<float>(state[SINEW_SPH_STATE_PHASES + e]); }
 bool fires(const float* emitters, const u32* state, u32 e) {
   return phase_of(state, e) + emitters[SINEW_SPH_EMITTER_FLOATS * e + 3] >= 1.0f;
@@ -39,7 +34,7 @@ void place(const SphFlowParams& p, const float* f, float phase, const float* lat
 
 void sph_boundary_move(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphFlowParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   auto* points = reinterpret_cast<float*>(bindings[1]);
   auto* velocity = reinterpret_cast<float*>(bindings[2]);
   const auto* position = reinterpret_cast<const float*>(bindings[3]);
@@ -56,7 +51,7 @@ void sph_boundary_move(const void* params, std::byte* const* bindings, std::uint
 
 void sph_sink_flags(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphFlowParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* sinks = reinterpret_cast<const float*>(bindings[2]);
   auto* flags = reinterpret_cast<u32*>(bindings[3]);
@@ -77,7 +72,7 @@ void sph_sink_flags(const void* params, std::byte* const* bindings, std::uint32_
 void sph_pack(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphFlowParams*>(params);
   const auto* counts = reinterpret_cast<const u32*>(bindings[0]);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const u32 kept_count = counts[p.kept_word] < n ? counts[p.kept_word] : n;
   const auto* kept = reinterpret_cast<const u32*>(bindings[1]);
   const auto* points = reinterpret_cast<const float*>(bindings[2]);
@@ -126,7 +121,7 @@ void sph_emit_flags(const void* params, std::byte* const* bindings, std::uint32_
 
 void sph_emit(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphFlowParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   auto* points = reinterpret_cast<float*>(bindings[1]);
   auto* velocity = reinterpret_cast<float*>(bindings[2]);
   const auto* emitters = reinterpret_cast<const float*>(bindings[3]);
@@ -155,7 +150,7 @@ void sph_emit_commit(const void* params, std::byte* const* bindings, std::uint32
   if (begin != 0 || end == 0) return;
   const auto& p = *static_cast<const SphFlowParams*>(params);
   auto* counts = reinterpret_cast<u32*>(bindings[0]);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* emitters = reinterpret_cast<const float*>(bindings[1]);
   auto* state = reinterpret_cast<u32*>(bindings[2]);
   const auto* flags = reinterpret_cast<const u32*>(bindings[3]);

@@ -10,6 +10,7 @@
 
 #include "cpu/cpu_kernels.h"
 #include "cpu/neighbour_cells.h"
+#include "cpu/sph_spline.h"
 #include "sph_params.h"
 
 namespace sinew::kernels {
@@ -18,30 +19,11 @@ namespace {
 using u32 = std::uint32_t;
 using cells::visit_cells;
 
-// n = min(counts[count_word], capacity), read when the kernel runs (sph_params.h).
-u32 particle_count(const SphParams& p, const std::byte* counts) {
-  const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
-  return stored < p.capacity ? stored : p.capacity;
-}
-
-// The cubic spline's shape w(q) and slope w'(q), 0 <= q < 2, in the GPU
-// twins' order of operations (sph_params.h).
-float cubic(float q) {
-  if (q < 1.0f) return (1.0f - (1.5f * q) * q) + ((0.75f * q) * q) * q;
-  const float t = 2.0f - q;
-  return ((0.25f * t) * t) * t;
-}
-float cubic_slope(float q) {
-  if (q < 1.0f) return (2.25f * q) * q - 3.0f * q;
-  const float t = 2.0f - q;
-  return (-0.75f * t) * t;
-}
-
 }  // namespace
 
 void sph_density(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
@@ -59,7 +41,7 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
       const float ex = y[0] - x[0], ey = y[1] - x[1], ez = y[2] - x[2];
       const float d2 = ex * ex + ey * ey + ez * ez;
       if (!(d2 < p.h2)) return;
-      sum = sum + std::fabs(y[3]) * cubic(std::sqrt(d2) * p.inv_l);
+      sum = sum + std::fabs(y[3]) * spline::shape(std::sqrt(d2) * p.inv_l);
     });
     density[s] = p.sigma * sum;
   }
@@ -67,7 +49,7 @@ void sph_density(const void* params, std::byte* const* bindings, std::uint32_t b
 
 void sph_gather(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* order = reinterpret_cast<const u32*>(bindings[1]);
   const auto* velocity = reinterpret_cast<const float*>(bindings[2]);
   auto* sorted_velocity = reinterpret_cast<float*>(bindings[3]);
@@ -91,7 +73,7 @@ float tait(const SphParams& p, float rho) {
 
 void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
@@ -123,7 +105,7 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
       const float d2 = ex * ex + ey * ey + ez * ez;
       if (!(d2 < p.h2) || !(d2 > 0.0f)) return;  // beyond the support, or no direction
       const float r = std::sqrt(d2);
-      const float gw = p.grad_sigma * cubic_slope(r * p.inv_l) / r;  // grad W = gw (x_i - x_j)
+      const float gw = p.grad_sigma * spline::slope(r * p.inv_l) / r;  // grad W = gw (x_i - x_j)
       float factor;
       if (y[3] > 0.0f) {  // a fluid particle: pressure and viscosity
         const float* w = sorted_velocity + 4 * std::size_t{t};
@@ -164,7 +146,7 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
 
 void sph_boundary_force(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
@@ -186,7 +168,7 @@ void sph_boundary_force(const void* params, std::byte* const* bindings, std::uin
       const float d2 = ex * ex + ey * ey + ez * ez;
       if (!(d2 < p.h2) || !(d2 > 0.0f)) return;
       const float r = std::sqrt(d2);
-      const float gw = p.grad_sigma * cubic_slope(r * p.inv_l) / r;
+      const float gw = p.grad_sigma * spline::slope(r * p.inv_l) / r;
       const float* v = sorted_velocity + 4 * std::size_t{t};
       const float ux = v[0] - w[0], uy = v[1] - w[1], uz = v[2] - w[2];
       const float approach = ux * ex + uy * ey + uz * ez;

@@ -9,6 +9,7 @@
 
 #include "cpu/cpu_kernels.h"
 #include "cpu/neighbour_cells.h"
+#include "cpu/sph_spline.h"
 #include "sph_tension_params.h"
 
 namespace sinew::kernels {
@@ -16,17 +17,6 @@ namespace {
 
 using u32 = std::uint32_t;
 using cells::visit_cells;
-
-u32 particle_count(const TensionParams& p, const std::byte* counts) {
-  const u32 stored = reinterpret_cast<const u32*>(counts)[p.count_word];
-  return stored < p.capacity ? stored : p.capacity;
-}
-
-float spline_slope(float q) {  // the cubic spline's w'(q) (sph_params.h)
-  if (q < 1.0f) return (2.25f * q) * q - 3.0f * q;
-  const float t = 2.0f - q;
-  return (-0.75f * t) * t;
-}
 
 float cohesion_spline(const TensionParams& p, float r) {
   const float t = p.h - r;
@@ -40,7 +30,7 @@ float cohesion_spline(const TensionParams& p, float r) {
 
 void sph_normals(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const TensionParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);
@@ -58,7 +48,7 @@ void sph_normals(const void* params, std::byte* const* bindings, std::uint32_t b
         const float d2 = ex * ex + ey * ey + ez * ez;
         if (!(d2 < p.h2) || !(d2 > 0.0f)) return;
         const float r = std::sqrt(d2);
-        const float k = ((y[3] / density[t]) * p.grad_sigma) * spline_slope(r * p.inv_l) / r;
+        const float k = ((y[3] / density[t]) * p.grad_sigma) * spline::slope(r * p.inv_l) / r;
         nx = nx + k * ex;
         ny = ny + k * ey;
         nz = nz + k * ez;
@@ -72,7 +62,7 @@ void sph_normals(const void* params, std::byte* const* bindings, std::uint32_t b
 
 void sph_tension(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const TensionParams*>(params);
-  const u32 n = particle_count(p, bindings[0]);
+  const u32 n = cells::count_of(p, bindings[0]);
   const auto* points = reinterpret_cast<const float*>(bindings[1]);
   const auto* cells = reinterpret_cast<const int*>(bindings[2]);
   const auto* ranges = reinterpret_cast<const u32*>(bindings[3]);

@@ -87,6 +87,20 @@ void frame_of(const std::array<double, 3>& d, std::array<double, 3>& t1, std::ar
   t2 = {d[1] * t1[2] - d[2] * t1[1], d[2] * t1[0] - d[0] * t1[2], d[0] * t1[1] - d[1] * t1[0]};
 }
 
+// The fields every fluid kernel shares with the WCSPH parameters: the
+// count's word, the capacity, the grid's buckets and the spline's radii.
+template <class Params>
+Params grid_fields(const kernels::SphParams& p) {
+  Params q{};
+  q.count_word = p.count_word;
+  q.capacity = p.capacity;
+  q.table_mask = p.table_mask;
+  q.h2 = p.h2;
+  q.inv_l = p.inv_l;
+  q.grad_sigma = p.grad_sigma;
+  return q;
+}
+
 }  // namespace
 
 SphSolver::~SphSolver() {
@@ -295,14 +309,8 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
   p.dt = float(settings.time_step);
   m.params_ = p;
   if (m.tension_) {
-    kernels::TensionParams t{};
-    t.count_word = 0;
-    t.capacity = p.capacity;
-    t.table_mask = p.table_mask;
-    t.h2 = p.h2;
+    kernels::TensionParams t = grid_fields<kernels::TensionParams>(p);
     t.h = float(h);
-    t.inv_l = p.inv_l;
-    t.grad_sigma = p.grad_sigma;
     t.gamma = float(settings.surface_tension);
     t.cohesion = float(32.0 / (std::numbers::pi * std::pow(h, 9)));
     t.h6_64 = float(std::pow(h, 6) / 64.0);
@@ -312,14 +320,8 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
     m.tension_params_ = t;
   }
   if (m.pbf_) {
-    kernels::PbfParams q{};
-    q.count_word = 0;
-    q.capacity = p.capacity;
-    q.table_mask = p.table_mask;
-    q.h2 = p.h2;
-    q.inv_l = p.inv_l;
+    kernels::PbfParams q = grid_fields<kernels::PbfParams>(p);
     q.sigma = p.sigma;
-    q.grad_sigma = p.grad_sigma;
     q.rho0 = p.rho0;
     q.inv_rho0 = float(1.0 / settings.rest_density);
     q.dt = p.dt;
