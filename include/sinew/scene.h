@@ -61,6 +61,10 @@ struct TetBodyDesc {
   double volume_compliance = 1e-6;      ///< c_v [1/Pa], >= 0 (1/K, the bulk compliance)
   std::vector<std::uint32_t> pinned;    ///< vertices held fixed (inverse mass 0)
   TetMaterial material = TetMaterial::none;  ///< FEM constraints per tet (with E and nu below)
+  /// Tearing, >= 0 (0: never tears): after each frame, a tet with an edge
+  /// stretched past (1 + tear_strain) times its rest length is removed
+  /// (Simulation::last_tears lists them). Needs SceneDesc::topology_changes.
+  double tear_strain = 0.0;
   /// Velocity damping k [1/s], >= 0: every substep multiplies the velocity
   /// of the body's particles by exp(-k h), so free motion decays as
   /// exp(-k t) whatever the substeps (like a drag through a viscous medium:
@@ -549,6 +553,12 @@ struct SceneDesc {
   /// this, the frame program has no force kernel and the device no force
   /// buffer; with it, one dispatch per substep and 16 bytes per particle.
   bool external_forces = false;
+  /// Tets removed while the scene runs (Simulation::remove_tets, cut_body,
+  /// cauterize, TetBodyDesc::tear_strain; runtime/topology_editor.h). A
+  /// scene pays only for what it uses: with this the Simulation keeps a
+  /// host copy of every constraint block (what a removal patches) and the
+  /// tet bodies' adjacency; without it those calls are errors.
+  bool topology_changes = false;
 };
 
 /// Checks every parameter of a scene; the first problem found is returned,

@@ -178,6 +178,59 @@ class Simulation {
   /// Errors: not a level-set collider; LevelSet::cut's.
   Result<CutReport> cut_collider(std::size_t index, const CutterShape& shape, const Pose& from, const Pose& to);
 
+  // ---- Topology changes (SceneDesc::topology_changes; runtime/topology_editor.h)
+  //
+  // Tets are removed, never split: what is left is whole original elements,
+  // so no sliver is ever made (the smallest element keeps its rest volume).
+  // A removed tet's volume (or FEM) constraints go, and so do the distance
+  // constraints of edges no remaining tet has; an edge that keeps some of
+  // its tets is made softer by the volume it lost (alpha_e = c_d L^2 / V_e,
+  // TetBodyDesc). Each removed constraint's colour gives its last constraint
+  // the slot, so every colour stays valid and only the changed slots are
+  // uploaded; the frame program is rebuilt with the new counts. A vertex left
+  // with no tet is fixed (inverse mass 0) and its mass handed to the
+  // vertices it shared a removed tet with (cuts and tears conserve the total
+  // mass); cautery burns its tets' mass away. Events are returned, for a
+  // renderer to update its meshes (current_tets).
+
+  /// What one change did to tet body `body`.
+  struct TopologyEvent {
+    std::size_t body = 0;
+    std::vector<std::uint32_t> tets_removed;      ///< indices into the body's mesh.tets
+    std::vector<std::uint32_t> vertices_removed;  ///< vertices left with no tet (now fixed and massless)
+    std::uint32_t constraints_removed = 0;  ///< volume, FEM and distance constraints taken out
+    std::uint32_t edges_softened = 0;       ///< distance constraints whose compliance grew
+    double mass_moved = 0.0;    ///< [kg] handed from removed vertices to their neighbours
+    double mass_removed = 0.0;  ///< [kg] that left the scene (burned, or no neighbour left)
+    double wall_ms = 0.0;       ///< host and device time of the change, the program rebuilt included
+  };
+  /// Removes tets of tet body `body` (indices into its mesh.tets, each
+  /// alive, no repeats). Errors: topology changes not enabled, a bad body
+  /// or tet (named); on an error nothing changed.
+  Result<TopologyEvent> remove_tets(std::size_t body, std::span<const std::uint32_t> tets);
+  /// A blade: the segment from `a` to `b` [m].
+  struct Blade {
+    std::array<double, 3> a{}, b{};
+  };
+  /// Cuts tet body `body` with a blade swept from `from` to `to` (the quad
+  /// they span, two triangles): every live tet the swept quad touches at the
+  /// body's current positions is removed. Mass is conserved.
+  Result<TopologyEvent> cut_body(std::size_t body, const Blade& from, const Blade& to);
+  /// A heated tip (a ball of `radius` [m] at `centre` [m]) touching tet body
+  /// `body` for `seconds` [s] (> 0): a live tet whose current centroid lies
+  /// in the ball accumulates that time, and is burned (removed with its
+  /// mass) once it has been touched for dwell_time [s] (> 0) in all. The
+  /// rate: the ball's volume inside the body goes every dwell_time.
+  Result<TopologyEvent> cauterize(std::size_t body, const std::array<double, 3>& centre, double radius,
+                                  double seconds, double dwell_time);
+  /// Tets torn in the last step() (TetBodyDesc::tear_strain), one event per
+  /// body that tore.
+  [[nodiscard]] const std::vector<TopologyEvent>& last_tears() const;
+  /// The live tets of tet body `body` (indices into its mesh.tets, as
+  /// tets; the vertices are the mesh's): its current topology, for
+  /// extract_boundary_surface. Errors: a bad body.
+  Result<std::vector<std::array<std::uint32_t, 4>>> current_tets(std::size_t body) const;
+
   /// A tool's state at the end of the last frame.
   struct ToolState {
     std::array<double, 3> position{};          ///< [m]

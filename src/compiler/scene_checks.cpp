@@ -452,6 +452,13 @@ Status check_scene(const SceneDesc& scene) {
     return Error(ErrorCode::bad_parameter, "needles are not supported with solver.chebyshev_rho > 0 (got " +
                                                str(scene.solver.chebyshev_rho) +
                                                "): the accelerator would extrapolate the punctured tissue");
+  for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i) {
+    const std::string name = "tet_bodies[" + std::to_string(i) + "].tear_strain";
+    if (Status s = non_negative(name, scene.tet_bodies[i].tear_strain); !s) return s;
+    if (scene.tet_bodies[i].tear_strain > 0.0 && !scene.topology_changes)
+      return Error(ErrorCode::bad_parameter, name + " = " + str(scene.tet_bodies[i].tear_strain) +
+                                                 " needs topology_changes = true (tearing removes tets)");
+  }
   for (std::size_t i = 0; i < scene.targets.size(); ++i)
     if (Status s = finite3("targets[" + std::to_string(i) + "]", scene.targets[i]); !s) return s;
   for (std::size_t i = 0; i < scene.attachments.size(); ++i)

@@ -36,11 +36,21 @@ struct ConstraintBlock {
   std::vector<std::uint32_t> particles;   ///< arity per constraint
   std::vector<float> data;                ///< data_stride per constraint, e.g. (rest value, compliance alpha)
   std::vector<std::uint32_t> color_offsets{0};
+  /// Constraints in use at the start of each colour (colour k solves
+  /// [color_offsets[k], color_offsets[k] + color_counts[k])); empty: every
+  /// slot. Topology changes (runtime/topology_editor.h) remove a constraint
+  /// by moving its colour's last one into its slot, so a colour keeps its
+  /// capacity and its constraints stay independent.
+  std::vector<std::uint32_t> color_counts;
   /// Constraint damping time tau [s] of its bodies (SolveParams::damping =
   /// tau / h): bodies with different taus get different blocks.
   double damping_time = 0.0;
   [[nodiscard]] std::uint32_t size() const { return arity ? static_cast<std::uint32_t>(particles.size() / arity) : 0; }
   [[nodiscard]] std::uint32_t colors() const { return static_cast<std::uint32_t>(color_offsets.size() - 1); }
+  /// Constraints colour k solves (see color_counts).
+  [[nodiscard]] std::uint32_t color_count(std::size_t k) const {
+    return color_counts.empty() ? color_offsets[k + 1] - color_offsets[k] : color_counts[k];
+  }
 };
 
 /// The constraints of one kernel before colouring.

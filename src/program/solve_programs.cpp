@@ -196,7 +196,8 @@ void SolvePrograms::append_warm_start(FrameProgram& program) const {
     p.arity = block.arity;
     for (std::size_t c = 0; c + 1 < block.color_offsets.size(); ++c) {
       p.first = block.color_offsets[c];
-      p.count = block.color_offsets[c + 1] - block.color_offsets[c];
+      p.count = block.color_count(c);
+      if (p.count == 0) continue;  // emptied by topology changes
       program.dispatch(Kernel::xpbd_warm_start, p.count,
                        {buffers_.position, buffers_.previous, buffers_.blocks[k].particles, buffers_.blocks[k].lambda}, p);
       program.barrier();

@@ -30,10 +30,25 @@ Result<BufferHandle> make_buffer(Device& device, const std::vector<T>& data, std
   return buffer;
 }
 
-// One Gauss-Seidel sweep over a block: a dispatch per range of
-// `offsets` (the colours), each followed by a barrier since the next colour
-// reads what this one wrote.
-void sweep(FrameProgram& program, const ConstraintBlock& block, std::span<const std::uint32_t> offsets,
+// A range of one block's slots that one dispatch solves.
+struct SlotRange {
+  std::uint32_t first, count;
+};
+
+// The block's colours, each the constraints in use at its start
+// (ConstraintBlock::color_counts); colours emptied by topology changes are
+// left out.
+std::vector<SlotRange> color_ranges(const ConstraintBlock& block) {
+  std::vector<SlotRange> ranges;
+  for (std::size_t c = 0; c < block.colors(); ++c)
+    if (const std::uint32_t n = block.color_count(c); n > 0) ranges.push_back({block.color_offsets[c], n});
+  return ranges;
+}
+
+// One Gauss-Seidel sweep over a block: a dispatch per range (the colours),
+// each followed by a barrier since the next colour reads what this one
+// wrote.
+void sweep(FrameProgram& program, const ConstraintBlock& block, std::span<const SlotRange> ranges,
            const BlockBuffers& buffers, const XpbdBuffers& scene_buffers, kernels::SolveParams p) {
   std::vector<BufferHandle> bindings{scene_buffers.position, buffers.particles, buffers.data, buffers.lambda,
                                      buffers.residual};
@@ -46,9 +61,9 @@ void sweep(FrameProgram& program, const ConstraintBlock& block, std::span<const 
       case SceneBuffer::level_set_grids: bindings.push_back(scene_buffers.level_set_grids); break;
     }
   }
-  for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
-    p.first = offsets[c];
-    p.count = offsets[c + 1] - offsets[c];
+  for (const SlotRange& r : ranges) {
+    p.first = r.first;
+    p.count = r.count;
     program.dispatch(block.kernel, p.count, bindings, p);
     program.barrier();
   }
@@ -157,7 +172,7 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
       p.substep_end = static_cast<float>(double(s + 1) / solver.substeps);
       for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
         p.damping = static_cast<float>(scene.blocks[k].damping_time / h);  // gamma of eq. 26
-        sweep(program, scene.blocks[k], scene.blocks[k].color_offsets, buffers.blocks[k], buffers, p);
+        sweep(program, scene.blocks[k], color_ranges(scene.blocks[k]), buffers.blocks[k], buffers, p);
       }
       if (mesh_contacts) {  // after the bodies' constraints, colour by colour
         kernels::MeshContactParams m = mesh_contacts->params;
@@ -208,9 +223,12 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
       p.h = static_cast<float>(h);
       p.substep_end = 1.0f;
       p.measure_only = 1;
+      // (A block with removed constraints measures its colours' ranges: the
+      // slots past them hold stale copies.)
       for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
-        const std::uint32_t whole[2] = {0, scene.blocks[k].size()};
-        sweep(program, scene.blocks[k], whole, buffers.blocks[k], buffers, p);
+        const ConstraintBlock& block = scene.blocks[k];
+        const std::vector<SlotRange> whole{{0, block.size()}};
+        sweep(program, block, block.color_counts.empty() ? whole : color_ranges(block), buffers.blocks[k], buffers, p);
       }
     }
     program.dispatch(Kernel::xpbd_update_velocity, particles, {buffers.position, buffers.previous, buffers.velocity},

@@ -79,6 +79,13 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     auto mesh_collision = MeshCollision::create(scene, *compiled, *impl->device);
     if (!mesh_collision) return mesh_collision.error();
     impl->mesh_collision = std::move(*mesh_collision);
+  }
+  if (scene.topology_changes) {
+    auto editor = TopologyEditor::create(scene, *compiled);
+    if (!editor) return editor.error();
+    impl->topology = std::move(*editor);
+  }
+  if (impl->mesh_collision || impl->topology) {  // programs rebuilt while the scene runs start from this
     impl->program_shape = *compiled;
     for (ConstraintBlock& block : impl->program_shape.blocks) block.data = {};
   }
@@ -144,6 +151,15 @@ Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
   return {};
 }
 
+Status Simulation::Impl::rebuild_program() {
+  if (!stepper) return prepare_program(program_shape);
+  if (Status s = stepper->rebuild(*device, program_shape, buffers, gravity, stats_plan, sweep_extras()); !s) return s;
+  program = stepper->frame_program();
+  info.dispatches_per_frame = static_cast<std::uint32_t>(program.dispatch_count());
+  info.barriers_per_frame = static_cast<std::uint32_t>(program.barrier_count());
+  return {};
+}
+
 Status Simulation::step() {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = impl_->begin_frame_forces(); !s) return s;
@@ -154,19 +170,8 @@ Status Simulation::step() {
                                                                impl_->tool_shapes(true), impl_->tool_shapes(false), grew);
         !s)
       return s;
-    if (grew) {
-      if (impl_->stepper) {
-        if (Status s = impl_->stepper->rebuild(*impl_->device, impl_->program_shape, impl_->buffers, impl_->gravity,
-                                               impl_->stats_plan, impl_->sweep_extras());
-            !s)
-          return s;
-        impl_->program = impl_->stepper->frame_program();
-        impl_->info.dispatches_per_frame = static_cast<std::uint32_t>(impl_->program.dispatch_count());
-        impl_->info.barriers_per_frame = static_cast<std::uint32_t>(impl_->program.barrier_count());
-      } else if (Status s = impl_->prepare_program(impl_->program_shape); !s) {
-        return s;
-      }
-    }
+    if (grew)
+      if (Status s = impl_->rebuild_program(); !s) return s;
     impl_->stats.mesh_contacts = impl_->mesh_collision->contacts();
     impl_->stats.mesh_contact_colors = impl_->mesh_collision->colors();
     impl_->stats.collision_margin = impl_->mesh_collision->margin();
@@ -215,6 +220,7 @@ Status Simulation::step() {
                                  (impl_->sutures ? impl_->sutures->read_back_bytes() : 0);
   if (Status s = impl_->after_frame(); !s) return s;
   if (impl_->measure_errors) impl_->measure(impl_->stats);
+  if (Status s = impl_->tear(); !s) return s;  // the next frame runs without what tore (last_tears)
   const auto end = std::chrono::steady_clock::now();
   impl_->stats.frame += 1;
   impl_->stats.time = static_cast<double>(impl_->stats.frame) * impl_->time_step;

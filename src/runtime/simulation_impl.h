@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "runtime/mesh_collision.h"
 #include "runtime/solve_stepper.h"
 #include "runtime/sutures.h"
+#include "runtime/topology_editor.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -57,8 +59,9 @@ struct Simulation::Impl {
   Status begin_frame_forces();
 
   // Contacts between meshes (mesh_collision.h; null when the scene has
-  // none). The program is rebuilt when they outgrow it, from the compiled
-  // scene's shape (its blocks without their data) kept here for that.
+  // none). The program is rebuilt when they outgrow it (or the topology
+  // changes), from the compiled scene's shape (its blocks without their
+  // data) kept here for that.
   std::unique_ptr<MeshCollision> mesh_collision;
   // The threads' continuous collision detection, run by the stepper after
   // every substep's sweeps (null unless MeshCollisionDesc::continuous).
@@ -74,6 +77,20 @@ struct Simulation::Impl {
   std::array<double, 3> gravity{};
   /// Builds the fixed-mode frame program (solve + statistics) and prepares it on the device.
   Status prepare_program(const CompiledScene& compiled);
+  /// Builds the frame's program(s) again from program_shape: after the mesh
+  /// contacts outgrew theirs, or a topology change.
+  Status rebuild_program();
+
+  // SceneDesc::topology_changes: the host copy of the constraints that
+  // removals patch (null without), and the last step's tears.
+  std::unique_ptr<TopologyEditor> topology;
+  std::vector<Simulation::TopologyEvent> tears;
+  /// After a frame: removes the tets stretched past their body's tear_strain.
+  Status tear();
+  /// Removes tets (topology_editor.h), rebuilds the program and times the
+  /// whole change from `start`.
+  Result<Simulation::TopologyEvent> apply_removal(std::size_t body, std::span<const std::uint32_t> tets, bool burn,
+                                                  std::chrono::steady_clock::time_point start);
 
   // simulation_contacts.cpp: host copies of the collider and target
   // buffers (rewritten before each frame) and the tools' rigid state.

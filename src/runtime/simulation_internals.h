@@ -3,6 +3,9 @@
 // (both internal types; users describe scenes, not dispatches).
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "backends/backend.h"
 #include "sinew/simulation.h"
 
@@ -12,6 +15,18 @@ struct SimulationInternals {
   static const Device& device(const Simulation& sim);
   static const FrameProgram& program(const Simulation& sim);
   static double frame_length(const Simulation& sim);  ///< SolverSettings::time_step [s]
+  /// The colouring checker (scenes with topology_changes): every block's
+  /// colours in use, read back from the device, and the particles they
+  /// share. conflicts: movable particles (inverse mass > 0 on the device)
+  /// met a second time in one colour (0 when every colour is valid).
+  struct ColorCheck {
+    std::uint32_t colors = 0;
+    std::uint64_t constraints = 0;  ///< in use
+    std::uint64_t conflicts = 0;
+    double total_mass = 0.0;  ///< sum of 1 / w over the device's movable particles [kg]
+    std::vector<std::uint32_t> references;  ///< per particle (user order): constraints in use naming it
+  };
+  static Result<ColorCheck> check_colors(const Simulation& sim);
 };
 
 }  // namespace sinew

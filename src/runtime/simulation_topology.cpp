@@ -1,0 +1,145 @@
+// simulation_topology.cpp — Simulation's topology changes: remove_tets,
+// cut_body, cauterize and the tears after each frame (topology_editor.h
+// patches the constraints, topology_queries.h finds the tets).
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "runtime/simulation_impl.h"
+#include "runtime/simulation_internals.h"
+#include "runtime/topology_queries.h"
+
+namespace sinew {
+
+namespace {
+
+Status need_topology(const std::unique_ptr<TopologyEditor>& editor, const char* call) {
+  if (editor) return {};
+  return Error(ErrorCode::bad_parameter,
+               std::string(call) + " needs SceneDesc::topology_changes = true when the Simulation is made");
+}
+
+Status check_body(const TopologyEditor& editor, std::size_t body) {
+  if (body < editor.bodies()) return {};
+  return Error(ErrorCode::bad_parameter, "tet body " + std::to_string(body) + " does not exist (the scene has " +
+                                             std::to_string(editor.bodies()) + ")");
+}
+
+}  // namespace
+
+Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(std::size_t body,
+                                                                 std::span<const std::uint32_t> tets, bool burn,
+                                                                 std::chrono::steady_clock::time_point start) {
+  auto event = topology->remove(*device, buffers, program_shape, body, tets, burn);
+  if (!event) return event.error();
+  if (!tets.empty())
+    if (Status s = rebuild_program(); !s) return s.error();
+  event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return event;
+}
+
+Result<Simulation::TopologyEvent> Simulation::remove_tets(std::size_t body, std::span<const std::uint32_t> tets) {
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = need_topology(impl_->topology, "remove_tets"); !s) return s.error();
+  return impl_->apply_removal(body, tets, false, start);
+}
+
+Result<Simulation::TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = need_topology(impl_->topology, "cut_body"); !s) return s.error();
+  if (Status s = check_body(*impl_->topology, body); !s) return s.error();
+  for (const auto& [p, name] : {std::pair{&from.a, "from.a"}, {&from.b, "from.b"}, {&to.a, "to.a"}, {&to.b, "to.b"}})
+    for (double c : *p)
+      if (!std::isfinite(c)) return Error(ErrorCode::bad_parameter, std::string("cut_body: blade ") + name + " is not finite");
+  std::vector<float> x;
+  if (Status s = read_positions(x); !s) return s.error();
+  const TopologyEditor& e = *impl_->topology;
+  const auto cut = tets_cut(e.mesh(body), e.alive(body), {x, e.first_particle(body)}, from.a, from.b, to.a, to.b);
+  return impl_->apply_removal(body, cut, false, start);
+}
+
+Result<Simulation::TopologyEvent> Simulation::cauterize(std::size_t body, const std::array<double, 3>& centre,
+                                                        double radius, double seconds, double dwell_time) {
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = need_topology(impl_->topology, "cauterize"); !s) return s.error();
+  if (Status s = check_body(*impl_->topology, body); !s) return s.error();
+  for (double c : centre)
+    if (!std::isfinite(c)) return Error(ErrorCode::bad_parameter, "cauterize: centre is not finite");
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    return Error(ErrorCode::bad_parameter, "cauterize: radius must be > 0 [m] (got " + std::to_string(radius) + ")");
+  if (!(seconds > 0.0) || !std::isfinite(seconds))
+    return Error(ErrorCode::bad_parameter, "cauterize: seconds must be > 0 (got " + std::to_string(seconds) + ")");
+  if (!(dwell_time > 0.0) || !std::isfinite(dwell_time))
+    return Error(ErrorCode::bad_parameter, "cauterize: dwell_time must be > 0 [s] (got " + std::to_string(dwell_time) + ")");
+  std::vector<float> x;
+  if (Status s = read_positions(x); !s) return s.error();
+  TopologyEditor& e = *impl_->topology;
+  const auto burned = tets_burned(e.mesh(body), e.alive(body), {x, e.first_particle(body)}, centre, radius, seconds,
+                                  dwell_time, e.heat(body));
+  return impl_->apply_removal(body, burned, true, start);
+}
+
+Status Simulation::Impl::tear() {
+  tears.clear();
+  if (!topology || !topology->tears()) return {};
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<float> x;
+  if (Status s = read_in_user_order(buffers.position, x); !s) return s;
+  for (std::size_t b = 0; b < topology->bodies(); ++b) {
+    if (!(topology->tear_strain(b) > 0.0)) continue;
+    const auto torn = tets_torn(topology->mesh(b), topology->alive(b), {x, topology->first_particle(b)},
+                                topology->tear_strain(b));
+    if (torn.empty()) continue;
+    auto event = apply_removal(b, torn, false, start);
+    if (!event) return event.error();
+    tears.push_back(std::move(*event));
+  }
+  return {};
+}
+
+const std::vector<Simulation::TopologyEvent>& Simulation::last_tears() const { return impl_->tears; }
+
+Result<std::vector<std::array<std::uint32_t, 4>>> Simulation::current_tets(std::size_t body) const {
+  if (Status s = need_topology(impl_->topology, "current_tets"); !s) return s.error();
+  if (Status s = check_body(*impl_->topology, body); !s) return s.error();
+  const TopologyEditor& e = *impl_->topology;
+  std::vector<std::array<std::uint32_t, 4>> tets;
+  for (std::size_t t = 0; t < e.alive(body).size(); ++t)
+    if (e.alive(body)[t]) tets.push_back(e.mesh(body).tets[t]);
+  return tets;
+}
+
+Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const Simulation& sim) {
+  const Simulation::Impl& impl = *sim.impl_;
+  if (Status s = need_topology(impl.topology, "check_colors"); !s) return s.error();
+  Device& device = *impl.device;
+  std::vector<kernels::float4> x(impl.program_shape.positions.size());
+  if (Status s = device.read_buffer(impl.buffers.position, 0, x.data(), x.size() * 16); !s) return s.error();
+  ColorCheck out;
+  out.references.assign(x.size(), 0);
+  std::vector<std::uint32_t> owner(x.size(), UINT32_MAX);  // the last colour that moved each particle
+  std::uint32_t colour_id = 0;
+  for (std::size_t k = 0; k < impl.program_shape.blocks.size(); ++k) {
+    const ConstraintBlock& block = impl.program_shape.blocks[k];
+    std::vector<std::uint32_t> particles(std::size_t{block.size()} * block.arity);
+    if (Status s = device.read_buffer(impl.buffers.blocks[k].particles, 0, particles.data(), particles.size() * 4); !s)
+      return s.error();
+    for (std::size_t c = 0; c < block.colors(); ++c, ++colour_id) {
+      ++out.colors;
+      for (std::uint32_t i = block.color_offsets[c]; i < block.color_offsets[c] + block.color_count(c); ++i) {
+        ++out.constraints;
+        for (std::uint32_t a = 0; a < block.arity; ++a) {
+          const std::uint32_t p = particles[std::size_t{i} * block.arity + a];
+          ++out.references[impl.order.user_of.empty() ? p : impl.order.user_of[p]];
+          if (!(x[p].w > 0.0f)) continue;  // immovable particles may be shared
+          if (owner[p] == colour_id) ++out.conflicts;
+          owner[p] = colour_id;
+        }
+      }
+    }
+  }
+  for (const auto& p : x) out.total_mass += p.w > 0.0f ? 1.0 / double(p.w) : 0.0;
+  return out;
+}
+
+}  // namespace sinew

@@ -1,0 +1,363 @@
+// topology_editor.cpp — see topology_editor.h (Box2D v3's constraint
+// graph: colours with spare capacity, a removal moves the colour's last
+// constraint into the freed slot).
+#include "runtime/topology_editor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "math/xpbd_math.h"
+
+namespace sinew {
+
+namespace {
+
+bool is_tet_kernel(Kernel k) {
+  return k == Kernel::xpbd_solve_volume || k == Kernel::xpbd_solve_neo_hookean || k == Kernel::xpbd_solve_stvk ||
+         k == Kernel::xpbd_solve_corotational;
+}
+
+constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+// Writes slots [first, first + count) of a per-slot array of `words` 32-bit
+// words each.
+template <class T>
+Status write_slots(Device& device, BufferHandle buffer, const std::vector<T>& host, std::uint32_t words,
+                   std::uint32_t first, std::uint32_t count) {
+  return device.write_buffer(buffer, std::size_t{first} * words * 4, host.data() + std::size_t{first} * words,
+                             std::size_t{count} * words * 4);
+}
+
+}  // namespace
+
+std::size_t TopologyEditor::TetKeyHash::operator()(const TetKey& k) const noexcept {
+  std::size_t h = 1469598103934665603ull;
+  for (std::uint32_t v : k) h = (h ^ v) * 1099511628211ull;
+  return h;
+}
+
+std::uint64_t TopologyEditor::edge_key(std::uint32_t a, std::uint32_t b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t{a} << 32) | b;
+}
+
+TopologyEditor::TetKey TopologyEditor::tet_key(const Body& b, std::uint32_t tet) const {
+  TetKey k;
+  for (int i = 0; i < 4; ++i) k[i] = b.device[b.mesh.tets[tet][i]];
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& scene, const CompiledScene& compiled) {
+  auto e = std::unique_ptr<TopologyEditor>(new TopologyEditor());
+  for (std::uint32_t k = 0; k < compiled.blocks.size(); ++k) {
+    const ConstraintBlock& c = compiled.blocks[k];
+    Block b;
+    b.kernel = c.kernel;
+    b.arity = c.arity;
+    b.data_stride = c.data_stride;
+    b.lambda_stride = c.lambda_stride;
+    b.particles = c.particles;
+    b.data = c.data;
+    b.offsets = c.color_offsets;
+    for (std::size_t col = 0; col < c.colors(); ++col) b.counts.push_back(c.color_count(col));
+    const bool tets = is_tet_kernel(c.kernel) && c.arity == 4, edges = c.kernel == Kernel::xpbd_solve_distance;
+    for (std::uint32_t i = 0; i < c.size() && (tets || edges); ++i) {
+      const std::uint32_t* p = &b.particles[std::size_t{i} * b.arity];
+      if (edges) {
+        e->edge_slots_[edge_key(p[0], p[1])] = {k, i};
+      } else {
+        TetKey key{p[0], p[1], p[2], p[3]};
+        std::sort(key.begin(), key.end());
+        e->tet_slots_[key].push_back({k, i});
+      }
+    }
+    e->blocks_.push_back(std::move(b));
+  }
+  e->mass_.resize(compiled.positions.size());
+  for (std::size_t i = 0; i < compiled.positions.size(); ++i)
+    e->mass_[i] = compiled.positions[i].w > 0.0f ? 1.0 / double(compiled.positions[i].w) : 0.0;
+  for (std::size_t bi = 0; bi < scene.tet_bodies.size(); ++bi) {
+    const TetBodyDesc& desc = scene.tet_bodies[bi];
+    Body b;
+    b.mesh = desc.mesh;
+    b.first = compiled.tet_body_first_particle[bi];
+    b.density = desc.density;
+    b.distance_compliance = desc.distance_compliance;
+    b.tear_strain = desc.tear_strain;
+    const std::size_t nv = desc.mesh.vertices.size(), nt = desc.mesh.tets.size();
+    for (std::uint32_t v = 0; v < nv; ++v) b.device.push_back(compiled.order.device_of[b.first + v]);
+    b.alive.assign(nt, 1);
+    b.heat.assign(nt, 0.0);
+    b.live_tets.assign(nv, 0);
+    b.tet_offsets.assign(nv + 1, 0);
+    // Rest volumes exactly as add_tet_body computes them (float positions, float volume).
+    auto at = [&](std::uint32_t v) {
+      const Vec3d& x = desc.mesh.vertices[v];
+      return kernels::float4{static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2]), 0.0f};
+    };
+    for (const auto& t : desc.mesh.tets) {
+      b.rest_volume.push_back(kernels::tet_volume(at(t[0]), at(t[1]), at(t[2]), at(t[3])));
+      for (std::uint32_t v : t) ++b.live_tets[v], ++b.tet_offsets[v + 1];
+    }
+    for (std::size_t v = 0; v < nv; ++v) b.tet_offsets[v + 1] += b.tet_offsets[v];
+    b.tet_list.resize(b.tet_offsets[nv]);
+    std::vector<std::uint32_t> fill(b.tet_offsets.begin(), b.tet_offsets.end() - 1);
+    for (std::uint32_t t = 0; t < nt; ++t)  // ascending: each vertex's tets in mesh order
+      for (std::uint32_t v : desc.mesh.tets[t]) b.tet_list[fill[v]++] = t;
+    e->bodies_.push_back(std::move(b));
+  }
+  return e;
+}
+
+bool TopologyEditor::tears() const {
+  return std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) { return b.tear_strain > 0.0; });
+}
+
+void TopologyEditor::swap_remove(std::uint32_t k, std::uint32_t slot) {
+  Block& b = blocks_[k];
+  const auto color = static_cast<std::uint32_t>(std::upper_bound(b.offsets.begin(), b.offsets.end(), slot) -
+                                                b.offsets.begin() - 1);
+  const std::uint32_t last = b.offsets[color] + b.counts[color] - 1;
+  if (slot != last) {
+    std::copy_n(&b.particles[std::size_t{last} * b.arity], b.arity, &b.particles[std::size_t{slot} * b.arity]);
+    std::copy_n(&b.data[std::size_t{last} * b.data_stride], b.data_stride, &b.data[std::size_t{slot} * b.data_stride]);
+    // The moved constraint's index entry follows it.
+    const std::uint32_t* p = &b.particles[std::size_t{slot} * b.arity];
+    if (b.kernel == Kernel::xpbd_solve_distance) {
+      edge_slots_[edge_key(p[0], p[1])] = {k, slot};
+    } else {
+      TetKey key{p[0], p[1], p[2], p[3]};
+      std::sort(key.begin(), key.end());
+      for (Slot& s : tet_slots_[key])
+        if (s.block == k && s.slot == last) s.slot = slot;
+    }
+    b.dirty.push_back(slot);
+  }
+  b.freed.push_back(last);
+  --b.counts[color];
+}
+
+double TopologyEditor::edge_share(const Body& b, std::uint32_t a, std::uint32_t v) const {
+  double share = 0.0;
+  for (std::uint32_t i = b.tet_offsets[a]; i < b.tet_offsets[a + 1]; ++i) {
+    const std::uint32_t t = b.tet_list[i];
+    const auto& q = b.mesh.tets[t];
+    if (b.alive[t] && (q[0] == v || q[1] == v || q[2] == v || q[3] == v))
+      share += static_cast<double>(b.rest_volume[t]) / 6.0;  // as add_tet_body sums it, in tet order
+  }
+  return share;
+}
+
+Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const XpbdBuffers& buffers,
+                                                         CompiledScene& shape, std::size_t body,
+                                                         std::span<const std::uint32_t> tets, bool burn) {
+  if (body >= bodies_.size())
+    return Error(ErrorCode::bad_parameter, "tet body " + std::to_string(body) + " does not exist (the scene has " +
+                                               std::to_string(bodies_.size()) + ")");
+  Body& b = bodies_[body];
+  std::vector<std::uint8_t> seen(b.mesh.tets.size(), 0);
+  for (std::uint32_t t : tets) {
+    const std::string name = "tet_bodies[" + std::to_string(body) + "] tet " + std::to_string(t);
+    if (t >= b.mesh.tets.size())
+      return Error(ErrorCode::bad_parameter, name + " does not exist (the mesh has " +
+                                                 std::to_string(b.mesh.tets.size()) + " tets)");
+    if (!b.alive[t]) return Error(ErrorCode::bad_parameter, name + " was removed already");
+    if (seen[t]) return Error(ErrorCode::bad_parameter, name + " is listed twice");
+    seen[t] = 1;
+  }
+  Simulation::TopologyEvent event;
+  event.body = body;
+  event.tets_removed.assign(tets.begin(), tets.end());
+
+  // The tets' own constraints: one of each block (volume, FEM) per tet.
+  std::vector<std::uint32_t> touched;  // vertices of the removed tets
+  for (std::uint32_t t : tets) {
+    b.alive[t] = 0;
+    b.heat[t] = 0.0;
+    for (std::uint32_t v : b.mesh.tets[t]) --b.live_tets[v], touched.push_back(v);
+    const auto it = tet_slots_.find(tet_key(b, t));
+    if (it == tet_slots_.end()) continue;  // a body without volume or FEM constraints
+    std::vector<Slot>& slots = it->second;
+    std::vector<std::uint32_t> done;
+    for (std::size_t i = 0; i < slots.size();) {
+      if (std::find(done.begin(), done.end(), slots[i].block) != done.end()) {
+        ++i;
+        continue;
+      }
+      const Slot s = slots[i];
+      done.push_back(s.block);
+      slots.erase(slots.begin() + std::ptrdiff_t(i));
+      swap_remove(s.block, s.slot);
+      ++event.constraints_removed;
+    }
+    if (slots.empty()) tet_slots_.erase(it);
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+
+  // Their edges: gone with their last tet, or softer by the volume they lost.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::uint32_t t : tets)
+    for (const auto& e : kEdges) {
+      const std::uint32_t u = b.mesh.tets[t][e[0]], v = b.mesh.tets[t][e[1]];
+      edges.emplace_back(std::min(u, v), std::max(u, v));
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& [u, v] : edges) {
+    const auto it = edge_slots_.find(edge_key(b.device[u], b.device[v]));
+    if (it == edge_slots_.end()) continue;  // a body without distance constraints
+    const Slot s = it->second;
+    const double share = edge_share(b, u, v);
+    if (share <= 0.0) {
+      edge_slots_.erase(it);
+      swap_remove(s.block, s.slot);
+      ++event.constraints_removed;
+      continue;
+    }
+    Block& k = blocks_[s.block];
+    float* data = &k.data[std::size_t{s.slot} * k.data_stride];
+    const float len = data[0];
+    const auto alpha = static_cast<float>(b.distance_compliance * static_cast<double>(len) * len / share);
+    if (alpha != data[1]) {
+      data[1] = alpha;
+      k.dirty.push_back(s.slot);
+      ++event.edges_softened;
+    }
+  }
+
+  // Masses.
+  std::vector<std::uint32_t> mass_changed;
+  if (burn) {
+    for (std::uint32_t t : tets) {
+      const double share = b.density * static_cast<double>(b.rest_volume[t]) / 4.0;  // as add_tet_body lumps it
+      for (std::uint32_t v : b.mesh.tets[t]) {
+        double& m = mass_[b.device[v]];
+        if (m <= 0.0) continue;  // pinned: its share was never on it
+        const double taken = std::min(m, share);
+        m -= taken;
+        event.mass_removed += taken;
+        mass_changed.push_back(b.device[v]);
+      }
+    }
+  }
+  for (std::uint32_t v : touched) {
+    double& m = mass_[b.device[v]];
+    if (b.live_tets[v] > 0 || m <= 0.0) continue;
+    event.vertices_removed.push_back(v);
+    mass_changed.push_back(b.device[v]);
+    if (burn) {  // what rounding left
+      event.mass_removed += m;
+      m = 0.0;
+      continue;
+    }
+    // Its neighbours through the removed tets that still hold tets and move.
+    std::vector<std::uint32_t> to;
+    for (std::uint32_t t : tets) {
+      const auto& q = b.mesh.tets[t];
+      if (std::find(q.begin(), q.end(), v) == q.end()) continue;
+      for (std::uint32_t u : q)
+        if (b.live_tets[u] > 0 && mass_[b.device[u]] > 0.0) to.push_back(u);
+    }
+    std::sort(to.begin(), to.end());
+    to.erase(std::unique(to.begin(), to.end()), to.end());
+    if (to.empty()) {  // none: the nearest live movable vertex of the body, at rest
+      double best = std::numeric_limits<double>::infinity();
+      std::uint32_t nearest = 0;
+      for (std::uint32_t u = 0; u < b.mesh.vertices.size(); ++u) {
+        if (b.live_tets[u] == 0 || mass_[b.device[u]] <= 0.0) continue;
+        double d2 = 0.0;
+        for (int a = 0; a < 3; ++a) d2 += (b.mesh.vertices[u][a] - b.mesh.vertices[v][a]) * (b.mesh.vertices[u][a] - b.mesh.vertices[v][a]);
+        if (d2 < best) best = d2, nearest = u;
+      }
+      if (std::isfinite(best)) to.push_back(nearest);
+    }
+    if (to.empty()) {  // nothing of the body is left to carry it
+      event.mass_removed += m;
+    } else {
+      for (std::uint32_t u : to) {
+        mass_[b.device[u]] += m / double(to.size());
+        mass_changed.push_back(b.device[u]);
+      }
+      event.mass_moved += m;
+    }
+    m = 0.0;
+  }
+  std::sort(mass_changed.begin(), mass_changed.end());
+  mass_changed.erase(std::unique(mass_changed.begin(), mass_changed.end()), mass_changed.end());
+  if (Status s = upload(device, buffers, mass_changed); !s) return s.error();
+  for (std::size_t k = 0; k < blocks_.size(); ++k) shape.blocks[k].color_counts = blocks_[k].counts;
+  return event;
+}
+
+Status TopologyEditor::upload(Device& device, const XpbdBuffers& buffers, std::span<const std::uint32_t> mass_changed) {
+  for (std::size_t k = 0; k < blocks_.size(); ++k) {
+    Block& b = blocks_[k];
+    const BlockBuffers& d = buffers.blocks[k];
+    std::sort(b.dirty.begin(), b.dirty.end());
+    b.dirty.erase(std::unique(b.dirty.begin(), b.dirty.end()), b.dirty.end());
+    // Runs of consecutive slots, one write per buffer each. A moved
+    // constraint's multiplier starts again from 0 (only a warm start would
+    // have carried it).
+    for (std::size_t i = 0; i < b.dirty.size();) {
+      std::size_t j = i + 1;
+      while (j < b.dirty.size() && b.dirty[j] == b.dirty[j - 1] + 1) ++j;
+      const std::uint32_t first = b.dirty[i], count = static_cast<std::uint32_t>(j - i);
+      if (Status s = write_slots(device, d.particles, b.particles, b.arity, first, count); !s) return s;
+      if (Status s = write_slots(device, d.data, b.data, b.data_stride, first, count); !s) return s;
+      const std::vector<float> zeros(std::size_t{count} * b.lambda_stride, 0.0f);
+      if (Status s = device.write_buffer(d.lambda, std::size_t{first} * b.lambda_stride * 4, zeros.data(),
+                                         zeros.size() * 4);
+          !s)
+        return s;
+      i = j;
+    }
+    // Freed slots: their residual (what the statistics and the residual
+    // checks reduce over the whole block) becomes 0.
+    for (std::uint32_t slot : b.freed) {
+      const float zero = 0.0f;
+      if (Status s = device.write_buffer(d.residual, std::size_t{slot} * 4, &zero, 4); !s) return s;
+    }
+    b.dirty.clear();
+    b.freed.clear();
+  }
+  // Inverse masses: read each changed particle (the device moved it) and
+  // write it back with its new w.
+  for (std::uint32_t p : mass_changed) {
+    kernels::float4 x{};
+    if (Status s = device.read_buffer(buffers.position, std::size_t{p} * 16, &x, 16); !s) return s;
+    x.w = mass_[p] > 0.0 ? static_cast<float>(1.0 / mass_[p]) : 0.0f;
+    if (Status s = device.write_buffer(buffers.position, std::size_t{p} * 16, &x, 16); !s) return s;
+  }
+  return {};
+}
+
+std::vector<TopologyEditor::ColorView> TopologyEditor::active_constraints() const {
+  std::vector<ColorView> out;
+  for (const Block& b : blocks_) {
+    ColorView v;
+    v.arity = b.arity;
+    for (std::size_t c = 0; c < b.counts.size(); ++c)
+      v.colors.emplace_back(b.particles.begin() + std::ptrdiff_t(std::size_t{b.offsets[c]} * b.arity),
+                            b.particles.begin() + std::ptrdiff_t(std::size_t{b.offsets[c] + b.counts[c]} * b.arity));
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> TopologyEditor::movable() const {
+  std::vector<std::uint8_t> m(mass_.size());
+  for (std::size_t i = 0; i < mass_.size(); ++i) m[i] = mass_[i] > 0.0;
+  return m;
+}
+
+double TopologyEditor::total_mass() const {
+  double sum = 0.0;
+  for (double m : mass_) sum += m;
+  return sum;
+}
+
+}  // namespace sinew

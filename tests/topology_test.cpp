@@ -1,0 +1,305 @@
+// Topology changes (issue 16): tets removed while the scene runs — by
+// hand, by a blade, by tearing and by cautery — on every backend. What
+// every change must keep: each colour valid (the colouring checker reads
+// the device's constraints back), no constraint naming a removed vertex,
+// the total mass (cuts and tears), and finite positions.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "runtime/simulation_internals.h"
+#include "test_support.h"
+
+namespace sinew::test {
+namespace {
+
+constexpr double kCell = 5e-3;  // [m]
+
+// A pad of nx x ny x nz cells of 5 mm (6 tets each), 300 kPa, pinned where
+// `pin` says.
+template <class Pin>
+SceneDesc pad(int nx, int ny, int nz, Pin pin, TetMaterial material = TetMaterial::none) {
+  SceneDesc scene;
+  TetBodyDesc body;
+  body.mesh = *make_tet_grid({.nx = nx, .ny = ny, .nz = nz, .cell_size = {kCell, kCell, kCell}});
+  body.density = 1000.0;
+  if (material == TetMaterial::none) {
+    EXPECT_TRUE(body.set_elastic(3e5, 0.3).ok());
+  } else {
+    EXPECT_TRUE(body.set_material(material, 3e5, 0.3).ok());
+  }
+  for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
+    if (pin(body.mesh.vertices[v])) body.pinned.push_back(v);
+  scene.tet_bodies.push_back(body);
+  scene.solver.time_step = 1.0 / 60.0;
+  scene.solver.substeps = 20;
+  scene.solver.iterations = 1;
+  scene.topology_changes = true;
+  return scene;
+}
+
+auto left_end = [](const Vec3d& p) { return p[0] < 1e-9; };
+
+// Steps `frames` frames; fails on an error or a non-finite position.
+void run(Simulation& sim, int frames) {
+  std::vector<float> x;
+  for (int f = 0; f < frames; ++f) ASSERT_TRUE(sim.step().ok());
+  ASSERT_TRUE(sim.read_positions(x).ok());
+  for (float c : x) ASSERT_TRUE(std::isfinite(c));
+}
+
+// The mean y of the vertices with x beyond `from` [m].
+double mean_y_beyond(const Simulation& sim, const TetMesh& mesh, double from) {
+  std::vector<float> x;
+  EXPECT_TRUE(sim.read_positions(x).ok());
+  double sum = 0.0;
+  int n = 0;
+  for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
+    if (mesh.vertices[v][0] > from) sum += x[4 * v + 1], ++n;
+  return sum / n;
+}
+
+// Colours valid, nothing naming a removed vertex, and the mass.
+void expect_consistent(const Simulation& sim, const std::vector<std::uint32_t>& removed_vertices, double mass) {
+  auto check = SimulationInternals::check_colors(sim);
+  ASSERT_TRUE(check.ok()) << check.error().message();
+  EXPECT_EQ(check->conflicts, 0u);
+  for (std::uint32_t v : removed_vertices) EXPECT_EQ(check->references[v], 0u) << "vertex " << v;
+  if (mass > 0.0) {
+    EXPECT_NEAR(check->total_mass, mass, 1e-6 * mass);
+  }
+}
+
+class Topology : public BackendTest {};
+
+TEST_P(Topology, APadCutInTwoFallsApart) {
+  // 16 x 1 x 4 cells (8 x 0.5 x 2 cm) pinned at its left end, one frame
+  // after its release (still nearly straight). A blade through the whole
+  // thickness sweeps across its width at x = 4 cm: the right half falls
+  // free, the left half stays, and the scene keeps its mass and valid
+  // colours. (Later the pad swings down and curls, and a plane at x = 4 cm
+  // would meet it near its tip instead.)
+  const SceneDesc scene = pad(16, 1, 4, left_end);
+  auto sim = create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  auto before = SimulationInternals::check_colors(*sim);
+  ASSERT_TRUE(before.ok());
+  EXPECT_EQ(before->conflicts, 0u);
+  run(*sim, 1);
+
+  const double cut_x = 0.0401;  // off the grid's planes
+  // The blade spans y from +5 to -15 cm and z from -10 to 10 cm,
+  // wherever the swinging (and twisting) pad is.
+  auto cut = sim->cut_body(0, {{cut_x, 0.05, -0.1}, {cut_x, -0.15, -0.1}}, {{cut_x, 0.05, 0.1}, {cut_x, -0.15, 0.1}});
+  ASSERT_TRUE(cut.ok()) << cut.error().message();
+  EXPECT_GT(cut->tets_removed.size(), 0u);
+  EXPECT_GT(cut->constraints_removed, cut->tets_removed.size());  // their volumes and the edges only they had
+  std::printf("cut: %zu tets, %zu vertices, %u constraints removed, %u edges softened, %.3g kg moved, %.2f ms\n",
+              cut->tets_removed.size(), cut->vertices_removed.size(), cut->constraints_removed, cut->edges_softened,
+              cut->mass_moved, cut->wall_ms);
+  expect_consistent(*sim, cut->vertices_removed, before->total_mass);
+
+  run(*sim, 20);  // a third of a second: free fall g t^2 / 2 = 0.545 m
+  const double fallen = mean_y_beyond(*sim, scene.tet_bodies[0].mesh, 0.045);
+  EXPECT_LT(fallen, -0.45) << "the right half did not fall free";
+  // The left half still hangs from its pins: none of it has fallen.
+  std::vector<float> x;
+  ASSERT_TRUE(sim->read_positions(x).ok());
+  for (std::uint32_t v = 0; v < scene.tet_bodies[0].mesh.vertices.size(); ++v)
+    if (scene.tet_bodies[0].mesh.vertices[v][0] < 0.035) {
+      EXPECT_GT(x[4 * v + 1], -0.05) << "vertex " << v;
+    }
+  expect_consistent(*sim, cut->vertices_removed, before->total_mass);
+}
+
+TEST_P(Topology, AnUncutPadKeepsHanging) {
+  // The control of the test above: without the cut the right half hangs.
+  const SceneDesc scene = pad(16, 1, 4, left_end);
+  auto sim = create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 40);
+  EXPECT_GT(mean_y_beyond(*sim, scene.tet_bodies[0].mesh, 0.045), -0.1);
+}
+
+TEST_P(Topology, EveryColourStaysValidThroughManyRemovals) {
+  // FEM and edge bodies alike: 30 removals of 7 random tets each, the
+  // colouring checked on the device after every one, frames between.
+  for (TetMaterial material : {TetMaterial::none, TetMaterial::corotational}) {
+    const SceneDesc scene = pad(6, 3, 3, left_end, material);
+    auto sim = create_or_skip(scene, GetParam());
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
+    const double mass = SimulationInternals::check_colors(*sim)->total_mass;
+    std::vector<std::uint32_t> live(scene.tet_bodies[0].mesh.tets.size()), gone_vertices;
+    std::iota(live.begin(), live.end(), 0u);
+    std::uint32_t seed = 16;
+    for (int round = 0; round < 30 && live.size() > 7; ++round) {
+      std::vector<std::uint32_t> take;
+      for (int i = 0; i < 7; ++i) {
+        seed = seed * 1664525u + 1013904223u;
+        const std::size_t at = (seed >> 8) % live.size();
+        take.push_back(live[at]);
+        live.erase(live.begin() + std::ptrdiff_t(at));
+      }
+      auto event = sim->remove_tets(0, take);
+      ASSERT_TRUE(event.ok()) << event.error().message();
+      gone_vertices.insert(gone_vertices.end(), event->vertices_removed.begin(), event->vertices_removed.end());
+      expect_consistent(*sim, gone_vertices, mass);
+      run(*sim, 2);
+    }
+    auto tets = sim->current_tets(0);
+    ASSERT_TRUE(tets.ok());
+    EXPECT_EQ(tets->size(), live.size());
+  }
+}
+
+TEST_P(Topology, AStripPulledPastItsThresholdTearsAndBelowItDoesNot) {
+  // A strip of 10 x 1 x 1 cells pinned at both ends, its right end held
+  // 30% (or 10%) beyond its rest length: tear_strain 0.2 tears the first
+  // within a frame and never the second.
+  for (const double stretch : {0.3, 0.1}) {
+    SceneDesc scene = pad(10, 1, 1, [](const Vec3d& p) { return p[0] < 1e-9 || p[0] > 10 * kCell - 1e-9; });
+    TetBodyDesc& body = scene.tet_bodies[0];
+    body.tear_strain = 0.2;
+    for (const Vec3d& v : body.mesh.vertices) body.initial_vertices.push_back({v[0] * (1.0 + stretch), v[1], v[2]});
+    auto sim = create_or_skip(scene, GetParam());
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
+    const double mass = SimulationInternals::check_colors(*sim)->total_mass;
+    std::size_t torn = 0;
+    std::vector<std::uint32_t> gone;
+    for (int f = 0; f < 30; ++f) {
+      ASSERT_TRUE(sim->step().ok());
+      for (const auto& e : sim->last_tears()) {
+        torn += e.tets_removed.size();
+        gone.insert(gone.end(), e.vertices_removed.begin(), e.vertices_removed.end());
+      }
+    }
+    if (stretch > 0.2) {
+      EXPECT_GT(torn, 0u) << "stretched 30%";
+    } else {
+      EXPECT_EQ(torn, 0u) << "stretched 10%";
+    }
+    expect_consistent(*sim, gone, mass);
+  }
+}
+
+TEST_P(Topology, CauteryBurnsTheBallsVolumeAfterItsDwellTime) {
+  // A block at rest (pinned at its base, no gravity, so the tets stay
+  // where they are); a tip of 10 mm radius centred on its top face burns
+  // for 0.5 s with a dwell time of 0.3 s: nothing before 0.3 s, then about
+  // half the ball's volume (the half inside the block), with its mass.
+  SceneDesc scene = pad(8, 4, 8, [](const Vec3d& p) { return p[1] < 1e-9; });
+  scene.gravity = {0.0, 0.0, 0.0};
+  auto sim = create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const TetMesh& mesh = scene.tet_bodies[0].mesh;
+  const double radius = 10e-3;
+  const std::array<double, 3> tip{4 * kCell, 4 * kCell, 4 * kCell};
+  double volume = 0.0, mass = 0.0;
+  for (int f = 1; f <= 30; ++f) {
+    auto event = sim->cauterize(0, tip, radius, 1.0 / 60.0, 0.3);
+    ASSERT_TRUE(event.ok()) << event.error().message();
+    if (f < 18) {  // 17 / 60 s < 0.3 s
+      EXPECT_TRUE(event->tets_removed.empty()) << "frame " << f;
+    }
+    for (std::uint32_t t : event->tets_removed) {
+      const auto& q = mesh.tets[t];
+      Vec3d e[3];
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) e[k][a] = mesh.vertices[q[k + 1]][a] - mesh.vertices[q[0]][a];
+      volume += (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6.0;
+    }
+    mass += event->mass_removed;
+    ASSERT_TRUE(sim->step().ok());
+  }
+  const double half_ball = 2.0 / 3.0 * 3.14159265358979 * radius * radius * radius;
+  std::printf("cautery: %.3g m^3 burned against half the ball %.3g m^3 (%.1f%%); %.3g kg\n", volume, half_ball,
+              100.0 * (volume / half_ball - 1.0), mass);
+  EXPECT_NEAR(volume, half_ball, 0.2 * half_ball);
+  EXPECT_NEAR(mass, 1000.0 * volume, 1e-6 * mass);
+  auto check = SimulationInternals::check_colors(*sim);
+  ASSERT_TRUE(check.ok());
+  EXPECT_EQ(check->conflicts, 0u);
+}
+
+TEST_P(Topology, ACutAlongTheGridsPlanesLeavesNoNaN) {
+  // A blade exactly on vertex planes touches faces and edges only; the
+  // tets it touches go, and the rest keeps running.
+  const SceneDesc scene = pad(8, 2, 2, left_end);
+  auto sim = create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 5);
+  const double x = 4 * kCell;
+  auto cut = sim->cut_body(0, {{x, 1.0, -1.0}, {x, -1.0, -1.0}}, {{x, 1.0, 1.0}, {x, -1.0, 1.0}});
+  ASSERT_TRUE(cut.ok()) << cut.error().message();
+  run(*sim, 30);
+  expect_consistent(*sim, cut->vertices_removed, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, Topology, ::testing::ValuesIn(backends()), backend_name);
+
+TEST(Topology, ScriptedCutsAgreeAcrossBackends) {
+  // The same scripted cuts and frames on every backend with a device:
+  // positions within 1e-5 m of the CPU's.
+  auto script = [](const std::string& backend, std::vector<float>& x) -> bool {
+    const SceneDesc scene = pad(12, 1, 3, left_end);
+    auto sim = create_or_skip(scene, backend);
+    if (!sim.ok()) return false;
+    for (int step = 0; step < 3; ++step) {
+      for (int f = 0; f < 5; ++f) EXPECT_TRUE(sim->step().ok());
+      const double cx = 0.011 + 0.0152 * step;
+      EXPECT_TRUE(sim->cut_body(0, {{cx, 0.05, -0.1}, {cx, -0.15, -0.1}}, {{cx, 0.05, 0.1}, {cx, -0.15, 0.1}}).ok());
+    }
+    for (int f = 0; f < 10; ++f) EXPECT_TRUE(sim->step().ok());
+    return sim->read_positions(x).ok();
+  };
+  std::vector<float> reference;
+  ASSERT_TRUE(script("cpu", reference));
+  for (const std::string& backend : backends()) {
+    if (backend == "cpu" || !missing_device(backend).empty()) continue;
+    std::vector<float> x;
+    ASSERT_TRUE(script(backend, x)) << backend;
+    ASSERT_EQ(x.size(), reference.size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) worst = std::max(worst, double(std::abs(x[i] - reference[i])));
+    std::printf("%s: largest difference from the CPU %.3g m\n", backend.c_str(), worst);
+    EXPECT_LT(worst, 1e-5) << backend;
+  }
+}
+
+TEST(Topology, BadInputIsNamed) {
+  SceneDesc scene = pad(2, 1, 1, left_end);
+  scene.topology_changes = false;
+  auto plain = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(plain.ok());
+  const std::uint32_t one[] = {0};
+  EXPECT_NE(plain->remove_tets(0, one).error().message().find("topology_changes"), std::string::npos);
+
+  scene.tet_bodies[0].tear_strain = 0.5;
+  EXPECT_NE(Simulation::create(scene, {.backend = "cpu", .quiet = true}).error().message().find("tear_strain"),
+            std::string::npos);
+  scene.topology_changes = true;
+  scene.tet_bodies[0].tear_strain = -1.0;
+  EXPECT_NE(Simulation::create(scene, {.backend = "cpu", .quiet = true}).error().message().find("tear_strain"),
+            std::string::npos);
+  scene.tet_bodies[0].tear_strain = 0.0;
+
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok());
+  const std::uint32_t twice[] = {1, 1}, beyond[] = {12};
+  EXPECT_NE(sim->remove_tets(1, one).error().message().find("tet body 1"), std::string::npos);
+  EXPECT_NE(sim->remove_tets(0, twice).error().message().find("twice"), std::string::npos);
+  EXPECT_NE(sim->remove_tets(0, beyond).error().message().find("tet 12"), std::string::npos);
+  ASSERT_TRUE(sim->remove_tets(0, one).ok());
+  EXPECT_NE(sim->remove_tets(0, one).error().message().find("removed already"), std::string::npos);
+  EXPECT_NE(sim->cauterize(0, {0, 0, 0}, 0.0, 0.1, 0.1).error().message().find("radius"), std::string::npos);
+  EXPECT_NE(sim->cauterize(0, {0, 0, 0}, 0.1, 0.1, -1.0).error().message().find("dwell_time"), std::string::npos);
+  EXPECT_NE(sim->cauterize(0, {0, NAN, 0}, 0.1, 0.1, 0.1).error().message().find("centre"), std::string::npos);
+  EXPECT_NE(sim->cut_body(0, {{0, 0, 0}, {0, INFINITY, 0}}, {}).error().message().find("from.b"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sinew::test
