@@ -203,6 +203,7 @@ class Simulation {
     double mass_moved = 0.0;    ///< [kg] handed from removed vertices to their neighbours
     double mass_removed = 0.0;  ///< [kg] that left the scene (burned, or no neighbour left)
     double wall_ms = 0.0;       ///< host and device time of the change, the program rebuilt included
+    double rebuild_ms = 0.0;    ///< of which rebuilding the frame program
   };
   /// Removes tets of tet body `body` (indices into its mesh.tets, each
   /// alive, no repeats). Errors: topology changes not enabled, a bad body

@@ -32,8 +32,11 @@ Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(std::size_t bo
                                                                  std::chrono::steady_clock::time_point start) {
   auto event = topology->remove(*device, buffers, program_shape, body, tets, burn);
   if (!event) return event.error();
-  if (!tets.empty())
+  if (!tets.empty()) {
+    const auto rebuild = std::chrono::steady_clock::now();
     if (Status s = rebuild_program(); !s) return s.error();
+    event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
+  }
   event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return event;
 }

@@ -113,6 +113,7 @@ class TopologyEditor {
   std::unordered_map<TetKey, std::vector<Slot>, TetKeyHash> tet_slots_;  // volume and FEM constraints
   std::unordered_map<std::uint64_t, Slot> edge_slots_;                   // distance constraints
   std::vector<double> mass_;                                             // per device slot [kg] (0: immovable)
+  bool warm_start_ = false;                                              // SolverSettings::warm_start
 };
 
 }  // namespace sinew
