@@ -239,7 +239,80 @@ TEST_P(Topology, ACutAlongTheGridsPlanesLeavesNoNaN) {
   expect_consistent(*sim, cut->vertices_removed, 0.0);
 }
 
+TEST_P(Topology, GraspingLiftsAFlapAndReleasingDropsIt) {
+  // A flap of 8 x 1 x 4 cells hangs from its left end. A grasper closes on
+  // whatever is inside a box around its free end, lifts it 5 cm over half
+  // a second, holds it, and opens: the end follows the jaws up, then falls
+  // back down.
+  SceneDesc scene = pad(8, 1, 4, left_end);
+  scene.graspers.push_back({.capacity = 64, .compliance = 0.0});
+  auto sim = create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 30);
+  const TetMesh& mesh = scene.tet_bodies[0].mesh;
+  std::vector<float> x;
+  ASSERT_TRUE(sim->read_positions(x).ok());
+  auto end_y = [&] {  // the mean y of the free end's vertices
+    EXPECT_TRUE(sim->read_positions(x).ok());
+    double y = 0.0;
+    int n = 0;
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
+      if (mesh.vertices[v][0] > 8 * kCell - 1e-9) y += x[4 * v + 1], ++n;
+    return y / n;
+  };
+  std::array<double, 3> centre{};
+  int n = 0;
+  for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
+    if (mesh.vertices[v][0] > 8 * kCell - 1e-9) {
+      for (int a = 0; a < 3; ++a) centre[a] += x[4 * v + a];
+      ++n;
+    }
+  for (double& c : centre) c /= n;
+  const double hanging = end_y();
+  Pose jaws{centre, {1, 0, 0, 0}};
+  auto held = sim->close_grasper(0, jaws, {0.006, 0.006, 0.015});
+  ASSERT_TRUE(held.ok()) << held.error().message();
+  EXPECT_GE(held->size(), 10u);  // the end's 10 vertices and some of their neighbours
+  auto check = SimulationInternals::check_colors(*sim);
+  ASSERT_TRUE(check.ok());
+  EXPECT_EQ(check->conflicts, 0u);
+  for (int f = 1; f <= 30; ++f) {
+    jaws.position[1] = centre[1] + 0.05 * f / 30.0;
+    ASSERT_TRUE(sim->move_grasper(0, jaws).ok());
+    ASSERT_TRUE(sim->step().ok());
+  }
+  run(*sim, 10);
+  EXPECT_NEAR(end_y(), hanging + 0.05, 2e-3) << "the held end follows the jaws";
+  auto released = sim->open_grasper(0);
+  ASSERT_TRUE(released.ok());
+  EXPECT_EQ(released->size(), held->size());
+  run(*sim, 15);
+  EXPECT_LT(end_y(), hanging + 0.05 - 0.01) << "released, the end falls";
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, Topology, ::testing::ValuesIn(backends()), backend_name);
+
+TEST(Topology, GraspersNameWhatIsWrong) {
+  SceneDesc scene = pad(4, 1, 1, left_end);
+  scene.graspers.push_back({.capacity = 4});
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const Pose pose{{0.02, 0.0, 0.0}, {1, 0, 0, 0}};
+  auto many = sim->close_grasper(0, pose, {0.1, 0.1, 0.1});
+  ASSERT_FALSE(many.ok());
+  EXPECT_EQ(many.error().code(), ErrorCode::capacity_exceeded);
+  EXPECT_NE(many.error().message().find("capacity 4"), std::string::npos) << many.error().message();
+  EXPECT_NE(sim->close_grasper(1, pose, {0.1, 0.1, 0.1}).error().message().find("grasper"), std::string::npos);
+  EXPECT_NE(sim->close_grasper(0, {{0, 0, 0}, {2, 0, 0, 0}}, {0.1, 0.1, 0.1}).error().message().find("unit quaternion"),
+            std::string::npos);
+  EXPECT_NE(sim->close_grasper(0, pose, {0.1, 0.0, 0.1}).error().message().find("half_extents[1]"), std::string::npos);
+  ASSERT_TRUE(sim->close_grasper(0, pose, {0.003, 0.003, 0.003}).ok());
+  EXPECT_NE(sim->close_grasper(0, pose, {0.003, 0.003, 0.003}).error().message().find("closed already"),
+            std::string::npos);
+  scene.graspers[0].capacity = 0;
+  EXPECT_NE(Simulation::create(scene, {.backend = "cpu", .quiet = true}).error().message().find("graspers[0].capacity"),
+            std::string::npos);
+}
 
 TEST(Topology, ScriptedCutsAgreeAcrossBackends) {
   // The same scripted cuts and frames on every backend with a device:

@@ -535,6 +535,17 @@ struct MeshCollisionDesc {
   int continuous_repairs = 4;
 };
 
+/// A grasper: jaws that hold whatever vertices they close on
+/// (Simulation::close_grasper, move_grasper, open_grasper). Each vertex it
+/// holds is attached by a zero-length constraint to its own target, a point
+/// fixed in the grasper's frame where the vertex was when the jaws closed;
+/// the targets move with the grasper. Each grasper is one colour of
+/// `capacity` slots (a vertex held by two graspers is solved twice).
+struct GrasperDesc {
+  std::uint32_t capacity = 64;  ///< the most vertices it holds at once, in [1, 2^20]
+  double compliance = 0.0;      ///< of each hold [m/N], >= 0 (0: rigid)
+};
+
 struct SceneDesc {
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
   SolverSettings solver;
@@ -546,6 +557,7 @@ struct SceneDesc {
   std::vector<AttachmentDesc> attachments;
   std::vector<ToolDesc> tools;
   std::vector<NeedleDesc> needles;
+  std::vector<GrasperDesc> graspers;
   MeshCollisionDesc mesh_collision;  ///< contacts between the bodies' meshes (off by default)
   /// Forces on single particles, set by the host before each frame
   /// (Simulation::set_particle_forces; e.g. a fluid's pressure on tissue,

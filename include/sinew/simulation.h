@@ -232,6 +232,25 @@ class Simulation {
   /// extract_boundary_surface. Errors: a bad body.
   Result<std::vector<std::array<std::uint32_t, 4>>> current_tets(std::size_t body) const;
 
+  // ---- Graspers (SceneDesc::graspers; runtime/graspers.h)
+
+  /// Closes grasper `index` at `pose` [m, unit quaternion (w, x, y, z)]: every
+  /// movable particle (of any body) inside the jaws, the box of
+  /// `half_extents` [m] (> 0) centred on the pose in its frame, is held
+  /// where it is now, at a point fixed in the grasper's frame. Returns the
+  /// held particles (the user's order, as read_positions). Errors: a bad
+  /// index, pose or box; closed already; more particles than its capacity
+  /// (capacity_exceeded, nothing held).
+  Result<std::vector<std::uint32_t>> close_grasper(std::size_t index, const Pose& pose,
+                                                   const std::array<double, 3>& half_extents);
+  /// Moves grasper `index` to `pose` by the end of the next frame (its held
+  /// particles' targets move across the frame's substeps). Errors: a bad
+  /// index or pose.
+  Status move_grasper(std::size_t index, const Pose& pose);
+  /// Opens grasper `index`: what it held is free from the next frame on.
+  /// Returns the released particles. Errors: a bad index.
+  Result<std::vector<std::uint32_t>> open_grasper(std::size_t index);
+
   /// A tool's state at the end of the last frame.
   struct ToolState {
     std::array<double, 3> position{};          ///< [m]

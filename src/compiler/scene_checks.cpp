@@ -459,6 +459,20 @@ Status check_scene(const SceneDesc& scene) {
       return Error(ErrorCode::bad_parameter, name + " = " + str(scene.tet_bodies[i].tear_strain) +
                                                  " needs topology_changes = true (tearing removes tets)");
   }
+  std::size_t grasper_targets = 0;
+  for (std::size_t i = 0; i < scene.graspers.size(); ++i) {
+    const std::string name = "graspers[" + std::to_string(i) + "]";
+    const GrasperDesc& g = scene.graspers[i];
+    if (g.capacity < 1 || g.capacity > (1u << 20))
+      return Error(ErrorCode::bad_parameter,
+                   name + ".capacity must be in [1, 2^20] (got " + std::to_string(g.capacity) + ")");
+    if (Status s = non_negative(name + ".compliance", g.compliance); !s) return s;
+    grasper_targets += g.capacity;
+  }
+  if (scene.targets.size() + grasper_targets >= (std::size_t{1} << 24))
+    return Error(ErrorCode::bad_parameter, "targets and graspers: " + std::to_string(scene.targets.size()) + " + " +
+                                               std::to_string(grasper_targets) +
+                                               " targets are more than the 2^24 an attachment can index");
   for (std::size_t i = 0; i < scene.targets.size(); ++i)
     if (Status s = finite3("targets[" + std::to_string(i) + "]", scene.targets[i]); !s) return s;
   for (std::size_t i = 0; i < scene.attachments.size(); ++i)

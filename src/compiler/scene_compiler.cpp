@@ -12,6 +12,7 @@
 #include "coloring/greedy_coloring.h"
 #include "compiler/particle_order.h"
 #include "compiler/solve_order.h"
+#include "contact_params.h"
 #include "math/xpbd_math.h"
 
 namespace sinew {
@@ -252,6 +253,29 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   });
   for (const RawConstraints& raw : b.raw)
     if (!raw.particles.empty()) out.blocks.push_back(color_and_sort(raw, movable, scene.solver.reorder_particles));
+  // Graspers, last in every sweep: a block each, one colour of `capacity`
+  // attachment slots, none in use (runtime/graspers.h fills them when the
+  // jaws close); each slot has its own target, after the scene's.
+  for (const GrasperDesc& g : scene.graspers) {
+    ConstraintBlock block;
+    block.kernel = Kernel::xpbd_solve_attachment;
+    block.arity = 1;
+    block.data_stride = SINEW_ATTACHMENT_DATA_STRIDE;
+    block.lambda_stride = 1;
+    block.extra_bindings = {SceneBuffer::targets};
+    block.particles.assign(g.capacity, 0);
+    const auto first_target = static_cast<std::uint32_t>(out.targets.size() / (sizeof(kernels::TargetEntry) / 4));
+    for (std::uint32_t i = 0; i < g.capacity; ++i) {
+      block.data.push_back(static_cast<float>(first_target + i));
+      block.data.push_back(static_cast<float>(g.compliance));
+      out.targets.insert(out.targets.end(), sizeof(kernels::TargetEntry) / 4, 0.0f);
+    }
+    block.color_offsets = {0, g.capacity};
+    block.color_counts = {0};
+    out.grasper_block.push_back(static_cast<std::uint32_t>(out.blocks.size()));
+    out.grasper_first_target.push_back(first_target);
+    out.blocks.push_back(std::move(block));
+  }
   out.positions = std::move(b.positions);
   return out;
 }

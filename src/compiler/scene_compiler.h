@@ -88,6 +88,10 @@ struct CompiledScene {
   /// SceneDesc::external_forces: the program applies a force buffer
   /// (xpbd_external_force) before every substep's predict.
   bool external_forces = false;
+  /// Per SceneDesc::graspers entry: its block (one colour, no constraint in
+  /// use until it closes) and its first target (its capacity follow, after
+  /// SceneDesc::targets).
+  std::vector<std::uint32_t> grasper_block, grasper_first_target;
   std::vector<std::uint32_t> tet_body_first_particle;
   std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;

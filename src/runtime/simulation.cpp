@@ -85,7 +85,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     if (!editor) return editor.error();
     impl->topology = std::move(*editor);
   }
-  if (impl->mesh_collision || impl->topology) {  // programs rebuilt while the scene runs start from this
+  if (!scene.graspers.empty()) impl->graspers = std::make_unique<Graspers>(scene, *compiled);
+  if (impl->mesh_collision || impl->topology || impl->graspers) {  // programs rebuilt while the scene runs start from this
     impl->program_shape = *compiled;
     for (ConstraintBlock& block : impl->program_shape.blocks) block.data = {};
   }

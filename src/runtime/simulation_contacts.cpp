@@ -35,12 +35,18 @@
 #include "compiler/float_words.h"
 #include "contact_params.h"
 #include "math/vec3.h"
+#include "runtime/call_checks.h"
 #include "runtime/simulation_impl.h"
 #include "runtime/tool_contacts.h"
 #include "runtime/tool_penalty.h"
 
 namespace sinew {
 namespace {
+
+using call_checks::check_finite;
+using call_checks::check_index;
+using call_checks::check_rotation;
+using call_checks::str;
 
 using kernels::ColliderEntry;
 using kernels::ColliderHeader;
@@ -62,36 +68,6 @@ std::size_t device_floats(const std::vector<float>& c) {
   for (std::size_t k = 0; k < entries && entry_at(k + 1) <= c.size(); ++k)
     nodes += load_words<ColliderEntry>(c, entry_at(k)).implicit_count;
   return entry_at(entries) + nodes * (sizeof(kernels::ImplicitEntry) / sizeof(float));
-}
-
-std::string str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-Status check_index(const char* call, const char* what, std::size_t index, std::size_t count) {
-  if (index < count) return {};
-  return Error(ErrorCode::bad_parameter,
-               std::string(call) + ": index " + std::to_string(index) + " is not a " + what + " (the scene has " +
-               std::to_string(count) + ")");
-}
-
-Status check_finite(const char* call, const char* name, const V3& v) {
-  for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(v[k]))
-      return Error(ErrorCode::bad_parameter,
-                   std::string(call) + ": " + name + "[" + std::to_string(k) + "] must be finite (got " + str(v[k]) +
-                   ")");
-  return {};
-}
-
-Status check_rotation(const char* call, const Q4& q) {
-  const double n = math::qnorm(q);
-  if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-6)
-    return Error(ErrorCode::bad_parameter,
-                 std::string(call) + ": rotation must be a unit quaternion (w, x, y, z) (its norm is " + str(n) + ")");
-  return {};
 }
 
 void set_end_pose(ColliderEntry& e, const V3& p, const Q4& q) {

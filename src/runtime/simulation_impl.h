@@ -16,6 +16,7 @@
 #include "runtime/continuous_collision.h"
 #include "runtime/mesh_collision.h"
 #include "runtime/solve_stepper.h"
+#include "runtime/graspers.h"
 #include "runtime/sutures.h"
 #include "runtime/topology_editor.h"
 #include "sinew/simulation.h"
@@ -81,6 +82,8 @@ struct Simulation::Impl {
   /// contacts outgrew theirs, or a topology change.
   Status rebuild_program();
 
+  // SceneDesc::graspers (null without).
+  std::unique_ptr<Graspers> graspers;
   // SceneDesc::topology_changes: the host copy of the constraints that
   // removals patch (null without), and the last step's tears.
   std::unique_ptr<TopologyEditor> topology;

@@ -290,7 +290,10 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
   std::sort(mass_changed.begin(), mass_changed.end());
   mass_changed.erase(std::unique(mass_changed.begin(), mass_changed.end()), mass_changed.end());
   if (Status s = upload(device, buffers, mass_changed); !s) return s.error();
-  for (std::size_t k = 0; k < blocks_.size(); ++k) shape.blocks[k].color_counts = blocks_[k].counts;
+  // The counts of the blocks a removal can change (graspers' blocks keep theirs).
+  for (std::size_t k = 0; k < blocks_.size(); ++k)
+    if (blocks_[k].kernel == Kernel::xpbd_solve_distance || is_tet_kernel(blocks_[k].kernel))
+      shape.blocks[k].color_counts = blocks_[k].counts;
   return event;
 }
 
