@@ -1,11 +1,13 @@
-// read_tetgen / read_gmsh / read_tet_mesh on the real meshes in
+// read_tetgen / read_gmsh / read_vtk / read_tet_mesh on the real meshes in
 // data/meshes/tet and on small files written here (Gmsh 2.2, 4.0
 // and 4.1 with sparse shuffled tags and mixed element types; TetGen
-// 1-based with attributes, markers and comments; 10-node tets).
+// 1-based with attributes, markers and comments; 10-node tets; legacy VTK
+// ASCII and big-endian BINARY, and malformed VTK files).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -412,6 +414,213 @@ TEST(MeshReaders, TetGenTenNodeTetsKeepCorners) {
   EXPECT_EQ(mesh->tets, grid.tets);
   EXPECT_EQ(mesh->vertices, nodes);
   EXPECT_NEAR(tet_volume_sum(*mesh), tet_volume_sum(grid), 1e-12);
+}
+
+// ------------------------------------------------------------ legacy VTK
+
+// meshio's export of a gallbladder: BINARY, 367 float points, 2,519 cells
+// (1,063 tets, 1,456 surface triangles), POINT_DATA and CELL_DATA fields.
+// Point 314, the file's largest x (-1.102), is in no cell at all and is
+// dropped, so the mesh's box ends at x = -3.677.
+TEST(VtkReader, GallbladderBinaryFromMeshio) {
+  const fs::path path = kTetDir / "gallbladder_volumetric.vtk";
+  const auto mesh = sinew::read_tet_mesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message();
+  EXPECT_EQ(mesh->tets.size(), 1063u);
+  EXPECT_EQ(mesh->vertices.size(), 366u);  // one of the 367 points is in no tet
+  EXPECT_TRUE(sinew::check_tet_mesh(*mesh, "gallbladder").ok());
+  expect_sound(*mesh, "gallbladder");
+  Vec3d lo = mesh->vertices[0], hi = mesh->vertices[0];
+  for (const Vec3d& p : mesh->vertices) {
+    for (std::size_t a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a]);
+    }
+  }
+  // Millimetres, as in the file.
+  EXPECT_NEAR(lo[0], -83.505, 0.01);
+  EXPECT_NEAR(hi[0], -3.677, 0.01);
+  EXPECT_NEAR(lo[1], -22.385, 0.01);
+  EXPECT_NEAR(hi[1], 29.292, 0.01);
+  EXPECT_NEAR(lo[2], -47.515, 0.01);
+  EXPECT_NEAR(hi[2], 0.659, 0.01);
+  const auto direct = sinew::read_vtk(path);
+  ASSERT_TRUE(direct.ok()) << direct.error().message();
+  EXPECT_EQ(direct->tets, mesh->tets);
+  EXPECT_EQ(direct->vertices, mesh->vertices);
+}
+
+// The parts of a small unstructured grid: two tets sharing the face 1 2 3,
+// a triangle between them and point 4, which no cell uses.
+struct VtkParts {
+  std::string dataset = "UNSTRUCTURED_GRID";
+  std::vector<Vec3d> points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {9, 9, 9}, {1, 1, 1}};
+  std::vector<std::vector<std::int32_t>> cells = {{0, 1, 2, 3}, {0, 1, 2}, {1, 2, 3, 5}};
+  std::vector<std::int32_t> types = {10, 5, 10};
+  std::int64_t cells_size = -1;  // CELLS size: -1 for the right one
+};
+
+std::int64_t cells_size(const VtkParts& v) {
+  if (v.cells_size >= 0) return v.cells_size;
+  std::int64_t size = 0;
+  for (const auto& c : v.cells) size += 1 + static_cast<std::int64_t>(c.size());
+  return size;
+}
+
+std::string vtk_ascii(const VtkParts& v) {
+  std::ostringstream s;
+  s << "# vtk DataFile Version 4.2\nsmall test mesh\nASCII\nDATASET " << v.dataset << "\n";
+  s << "POINTS " << v.points.size() << " double\n";
+  for (const Vec3d& p : v.points) s << xyz(p) << "\n";
+  s << "\nCELLS " << v.cells.size() << " " << cells_size(v) << "\n";
+  for (const auto& c : v.cells) {
+    s << c.size();
+    for (std::int32_t i : c) s << " " << i;
+    s << "\n";
+  }
+  s << "CELL_TYPES " << v.types.size() << "\n";
+  for (std::int32_t t : v.types) s << t << "\n";
+  s << "CELL_DATA " << v.types.size() << "\nSCALARS id int 1\nLOOKUP_TABLE default\n";
+  for (std::size_t i = 0; i < v.types.size(); ++i) s << i << "\n";
+  return s.str();
+}
+
+void put_big_endian(std::string& s, std::uint64_t bits, int bytes) {
+  for (int i = bytes - 1; i >= 0; --i) s.push_back(static_cast<char>((bits >> (8 * i)) & 0xffu));
+}
+
+void put_int32(std::string& s, std::int32_t v) { put_big_endian(s, std::bit_cast<std::uint32_t>(v), 4); }
+
+// As meshio writes it: big-endian blocks, each followed by a '\n'.
+std::string vtk_binary(const VtkParts& v, bool doubles) {
+  std::string s = "# vtk DataFile Version 4.2\nsmall test mesh\nBINARY\nDATASET " + v.dataset + "\n";
+  s += "POINTS " + std::to_string(v.points.size()) + (doubles ? " double\n" : " float\n");
+  for (const Vec3d& p : v.points) {
+    for (double x : p) {
+      if (doubles) {
+        put_big_endian(s, std::bit_cast<std::uint64_t>(x), 8);
+      } else {
+        put_big_endian(s, std::bit_cast<std::uint32_t>(static_cast<float>(x)), 4);
+      }
+    }
+  }
+  s += "\nCELLS " + std::to_string(v.cells.size()) + " " + std::to_string(cells_size(v)) + "\n";
+  for (const auto& c : v.cells) {
+    put_int32(s, static_cast<std::int32_t>(c.size()));
+    for (std::int32_t i : c) put_int32(s, i);
+  }
+  s += "\nCELL_TYPES " + std::to_string(v.types.size()) + "\n";
+  for (std::int32_t t : v.types) put_int32(s, t);
+  s += "\nCELL_DATA " + std::to_string(v.types.size()) + "\nFIELD FieldData 1\nid 1 " +
+       std::to_string(v.types.size()) + " int\n";
+  for (std::size_t i = 0; i < v.types.size(); ++i) put_int32(s, static_cast<std::int32_t>(i));
+  return s + "\n";
+}
+
+// Two tets, the triangle dropped, point 4 dropped and 5 renumbered to 4.
+void expect_two_tets(const TetMesh& m) {
+  const std::vector<Vec3d> vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  const std::vector<std::array<std::uint32_t, 4>> tets = {{0, 1, 2, 3}, {1, 2, 3, 4}};
+  EXPECT_EQ(m.vertices, vertices);
+  EXPECT_EQ(m.tets, tets);
+  EXPECT_TRUE(sinew::check_tet_mesh(m, "two tets").ok());
+}
+
+TEST(VtkReader, AsciiKeepsTetsDropsOtherCellsAndUnusedPoints) {
+  const fs::path p = tmp_dir() / "two_tets_ascii.vtk";
+  write_file(p, vtk_ascii(VtkParts{}));
+  const auto mesh = sinew::read_vtk(p);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message();
+  expect_two_tets(*mesh);
+}
+
+TEST(VtkReader, BinaryBigEndianReadsLikeAscii) {
+  for (bool doubles : {false, true}) {
+    const fs::path p = tmp_dir() / (doubles ? "two_tets_binary_double.vtk" : "two_tets_binary_float.vtk");
+    write_file(p, vtk_binary(VtkParts{}, doubles));
+    const auto mesh = sinew::read_tet_mesh(p);
+    ASSERT_TRUE(mesh.ok()) << mesh.error().message();
+    expect_two_tets(*mesh);
+  }
+}
+
+// Reads `content` as `name` and expects an error naming the file and
+// holding `what`.
+void expect_vtk_error(const std::string& name, const std::string& content, const std::string& what) {
+  const fs::path p = tmp_dir() / name;
+  write_file(p, content);
+  const auto mesh = sinew::read_vtk(p);
+  ASSERT_FALSE(mesh.ok()) << name << " was read";
+  const std::string& message = mesh.error().message();
+  EXPECT_EQ(mesh.error().code(), sinew::ErrorCode::bad_input_file) << message;
+  EXPECT_NE(message.find(p.string()), std::string::npos) << message;
+  EXPECT_NE(message.find(what), std::string::npos) << "expected '" << what << "' in: " << message;
+}
+
+TEST(VtkReader, MalformedFilesNameTheProblem) {
+  const std::string binary = vtk_binary(VtkParts{}, false);
+  const std::size_t points_data = binary.find("float\n") + 6;
+  expect_vtk_error("truncated_points.vtk", binary.substr(0, points_data + 10), "POINTS: binary data truncated");
+  expect_vtk_error("truncated_cells.vtk", binary.substr(0, binary.find("\nCELLS") + 30),
+                   "CELLS: binary data truncated");
+
+  VtkParts types_mismatch;
+  types_mismatch.types.pop_back();
+  expect_vtk_error("types_mismatch.vtk", vtk_ascii(types_mismatch),
+                   "CELL_TYPES holds 2 cell types, but CELLS");
+
+  VtkParts wrong_size;  // the cells take 14 values
+  wrong_size.cells_size = 15;
+  expect_vtk_error("size_too_large.vtk", vtk_binary(wrong_size, false),
+                   "CELLS: its size is 15, but its 3 cells take 14");
+  expect_vtk_error("size_too_large_ascii.vtk", vtk_ascii(wrong_size),
+                   "CELLS: expected value 15 of 15, found 'CELL_TYPES' (fewer values than its header announces)");
+  wrong_size.cells_size = 13;
+  expect_vtk_error("size_too_small.vtk", vtk_ascii(wrong_size), "cell 2 has 4 points, which run past its size 13");
+
+  VtkParts out_of_range;
+  out_of_range.cells[2][3] = 6;
+  expect_vtk_error("out_of_range.vtk", vtk_ascii(out_of_range),
+                   "cell 2 refers to point 6, but POINTS holds 6 points");
+  VtkParts negative = out_of_range;
+  negative.cells[2][3] = -1;
+  expect_vtk_error("negative_index.vtk", vtk_binary(negative, true), "cell 2 refers to point -1");
+
+  VtkParts three_point_tet;
+  three_point_tet.types[1] = 10;
+  expect_vtk_error("three_point_tet.vtk", vtk_ascii(three_point_tet),
+                   "cell 1 has type 10 (VTK_TETRA) but 3 points, not 4");
+
+  VtkParts no_tets;
+  no_tets.cells = {{0, 1, 2}};
+  no_tets.types = {5};
+  expect_vtk_error("no_tets.vtk", vtk_ascii(no_tets), "no tetrahedra");
+
+  VtkParts polydata;
+  polydata.dataset = "POLYDATA";
+  expect_vtk_error("polydata.vtk", vtk_ascii(polydata), "the dataset is 'POLYDATA'");
+
+  VtkParts inverted;
+  inverted.cells[2] = {1, 3, 2, 5};
+  expect_vtk_error("inverted.vtk", vtk_ascii(inverted), "is inverted");
+
+  std::string nan = vtk_ascii(VtkParts{});
+  nan.replace(nan.find("\n9 9 9\n") + 1, 1, "nan");
+  expect_vtk_error("nan.vtk", nan, "non-finite coordinate 'nan'");
+
+  const std::string ascii = vtk_ascii(VtkParts{});
+  expect_vtk_error("no_cell_types.vtk", ascii.substr(0, ascii.find("CELL_TYPES")), "without a CELL_TYPES section");
+  expect_vtk_error("not_vtk.vtk", "solid cube\n", "not a legacy VTK file");
+  expect_vtk_error("empty.vtk", "", "not a legacy VTK file");
+}
+
+TEST(VtkReader, MissingFile) {
+  const fs::path p = tmp_dir() / "no_such_mesh.vtk";
+  const auto mesh = sinew::read_tet_mesh(p);
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.error().code(), sinew::ErrorCode::bad_input_file);
+  EXPECT_NE(mesh.error().message().find(p.string()), std::string::npos) << mesh.error().message();
+  EXPECT_NE(mesh.error().message().find("does not exist"), std::string::npos) << mesh.error().message();
 }
 
 }  // namespace

@@ -101,7 +101,20 @@ Result<TetMesh> read_tetgen(const std::filesystem::path& path);
 /// dropped. [out] a mesh that passes check_tet_mesh; errors name file:line.
 Result<TetMesh> read_gmsh(const std::filesystem::path& path);
 
-/// Reads a tet mesh by extension: .msh (Gmsh), .node/.ele (TetGen).
+/// Reads a legacy VTK file (.vtk, first line "# vtk DataFile Version x.y"),
+/// ASCII or BINARY (big-endian), DATASET UNSTRUCTURED_GRID: POINTS (float or
+/// double), CELLS and CELL_TYPES, keeping the cells of type 10 (VTK_TETRA)
+/// and dropping other cell types; POINT_DATA, CELL_DATA and FIELD sections
+/// after them are ignored. Points used by no tet are dropped and the others
+/// renumbered in the order the tets first use them (drop_unused_vertices).
+/// Float coordinates are widened to double. VTK 5.x cells (OFFSETS and
+/// CONNECTIVITY arrays) are not read. [out] a mesh that passes
+/// check_tet_mesh; errors (bad_input_file) name file:line, or file: byte N
+/// past binary data, and the section at fault.
+Result<TetMesh> read_vtk(const std::filesystem::path& path);
+
+/// Reads a tet mesh by extension: .msh (Gmsh), .node/.ele (TetGen), .vtk
+/// (legacy VTK).
 Result<TetMesh> read_tet_mesh(const std::filesystem::path& path);
 
 /// Checks a tet mesh: at least one tet; all coordinates finite; all indices

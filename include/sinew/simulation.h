@@ -76,7 +76,11 @@ struct FrameStats {
   double residual_rms = 0.0;
   double max_residual = 0.0;     ///< the largest of those normalised residuals
   double kinetic_energy = 0.0;   ///< sum of m |v|^2 / 2 over movable particles [J]
-  double volume_change = 0.0;    ///< total tet volume / rest total - 1 (0 without tet bodies)
+  /// Total tet volume / rest total - 1 (0 without tet bodies), measured
+  /// inside the bodies' boundary surfaces as the scene was made: after
+  /// topology changes (remove_tets, cuts, tears, cautery) it still measures
+  /// those surfaces, not what is left.
+  double volume_change = 0.0;
   /// Gauss-Seidel sweeps (iterations) run in the last frame, over all its substeps.
   std::uint64_t sweeps = 0;
   /// How the sweeps ended; in residual mode the worst substep's reason
@@ -215,7 +219,10 @@ class Simulation {
   };
   /// Cuts tet body `body` with a blade swept from `from` to `to` (the quad
   /// they span, two triangles): every live tet the swept quad touches at the
-  /// body's current positions is removed. Mass is conserved.
+  /// body's current positions is removed. Mass is conserved. The query sees
+  /// the tissue where it is now: tissue moving across the blade's path
+  /// between strokes can slip past uncut, so strokes along a line should
+  /// overlap (examples/cholecystectomy.cpp).
   Result<TopologyEvent> cut_body(std::size_t body, const Blade& from, const Blade& to);
   /// A heated tip (a ball of `radius` [m] at `centre` [m]) touching tet body
   /// `body` for `seconds` [s] (> 0): a live tet whose current centroid lies

@@ -342,9 +342,10 @@ Result<TetMesh> read_tet_mesh(const std::filesystem::path& path) {
   const std::string ext = lower(path.extension().string());
   if (ext == ".msh") return read_gmsh(path);
   if (ext == ".node" || ext == ".ele") return read_tetgen(path);
+  if (ext == ".vtk") return read_vtk(path);
   return Error(ErrorCode::bad_input_file,
                path.string() + ": unknown tet mesh extension '" + path.extension().string() +
-               "' (expected .msh, .node or .ele)");
+               "' (expected .msh, .node, .ele or .vtk)");
 }
 
 }  // namespace sinew
