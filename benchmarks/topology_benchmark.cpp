@@ -15,6 +15,8 @@
 //   rebuild_ms       of which rebuilding the frame program;
 //   frame_after_ms   a frame after the 10 cuts (20 frames);
 //   tets_per_cut     the largest cut (its tets).
+// fem:1 uses corotational FEM; collision:1 turns mesh collision on, which
+// each change makes again from the live tets.
 //
 //   SINEW_BACKEND=cpu build/benchmarks/bench_topology --benchmark_repetitions=3
 //       --benchmark_format=csv > benchmarks/results/topology_<date>.csv
@@ -35,7 +37,7 @@ using namespace sinew;
 constexpr double kCell = 5e-3;  // [m]
 constexpr int kNx = 20, kNy = 21, kNz = 20;
 
-SceneDesc block(bool fem) {
+SceneDesc block(bool fem, bool collision) {
   SceneDesc scene;
   TetBodyDesc body;
   body.mesh = *make_tet_grid({.nx = kNx, .ny = kNy, .nz = kNz, .cell_size = {kCell, kCell, kCell}});
@@ -53,6 +55,10 @@ SceneDesc block(bool fem) {
   scene.solver.iterations = 2;
   scene.solver.measure_errors = false;
   scene.topology_changes = true;
+  // collision:1 turns mesh collision on (self-collision of the block's
+  // surface), which a change makes again from the live tets.
+  scene.mesh_collision.enabled = collision;
+  scene.mesh_collision.thickness = 5e-4;
   return scene;
 }
 
@@ -67,11 +73,11 @@ double frames_ms(Simulation& sim, int frames, benchmark::State& state) {
 }
 
 void BM_Cut(benchmark::State& state) {
-  const bool fem = state.range(0) == 1;
+  const bool fem = state.range(0) == 1, collision = state.range(1) == 1;
   std::vector<double> before, cut, rebuild, after;
   double most = 0;
   for (auto _ : state) {
-    auto sim = Simulation::create(block(fem), {.backend = bench::backend(), .quiet = true});
+    auto sim = Simulation::create(block(fem, collision), {.backend = bench::backend(), .quiet = true});
     if (!sim) {
       state.SkipWithError(sim.error().message().c_str());
       return;
@@ -109,5 +115,11 @@ void BM_Cut(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_Cut)->ArgName("fem")->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Cut)
+    ->ArgNames({"fem", "collision"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({0, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

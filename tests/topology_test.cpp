@@ -290,6 +290,49 @@ TEST_P(Topology, GraspingLiftsAFlapAndReleasingDropsIt) {
   EXPECT_LT(end_y(), hanging + 0.05 - 0.01) << "released, the end falls";
 }
 
+TEST_P(Topology, MeshCollisionSeesTheNewSurface) {
+  // An 8 mm cube rests on a block (mesh collision between them). A hole of
+  // 10 x 5 x 10 mm is cut under it: the cube must fall into the hole, onto
+  // its floor (the new faces), not stay on the faces of the tets that are
+  // gone, nor fall through the floor.
+  SceneDesc scene = pad(6, 3, 6, [](const Vec3d& p) { return p[1] < 1e-9; });
+  TetBodyDesc cube;
+  cube.mesh = *make_tet_grid({.nx = 2, .ny = 2, .nz = 2, .origin = {0.011, 0.0155, 0.011}, .cell_size = {4e-3, 4e-3, 4e-3}});
+  cube.density = 1000.0;
+  ASSERT_TRUE(cube.set_elastic(3e5, 0.3).ok());
+  scene.tet_bodies.push_back(cube);
+  scene.mesh_collision.enabled = true;
+  scene.mesh_collision.thickness = 5e-4;
+  scene.mesh_collision.self_collision = false;
+  auto sim = create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  auto lowest = [&] {
+    std::vector<float> x;
+    EXPECT_TRUE(sim->read_positions(x).ok());
+    double y = 1.0;
+    for (std::uint32_t v = 0; v < scene.tet_bodies[1].mesh.vertices.size(); ++v)
+      y = std::min(y, double(x[4 * (sim->info().tet_body_first_particle[1] + v) + 1]));
+    return y;
+  };
+  run(*sim, 20);
+  EXPECT_GT(lowest(), 0.015);  // resting on the block's top (15 mm)
+  const TetMesh& block = scene.tet_bodies[0].mesh;
+  std::vector<std::uint32_t> hole;
+  for (std::uint32_t t = 0; t < block.tets.size(); ++t) {
+    Vec3d c{};
+    for (std::uint32_t v : block.tets[t])
+      for (int a = 0; a < 3; ++a) c[a] += 0.25 * block.vertices[v][a];
+    if (c[0] > 0.01 && c[0] < 0.02 && c[2] > 0.01 && c[2] < 0.02 && c[1] > 0.01) hole.push_back(t);
+  }
+  auto removed = sim->remove_tets(0, hole);
+  ASSERT_TRUE(removed.ok()) << removed.error().message();
+  run(*sim, 40);
+  const double bottom = lowest();
+  std::printf("the cube's lowest point: %.2f mm (the hole's floor at 10 mm)\n", 1e3 * bottom);
+  EXPECT_LT(bottom, 0.0115) << "the cube did not fall into the hole";
+  EXPECT_GT(bottom, 0.0095) << "the cube fell through the hole's floor";
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, Topology, ::testing::ValuesIn(backends()), backend_name);
 
 TEST(Topology, GraspersNameWhatIsWrong) {

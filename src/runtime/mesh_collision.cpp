@@ -165,6 +165,17 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   return mc;
 }
 
+Status MeshCollision::release(Device& device) {
+  MeshContactBuffers& b = buffers_;
+  for (BufferHandle* h : {&b.table, &b.particles, &b.coefficients, &b.normals, &b.lambda, &b.lambda_sum, &b.motion,
+                          &b.delta, &b.touched, &b.offsets, &b.slots})
+    if (h->valid()) {
+      if (Status s = device.destroy_buffer(*h); !s) return s;
+      *h = {};
+    }
+  return {};
+}
+
 // The broad phase at the start (boxes grown by half the thickness: every
 // pair closer than it overlaps), then the exact distance of each candidate.
 // A mesh's fissures and sharp creases, closer than the thickness before

@@ -72,6 +72,10 @@ class MeshCollision {
   /// again, or its fail-safe acts on them).
   Result<std::uint32_t> append_contacts(Device& device, std::span<const collision::Contact> contacts);
 
+  /// Destroys its device buffers (before a MeshCollision made for the
+  /// scene's new topology replaces it).
+  Status release(Device& device);
+
   /// [in] mask: per particle, what sutures exempt (suture_exemption.h);
   /// outlives this, read every frame.
   void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }

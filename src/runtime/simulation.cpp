@@ -85,6 +85,11 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     if (!editor) return editor.error();
     impl->topology = std::move(*editor);
   }
+  if (impl->topology && impl->mesh_collision) {
+    impl->collision_scene = std::make_unique<SceneDesc>(scene);
+    impl->collision_scene->attachments.clear();  // what MeshCollision does not read
+    impl->collision_scene->targets.clear();
+  }
   if (!scene.graspers.empty()) impl->graspers = std::make_unique<Graspers>(scene, *compiled);
   if (impl->mesh_collision || impl->topology || impl->graspers) {  // programs rebuilt while the scene runs start from this
     impl->program_shape = *compiled;

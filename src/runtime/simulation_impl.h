@@ -82,6 +82,13 @@ struct Simulation::Impl {
   /// contacts outgrew theirs, or a topology change.
   Status rebuild_program();
 
+  // With topology changes and mesh collision: the scene's bodies as the
+  // collision sees them (each tet body's live tets), to make the mesh
+  // collision again after a change (null otherwise).
+  std::unique_ptr<SceneDesc> collision_scene;
+  /// After a topology change: the mesh collision (and continuous collision)
+  /// made again from the live tets.
+  Status remake_collision();
   // SceneDesc::graspers (null without).
   std::unique_ptr<Graspers> graspers;
   // SceneDesc::topology_changes: the host copy of the constraints that

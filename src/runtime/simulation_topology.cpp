@@ -32,6 +32,8 @@ Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(std::size_t bo
                                                                  std::chrono::steady_clock::time_point start) {
   auto event = topology->remove(*device, buffers, program_shape, body, tets, burn);
   if (!event) return event.error();
+  if (!tets.empty() && collision_scene)
+    if (Status s = remake_collision(); !s) return s.error();
   if (!tets.empty()) {
     const auto rebuild = std::chrono::steady_clock::now();
     if (Status s = rebuild_program(); !s) return s.error();
@@ -39,6 +41,30 @@ Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(std::size_t bo
   }
   event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return event;
+}
+
+Status Simulation::Impl::remake_collision() {
+  // Each tet body's live tets: their boundary is the collision surface
+  // (cut faces included, removed tets' faces gone).
+  for (std::size_t b = 0; b < topology->bodies(); ++b) {
+    auto& tets = collision_scene->tet_bodies[b].mesh.tets;
+    tets.clear();
+    for (std::size_t t = 0; t < topology->alive(b).size(); ++t)
+      if (topology->alive(b)[t]) tets.push_back(topology->mesh(b).tets[t]);
+  }
+  auto made = MeshCollision::create(*collision_scene, program_shape, *device);
+  if (!made) return made.error();
+  if (Status s = mesh_collision->release(*device); !s) return s;
+  mesh_collision = std::move(*made);
+  if (continuous)
+    continuous = std::make_unique<ContinuousCollision>(mesh_collision->segments(), mesh_collision->triangles(),
+                                                       *mesh_collision, buffers, collision_scene->mesh_collision,
+                                                       collision_scene->solver.substeps);
+  if (sutures) {
+    mesh_collision->set_suture_exemption(sutures->exemption());
+    if (continuous) continuous->set_suture_exemption(sutures->exemption());
+  }
+  return {};
 }
 
 Result<Simulation::TopologyEvent> Simulation::remove_tets(std::size_t body, std::span<const std::uint32_t> tets) {
