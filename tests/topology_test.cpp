@@ -333,6 +333,91 @@ TEST_P(Topology, MeshCollisionSeesTheNewSurface) {
   EXPECT_GT(bottom, 0.0095) << "the cube fell through the hole's floor";
 }
 
+// A thread of 20 links of 5 mm (with bending) held at both ends, its
+// vertices starting `stretch` beyond their rest positions along x. Its
+// compliance (0.1 m/N a link) keeps the stretch even along it: a stiffer
+// thread held beyond its length is infeasible, and Gauss-Seidel leaves the
+// whole excess on the last links it sweeps (they tore at 10%).
+SceneDesc thread(double stretch, double tear_strain) {
+  SceneDesc scene;
+  LineBodyDesc line;
+  for (int i = 0; i <= 20; ++i) {
+    line.vertices.push_back({5e-3 * i, 0.0, 0.0});
+    line.initial_vertices.push_back({5e-3 * i * (1.0 + stretch), 0.0, 0.0});
+    line.masses.push_back(1e-4);
+  }
+  for (std::uint32_t i = 0; i < 20; ++i) line.segments.push_back({i, i + 1});
+  line.compliance = 0.1;
+  line.bending_compliance = 1.0;
+  line.pinned = {0, 20};
+  line.tear_strain = tear_strain;
+  scene.line_bodies.push_back(line);
+  scene.solver.time_step = 1.0 / 60.0;
+  scene.solver.substeps = 20;
+  scene.topology_changes = true;
+  return scene;
+}
+
+TEST_P(Topology, AThreadPulledPastItsThresholdSnapsAndBelowItHolds) {
+  // Without gravity, held 30% beyond its length it snaps at tear_strain
+  // 0.2 and its pieces spring back; held 10% beyond, it holds.
+  for (const double stretch : {0.3, 0.1}) {
+    SceneDesc scene = thread(stretch, 0.2);
+    scene.gravity = {0.0, 0.0, 0.0};
+    auto sim = create_or_skip(scene, GetParam());
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
+    std::size_t broken = 0;
+    for (int f = 0; f < 30; ++f) {
+      ASSERT_TRUE(sim->step().ok());
+      for (const auto& e : sim->last_tears()) {
+        EXPECT_EQ(e.body_kind, BodyKind::line);
+        EXPECT_GE(e.constraints_removed, e.segments_removed.size());
+        broken += e.segments_removed.size();
+      }
+    }
+    auto check = SimulationInternals::check_colors(*sim);
+    ASSERT_TRUE(check.ok());
+    EXPECT_EQ(check->conflicts, 0u);
+    std::vector<float> x;
+    ASSERT_TRUE(sim->read_positions(x).ok());
+    double longest = 0.0;  // the longest whole link now / its rest length
+    for (int i = 0; i < 20; ++i) longest = std::max(longest, std::abs(double(x[4 * (i + 1)] - x[4 * i])) / 5e-3);
+    if (stretch > 0.2) {
+      EXPECT_GT(broken, 0u) << "stretched 30%";
+    } else {
+      EXPECT_EQ(broken, 0u) << "stretched 10%";
+      EXPECT_NEAR(longest, 1.1, 0.02) << "held 10% beyond, evenly";
+    }
+  }
+}
+
+TEST_P(Topology, ScissorsCutAThreadAndItsBending) {
+  // Cutting the middle link of a thread held at both ends takes its
+  // distance constraint and the two bending constraints across it; each
+  // half then hangs from its end.
+  auto sim = create_or_skip(thread(0.0, 0.0), GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 5);
+  const std::uint32_t middle[] = {10};
+  auto cut = sim->remove_segments(0, middle);
+  ASSERT_TRUE(cut.ok()) << cut.error().message();
+  EXPECT_EQ(cut->constraints_removed, 3u);
+  run(*sim, 20);
+  std::vector<float> x;
+  ASSERT_TRUE(sim->read_positions(x).ok());
+  // The cut ends swing down towards their own pins, apart (5 mm at rest).
+  const double apart = std::hypot(x[4 * 11] - x[4 * 10], x[4 * 11 + 1] - x[4 * 10 + 1]);
+  EXPECT_GT(apart, 0.02);
+  EXPECT_LT(x[4 * 10 + 1], -0.01);
+  auto check = SimulationInternals::check_colors(*sim);
+  ASSERT_TRUE(check.ok());
+  EXPECT_EQ(check->conflicts, 0u);
+  EXPECT_NE(sim->remove_segments(0, middle).error().message().find("broken already"), std::string::npos);
+  const std::uint32_t beyond[] = {20};
+  EXPECT_NE(sim->remove_segments(0, beyond).error().message().find("segment 20"), std::string::npos);
+  EXPECT_NE(sim->remove_segments(1, beyond).error().message().find("line body 1"), std::string::npos);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, Topology, ::testing::ValuesIn(backends()), backend_name);
 
 TEST(Topology, GraspersNameWhatIsWrong) {

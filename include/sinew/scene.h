@@ -108,6 +108,11 @@ struct LineBodyDesc {
   double compliance = 0.0;                              ///< per segment [m/N], >= 0
   double bending_compliance = -1.0;                     ///< [m/N], >= 0; < 0: no bending constraints
   std::vector<std::uint32_t> pinned;                    ///< vertices held fixed
+  /// Tearing, >= 0 (0: never): after each frame, a segment stretched past
+  /// (1 + tear_strain) times its rest length breaks, with the bending
+  /// constraints across it (Simulation::last_tears). Needs
+  /// SceneDesc::topology_changes.
+  double tear_strain = 0.0;
   /// Velocity damping k [1/s], >= 0: every substep multiplies the velocity
   /// of the body's particles by exp(-k h), so free motion decays as
   /// exp(-k t) whatever the substeps (like a drag through a viscous medium:

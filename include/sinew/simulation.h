@@ -197,10 +197,13 @@ class Simulation {
   // mass); cautery burns its tets' mass away. Events are returned, for a
   // renderer to update its meshes (current_tets).
 
-  /// What one change did to tet body `body`.
+  /// What one change did to body `body` (a tet body, or a line body whose
+  /// segments broke: body_kind).
   struct TopologyEvent {
+    BodyKind body_kind = BodyKind::tet;
     std::size_t body = 0;
     std::vector<std::uint32_t> tets_removed;      ///< indices into the body's mesh.tets
+    std::vector<std::uint32_t> segments_removed;  ///< a line body's: indices into its segments
     std::vector<std::uint32_t> vertices_removed;  ///< vertices left with no tet (now fixed and massless)
     std::uint32_t constraints_removed = 0;  ///< volume, FEM and distance constraints taken out
     std::uint32_t edges_softened = 0;       ///< distance constraints whose compliance grew
@@ -231,8 +234,13 @@ class Simulation {
   /// rate: the ball's volume inside the body goes every dwell_time.
   Result<TopologyEvent> cauterize(std::size_t body, const std::array<double, 3>& centre, double radius,
                                   double seconds, double dwell_time);
-  /// Tets torn in the last step() (TetBodyDesc::tear_strain), one event per
-  /// body that tore.
+  /// Breaks segments of line body `body` (indices into its segments, each
+  /// whole, no repeats): their distance constraints go, with the bending
+  /// constraints across them (a thread cut with scissors). Errors as
+  /// remove_tets'.
+  Result<TopologyEvent> remove_segments(std::size_t body, std::span<const std::uint32_t> segments);
+  /// What tore in the last step() (TetBodyDesc::tear_strain,
+  /// LineBodyDesc::tear_strain), one event per body that tore.
   [[nodiscard]] const std::vector<TopologyEvent>& last_tears() const;
   /// The live tets of tet body `body` (indices into its mesh.tets, as
   /// tets; the vertices are the mesh's): its current topology, for

@@ -452,13 +452,21 @@ Status check_scene(const SceneDesc& scene) {
     return Error(ErrorCode::bad_parameter, "needles are not supported with solver.chebyshev_rho > 0 (got " +
                                                str(scene.solver.chebyshev_rho) +
                                                "): the accelerator would extrapolate the punctured tissue");
-  for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i) {
-    const std::string name = "tet_bodies[" + std::to_string(i) + "].tear_strain";
-    if (Status s = non_negative(name, scene.tet_bodies[i].tear_strain); !s) return s;
-    if (scene.tet_bodies[i].tear_strain > 0.0 && !scene.topology_changes)
-      return Error(ErrorCode::bad_parameter, name + " = " + str(scene.tet_bodies[i].tear_strain) +
-                                                 " needs topology_changes = true (tearing removes tets)");
-  }
+  // Tearing: a strain >= 0, and the topology changes it needs.
+  const auto check_tear = [&](const std::string& name, double strain) -> Status {
+    if (Status s = non_negative(name, strain); !s) return s;
+    if (strain > 0.0 && !scene.topology_changes)
+      return Error(ErrorCode::bad_parameter,
+                   name + " = " + str(strain) + " needs topology_changes = true (tearing removes elements)");
+    return {};
+  };
+  for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i)
+    if (Status s = check_tear("tet_bodies[" + std::to_string(i) + "].tear_strain", scene.tet_bodies[i].tear_strain); !s)
+      return s;
+  for (std::size_t i = 0; i < scene.line_bodies.size(); ++i)
+    if (Status s = check_tear("line_bodies[" + std::to_string(i) + "].tear_strain", scene.line_bodies[i].tear_strain);
+        !s)
+      return s;
   std::size_t grasper_targets = 0;
   for (std::size_t i = 0; i < scene.graspers.size(); ++i) {
     const std::string name = "graspers[" + std::to_string(i) + "]";

@@ -101,6 +101,10 @@ struct Simulation::Impl {
   /// whole change from `start`.
   Result<Simulation::TopologyEvent> apply_removal(std::size_t body, std::span<const std::uint32_t> tets, bool burn,
                                                   std::chrono::steady_clock::time_point start);
+  /// After the editor changed something: the mesh collision made again,
+  /// the program rebuilt, the event's times filled in.
+  Result<Simulation::TopologyEvent> finish_change(Result<Simulation::TopologyEvent> event, bool changed,
+                                                  std::chrono::steady_clock::time_point start);
 
   // simulation_contacts.cpp: host copies of the collider and target
   // buffers (rewritten before each frame) and the tools' rigid state.

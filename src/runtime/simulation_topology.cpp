@@ -30,11 +30,16 @@ Status check_body(const TopologyEditor& editor, std::size_t body) {
 Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(std::size_t body,
                                                                  std::span<const std::uint32_t> tets, bool burn,
                                                                  std::chrono::steady_clock::time_point start) {
-  auto event = topology->remove(*device, buffers, program_shape, body, tets, burn);
+  return finish_change(topology->remove(*device, buffers, program_shape, body, tets, burn), !tets.empty(), start);
+}
+
+Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulation::TopologyEvent> event,
+                                                                  bool changed,
+                                                                  std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
-  if (!tets.empty() && collision_scene)
+  if (changed && collision_scene)
     if (Status s = remake_collision(); !s) return s.error();
-  if (!tets.empty()) {
+  if (changed) {
     const auto rebuild = std::chrono::steady_clock::now();
     if (Status s = rebuild_program(); !s) return s.error();
     event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
@@ -51,6 +56,12 @@ Status Simulation::Impl::remake_collision() {
     tets.clear();
     for (std::size_t t = 0; t < topology->alive(b).size(); ++t)
       if (topology->alive(b)[t]) tets.push_back(topology->mesh(b).tets[t]);
+  }
+  for (std::size_t b = 0; b < topology->line_bodies(); ++b) {  // and each line body's whole segments
+    auto& segments = collision_scene->line_bodies[b].segments;
+    segments.clear();
+    for (std::size_t s = 0; s < topology->whole(b).size(); ++s)
+      if (topology->whole(b)[s]) segments.push_back(topology->line(b).segments[s]);
   }
   auto made = MeshCollision::create(*collision_scene, program_shape, *device);
   if (!made) return made.error();
@@ -71,6 +82,15 @@ Result<Simulation::TopologyEvent> Simulation::remove_tets(std::size_t body, std:
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_tets"); !s) return s.error();
   return impl_->apply_removal(body, tets, false, start);
+}
+
+Result<Simulation::TopologyEvent> Simulation::remove_segments(std::size_t body,
+                                                              std::span<const std::uint32_t> segments) {
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = need_topology(impl_->topology, "remove_segments"); !s) return s.error();
+  return impl_->finish_change(impl_->topology->remove_segments(*impl_->device, impl_->buffers, impl_->program_shape,
+                                                               body, segments),
+                              !segments.empty(), start);
 }
 
 Result<Simulation::TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
@@ -120,6 +140,15 @@ Status Simulation::Impl::tear() {
                                 topology->tear_strain(b));
     if (torn.empty()) continue;
     auto event = apply_removal(b, torn, false, start);
+    if (!event) return event.error();
+    tears.push_back(std::move(*event));
+  }
+  for (std::size_t b = 0; b < topology->line_bodies(); ++b) {
+    const double strain = topology->line(b).tear_strain;
+    if (!(strain > 0.0)) continue;
+    const auto torn = segments_torn(topology->line(b), topology->whole(b), {x, topology->line_first_particle(b)}, strain);
+    if (torn.empty()) continue;
+    auto event = finish_change(topology->remove_segments(*device, buffers, program_shape, b, torn), true, start);
     if (!event) return event.error();
     tears.push_back(std::move(*event));
   }

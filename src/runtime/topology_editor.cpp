@@ -65,10 +65,13 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
     b.offsets = c.color_offsets;
     for (std::size_t col = 0; col < c.colors(); ++col) b.counts.push_back(c.color_count(col));
     const bool tets = is_tet_kernel(c.kernel) && c.arity == 4, edges = c.kernel == Kernel::xpbd_solve_distance;
-    for (std::uint32_t i = 0; i < c.size() && (tets || edges); ++i) {
+    const bool bends = c.kernel == Kernel::xpbd_solve_line_bending;
+    for (std::uint32_t i = 0; i < c.size() && (tets || edges || bends); ++i) {
       const std::uint32_t* p = &b.particles[std::size_t{i} * b.arity];
       if (edges) {
         e->edge_slots_[edge_key(p[0], p[1])] = {k, i};
+      } else if (bends) {
+        e->bend_slots_[p[1]] = {k, i};
       } else {
         TetKey key{p[0], p[1], p[2], p[3]};
         std::sort(key.begin(), key.end());
@@ -80,6 +83,14 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
   e->mass_.resize(compiled.positions.size());
   for (std::size_t i = 0; i < compiled.positions.size(); ++i)
     e->mass_[i] = compiled.positions[i].w > 0.0f ? 1.0 / double(compiled.positions[i].w) : 0.0;
+  for (std::size_t bi = 0; bi < scene.line_bodies.size(); ++bi) {
+    Line l;
+    l.desc = scene.line_bodies[bi];
+    l.first = compiled.line_body_first_particle[bi];
+    for (std::uint32_t v = 0; v < l.desc.vertices.size(); ++v) l.device.push_back(compiled.order.device_of[l.first + v]);
+    l.whole.assign(l.desc.segments.size(), 1);
+    e->lines_.push_back(std::move(l));
+  }
   for (std::size_t bi = 0; bi < scene.tet_bodies.size(); ++bi) {
     const TetBodyDesc& desc = scene.tet_bodies[bi];
     Body b;
@@ -114,7 +125,8 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
 }
 
 bool TopologyEditor::tears() const {
-  return std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) { return b.tear_strain > 0.0; });
+  return std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) { return b.tear_strain > 0.0; }) ||
+         std::any_of(lines_.begin(), lines_.end(), [](const Line& l) { return l.desc.tear_strain > 0.0; });
 }
 
 void TopologyEditor::swap_remove(std::uint32_t k, std::uint32_t slot) {
@@ -129,6 +141,8 @@ void TopologyEditor::swap_remove(std::uint32_t k, std::uint32_t slot) {
     const std::uint32_t* p = &b.particles[std::size_t{slot} * b.arity];
     if (b.kernel == Kernel::xpbd_solve_distance) {
       edge_slots_[edge_key(p[0], p[1])] = {k, slot};
+    } else if (b.kernel == Kernel::xpbd_solve_line_bending) {
+      bend_slots_[p[1]] = {k, slot};
     } else {
       TetKey key{p[0], p[1], p[2], p[3]};
       std::sort(key.begin(), key.end());
@@ -289,11 +303,65 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
   }
   std::sort(mass_changed.begin(), mass_changed.end());
   mass_changed.erase(std::unique(mass_changed.begin(), mass_changed.end()), mass_changed.end());
-  if (Status s = upload(device, buffers, mass_changed); !s) return s.error();
+  if (Status s = commit(device, buffers, shape, mass_changed); !s) return s.error();
+  return event;
+}
+
+Status TopologyEditor::commit(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+                              std::span<const std::uint32_t> mass_changed) {
+  if (Status s = upload(device, buffers, mass_changed); !s) return s;
   // The counts of the blocks a removal can change (graspers' blocks keep theirs).
   for (std::size_t k = 0; k < blocks_.size(); ++k)
-    if (blocks_[k].kernel == Kernel::xpbd_solve_distance || is_tet_kernel(blocks_[k].kernel))
+    if (blocks_[k].kernel == Kernel::xpbd_solve_distance || blocks_[k].kernel == Kernel::xpbd_solve_line_bending ||
+        is_tet_kernel(blocks_[k].kernel))
       shape.blocks[k].color_counts = blocks_[k].counts;
+  return {};
+}
+
+Result<Simulation::TopologyEvent> TopologyEditor::remove_segments(Device& device, const XpbdBuffers& buffers,
+                                                                  CompiledScene& shape, std::size_t body,
+                                                                  std::span<const std::uint32_t> segments) {
+  if (body >= lines_.size())
+    return Error(ErrorCode::bad_parameter, "line body " + std::to_string(body) + " does not exist (the scene has " +
+                                               std::to_string(lines_.size()) + ")");
+  Line& l = lines_[body];
+  std::vector<std::uint8_t> seen(l.whole.size(), 0);
+  for (std::uint32_t s : segments) {
+    const std::string name = "line_bodies[" + std::to_string(body) + "] segment " + std::to_string(s);
+    if (s >= l.whole.size())
+      return Error(ErrorCode::bad_parameter,
+                   name + " does not exist (the body has " + std::to_string(l.whole.size()) + " segments)");
+    if (!l.whole[s]) return Error(ErrorCode::bad_parameter, name + " was broken already");
+    if (seen[s]) return Error(ErrorCode::bad_parameter, name + " is listed twice");
+    seen[s] = 1;
+  }
+  Simulation::TopologyEvent event;
+  event.body_kind = BodyKind::line;
+  event.body = body;
+  event.segments_removed.assign(segments.begin(), segments.end());
+  for (std::uint32_t s : segments) {
+    l.whole[s] = 0;
+    const std::uint32_t p = l.device[l.desc.segments[s][0]], q = l.device[l.desc.segments[s][1]];
+    if (const auto it = edge_slots_.find(edge_key(p, q)); it != edge_slots_.end()) {
+      const Slot slot = it->second;
+      edge_slots_.erase(it);
+      swap_remove(slot.block, slot.slot);
+      ++event.constraints_removed;
+    }
+    // The bending constraints across it: those centred on either end that
+    // reach the other.
+    for (const auto& [middle, other] : {std::pair{p, q}, std::pair{q, p}}) {
+      const auto it = bend_slots_.find(middle);
+      if (it == bend_slots_.end()) continue;
+      const Slot slot = it->second;
+      const std::uint32_t* ends = &blocks_[slot.block].particles[std::size_t{slot.slot} * 3];
+      if (ends[0] != other && ends[2] != other) continue;
+      bend_slots_.erase(it);
+      swap_remove(slot.block, slot.slot);
+      ++event.constraints_removed;
+    }
+  }
+  if (Status s = commit(device, buffers, shape, {}); !s) return s.error();
   return event;
 }
 

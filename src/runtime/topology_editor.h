@@ -46,6 +46,19 @@ class TopologyEditor {
   Result<Simulation::TopologyEvent> remove(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
                                            std::size_t body, std::span<const std::uint32_t> tets, bool burn);
 
+  /// Breaks segments of line body `body` (checked: whole, no repeats; on
+  /// an error nothing changed): their distance constraints and the bending
+  /// constraints across them. Patches the device and shape as remove does;
+  /// masses stay (a piece of thread keeps its beads).
+  Result<Simulation::TopologyEvent> remove_segments(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+                                                    std::size_t body, std::span<const std::uint32_t> segments);
+  [[nodiscard]] std::size_t line_bodies() const { return lines_.size(); }
+  /// Line body `body`'s rest vertices and segments, which are whole, its
+  /// first particle (user order) and tear strain.
+  [[nodiscard]] const LineBodyDesc& line(std::size_t body) const { return lines_[body].desc; }
+  [[nodiscard]] const std::vector<std::uint8_t>& whole(std::size_t body) const { return lines_[body].whole; }
+  [[nodiscard]] std::uint32_t line_first_particle(std::size_t body) const { return lines_[body].first; }
+
   [[nodiscard]] std::size_t bodies() const { return bodies_.size(); }
   /// Tet body `body`'s rest mesh and which of its tets are alive.
   [[nodiscard]] const TetMesh& mesh(std::size_t body) const { return bodies_[body].mesh; }
@@ -53,6 +66,7 @@ class TopologyEditor {
   /// The user-order particle of the body's vertex 0.
   [[nodiscard]] std::uint32_t first_particle(std::size_t body) const { return bodies_[body].first; }
   [[nodiscard]] double tear_strain(std::size_t body) const { return bodies_[body].tear_strain; }
+  /// Whether any tet or line body tears (tear_strain > 0).
   [[nodiscard]] bool tears() const;
   /// Seconds each tet has been touched by a cautery tip (cauterize).
   [[nodiscard]] std::vector<double>& heat(std::size_t body) { return bodies_[body].heat; }
@@ -100,7 +114,17 @@ class TopologyEditor {
     double density = 0.0, distance_compliance = 0.0, tear_strain = 0.0;
   };
 
+  struct Line {
+    LineBodyDesc desc;                  // its vertices and segments (rest)
+    std::uint32_t first = 0;            // user particle of vertex 0
+    std::vector<std::uint32_t> device;  // device slot of each vertex
+    std::vector<std::uint8_t> whole;    // per segment
+  };
+
   TetKey tet_key(const Body& b, std::uint32_t tet) const;
+  // Writes what changed to the device and the new counts into shape.
+  Status commit(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+                std::span<const std::uint32_t> mass_changed);
   static std::uint64_t edge_key(std::uint32_t a, std::uint32_t b);
   // Gives slot `slot` of block `k` to its colour's last constraint.
   void swap_remove(std::uint32_t k, std::uint32_t slot);
@@ -112,6 +136,8 @@ class TopologyEditor {
   std::vector<Body> bodies_;
   std::unordered_map<TetKey, std::vector<Slot>, TetKeyHash> tet_slots_;  // volume and FEM constraints
   std::unordered_map<std::uint64_t, Slot> edge_slots_;                   // distance constraints
+  std::unordered_map<std::uint32_t, Slot> bend_slots_;                   // line bending, by its middle particle
+  std::vector<Line> lines_;
   std::vector<double> mass_;                                             // per device slot [kg] (0: immovable)
   bool warm_start_ = false;                                              // SolverSettings::warm_start
 };

@@ -97,6 +97,19 @@ std::vector<std::uint32_t> tets_torn(const TetMesh& mesh, std::span<const std::u
   return out;
 }
 
+std::vector<std::uint32_t> segments_torn(const LineBodyDesc& line, std::span<const std::uint8_t> whole,
+                                         const BodyPositions& x, double strain) {
+  const double limit = (1.0 + strain) * (1.0 + strain);
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t s = 0; s < line.segments.size(); ++s) {
+    if (!whole[s]) continue;
+    const auto [a, b] = line.segments[s];
+    const Point3 now = sub(x.at(b), x.at(a)), rest = sub(line.vertices[b], line.vertices[a]);
+    if (dot(now, now) > limit * dot(rest, rest)) out.push_back(s);
+  }
+  return out;
+}
+
 std::vector<std::uint32_t> tets_burned(const TetMesh& mesh, std::span<const std::uint8_t> alive,
                                        const BodyPositions& x, const Point3& centre, double radius, double seconds,
                                        double dwell, std::vector<double>& heat) {

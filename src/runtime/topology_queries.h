@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sinew/mesh.h"
+#include "sinew/scene.h"
 
 namespace sinew {
 
@@ -42,6 +43,11 @@ std::vector<std::uint32_t> tets_cut(const TetMesh& mesh, std::span<const std::ui
 /// The live tets with an edge longer than (1 + strain) times its rest length.
 std::vector<std::uint32_t> tets_torn(const TetMesh& mesh, std::span<const std::uint8_t> alive, const BodyPositions& x,
                                      double strain);
+
+/// The whole segments of a line body stretched past (1 + strain) times
+/// their rest length (its vertices at `x`).
+std::vector<std::uint32_t> segments_torn(const LineBodyDesc& line, std::span<const std::uint8_t> whole,
+                                         const BodyPositions& x, double strain);
 
 /// Adds `seconds` to heat[t] of every live tet whose centroid is within
 /// `radius` of `centre`, and returns those whose heat reached `dwell`.
