@@ -545,7 +545,8 @@ struct MeshCollisionDesc {
 /// holds is attached by a zero-length constraint to its own target, a point
 /// fixed in the grasper's frame where the vertex was when the jaws closed;
 /// the targets move with the grasper. Each grasper is one colour of
-/// `capacity` slots (a vertex held by two graspers is solved twice).
+/// `capacity` slots (a vertex held by two graspers is solved twice). Like
+/// every attachment, graspers cannot run with solver.warm_start.
 struct GrasperDesc {
   std::uint32_t capacity = 64;  ///< the most vertices it holds at once, in [1, 2^20]
   double compliance = 0.0;      ///< of each hold [m/N], >= 0 (0: rigid)

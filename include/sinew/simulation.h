@@ -192,10 +192,13 @@ class Simulation {
   // TetBodyDesc). Each removed constraint's colour gives its last constraint
   // the slot, so every colour stays valid and only the changed slots are
   // uploaded; the frame program is rebuilt with the new counts. A vertex left
-  // with no tet is fixed (inverse mass 0) and its mass handed to the
-  // vertices it shared a removed tet with (cuts and tears conserve the total
-  // mass); cautery burns its tets' mass away. Events are returned, for a
-  // renderer to update its meshes (current_tets).
+  // with no tet is fixed (inverse mass 0) and its mass handed to the movable
+  // vertices it shared a removed tet with, or else to the nearest live
+  // movable vertex of its body; cuts and tears conserve the total mass
+  // unless nothing movable is left to take it (then it is mass_removed).
+  // Cautery burns its tets' mass away. Events are returned, for a renderer
+  // to update its meshes (current_tets). Errors in the arguments change
+  // nothing; a device error during a change leaves the Simulation unusable.
 
   /// What one change did to body `body` (a tet body, or a line body whose
   /// segments broke: body_kind).
@@ -204,8 +207,8 @@ class Simulation {
     std::size_t body = 0;
     std::vector<std::uint32_t> tets_removed;      ///< indices into the body's mesh.tets
     std::vector<std::uint32_t> segments_removed;  ///< a line body's: indices into its segments
-    std::vector<std::uint32_t> vertices_removed;  ///< vertices left with no tet (now fixed and massless)
-    std::uint32_t constraints_removed = 0;  ///< volume, FEM and distance constraints taken out
+    std::vector<std::uint32_t> vertices_removed;  ///< movable vertices left with no tet (now fixed and massless)
+    std::uint32_t constraints_removed = 0;  ///< volume, FEM, distance and line bending constraints taken out
     std::uint32_t edges_softened = 0;       ///< distance constraints whose compliance grew
     double mass_moved = 0.0;    ///< [kg] handed from removed vertices to their neighbours
     double mass_removed = 0.0;  ///< [kg] that left the scene (burned, or no neighbour left)
@@ -222,7 +225,7 @@ class Simulation {
   };
   /// Cuts tet body `body` with a blade swept from `from` to `to` (the quad
   /// they span, two triangles): every live tet the swept quad touches at the
-  /// body's current positions is removed. Mass is conserved. The query sees
+  /// body's current positions is removed (mass as above). The query sees
   /// the tissue where it is now: tissue moving across the blade's path
   /// between strokes can slip past uncut, so strokes along a line should
   /// overlap (examples/cholecystectomy.cpp).

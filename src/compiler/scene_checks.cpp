@@ -452,6 +452,10 @@ Status check_scene(const SceneDesc& scene) {
     return Error(ErrorCode::bad_parameter, "needles are not supported with solver.chebyshev_rho > 0 (got " +
                                                str(scene.solver.chebyshev_rho) +
                                                "): the accelerator would extrapolate the punctured tissue");
+  if (!scene.needles.empty() && scene.topology_changes)
+    return Error(ErrorCode::bad_parameter,
+                 "needles are not supported with topology_changes = true yet: their puncturable surfaces and "
+                 "sutures are made once, from the meshes the scene starts with");
   // Tearing: a strain >= 0, and the topology changes it needs.
   const auto check_tear = [&](const std::string& name, double strain) -> Status {
     if (Status s = non_negative(name, strain); !s) return s;

@@ -47,6 +47,13 @@ struct ConstraintBlock {
   double damping_time = 0.0;
   [[nodiscard]] std::uint32_t size() const { return arity ? static_cast<std::uint32_t>(particles.size() / arity) : 0; }
   [[nodiscard]] std::uint32_t colors() const { return static_cast<std::uint32_t>(color_offsets.size() - 1); }
+  /// Constraints in use (the sum of color_count): what the residuals'
+  /// RMS divides by, after topology changes or in a grasper's block.
+  [[nodiscard]] std::uint32_t in_use() const {
+    std::uint32_t n = 0;
+    for (std::size_t k = 0; k < colors(); ++k) n += color_count(k);
+    return n;
+  }
   /// Constraints colour k solves (see color_counts).
   [[nodiscard]] std::uint32_t color_count(std::size_t k) const {
     return color_counts.empty() ? color_offsets[k + 1] - color_offsets[k] : color_counts[k];

@@ -262,6 +262,7 @@ Result<ResidualCheck> make_residual_check(Device& device, const CompiledScene& s
   std::uint32_t scratch_words = 0;
   for (const ConstraintBlock& block : scene.blocks) {
     check.block_sizes.push_back(block.size());
+    check.in_use.push_back(block.in_use());
     check.squares_word.push_back(check.result_words);
     check.max_word.push_back(check.result_words + 2);
     check.result_words += 3;
@@ -294,7 +295,7 @@ Result<CheckedResidual> read_residual_check(Device& device, ResidualCheck& check
     if (check.block_sizes[k] == 0) continue;
     sum += double(r[check.squares_word[k]]) + double(r[check.squares_word[k] + 1]);
     out.max = std::max(out.max, double(r[check.max_word[k]]));
-    constraints += check.block_sizes[k];
+    constraints += check.in_use[k];
   }
   out.rms = constraints ? std::sqrt(sum / double(constraints)) : 0.0;
   return out;

@@ -39,6 +39,7 @@ struct ChebyshevBuffers {
 struct ResidualCheck {
   BufferHandle constants, scratch, results;
   std::vector<std::uint32_t> block_sizes;
+  std::vector<std::uint32_t> in_use;  ///< per block, constraints in use (as StatsPlan::in_use)
   std::vector<std::uint32_t> squares_word, max_word;  ///< per block, in `results`
   std::uint32_t result_words = 0;
   std::vector<float> read_back;

@@ -68,7 +68,10 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
   plan.tools = tools;
   plan.particles = static_cast<std::uint32_t>(scene.positions.size());
   plan.face_count = errors ? static_cast<std::uint32_t>(faces.size()) : 0u;
-  for (const ConstraintBlock& block : scene.blocks) plan.block_sizes.push_back(block.size());
+  for (const ConstraintBlock& block : scene.blocks) {
+    plan.block_sizes.push_back(block.size());
+    plan.in_use.push_back(block.in_use());
+  }
   if (!errors && tools == 0) return plan;
 
   std::vector<std::uint32_t> constants{plan.particles, plan.face_count, plan.particles * tools};
@@ -177,7 +180,7 @@ Status read_stats(Device& device, StatsPlan& plan, DeviceStats& out) {
       if (plan.block_sizes[k] == 0) continue;
       out.residual_sum_squares += pair(r, plan.residual_squares[k]);
       out.residual_max = std::max(out.residual_max, double(r[plan.residual_max[k]]));
-      out.constraints += plan.block_sizes[k];
+      out.constraints += plan.in_use[k];
     }
     out.kinetic_energy = pair(r, plan.kinetic_energy);
     out.volume = pair(r, plan.volume) / 6.0;  // the terms are 6 x volume

@@ -37,6 +37,10 @@ struct StatsPlan {
   bool errors = false;             ///< residuals, kinetic energy and volume are reduced
   std::uint32_t tools = 0;
   std::vector<std::uint32_t> block_sizes;
+  /// Per block, the constraints in use (ConstraintBlock::in_use): the
+  /// residuals' RMS divides by their sum (a block's unused slots hold
+  /// residual 0). The Simulation refreshes it when the counts change.
+  std::vector<std::uint32_t> in_use;
   std::uint32_t particles = 0, face_count = 0;
   BufferHandle constants, faces, terms, scratch, results;
   std::uint32_t result_words = 0;

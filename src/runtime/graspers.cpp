@@ -83,8 +83,14 @@ void Graspers::move(std::vector<float>& targets, std::size_t index, const Pose& 
   }
 }
 
-std::vector<std::uint32_t> Graspers::open(CompiledScene& shape, std::size_t index) {
+Result<std::vector<std::uint32_t>> Graspers::open(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+                                                  std::size_t index) {
   Grasper& g = graspers_[index];
+  if (!g.held.empty()) {
+    const std::vector<float> zeros(g.held.size(), 0.0f);
+    if (Status s = device.write_buffer(buffers.blocks[g.block].residual, 0, zeros.data(), zeros.size() * 4); !s)
+      return s.error();
+  }
   std::vector<std::uint32_t> released = std::move(g.held);
   g.held.clear();
   g.offsets.clear();

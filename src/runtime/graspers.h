@@ -42,10 +42,14 @@ class Graspers {
                                            std::size_t index, const Pose& pose,
                                            const std::array<double, 3>& half_extents, std::span<const float> xyzw);
   /// The pose the grasper reaches by the end of the next frame: its held
-  /// particles' targets' end points.
+  /// particles' targets' end points (an open grasper holds none: nothing
+  /// changes).
   void move(std::vector<float>& targets, std::size_t index, const Pose& pose);
-  /// Releases what it holds (returned, user order); its count in shape is 0.
-  std::vector<std::uint32_t> open(CompiledScene& shape, std::size_t index);
+  /// Releases what it holds (returned, user order); its count in shape is
+  /// 0, and its slots' residuals (which the statistics reduce over the
+  /// whole block) are zeroed on the device.
+  Result<std::vector<std::uint32_t>> open(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+                                          std::size_t index);
 
  private:
   struct Grasper {

@@ -45,6 +45,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   if (compiled->external_forces) impl->force_scratch.resize(compiled->positions.size());
   if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
   impl->order = compiled->order;
+  impl->scene_targets = scene.targets.size();
   impl->time_step = scene.solver.time_step;
   impl->measure_errors = scene.solver.measure_errors;
   impl->substeps = scene.solver.substeps;
@@ -158,6 +159,8 @@ Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
 }
 
 Status Simulation::Impl::rebuild_program() {
+  stats_plan.in_use.clear();  // the residuals' RMS divides by the constraints in use
+  for (const ConstraintBlock& block : program_shape.blocks) stats_plan.in_use.push_back(block.in_use());
   if (!stepper) return prepare_program(program_shape);
   if (Status s = stepper->rebuild(*device, program_shape, buffers, gravity, stats_plan, sweep_extras()); !s) return s;
   program = stepper->frame_program();

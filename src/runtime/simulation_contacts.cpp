@@ -280,7 +280,7 @@ Status Simulation::set_collider_pose(std::size_t index, const std::array<double,
 Status Simulation::set_target(std::size_t index, const std::array<double, 3>& position) {
   constexpr const char* call = "set_target";
   std::vector<float>& targets = impl_->targets;
-  if (Status s = check_index(call, "target", index, targets.size() / kTargetFloats); !s) return s;
+  if (Status s = check_index(call, "target", index, impl_->scene_targets); !s) return s;
   if (Status s = check_finite(call, "position", position); !s) return s;
   auto e = load_words<TargetEntry>(targets, index * kTargetFloats);
   e.end_x = static_cast<float>(position[0]);

@@ -53,7 +53,8 @@ Status Simulation::move_grasper(std::size_t index, const Pose& pose) {
 Result<std::vector<std::uint32_t>> Simulation::open_grasper(std::size_t index) {
   if (Status s = check_grasper(impl_->graspers.get(), "open_grasper", index); !s) return s.error();
   const bool was_closed = impl_->graspers->closed(index);
-  std::vector<std::uint32_t> released = impl_->graspers->open(impl_->program_shape, index);
+  auto released = impl_->graspers->open(*impl_->device, impl_->buffers, impl_->program_shape, index);
+  if (!released) return released.error();
   if (was_closed)
     if (Status s = impl_->rebuild_program(); !s) return s.error();
   return released;

@@ -110,6 +110,7 @@ struct Simulation::Impl {
   // buffers (rewritten before each frame) and the tools' rigid state.
   std::vector<float> colliders;
   std::vector<float> targets;
+  std::size_t scene_targets = 0;  ///< SceneDesc::targets (the graspers' own targets follow them)
   ContactState contacts;
   Status init_contacts(const SceneDesc& scene, const CompiledScene& compiled);
   Status before_frame();  ///< integrates the tools (rigid_tool.h), uploads what moved

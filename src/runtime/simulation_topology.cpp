@@ -131,7 +131,7 @@ Result<Simulation::TopologyEvent> Simulation::cauterize(std::size_t body, const 
 Status Simulation::Impl::tear() {
   tears.clear();
   if (!topology || !topology->tears()) return {};
-  const auto start = std::chrono::steady_clock::now();
+  auto start = std::chrono::steady_clock::now();  // each event's time: its query and change (the first's: the read-back too)
   std::vector<float> x;
   if (Status s = read_in_user_order(buffers.position, x); !s) return s;
   for (std::size_t b = 0; b < topology->bodies(); ++b) {
@@ -142,6 +142,7 @@ Status Simulation::Impl::tear() {
     auto event = apply_removal(b, torn, false, start);
     if (!event) return event.error();
     tears.push_back(std::move(*event));
+    start = std::chrono::steady_clock::now();
   }
   for (std::size_t b = 0; b < topology->line_bodies(); ++b) {
     const double strain = topology->line(b).tear_strain;
@@ -151,6 +152,7 @@ Status Simulation::Impl::tear() {
     auto event = finish_change(topology->remove_segments(*device, buffers, program_shape, b, torn), true, start);
     if (!event) return event.error();
     tears.push_back(std::move(*event));
+    start = std::chrono::steady_clock::now();
   }
   return {};
 }

@@ -78,6 +78,8 @@ Result<std::unique_ptr<SolveStepper>> SolveStepper::create(Device& device, const
 Status SolveStepper::rebuild(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
                              const std::array<double, 3>& gravity, const StatsPlan& stats,
                              SweepExtras extras) {
+  check_.in_use.clear();  // the counts in use changed (topology changes, graspers)
+  for (const ConstraintBlock& block : scene.blocks) check_.in_use.push_back(block.in_use());
   std::vector<ProgramHandle> all{whole_, end_};
   all.insert(all.end(), begin_.begin(), begin_.end());
   all.insert(all.end(), repair_.begin(), repair_.end());

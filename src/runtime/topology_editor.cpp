@@ -400,11 +400,14 @@ Status TopologyEditor::upload(Device& device, const XpbdBuffers& buffers, std::s
       if (Status s = write_slots(device, d.particles, b.particles, b.arity, first, last - first + 1); !s) return s;
       if (Status s = write_slots(device, d.data, b.data, b.data_stride, first, last - first + 1); !s) return s;
     }
-    // A moved constraint's multiplier: only a warm start carries one from
-    // substep to substep (otherwise the first sweep resets it), and there
-    // it would be its slot's last owner's. It starts again from 0.
-    if (warm_start_)
-      for (const auto& [first, last] : merged_runs(b.dirty, 0)) {
+    // A moved constraint's lambda record would be its slot's last owner's.
+    // It matters where something outlives the first sweep's reset: a warm
+    // start's multipliers, and the corotational tets' rotation, kept in the
+    // record from solve to solve (fem_params.h, SINEW_FEM_ROTATION; all
+    // zero: start from the exact rotation). There it starts again from 0,
+    // slot by slot (a merged run would reset the records between).
+    if (warm_start_ || b.kernel == Kernel::xpbd_solve_corotational)
+      for (const auto& [first, last] : merged_runs(b.dirty, 1)) {
         const std::vector<float> zeros(std::size_t{last - first + 1} * b.lambda_stride, 0.0f);
         if (Status s = device.write_buffer(d.lambda, std::size_t{first} * b.lambda_stride * 4, zeros.data(),
                                            zeros.size() * 4);
@@ -432,31 +435,6 @@ Status TopologyEditor::upload(Device& device, const XpbdBuffers& buffers, std::s
     if (Status s = device.write_buffer(buffers.position, std::size_t{p} * 16, &x, 16); !s) return s;
   }
   return {};
-}
-
-std::vector<TopologyEditor::ColorView> TopologyEditor::active_constraints() const {
-  std::vector<ColorView> out;
-  for (const Block& b : blocks_) {
-    ColorView v;
-    v.arity = b.arity;
-    for (std::size_t c = 0; c < b.counts.size(); ++c)
-      v.colors.emplace_back(b.particles.begin() + std::ptrdiff_t(std::size_t{b.offsets[c]} * b.arity),
-                            b.particles.begin() + std::ptrdiff_t(std::size_t{b.offsets[c] + b.counts[c]} * b.arity));
-    out.push_back(std::move(v));
-  }
-  return out;
-}
-
-std::vector<std::uint8_t> TopologyEditor::movable() const {
-  std::vector<std::uint8_t> m(mass_.size());
-  for (std::size_t i = 0; i < mass_.size(); ++i) m[i] = mass_[i] > 0.0;
-  return m;
-}
-
-double TopologyEditor::total_mass() const {
-  double sum = 0.0;
-  for (double m : mass_) sum += m;
-  return sum;
 }
 
 }  // namespace sinew

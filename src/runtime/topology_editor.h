@@ -71,17 +71,6 @@ class TopologyEditor {
   /// Seconds each tet has been touched by a cautery tip (cauterize).
   [[nodiscard]] std::vector<double>& heat(std::size_t body) { return bodies_[body].heat; }
 
-  /// A block's constraints in use, colour by colour (for the colouring
-  /// checker in the tests): particles in device slots.
-  struct ColorView {
-    std::uint32_t arity = 0;
-    std::vector<std::vector<std::uint32_t>> colors;  ///< per colour: arity particles per constraint
-  };
-  [[nodiscard]] std::vector<ColorView> active_constraints() const;
-  /// Device slots whose particle is movable (inverse mass > 0) now.
-  [[nodiscard]] std::vector<std::uint8_t> movable() const;
-  /// The total mass of the scene's particles [kg] (host copy).
-  [[nodiscard]] double total_mass() const;
 
  private:
   struct Block {
