@@ -73,6 +73,39 @@ void expect_consistent(const Simulation& sim, const std::vector<std::uint32_t>& 
   }
 }
 
+// The device's constraints in use are exactly what tet body 0's live tets
+// call for: one volume constraint per live tet and one distance constraint
+// per edge of a live tet (edge network), or one FEM constraint per live tet
+// (TetMaterial): none dropped, none doubled, none left over.
+void expect_constraints_match(const Simulation& sim, TetMaterial material) {
+  auto check = SimulationInternals::check_colors(sim);
+  ASSERT_TRUE(check.ok());
+  auto tets = sim.current_tets(0);
+  ASSERT_TRUE(tets.ok());
+  const std::uint32_t first = sim.info().tet_body_first_particle[0];
+  using Entry = std::pair<Kernel, std::vector<std::uint32_t>>;
+  std::vector<Entry> expected, actual;
+  const Kernel per_tet = material == TetMaterial::none ? Kernel::xpbd_solve_volume : Kernel::xpbd_solve_corotational;
+  std::vector<std::vector<std::uint32_t>> edges;
+  for (const auto& t : *tets) {
+    std::vector<std::uint32_t> q{first + t[0], first + t[1], first + t[2], first + t[3]};
+    std::sort(q.begin(), q.end());
+    expected.emplace_back(per_tet, q);
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) edges.push_back({q[a], q[b]});
+  }
+  if (material == TetMaterial::none) {
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    for (auto& e : edges) expected.emplace_back(Kernel::xpbd_solve_distance, e);
+  }
+  for (const Entry& e : check->in_use)
+    if (e.first == per_tet || e.first == Kernel::xpbd_solve_distance) actual.push_back(e);
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(actual.size(), expected.size());
+  EXPECT_TRUE(actual == expected) << "the device's constraints differ from the live tets'";
+}
+
 class Topology : public BackendTest {};
 
 TEST_P(Topology, APadCutInTwoFallsApart) {
@@ -101,6 +134,7 @@ TEST_P(Topology, APadCutInTwoFallsApart) {
               cut->tets_removed.size(), cut->vertices_removed.size(), cut->constraints_removed, cut->edges_softened,
               cut->mass_moved, cut->wall_ms);
   expect_consistent(*sim, cut->vertices_removed, before->total_mass);
+  expect_constraints_match(*sim, TetMaterial::none);
 
   run(*sim, 20);  // a third of a second: free fall g t^2 / 2 = 0.545 m
   const double fallen = mean_y_beyond(*sim, scene.tet_bodies[0].mesh, 0.045);
@@ -147,6 +181,7 @@ TEST_P(Topology, EveryColourStaysValidThroughManyRemovals) {
       ASSERT_TRUE(event.ok()) << event.error().message();
       gone_vertices.insert(gone_vertices.end(), event->vertices_removed.begin(), event->vertices_removed.end());
       expect_consistent(*sim, gone_vertices, mass);
+      expect_constraints_match(*sim, material);
       run(*sim, 2);
     }
     auto tets = sim->current_tets(0);
@@ -223,6 +258,7 @@ TEST_P(Topology, CauteryBurnsTheBallsVolumeAfterItsDwellTime) {
   auto check = SimulationInternals::check_colors(*sim);
   ASSERT_TRUE(check.ok());
   EXPECT_EQ(check->conflicts, 0u);
+  expect_constraints_match(*sim, TetMaterial::none);
 }
 
 TEST_P(Topology, ACutAlongTheGridsPlanesLeavesNoNaN) {
@@ -240,6 +276,7 @@ TEST_P(Topology, ACutAlongTheGridsPlanesLeavesNoNaN) {
   EXPECT_GT(cut->tets_removed.size(), 0u);
   run(*sim, 30);
   expect_consistent(*sim, cut->vertices_removed, 0.0);
+  expect_constraints_match(*sim, TetMaterial::none);
 }
 
 TEST_P(Topology, GraspingLiftsAFlapAndReleasingDropsIt) {

@@ -1,6 +1,7 @@
 // simulation_topology.cpp — Simulation's topology changes: remove_tets,
 // cut_body, cauterize and the tears after each frame (topology_editor.h
 // patches the constraints, topology_queries.h finds the tets).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -188,6 +189,13 @@ Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const 
       ++out.colors;
       for (std::uint32_t i = block.color_offsets[c]; i < block.color_offsets[c] + block.color_count(c); ++i) {
         ++out.constraints;
+        std::vector<std::uint32_t> users;
+        for (std::uint32_t a = 0; a < block.arity; ++a) {
+          const std::uint32_t d = particles[std::size_t{i} * block.arity + a];
+          users.push_back(impl.order.user_of.empty() ? d : impl.order.user_of[d]);
+        }
+        std::sort(users.begin(), users.end());
+        out.in_use.emplace_back(block.kernel, std::move(users));
         for (std::uint32_t a = 0; a < block.arity; ++a) {
           const std::uint32_t p = particles[std::size_t{i} * block.arity + a];
           ++out.references[impl.order.user_of.empty() ? p : impl.order.user_of[p]];
@@ -199,6 +207,7 @@ Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const 
     }
   }
   for (const auto& p : x) out.total_mass += p.w > 0.0f ? 1.0 / double(p.w) : 0.0;
+  std::sort(out.in_use.begin(), out.in_use.end());
   return out;
 }
 
