@@ -24,7 +24,6 @@ struct SimulationInternals {
     std::uint64_t constraints = 0;  ///< in use
     std::uint64_t conflicts = 0;
     double total_mass = 0.0;  ///< sum of 1 / w over the device's movable particles [kg]
-    std::vector<std::uint32_t> references;  ///< per particle (user order): constraints in use naming it
     /// Every constraint in use: its kernel and its particles (user order,
     /// sorted), the list sorted; what a test compares with the topology.
     std::vector<std::pair<Kernel, std::vector<std::uint32_t>>> in_use;

@@ -177,7 +177,6 @@ Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const 
   std::vector<kernels::float4> x(impl.program_shape.positions.size());
   if (Status s = device.read_buffer(impl.buffers.position, 0, x.data(), x.size() * 16); !s) return s.error();
   ColorCheck out;
-  out.references.assign(x.size(), 0);
   std::vector<std::uint32_t> owner(x.size(), UINT32_MAX);  // the last colour that moved each particle
   std::uint32_t colour_id = 0;
   for (std::size_t k = 0; k < impl.program_shape.blocks.size(); ++k) {
@@ -198,7 +197,6 @@ Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const 
         out.in_use.emplace_back(block.kernel, std::move(users));
         for (std::uint32_t a = 0; a < block.arity; ++a) {
           const std::uint32_t p = particles[std::size_t{i} * block.arity + a];
-          ++out.references[impl.order.user_of.empty() ? p : impl.order.user_of[p]];
           if (!(x[p].w > 0.0f)) continue;  // immovable particles may be shared
           if (owner[p] == colour_id) ++out.conflicts;
           owner[p] = colour_id;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "math/xpbd_math.h"
+#include "runtime/topology_queries.h"
 
 namespace sinew {
 
@@ -18,8 +19,6 @@ bool is_tet_kernel(Kernel k) {
   return k == Kernel::xpbd_solve_volume || k == Kernel::xpbd_solve_neo_hookean || k == Kernel::xpbd_solve_stvk ||
          k == Kernel::xpbd_solve_corotational;
 }
-
-constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
 // Writes slots [first, first + count) of a per-slot array of `words` 32-bit
 // words each.
@@ -216,7 +215,7 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
   // Their edges: gone with their last tet, or softer by the volume they lost.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
   for (std::uint32_t t : tets)
-    for (const auto& e : kEdges) {
+    for (const auto& e : kTetEdges) {
       const std::uint32_t u = b.mesh.tets[t][e[0]], v = b.mesh.tets[t][e[1]];
       edges.emplace_back(std::min(u, v), std::max(u, v));
     }

@@ -45,10 +45,9 @@ bool triangle_touches_tet(const std::array<Point3, 3>& tri, const std::array<Poi
   static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
   for (const auto& f : kFaces)
     if (separates(cross(sub(tet[f[1]], tet[f[0]]), sub(tet[f[2]], tet[f[0]])))) return false;
-  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   for (int i = 0; i < 3; ++i) {
     const Point3 e = sub(tri[(i + 1) % 3], tri[i]);
-    for (const auto& k : kEdges)
+    for (const auto& k : kTetEdges)
       if (separates(cross(e, sub(tet[k[1]], tet[k[0]])))) return false;
   }
   return true;
@@ -79,13 +78,12 @@ std::vector<std::uint32_t> tets_cut(const TetMesh& mesh, std::span<const std::ui
 
 std::vector<std::uint32_t> tets_torn(const TetMesh& mesh, std::span<const std::uint8_t> alive, const BodyPositions& x,
                                      double strain) {
-  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   const double limit = (1.0 + strain) * (1.0 + strain);
   std::vector<std::uint32_t> out;
   for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
     if (!alive[t]) continue;
     const auto& q = mesh.tets[t];
-    for (const auto& e : kEdges) {
+    for (const auto& e : kTetEdges) {
       const Point3 now = sub(x.at(q[e[1]]), x.at(q[e[0]]));
       const Point3 rest = sub(mesh.vertices[q[e[1]]], mesh.vertices[q[e[0]]]);
       if (dot(now, now) > limit * dot(rest, rest)) {

@@ -17,6 +17,9 @@ namespace sinew {
 
 using Point3 = std::array<double, 3>;
 
+/// A tet's six edges, as pairs of its corners.
+inline constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
 /// The current position of the body's vertex v: xyzw in the user's
 /// particle order (Simulation::read_positions), the body's vertex 0 at `first`.
 struct BodyPositions {
