@@ -10,8 +10,7 @@
 #include <numeric>
 #include <vector>
 
-#include "runtime/simulation_internals.h"
-#include "test_support.h"
+#include "topology_support.h"
 
 namespace sinew::test {
 namespace {
@@ -43,14 +42,6 @@ SceneDesc pad(int nx, int ny, int nz, Pin pin, TetMaterial material = TetMateria
 
 auto left_end = [](const Vec3d& p) { return p[0] < 1e-9; };
 
-// Steps `frames` frames; fails on an error or a non-finite position.
-void run(Simulation& sim, int frames) {
-  std::vector<float> x;
-  for (int f = 0; f < frames; ++f) ASSERT_TRUE(sim.step().ok());
-  ASSERT_TRUE(sim.read_positions(x).ok());
-  for (float c : x) ASSERT_TRUE(std::isfinite(c));
-}
-
 // The mean y of the vertices with x beyond `from` [m].
 double mean_y_beyond(const Simulation& sim, const TetMesh& mesh, double from) {
   std::vector<float> x;
@@ -60,19 +51,6 @@ double mean_y_beyond(const Simulation& sim, const TetMesh& mesh, double from) {
   for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
     if (mesh.vertices[v][0] > from) sum += x[4 * v + 1], ++n;
   return sum / n;
-}
-
-// Colours valid, nothing naming a removed vertex, and the mass.
-void expect_consistent(const Simulation& sim, const std::vector<std::uint32_t>& removed_vertices, double mass) {
-  auto check = SimulationInternals::check_colors(sim);
-  ASSERT_TRUE(check.ok()) << check.error().message();
-  EXPECT_EQ(check->conflicts, 0u);
-  for (const auto& [kernel, particles] : check->in_use)
-    for (std::uint32_t v : removed_vertices)
-      EXPECT_EQ(std::count(particles.begin(), particles.end(), v), 0) << "a constraint names removed vertex " << v;
-  if (mass > 0.0) {
-    EXPECT_NEAR(check->total_mass, mass, 1e-6 * mass);
-  }
 }
 
 // The device's constraints in use are exactly what tet body 0's live tets
@@ -135,7 +113,7 @@ TEST_P(Topology, APadCutInTwoFallsApart) {
   std::printf("cut: %zu tets, %zu vertices, %u constraints removed, %u edges softened, %.3g kg moved, %.2f ms\n",
               cut->tets_removed.size(), cut->vertices_removed.size(), cut->constraints_removed, cut->edges_softened,
               cut->mass_moved, cut->wall_ms);
-  expect_consistent(*sim, cut->vertices_removed, before->total_mass);
+  expect_consistent(*sim, 0, cut->vertices_removed, before->total_mass);
   expect_constraints_match(*sim, TetMaterial::none);
 
   run(*sim, 20);  // a third of a second: free fall g t^2 / 2 = 0.545 m
@@ -148,7 +126,7 @@ TEST_P(Topology, APadCutInTwoFallsApart) {
     if (scene.tet_bodies[0].mesh.vertices[v][0] < 0.035) {
       EXPECT_GT(x[4 * v + 1], -0.05) << "vertex " << v;
     }
-  expect_consistent(*sim, cut->vertices_removed, before->total_mass);
+  expect_consistent(*sim, 0, cut->vertices_removed, before->total_mass);
 }
 
 TEST_P(Topology, AnUncutPadKeepsHanging) {
@@ -172,17 +150,11 @@ TEST_P(Topology, EveryColourStaysValidThroughManyRemovals) {
     std::iota(live.begin(), live.end(), 0u);
     std::uint32_t seed = 16;
     for (int round = 0; round < 30 && live.size() > 7; ++round) {
-      std::vector<std::uint32_t> take;
-      for (int i = 0; i < 7; ++i) {
-        seed = seed * 1664525u + 1013904223u;
-        const std::size_t at = (seed >> 8) % live.size();
-        take.push_back(live[at]);
-        live.erase(live.begin() + std::ptrdiff_t(at));
-      }
+      const std::vector<std::uint32_t> take = take_random(live, 7, seed);
       auto event = sim->remove_tets(0, take);
       ASSERT_TRUE(event.ok()) << event.error().message();
       gone_vertices.insert(gone_vertices.end(), event->vertices_removed.begin(), event->vertices_removed.end());
-      expect_consistent(*sim, gone_vertices, mass);
+      expect_consistent(*sim, 0, gone_vertices, mass);
       expect_constraints_match(*sim, material);
       run(*sim, 2);
     }
@@ -218,7 +190,7 @@ TEST_P(Topology, AStripPulledPastItsThresholdTearsAndBelowItDoesNot) {
     } else {
       EXPECT_EQ(torn, 0u) << "stretched 10%";
     }
-    expect_consistent(*sim, gone, mass);
+    expect_consistent(*sim, 0, gone, mass);
   }
 }
 
@@ -277,7 +249,7 @@ TEST_P(Topology, ACutAlongTheGridsPlanesLeavesNoNaN) {
   // (after 5 frames the pad has sagged a little, so some are off it).
   EXPECT_GT(cut->tets_removed.size(), 0u);
   run(*sim, 30);
-  expect_consistent(*sim, cut->vertices_removed, 0.0);
+  expect_consistent(*sim, 0, cut->vertices_removed, 0.0);
   expect_constraints_match(*sim, TetMaterial::none);
 }
 
@@ -512,18 +484,7 @@ TEST(Topology, ScriptedCutsAgreeAcrossBackends) {
     for (int f = 0; f < 10; ++f) EXPECT_TRUE(sim->step().ok());
     return sim->read_positions(x).ok();
   };
-  std::vector<float> reference;
-  ASSERT_TRUE(script("cpu", reference));
-  for (const std::string& backend : backends()) {
-    if (backend == "cpu" || !missing_device(backend).empty()) continue;
-    std::vector<float> x;
-    ASSERT_TRUE(script(backend, x)) << backend;
-    ASSERT_EQ(x.size(), reference.size());
-    double worst = 0.0;
-    for (std::size_t i = 0; i < x.size(); ++i) worst = std::max(worst, double(std::abs(x[i] - reference[i])));
-    std::printf("%s: largest difference from the CPU %.3g m\n", backend.c_str(), worst);
-    EXPECT_LT(worst, 1e-5) << backend;
-  }
+  expect_backends_agree(script);
 }
 
 TEST(Topology, BadInputIsNamed) {

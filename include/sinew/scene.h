@@ -146,6 +146,11 @@ struct TriBodyDesc {
   double area_compliance = 1e-5;          ///< c_a [1/Pa], >= 0
   double bending_compliance = -1.0;       ///< [1/(N m)], >= 0; < 0: no bending constraints
   std::vector<std::uint32_t> pinned;      ///< vertices held fixed
+  /// Tearing, >= 0 (0: never tears): after each frame, a triangle with an
+  /// edge stretched past (1 + tear_strain) times its rest length is
+  /// removed, with the hinges it was part of (Simulation::last_tears).
+  /// Needs SceneDesc::topology_changes.
+  double tear_strain = 0.0;
   /// Velocity damping k [1/s], >= 0: every substep multiplies the velocity
   /// of the body's particles by exp(-k h), so free motion decays as
   /// exp(-k t) whatever the substeps (like a drag through a viscous medium:
@@ -571,11 +576,12 @@ struct SceneDesc {
   /// this, the frame program has no force kernel and the device no force
   /// buffer; with it, one dispatch per substep and 16 bytes per particle.
   bool external_forces = false;
-  /// Tets removed while the scene runs (Simulation::remove_tets, cut_body,
-  /// cauterize, TetBodyDesc::tear_strain; runtime/topology_editor.h). A
+  /// Tets, triangles and thread segments removed while the scene runs
+  /// (Simulation::remove_tets, remove_triangles, remove_segments, cut_body,
+  /// cauterize, the bodies' tear_strain; runtime/topology_editor.h). A
   /// scene pays only for what it uses: with this the Simulation keeps a
   /// host copy of every constraint block (what a removal patches) and the
-  /// tet bodies' adjacency; without it those calls are errors.
+  /// tet and tri bodies' adjacency; without it those calls are errors.
   bool topology_changes = false;
 };
 

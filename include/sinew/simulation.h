@@ -184,31 +184,36 @@ class Simulation {
 
   // ---- Topology changes (SceneDesc::topology_changes; runtime/topology_editor.h)
   //
-  // Tets are removed, never split: what is left is whole original elements,
-  // so no sliver is ever made (the smallest element keeps its rest volume).
-  // A removed tet's volume (or FEM) constraints go, and so do the distance
-  // constraints of edges no remaining tet has; an edge that keeps some of
-  // its tets is made softer by the volume it lost (alpha_e = c_d L^2 / V_e,
-  // TetBodyDesc). Each removed constraint's colour gives its last constraint
-  // the slot, so every colour stays valid and only the changed slots are
-  // uploaded; the frame program is rebuilt with the new counts. A vertex left
-  // with no tet is fixed (inverse mass 0) and its mass handed to the movable
-  // vertices it shared a removed tet with, or else to the nearest live
-  // movable vertex of its body; cuts and tears conserve the total mass
-  // unless nothing movable is left to take it (then it is mass_removed).
-  // Cautery burns its tets' mass away. Events are returned, for a renderer
-  // to update its meshes (current_tets). Errors in the arguments change
+  // Elements (a tet body's tets, a tri body's triangles) are removed, never
+  // split: what is left is whole original elements, so no sliver is ever
+  // made (the smallest element keeps its rest volume or area). A removed
+  // element's own constraints go (volume and FEM; area), and so do the
+  // distance constraints of edges no remaining element has and, on a tri
+  // body, the dihedral (bending) constraints of the hinges it was part of;
+  // an edge that keeps some of its elements is made softer by the share it
+  // lost (alpha_e = c_d L^2 / V_e, TetBodyDesc; c_d L^2 / (A_e t),
+  // TriBodyDesc). Each removed constraint's colour gives its last
+  // constraint the slot, so every colour stays valid and only the changed
+  // slots are uploaded; the frame program is rebuilt with the new counts.
+  // A vertex left with no element is fixed (inverse mass 0) and its mass
+  // handed to the movable vertices it shared a removed element with, or
+  // else to the nearest live movable vertex of its body; cuts and tears
+  // conserve the total mass unless nothing movable is left to take it
+  // (then it is mass_removed). Cautery burns its elements' mass away.
+  // Events are returned, for a renderer to update its meshes
+  // (current_tets, current_triangles). Errors in the arguments change
   // nothing; a device error during a change leaves the Simulation unusable.
 
-  /// What one change did to body `body` (a tet body, or a line body whose
-  /// segments broke: body_kind).
+  /// What one change did to body `body` (a tet body, a tri body, or a line
+  /// body whose segments broke: body_kind).
   struct TopologyEvent {
     BodyKind body_kind = BodyKind::tet;
     std::size_t body = 0;
-    std::vector<std::uint32_t> tets_removed;      ///< indices into the body's mesh.tets
+    std::vector<std::uint32_t> tets_removed;      ///< a tet body's: indices into its mesh.tets
+    std::vector<std::uint32_t> triangles_removed; ///< a tri body's: indices into its mesh.triangles
     std::vector<std::uint32_t> segments_removed;  ///< a line body's: indices into its segments
-    std::vector<std::uint32_t> vertices_removed;  ///< movable vertices left with no tet (now fixed and massless)
-    std::uint32_t constraints_removed = 0;  ///< volume, FEM, distance and line bending constraints taken out
+    std::vector<std::uint32_t> vertices_removed;  ///< movable vertices left with no element (now fixed and massless)
+    std::uint32_t constraints_removed = 0;  ///< volume, FEM, area, distance and bending constraints taken out
     std::uint32_t edges_softened = 0;       ///< distance constraints whose compliance grew
     double mass_moved = 0.0;    ///< [kg] handed from removed vertices to their neighbours
     double mass_removed = 0.0;  ///< [kg] that left the scene (burned, or no neighbour left)
@@ -219,22 +224,33 @@ class Simulation {
   /// alive, no repeats). Errors: topology changes not enabled, a bad body
   /// or tet (named); on an error nothing changed.
   Result<TopologyEvent> remove_tets(std::size_t body, std::span<const std::uint32_t> tets);
+  /// Removes triangles of tri body `body` (indices into its mesh.triangles,
+  /// each alive, no repeats). Errors as remove_tets'.
+  Result<TopologyEvent> remove_triangles(std::size_t body, std::span<const std::uint32_t> triangles);
   /// A blade: the segment from `a` to `b` [m].
   struct Blade {
     std::array<double, 3> a{}, b{};
   };
-  /// Cuts tet body `body` with a blade swept from `from` to `to` (the quad
-  /// they span, two triangles): every live tet the swept quad touches at the
-  /// body's current positions is removed (mass as above). The query sees
-  /// the tissue where it is now: tissue moving across the blade's path
-  /// between strokes can slip past uncut, so strokes along a line should
-  /// overlap (examples/cholecystectomy.cpp).
+  /// Cuts body `body` of `kind` (tet or tri) with a blade swept from `from`
+  /// to `to` (the quad they span, two triangles): every live tet or
+  /// triangle the swept quad touches at the body's current positions is
+  /// removed (mass as above). A sheet cut in its own plane loses the
+  /// triangles the quad overlaps. The query sees the tissue where it is
+  /// now: tissue moving across the blade's path between strokes can slip
+  /// past uncut, so strokes along a line should overlap
+  /// (examples/cholecystectomy.cpp).
+  Result<TopologyEvent> cut_body(BodyKind kind, std::size_t body, const Blade& from, const Blade& to);
+  /// cut_body(BodyKind::tet, body, from, to).
   Result<TopologyEvent> cut_body(std::size_t body, const Blade& from, const Blade& to);
-  /// A heated tip (a ball of `radius` [m] at `centre` [m]) touching tet body
-  /// `body` for `seconds` [s] (> 0): a live tet whose current centroid lies
-  /// in the ball accumulates that time, and is burned (removed with its
-  /// mass) once it has been touched for dwell_time [s] (> 0) in all. The
-  /// rate: the ball's volume inside the body goes every dwell_time.
+  /// A heated tip (a ball of `radius` [m] at `centre` [m]) touching body
+  /// `body` of `kind` (tet or tri) for `seconds` [s] (> 0): a live element
+  /// whose current centroid lies in the ball accumulates that time, and is
+  /// burned (removed with its mass) once it has been touched for
+  /// dwell_time [s] (> 0) in all. The rate: the ball's volume inside a tet
+  /// body (its disc's area across a sheet) goes every dwell_time.
+  Result<TopologyEvent> cauterize(BodyKind kind, std::size_t body, const std::array<double, 3>& centre, double radius,
+                                  double seconds, double dwell_time);
+  /// cauterize(BodyKind::tet, body, ...).
   Result<TopologyEvent> cauterize(std::size_t body, const std::array<double, 3>& centre, double radius,
                                   double seconds, double dwell_time);
   /// Breaks segments of line body `body` (indices into its segments, each
@@ -243,12 +259,16 @@ class Simulation {
   /// remove_tets'.
   Result<TopologyEvent> remove_segments(std::size_t body, std::span<const std::uint32_t> segments);
   /// What tore in the last step() (TetBodyDesc::tear_strain,
-  /// LineBodyDesc::tear_strain), one event per body that tore.
+  /// TriBodyDesc::tear_strain, LineBodyDesc::tear_strain), one event per
+  /// body that tore.
   [[nodiscard]] const std::vector<TopologyEvent>& last_tears() const;
   /// The live tets of tet body `body` (indices into its mesh.tets, as
   /// tets; the vertices are the mesh's): its current topology, for
   /// extract_boundary_surface. Errors: a bad body.
   Result<std::vector<std::array<std::uint32_t, 4>>> current_tets(std::size_t body) const;
+  /// The live triangles of tri body `body` (as triangles of its mesh's
+  /// vertices): its current surface, for a renderer. Errors: a bad body.
+  Result<std::vector<std::array<std::uint32_t, 3>>> current_triangles(std::size_t body) const;
 
   // ---- Graspers (SceneDesc::graspers; runtime/graspers.h)
 

@@ -467,6 +467,9 @@ Status check_scene(const SceneDesc& scene) {
   for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i)
     if (Status s = check_tear("tet_bodies[" + std::to_string(i) + "].tear_strain", scene.tet_bodies[i].tear_strain); !s)
       return s;
+  for (std::size_t i = 0; i < scene.tri_bodies.size(); ++i)
+    if (Status s = check_tear("tri_bodies[" + std::to_string(i) + "].tear_strain", scene.tri_bodies[i].tear_strain); !s)
+      return s;
   for (std::size_t i = 0; i < scene.line_bodies.size(); ++i)
     if (Status s = check_tear("line_bodies[" + std::to_string(i) + "].tear_strain", scene.line_bodies[i].tear_strain);
         !s)

@@ -95,11 +95,13 @@ struct Simulation::Impl {
   // removals patch (null without), and the last step's tears.
   std::unique_ptr<TopologyEditor> topology;
   std::vector<Simulation::TopologyEvent> tears;
-  /// After a frame: removes the tets stretched past their body's tear_strain.
+  /// After a frame: removes the tets, triangles and segments stretched
+  /// past their body's tear_strain.
   Status tear();
-  /// Removes tets (topology_editor.h), rebuilds the program and times the
-  /// whole change from `start`.
-  Result<Simulation::TopologyEvent> apply_removal(std::size_t body, std::span<const std::uint32_t> tets, bool burn,
+  /// Removes elements of a tet or tri body (topology_editor.h), rebuilds
+  /// the program and times the whole change from `start`.
+  Result<Simulation::TopologyEvent> apply_removal(BodyKind kind, std::size_t body,
+                                                  std::span<const std::uint32_t> elements, bool burn,
                                                   std::chrono::steady_clock::time_point start);
   /// After the editor changed something: the mesh collision made again,
   /// the program rebuilt, the event's times filled in.

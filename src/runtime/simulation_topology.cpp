@@ -1,6 +1,7 @@
 // simulation_topology.cpp — Simulation's topology changes: remove_tets,
-// cut_body, cauterize and the tears after each frame (topology_editor.h
-// patches the constraints, topology_queries.h finds the tets).
+// remove_triangles, remove_segments, cut_body, cauterize and the tears after
+// each frame (topology_editor.h patches the constraints, topology_queries.h
+// finds the elements).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,18 +21,23 @@ Status need_topology(const std::unique_ptr<TopologyEditor>& editor, const char* 
                std::string(call) + " needs SceneDesc::topology_changes = true when the Simulation is made");
 }
 
-Status check_body(const TopologyEditor& editor, std::size_t body) {
-  if (body < editor.bodies()) return {};
-  return Error(ErrorCode::bad_parameter, "tet body " + std::to_string(body) + " does not exist (the scene has " +
-                                             std::to_string(editor.bodies()) + ")");
+// A tet or tri body of the scene.
+Status check_body(const TopologyEditor& editor, BodyKind kind, std::size_t body) {
+  if (kind == BodyKind::line)
+    return Error(ErrorCode::bad_parameter, "a line body has no tets or triangles (remove_segments breaks threads)");
+  if (body < editor.bodies(kind)) return {};
+  return Error(ErrorCode::bad_parameter, std::string(kind == BodyKind::tri ? "tri body " : "tet body ") +
+                                             std::to_string(body) + " does not exist (the scene has " +
+                                             std::to_string(editor.bodies(kind)) + ")");
 }
 
 }  // namespace
 
-Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(std::size_t body,
-                                                                 std::span<const std::uint32_t> tets, bool burn,
+Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(BodyKind kind, std::size_t body,
+                                                                 std::span<const std::uint32_t> elements, bool burn,
                                                                  std::chrono::steady_clock::time_point start) {
-  return finish_change(topology->remove(*device, buffers, program_shape, body, tets, burn), !tets.empty(), start);
+  return finish_change(topology->remove(*device, buffers, program_shape, kind, body, elements, burn),
+                       !elements.empty(), start);
 }
 
 Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulation::TopologyEvent> event,
@@ -58,6 +64,12 @@ Status Simulation::Impl::remake_collision() {
     for (std::size_t t = 0; t < topology->alive(b).size(); ++t)
       if (topology->alive(b)[t]) tets.push_back(topology->mesh(b).tets[t]);
   }
+  for (std::size_t b = 0; b < topology->sheets(); ++b) {  // each tri body's live triangles
+    auto& triangles = collision_scene->tri_bodies[b].mesh.triangles;
+    triangles.clear();
+    for (std::size_t t = 0; t < topology->sheet_alive(b).size(); ++t)
+      if (topology->sheet_alive(b)[t]) triangles.push_back(topology->sheet_mesh(b).triangles[t]);
+  }
   for (std::size_t b = 0; b < topology->line_bodies(); ++b) {  // and each line body's whole segments
     auto& segments = collision_scene->line_bodies[b].segments;
     segments.clear();
@@ -82,7 +94,14 @@ Status Simulation::Impl::remake_collision() {
 Result<Simulation::TopologyEvent> Simulation::remove_tets(std::size_t body, std::span<const std::uint32_t> tets) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_tets"); !s) return s.error();
-  return impl_->apply_removal(body, tets, false, start);
+  return impl_->apply_removal(BodyKind::tet, body, tets, false, start);
+}
+
+Result<Simulation::TopologyEvent> Simulation::remove_triangles(std::size_t body,
+                                                               std::span<const std::uint32_t> triangles) {
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = need_topology(impl_->topology, "remove_triangles"); !s) return s.error();
+  return impl_->apply_removal(BodyKind::tri, body, triangles, false, start);
 }
 
 Result<Simulation::TopologyEvent> Simulation::remove_segments(std::size_t body,
@@ -95,24 +114,35 @@ Result<Simulation::TopologyEvent> Simulation::remove_segments(std::size_t body,
 }
 
 Result<Simulation::TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
+  return cut_body(BodyKind::tet, body, from, to);
+}
+
+Result<Simulation::TopologyEvent> Simulation::cut_body(BodyKind kind, std::size_t body, const Blade& from,
+                                                       const Blade& to) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "cut_body"); !s) return s.error();
-  if (Status s = check_body(*impl_->topology, body); !s) return s.error();
+  if (Status s = check_body(*impl_->topology, kind, body); !s) return s.error();
   for (const auto& [p, name] : {std::pair{&from.a, "from.a"}, {&from.b, "from.b"}, {&to.a, "to.a"}, {&to.b, "to.b"}})
     for (double c : *p)
       if (!std::isfinite(c)) return Error(ErrorCode::bad_parameter, std::string("cut_body: blade ") + name + " is not finite");
   std::vector<float> x;
   if (Status s = read_positions(x); !s) return s.error();
   const TopologyEditor& e = *impl_->topology;
-  const auto cut = tets_cut(e.mesh(body), e.alive(body), {x, e.first_particle(body)}, from.a, from.b, to.a, to.b);
-  return impl_->apply_removal(body, cut, false, start);
+  const auto cut = elements_cut(e.view(kind, body), {x, e.first_particle(kind, body)}, from.a, from.b, to.a, to.b);
+  return impl_->apply_removal(kind, body, cut, false, start);
 }
 
 Result<Simulation::TopologyEvent> Simulation::cauterize(std::size_t body, const std::array<double, 3>& centre,
                                                         double radius, double seconds, double dwell_time) {
+  return cauterize(BodyKind::tet, body, centre, radius, seconds, dwell_time);
+}
+
+Result<Simulation::TopologyEvent> Simulation::cauterize(BodyKind kind, std::size_t body,
+                                                        const std::array<double, 3>& centre, double radius,
+                                                        double seconds, double dwell_time) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "cauterize"); !s) return s.error();
-  if (Status s = check_body(*impl_->topology, body); !s) return s.error();
+  if (Status s = check_body(*impl_->topology, kind, body); !s) return s.error();
   for (double c : centre)
     if (!std::isfinite(c)) return Error(ErrorCode::bad_parameter, "cauterize: centre is not finite");
   if (!(radius > 0.0) || !std::isfinite(radius))
@@ -124,9 +154,9 @@ Result<Simulation::TopologyEvent> Simulation::cauterize(std::size_t body, const 
   std::vector<float> x;
   if (Status s = read_positions(x); !s) return s.error();
   TopologyEditor& e = *impl_->topology;
-  const auto burned = tets_burned(e.mesh(body), e.alive(body), {x, e.first_particle(body)}, centre, radius, seconds,
-                                  dwell_time, e.heat(body));
-  return impl_->apply_removal(body, burned, true, start);
+  const auto burned = elements_burned(e.view(kind, body), {x, e.first_particle(kind, body)}, centre, radius, seconds,
+                                      dwell_time, e.heat(kind, body));
+  return impl_->apply_removal(kind, body, burned, true, start);
 }
 
 Status Simulation::Impl::tear() {
@@ -135,16 +165,17 @@ Status Simulation::Impl::tear() {
   auto start = std::chrono::steady_clock::now();  // each event's time: its query and change (the first's: the read-back too)
   std::vector<float> x;
   if (Status s = read_in_user_order(buffers.position, x); !s) return s;
-  for (std::size_t b = 0; b < topology->bodies(); ++b) {
-    if (!(topology->tear_strain(b) > 0.0)) continue;
-    const auto torn = tets_torn(topology->mesh(b), topology->alive(b), {x, topology->first_particle(b)},
-                                topology->tear_strain(b));
-    if (torn.empty()) continue;
-    auto event = apply_removal(b, torn, false, start);
-    if (!event) return event.error();
-    tears.push_back(std::move(*event));
-    start = std::chrono::steady_clock::now();
-  }
+  for (BodyKind kind : {BodyKind::tet, BodyKind::tri})
+    for (std::size_t b = 0; b < topology->bodies(kind); ++b) {
+      const double strain = topology->tear_strain(kind, b);
+      if (!(strain > 0.0)) continue;
+      const auto torn = elements_torn(topology->view(kind, b), {x, topology->first_particle(kind, b)}, strain);
+      if (torn.empty()) continue;
+      auto event = apply_removal(kind, b, torn, false, start);
+      if (!event) return event.error();
+      tears.push_back(std::move(*event));
+      start = std::chrono::steady_clock::now();
+    }
   for (std::size_t b = 0; b < topology->line_bodies(); ++b) {
     const double strain = topology->line(b).tear_strain;
     if (!(strain > 0.0)) continue;
@@ -162,12 +193,22 @@ const std::vector<Simulation::TopologyEvent>& Simulation::last_tears() const { r
 
 Result<std::vector<std::array<std::uint32_t, 4>>> Simulation::current_tets(std::size_t body) const {
   if (Status s = need_topology(impl_->topology, "current_tets"); !s) return s.error();
-  if (Status s = check_body(*impl_->topology, body); !s) return s.error();
+  if (Status s = check_body(*impl_->topology, BodyKind::tet, body); !s) return s.error();
   const TopologyEditor& e = *impl_->topology;
   std::vector<std::array<std::uint32_t, 4>> tets;
   for (std::size_t t = 0; t < e.alive(body).size(); ++t)
     if (e.alive(body)[t]) tets.push_back(e.mesh(body).tets[t]);
   return tets;
+}
+
+Result<std::vector<std::array<std::uint32_t, 3>>> Simulation::current_triangles(std::size_t body) const {
+  if (Status s = need_topology(impl_->topology, "current_triangles"); !s) return s.error();
+  if (Status s = check_body(*impl_->topology, BodyKind::tri, body); !s) return s.error();
+  const TopologyEditor& e = *impl_->topology;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (std::size_t t = 0; t < e.sheet_alive(body).size(); ++t)
+    if (e.sheet_alive(body)[t]) triangles.push_back(e.sheet_mesh(body).triangles[t]);
+  return triangles;
 }
 
 Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const Simulation& sim) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "math/thin_math.h"
 #include "math/xpbd_math.h"
 #include "runtime/topology_queries.h"
 
@@ -15,9 +16,20 @@ namespace sinew {
 
 namespace {
 
-bool is_tet_kernel(Kernel k) {
-  return k == Kernel::xpbd_solve_volume || k == Kernel::xpbd_solve_neo_hookean || k == Kernel::xpbd_solve_stvk ||
-         k == Kernel::xpbd_solve_corotational;
+// The blocks whose constraints a change can remove or soften (graspers'
+// and contacts' blocks are managed by their owners).
+bool is_editable(Kernel k) {
+  switch (k) {
+    case Kernel::xpbd_solve_volume:
+    case Kernel::xpbd_solve_neo_hookean:
+    case Kernel::xpbd_solve_stvk:
+    case Kernel::xpbd_solve_corotational:
+    case Kernel::xpbd_solve_area:
+    case Kernel::xpbd_solve_dihedral:
+    case Kernel::xpbd_solve_distance:
+    case Kernel::xpbd_solve_line_bending: return true;
+    default: return false;
+  }
 }
 
 // Writes slots [first, first + count) of a per-slot array of `words` 32-bit
@@ -31,7 +43,7 @@ Status write_slots(Device& device, BufferHandle buffer, const std::vector<T>& ho
 
 }  // namespace
 
-std::size_t TopologyEditor::TetKeyHash::operator()(const TetKey& k) const noexcept {
+std::size_t TopologyEditor::ElementKeyHash::operator()(const ElementKey& k) const noexcept {
   std::size_t h = 1469598103934665603ull;
   for (std::uint32_t v : k) h = (h ^ v) * 1099511628211ull;
   return h;
@@ -42,11 +54,51 @@ std::uint64_t TopologyEditor::edge_key(std::uint32_t a, std::uint32_t b) {
   return (std::uint64_t{a} << 32) | b;
 }
 
-TopologyEditor::TetKey TopologyEditor::tet_key(const Body& b, std::uint32_t tet) const {
-  TetKey k;
-  for (int i = 0; i < 4; ++i) k[i] = b.device[b.mesh.tets[tet][i]];
-  std::sort(k.begin(), k.end());
+TopologyEditor::ElementKey TopologyEditor::sorted_key(const std::uint32_t* particles, std::uint32_t arity) {
+  ElementKey k{kNone, kNone, kNone, kNone};
+  std::copy_n(particles, arity, k.begin());
+  std::sort(k.begin(), k.begin() + arity);
   return k;
+}
+
+TopologyEditor::ElementKey TopologyEditor::element_key(const Body& b, std::uint32_t e) const {
+  std::uint32_t p[4];
+  for (std::uint32_t i = 0; i < b.arity; ++i) p[i] = b.device[b.of(e)[i]];
+  return sorted_key(p, b.arity);
+}
+
+TopologyEditor::Body TopologyEditor::make_body(std::uint32_t arity, const std::vector<Vec3d>& rest,
+                                               std::span<const std::uint32_t> corners, std::uint32_t first,
+                                               const CompiledScene& compiled) {
+  Body b;
+  b.arity = arity;
+  b.rest = rest;
+  b.corners.assign(corners.begin(), corners.end());
+  b.first = first;
+  const std::size_t nv = rest.size(), ne = corners.size() / arity;
+  for (std::uint32_t v = 0; v < nv; ++v) b.device.push_back(compiled.order.device_of[first + v]);
+  b.alive.assign(ne, 1);
+  b.heat.assign(ne, 0.0);
+  b.live.assign(nv, 0);
+  b.offsets.assign(nv + 1, 0);
+  // Rest measures exactly as the compile computes them (float positions,
+  // float volume or area: add_tet_body, add_tri_body).
+  auto at = [&](std::uint32_t v) {
+    return kernels::float4{static_cast<float>(rest[v][0]), static_cast<float>(rest[v][1]),
+                           static_cast<float>(rest[v][2]), 0.0f};
+  };
+  for (std::size_t e = 0; e < ne; ++e) {
+    const std::uint32_t* q = b.of(e);
+    b.rest_measure.push_back(arity == 4 ? kernels::tet_volume(at(q[0]), at(q[1]), at(q[2]), at(q[3]))
+                                        : kernels::thin::triangle_area(at(q[0]), at(q[1]), at(q[2])));
+    for (std::uint32_t i = 0; i < arity; ++i) ++b.live[q[i]], ++b.offsets[q[i] + 1];
+  }
+  for (std::size_t v = 0; v < nv; ++v) b.offsets[v + 1] += b.offsets[v];
+  b.list.resize(b.offsets[nv]);
+  std::vector<std::uint32_t> fill(b.offsets.begin(), b.offsets.end() - 1);
+  for (std::uint32_t e = 0; e < ne; ++e)  // ascending: each vertex's elements in mesh order
+    for (std::uint32_t i = 0; i < arity; ++i) b.list[fill[b.of(e)[i]]++] = e;
+  return b;
 }
 
 Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& scene, const CompiledScene& compiled) {
@@ -63,20 +115,8 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
     b.data = c.data;
     b.offsets = c.color_offsets;
     for (std::size_t col = 0; col < c.colors(); ++col) b.counts.push_back(c.color_count(col));
-    const bool tets = is_tet_kernel(c.kernel) && c.arity == 4, edges = c.kernel == Kernel::xpbd_solve_distance;
-    const bool bends = c.kernel == Kernel::xpbd_solve_line_bending;
-    for (std::uint32_t i = 0; i < c.size() && (tets || edges || bends); ++i) {
-      const std::uint32_t* p = &b.particles[std::size_t{i} * b.arity];
-      if (edges) {
-        e->edge_slots_[edge_key(p[0], p[1])] = {k, i};
-      } else if (bends) {
-        e->bend_slots_[p[1]] = {k, i};
-      } else {
-        TetKey key{p[0], p[1], p[2], p[3]};
-        std::sort(key.begin(), key.end());
-        e->tet_slots_[key].push_back({k, i});
-      }
-    }
+    if (is_editable(c.kernel))
+      for (std::uint32_t i = 0; i < c.size(); ++i) e->index(k, b, i);
     e->blocks_.push_back(std::move(b));
   }
   e->mass_.resize(compiled.positions.size());
@@ -92,40 +132,49 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
   }
   for (std::size_t bi = 0; bi < scene.tet_bodies.size(); ++bi) {
     const TetBodyDesc& desc = scene.tet_bodies[bi];
-    Body b;
-    b.mesh = desc.mesh;
-    b.first = compiled.tet_body_first_particle[bi];
-    b.density = desc.density;
+    const auto corners = std::span<const std::uint32_t>(desc.mesh.tets.data()->data(), desc.mesh.tets.size() * 4);
+    Body b = make_body(4, desc.mesh.vertices, corners, compiled.tet_body_first_particle[bi], compiled);
+    b.mass_density = desc.density;
+    b.edge_depth = 1.0;
     b.distance_compliance = desc.distance_compliance;
     b.tear_strain = desc.tear_strain;
-    const std::size_t nv = desc.mesh.vertices.size(), nt = desc.mesh.tets.size();
-    for (std::uint32_t v = 0; v < nv; ++v) b.device.push_back(compiled.order.device_of[b.first + v]);
-    b.alive.assign(nt, 1);
-    b.heat.assign(nt, 0.0);
-    b.live_tets.assign(nv, 0);
-    b.tet_offsets.assign(nv + 1, 0);
-    // Rest volumes exactly as add_tet_body computes them (float positions, float volume).
-    auto at = [&](std::uint32_t v) {
-      const Vec3d& x = desc.mesh.vertices[v];
-      return kernels::float4{static_cast<float>(x[0]), static_cast<float>(x[1]), static_cast<float>(x[2]), 0.0f};
-    };
-    for (const auto& t : desc.mesh.tets) {
-      b.rest_volume.push_back(kernels::tet_volume(at(t[0]), at(t[1]), at(t[2]), at(t[3])));
-      for (std::uint32_t v : t) ++b.live_tets[v], ++b.tet_offsets[v + 1];
-    }
-    for (std::size_t v = 0; v < nv; ++v) b.tet_offsets[v + 1] += b.tet_offsets[v];
-    b.tet_list.resize(b.tet_offsets[nv]);
-    std::vector<std::uint32_t> fill(b.tet_offsets.begin(), b.tet_offsets.end() - 1);
-    for (std::uint32_t t = 0; t < nt; ++t)  // ascending: each vertex's tets in mesh order
-      for (std::uint32_t v : desc.mesh.tets[t]) b.tet_list[fill[v]++] = t;
-    e->bodies_.push_back(std::move(b));
+    e->tets_.push_back(std::move(b));
+    e->tet_meshes_.push_back(desc.mesh);
+  }
+  for (std::size_t bi = 0; bi < scene.tri_bodies.size(); ++bi) {
+    const TriBodyDesc& desc = scene.tri_bodies[bi];
+    const auto corners =
+        std::span<const std::uint32_t>(desc.mesh.triangles.data()->data(), desc.mesh.triangles.size() * 3);
+    Body b = make_body(3, desc.mesh.vertices, corners, compiled.tri_body_first_particle[bi], compiled);
+    b.mass_density = desc.density * desc.thickness;
+    b.edge_depth = desc.thickness;
+    b.distance_compliance = desc.distance_compliance;
+    b.tear_strain = desc.tear_strain;
+    e->sheets_.push_back(std::move(b));
+    e->tri_meshes_.push_back(desc.mesh);
   }
   return e;
 }
 
+ElementView TopologyEditor::view(BodyKind kind, std::size_t body) const {
+  const Body& b = of(kind, body);
+  return {b.rest, b.corners, b.arity, b.alive};
+}
+
 bool TopologyEditor::tears() const {
-  return std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) { return b.tear_strain > 0.0; }) ||
+  const auto tear = [](const Body& b) { return b.tear_strain > 0.0; };
+  return std::any_of(tets_.begin(), tets_.end(), tear) || std::any_of(sheets_.begin(), sheets_.end(), tear) ||
          std::any_of(lines_.begin(), lines_.end(), [](const Line& l) { return l.desc.tear_strain > 0.0; });
+}
+
+void TopologyEditor::index(std::uint32_t k, const Block& b, std::uint32_t slot) {
+  const std::uint32_t* p = &b.particles[std::size_t{slot} * b.arity];
+  switch (b.kernel) {
+    case Kernel::xpbd_solve_distance: edge_slots_[edge_key(p[0], p[1])] = {k, slot}; break;
+    case Kernel::xpbd_solve_line_bending: bend_slots_[p[1]] = {k, slot}; break;
+    case Kernel::xpbd_solve_dihedral: hinge_slots_[edge_key(p[0], p[1])] = {k, slot}; break;  // the hinge's edge
+    default: element_slots_[sorted_key(p, b.arity)].push_back({k, slot}); break;  // volume, FEM, area
+  }
 }
 
 void TopologyEditor::swap_remove(std::uint32_t k, std::uint32_t slot) {
@@ -138,15 +187,14 @@ void TopologyEditor::swap_remove(std::uint32_t k, std::uint32_t slot) {
     std::copy_n(&b.data[std::size_t{last} * b.data_stride], b.data_stride, &b.data[std::size_t{slot} * b.data_stride]);
     // The moved constraint's index entry follows it.
     const std::uint32_t* p = &b.particles[std::size_t{slot} * b.arity];
-    if (b.kernel == Kernel::xpbd_solve_distance) {
-      edge_slots_[edge_key(p[0], p[1])] = {k, slot};
-    } else if (b.kernel == Kernel::xpbd_solve_line_bending) {
-      bend_slots_[p[1]] = {k, slot};
-    } else {
-      TetKey key{p[0], p[1], p[2], p[3]};
-      std::sort(key.begin(), key.end());
-      for (Slot& s : tet_slots_[key])
-        if (s.block == k && s.slot == last) s.slot = slot;
+    switch (b.kernel) {
+      case Kernel::xpbd_solve_distance: edge_slots_[edge_key(p[0], p[1])] = {k, slot}; break;
+      case Kernel::xpbd_solve_line_bending: bend_slots_[p[1]] = {k, slot}; break;
+      case Kernel::xpbd_solve_dihedral: hinge_slots_[edge_key(p[0], p[1])] = {k, slot}; break;
+      default:
+        for (Slot& s : element_slots_[sorted_key(p, b.arity)])
+          if (s.block == k && s.slot == last) s.slot = slot;
+        break;
     }
     b.dirty.push_back(slot);
   }
@@ -155,45 +203,85 @@ void TopologyEditor::swap_remove(std::uint32_t k, std::uint32_t slot) {
 }
 
 double TopologyEditor::edge_share(const Body& b, std::uint32_t a, std::uint32_t v) const {
+  const double parts = b.arity == 4 ? 6.0 : 3.0;  // a tet's six edges, a triangle's three
   double share = 0.0;
-  for (std::uint32_t i = b.tet_offsets[a]; i < b.tet_offsets[a + 1]; ++i) {
-    const std::uint32_t t = b.tet_list[i];
-    const auto& q = b.mesh.tets[t];
-    if (b.alive[t] && (q[0] == v || q[1] == v || q[2] == v || q[3] == v))
-      share += static_cast<double>(b.rest_volume[t]) / 6.0;  // as add_tet_body sums it, in tet order
+  for (std::uint32_t i = b.offsets[a]; i < b.offsets[a + 1]; ++i) {
+    const std::uint32_t e = b.list[i];
+    const std::uint32_t* q = b.of(e);
+    if (b.alive[e] && std::find(q, q + b.arity, v) != q + b.arity)
+      share += static_cast<double>(b.rest_measure[e]) / parts;  // as the compile sums it, in element order
   }
   return share;
 }
 
+double TopologyEditor::hand_off(const Body& b, std::uint32_t v, std::span<const std::uint32_t> removed,
+                                std::vector<std::uint32_t>& changed, double& moved) {
+  double& m = mass_[b.device[v]];
+  // Its neighbours through the removed elements that still hold elements and move.
+  std::vector<std::uint32_t> to;
+  for (std::uint32_t e : removed) {
+    const std::uint32_t* q = b.of(e);
+    if (std::find(q, q + b.arity, v) == q + b.arity) continue;
+    for (std::uint32_t i = 0; i < b.arity; ++i)
+      if (b.live[q[i]] > 0 && mass_[b.device[q[i]]] > 0.0) to.push_back(q[i]);
+  }
+  std::sort(to.begin(), to.end());
+  to.erase(std::unique(to.begin(), to.end()), to.end());
+  if (to.empty()) {  // none: the nearest live movable vertex of the body, at rest
+    double best = std::numeric_limits<double>::infinity();
+    std::uint32_t nearest = 0;
+    for (std::uint32_t u = 0; u < b.rest.size(); ++u) {
+      if (b.live[u] == 0 || mass_[b.device[u]] <= 0.0) continue;
+      double d2 = 0.0;
+      for (int a = 0; a < 3; ++a) d2 += (b.rest[u][a] - b.rest[v][a]) * (b.rest[u][a] - b.rest[v][a]);
+      if (d2 < best) best = d2, nearest = u;
+    }
+    if (std::isfinite(best)) to.push_back(nearest);
+  }
+  const double mass = m;
+  m = 0.0;
+  if (to.empty()) return mass;  // nothing of the body is left to carry it
+  for (std::uint32_t u : to) {
+    mass_[b.device[u]] += mass / double(to.size());
+    changed.push_back(b.device[u]);
+  }
+  moved += mass;
+  return 0.0;
+}
+
 Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const XpbdBuffers& buffers,
-                                                         CompiledScene& shape, std::size_t body,
-                                                         std::span<const std::uint32_t> tets, bool burn) {
-  if (body >= bodies_.size())
-    return Error(ErrorCode::bad_parameter, "tet body " + std::to_string(body) + " does not exist (the scene has " +
-                                               std::to_string(bodies_.size()) + ")");
-  Body& b = bodies_[body];
-  std::vector<std::uint8_t> seen(b.mesh.tets.size(), 0);
-  for (std::uint32_t t : tets) {
-    const std::string name = "tet_bodies[" + std::to_string(body) + "] tet " + std::to_string(t);
-    if (t >= b.mesh.tets.size())
-      return Error(ErrorCode::bad_parameter, name + " does not exist (the mesh has " +
-                                                 std::to_string(b.mesh.tets.size()) + " tets)");
+                                                         CompiledScene& shape, BodyKind kind, std::size_t body,
+                                                         std::span<const std::uint32_t> elements, bool burn) {
+  const bool tri = kind == BodyKind::tri;
+  const char* what = tri ? "tri_bodies[" : "tet_bodies[";
+  const char* element = tri ? "] triangle " : "] tet ";
+  if (kind == BodyKind::line || body >= bodies(kind))
+    return Error(ErrorCode::bad_parameter, std::string(tri ? "tri body " : "tet body ") + std::to_string(body) +
+                                               " does not exist (the scene has " + std::to_string(bodies(kind)) + ")");
+  Body& b = of(kind, body);
+  std::vector<std::uint8_t> seen(b.alive.size(), 0);
+  for (std::uint32_t t : elements) {
+    const std::string name = what + std::to_string(body) + element + std::to_string(t);
+    if (t >= b.alive.size())
+      return Error(ErrorCode::bad_parameter, name + " does not exist (the mesh has " + std::to_string(b.alive.size()) +
+                                                 (tri ? " triangles)" : " tets)"));
     if (!b.alive[t]) return Error(ErrorCode::bad_parameter, name + " was removed already");
     if (seen[t]) return Error(ErrorCode::bad_parameter, name + " is listed twice");
     seen[t] = 1;
   }
   Simulation::TopologyEvent event;
+  event.body_kind = kind;
   event.body = body;
-  event.tets_removed.assign(tets.begin(), tets.end());
+  (tri ? event.triangles_removed : event.tets_removed).assign(elements.begin(), elements.end());
 
-  // The tets' own constraints: one of each block (volume, FEM) per tet.
-  std::vector<std::uint32_t> touched;  // vertices of the removed tets
-  for (std::uint32_t t : tets) {
+  // The elements' own constraints: one of each block (volume, FEM; area) per element.
+  std::vector<std::uint32_t> touched;  // vertices of the removed elements
+  for (std::uint32_t t : elements) {
     b.alive[t] = 0;
     b.heat[t] = 0.0;
-    for (std::uint32_t v : b.mesh.tets[t]) --b.live_tets[v], touched.push_back(v);
-    const auto it = tet_slots_.find(tet_key(b, t));
-    if (it == tet_slots_.end()) continue;  // a body without volume or FEM constraints
+    for (std::uint32_t i = 0; i < b.arity; ++i) --b.live[b.of(t)[i]], touched.push_back(b.of(t)[i]);
+    const auto it = element_slots_.find(element_key(b, t));
+    if (it == element_slots_.end()) continue;  // a body without volume, FEM or area constraints
     std::vector<Slot>& slots = it->second;
     std::vector<std::uint32_t> done;
     for (std::size_t i = 0; i < slots.size();) {
@@ -207,22 +295,30 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
       swap_remove(s.block, s.slot);
       ++event.constraints_removed;
     }
-    if (slots.empty()) tet_slots_.erase(it);
+    if (slots.empty()) element_slots_.erase(it);
   }
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
 
-  // Their edges: gone with their last tet, or softer by the volume they lost.
+  // Their edges: a hinge goes with either of its triangles; a distance
+  // constraint goes with its last element, or is softer by the share it lost.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-  for (std::uint32_t t : tets)
-    for (const auto& e : kTetEdges) {
-      const std::uint32_t u = b.mesh.tets[t][e[0]], v = b.mesh.tets[t][e[1]];
+  for (std::uint32_t t : elements)
+    for (const auto& e : element_edges(b.arity)) {
+      const std::uint32_t u = b.of(t)[e[0]], v = b.of(t)[e[1]];
       edges.emplace_back(std::min(u, v), std::max(u, v));
     }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   for (const auto& [u, v] : edges) {
-    const auto it = edge_slots_.find(edge_key(b.device[u], b.device[v]));
+    const std::uint64_t key = edge_key(b.device[u], b.device[v]);
+    if (const auto it = hinge_slots_.find(key); tri && it != hinge_slots_.end()) {
+      const Slot s = it->second;
+      hinge_slots_.erase(it);
+      swap_remove(s.block, s.slot);
+      ++event.constraints_removed;
+    }
+    const auto it = edge_slots_.find(key);
     if (it == edge_slots_.end()) continue;  // a body without distance constraints
     const Slot s = it->second;
     const double share = edge_share(b, u, v);
@@ -235,7 +331,8 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
     Block& k = blocks_[s.block];
     float* data = &k.data[std::size_t{s.slot} * k.data_stride];
     const float len = data[0];
-    const auto alpha = static_cast<float>(b.distance_compliance * static_cast<double>(len) * len / share);
+    const auto alpha =
+        static_cast<float>(b.distance_compliance * static_cast<double>(len) * len / (share * b.edge_depth));
     if (alpha != data[1]) {
       data[1] = alpha;
       k.dirty.push_back(s.slot);
@@ -246,21 +343,22 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
   // Masses.
   std::vector<std::uint32_t> mass_changed;
   if (burn) {
-    for (std::uint32_t t : tets) {
-      const double share = b.density * static_cast<double>(b.rest_volume[t]) / 4.0;  // as add_tet_body lumps it
-      for (std::uint32_t v : b.mesh.tets[t]) {
-        double& m = mass_[b.device[v]];
+    for (std::uint32_t t : elements) {
+      const double share = b.mass_density * static_cast<double>(b.rest_measure[t]) / b.arity;  // as the compile lumps it
+      for (std::uint32_t i = 0; i < b.arity; ++i) {
+        const std::uint32_t d = b.device[b.of(t)[i]];
+        double& m = mass_[d];
         if (m <= 0.0) continue;  // pinned: its share was never on it
         const double taken = std::min(m, share);
         m -= taken;
         event.mass_removed += taken;
-        mass_changed.push_back(b.device[v]);
+        mass_changed.push_back(d);
       }
     }
   }
   for (std::uint32_t v : touched) {
     double& m = mass_[b.device[v]];
-    if (b.live_tets[v] > 0 || m <= 0.0) continue;
+    if (b.live[v] > 0 || m <= 0.0) continue;
     event.vertices_removed.push_back(v);
     mass_changed.push_back(b.device[v]);
     if (burn) {  // what rounding left
@@ -268,37 +366,7 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
       m = 0.0;
       continue;
     }
-    // Its neighbours through the removed tets that still hold tets and move.
-    std::vector<std::uint32_t> to;
-    for (std::uint32_t t : tets) {
-      const auto& q = b.mesh.tets[t];
-      if (std::find(q.begin(), q.end(), v) == q.end()) continue;
-      for (std::uint32_t u : q)
-        if (b.live_tets[u] > 0 && mass_[b.device[u]] > 0.0) to.push_back(u);
-    }
-    std::sort(to.begin(), to.end());
-    to.erase(std::unique(to.begin(), to.end()), to.end());
-    if (to.empty()) {  // none: the nearest live movable vertex of the body, at rest
-      double best = std::numeric_limits<double>::infinity();
-      std::uint32_t nearest = 0;
-      for (std::uint32_t u = 0; u < b.mesh.vertices.size(); ++u) {
-        if (b.live_tets[u] == 0 || mass_[b.device[u]] <= 0.0) continue;
-        double d2 = 0.0;
-        for (int a = 0; a < 3; ++a) d2 += (b.mesh.vertices[u][a] - b.mesh.vertices[v][a]) * (b.mesh.vertices[u][a] - b.mesh.vertices[v][a]);
-        if (d2 < best) best = d2, nearest = u;
-      }
-      if (std::isfinite(best)) to.push_back(nearest);
-    }
-    if (to.empty()) {  // nothing of the body is left to carry it
-      event.mass_removed += m;
-    } else {
-      for (std::uint32_t u : to) {
-        mass_[b.device[u]] += m / double(to.size());
-        mass_changed.push_back(b.device[u]);
-      }
-      event.mass_moved += m;
-    }
-    m = 0.0;
+    event.mass_removed += hand_off(b, v, elements, mass_changed, event.mass_moved);
   }
   std::sort(mass_changed.begin(), mass_changed.end());
   mass_changed.erase(std::unique(mass_changed.begin(), mass_changed.end()), mass_changed.end());
@@ -311,9 +379,7 @@ Status TopologyEditor::commit(Device& device, const XpbdBuffers& buffers, Compil
   if (Status s = upload(device, buffers, mass_changed); !s) return s;
   // The counts of the blocks a removal can change (graspers' blocks keep theirs).
   for (std::size_t k = 0; k < blocks_.size(); ++k)
-    if (blocks_[k].kernel == Kernel::xpbd_solve_distance || blocks_[k].kernel == Kernel::xpbd_solve_line_bending ||
-        is_tet_kernel(blocks_[k].kernel))
-      shape.blocks[k].color_counts = blocks_[k].counts;
+    if (is_editable(blocks_[k].kernel)) shape.blocks[k].color_counts = blocks_[k].counts;
   return {};
 }
 

@@ -1,5 +1,6 @@
-// topology_editor.h — removes tets from a running scene (SceneDesc::
-// topology_changes): cuts, tears and cautery all end here.
+// topology_editor.h — removes tets, triangles and thread segments from a
+// running scene (SceneDesc::topology_changes): cuts, tears and cautery all
+// end here.
 //
 // Constraint storage follows Box2D v3's constraint graph (E. Catto,
 // box2d/src/constraint_graph.c, 2024): every colour is a range of slots
@@ -10,8 +11,10 @@
 // each colour's end are its spare capacity.
 //
 // The editor keeps a host copy of every block's particles and data (what
-// the compile made), finds a tet's constraints by their particles (sorted
-// device slots) and an edge's distance constraint likewise, and after a
+// the compile made), finds an element's constraints (a tet's volume and
+// FEM ones, a triangle's area one) by their particles (sorted device
+// slots), an edge's distance and dihedral constraints by its two, and
+// after a
 // change uploads only the slots that changed, the masses that changed, and
 // the new colour counts into the program's shape; the caller rebuilds the
 // frame program from it.
@@ -27,6 +30,7 @@
 #include "backends/backend.h"
 #include "compiler/scene_compiler.h"
 #include "program/xpbd_program.h"
+#include "runtime/topology_queries.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -36,15 +40,22 @@ class TopologyEditor {
   /// [in] scene, compiled: the scene and what compile_scene made of it.
   static Result<std::unique_ptr<TopologyEditor>> create(const SceneDesc& scene, const CompiledScene& compiled);
 
-  /// Removes tets of tet body `body` (checked: alive, no repeats; on an
-  /// error nothing changed). burn: their lumped mass (density V / 4 per
-  /// vertex) leaves the scene (cautery); otherwise a vertex left with no
-  /// tet hands its mass to the vertices it shared a removed tet with (cuts,
-  /// tears: the total is conserved). Patches the device's constraint
-  /// buffers and inverse masses, and [in/out] shape's colour counts; the
-  /// caller rebuilds the program. Fills the event but its wall_ms.
+  /// Removes elements of body `body` of `kind` (tet: its tets; tri: its
+  /// triangles; checked: alive, no repeats; on an error nothing changed).
+  /// Their own constraints go (volume and FEM; area), so do the edges'
+  /// distance constraints no live element keeps and, on a tri body, the
+  /// dihedral constraints of the hinges they were part of; an edge that
+  /// keeps some of its elements is softened by the share it lost (as the
+  /// compile would set it). burn: their lumped mass (a tet's density V / 4,
+  /// a triangle's density t A / 3, per vertex) leaves the scene (cautery);
+  /// otherwise a vertex left with no element hands its mass to the vertices
+  /// it shared a removed element with (cuts, tears: the total is
+  /// conserved). Patches the device's constraint buffers and inverse
+  /// masses, and [in/out] shape's colour counts; the caller rebuilds the
+  /// program. Fills the event but its wall_ms.
   Result<Simulation::TopologyEvent> remove(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
-                                           std::size_t body, std::span<const std::uint32_t> tets, bool burn);
+                                           BodyKind kind, std::size_t body, std::span<const std::uint32_t> elements,
+                                           bool burn);
 
   /// Breaks segments of line body `body` (checked: whole, no repeats; on
   /// an error nothing changed): their distance constraints and the bending
@@ -59,18 +70,26 @@ class TopologyEditor {
   [[nodiscard]] const std::vector<std::uint8_t>& whole(std::size_t body) const { return lines_[body].whole; }
   [[nodiscard]] std::uint32_t line_first_particle(std::size_t body) const { return lines_[body].first; }
 
-  [[nodiscard]] std::size_t bodies() const { return bodies_.size(); }
+  /// Tet bodies (tets()) and tri bodies (sheets()): how many.
+  [[nodiscard]] std::size_t bodies() const { return tets_.size(); }
+  [[nodiscard]] std::size_t sheets() const { return sheets_.size(); }
+  [[nodiscard]] std::size_t bodies(BodyKind kind) const { return kind == BodyKind::tri ? sheets() : bodies(); }
   /// Tet body `body`'s rest mesh and which of its tets are alive.
-  [[nodiscard]] const TetMesh& mesh(std::size_t body) const { return bodies_[body].mesh; }
-  [[nodiscard]] const std::vector<std::uint8_t>& alive(std::size_t body) const { return bodies_[body].alive; }
+  [[nodiscard]] const TetMesh& mesh(std::size_t body) const { return tet_meshes_[body]; }
+  [[nodiscard]] const std::vector<std::uint8_t>& alive(std::size_t body) const { return tets_[body].alive; }
+  /// Tri body `body`'s rest mesh and which of its triangles are alive.
+  [[nodiscard]] const TriMesh& sheet_mesh(std::size_t body) const { return tri_meshes_[body]; }
+  [[nodiscard]] const std::vector<std::uint8_t>& sheet_alive(std::size_t body) const { return sheets_[body].alive; }
+  /// A tet or tri body's elements, for topology_queries.h.
+  [[nodiscard]] ElementView view(BodyKind kind, std::size_t body) const;
   /// The user-order particle of the body's vertex 0.
-  [[nodiscard]] std::uint32_t first_particle(std::size_t body) const { return bodies_[body].first; }
-  [[nodiscard]] double tear_strain(std::size_t body) const { return bodies_[body].tear_strain; }
-  /// Whether any tet or line body tears (tear_strain > 0).
+  [[nodiscard]] std::uint32_t first_particle(std::size_t body) const { return tets_[body].first; }
+  [[nodiscard]] std::uint32_t first_particle(BodyKind kind, std::size_t body) const { return of(kind, body).first; }
+  [[nodiscard]] double tear_strain(BodyKind kind, std::size_t body) const { return of(kind, body).tear_strain; }
+  /// Whether any tet, tri or line body tears (tear_strain > 0).
   [[nodiscard]] bool tears() const;
-  /// Seconds each tet has been touched by a cautery tip (cauterize).
-  [[nodiscard]] std::vector<double>& heat(std::size_t body) { return bodies_[body].heat; }
-
+  /// Seconds each element has been touched by a cautery tip (cauterize).
+  [[nodiscard]] std::vector<double>& heat(BodyKind kind, std::size_t body) { return of(kind, body).heat; }
 
  private:
   struct Block {
@@ -86,22 +105,35 @@ class TopologyEditor {
   struct Slot {
     std::uint32_t block, slot;
   };
-  using TetKey = std::array<std::uint32_t, 4>;  // sorted device slots
-  struct TetKeyHash {
-    std::size_t operator()(const TetKey& k) const noexcept;
+  // An element's sorted device slots (a triangle's fourth is kNone).
+  using ElementKey = std::array<std::uint32_t, 4>;
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+  struct ElementKeyHash {
+    std::size_t operator()(const ElementKey& k) const noexcept;
   };
+  // A tet body (arity 4: tets, volumes, a vertex's share of a tet V/4, an
+  // edge's V/6) or a tri body (arity 3: triangles, areas, A/3 and A/3).
   struct Body {
-    TetMesh mesh;
+    std::uint32_t arity = 4;
+    std::vector<Vec3d> rest;                 // rest vertices [m]
+    std::vector<std::uint32_t> corners;      // arity per element
     std::uint32_t first = 0;                 // user particle of vertex 0
     std::vector<std::uint32_t> device;       // device slot of each vertex
-    std::vector<std::uint8_t> alive;         // per tet
-    std::vector<float> rest_volume;          // per tet, as the compile computed it
-    std::vector<std::uint32_t> live_tets;    // per vertex: alive tets using it
-    std::vector<std::uint32_t> tet_offsets;  // per vertex: its tets (CSR, rest mesh)
-    std::vector<std::uint32_t> tet_list;
-    std::vector<double> heat;                // cautery (per tet) [s]
-    double density = 0.0, distance_compliance = 0.0, tear_strain = 0.0;
+    std::vector<std::uint8_t> alive;         // per element
+    std::vector<float> rest_measure;         // per element: volume [m^3] or area [m^2], as the compile computed it
+    std::vector<std::uint32_t> live;         // per vertex: alive elements using it
+    std::vector<std::uint32_t> offsets;      // per vertex: its elements (CSR, rest mesh)
+    std::vector<std::uint32_t> list;
+    std::vector<double> heat;                // cautery (per element) [s]
+    double mass_density = 0.0;               // per unit measure: density (tets), density x thickness (triangles)
+    double edge_depth = 1.0;                 // alpha_e = c_d L^2 / (share x edge_depth): 1 (tets), thickness (triangles)
+    double distance_compliance = 0.0, tear_strain = 0.0;
+    [[nodiscard]] const std::uint32_t* of(std::size_t e) const { return &corners[e * arity]; }
   };
+  static Body make_body(std::uint32_t arity, const std::vector<Vec3d>& rest, std::span<const std::uint32_t> corners,
+                        std::uint32_t first, const CompiledScene& compiled);
+  Body& of(BodyKind kind, std::size_t body) { return kind == BodyKind::tri ? sheets_[body] : tets_[body]; }
+  const Body& of(BodyKind kind, std::size_t body) const { return kind == BodyKind::tri ? sheets_[body] : tets_[body]; }
 
   struct Line {
     LineBodyDesc desc;                  // its vertices and segments (rest)
@@ -110,21 +142,34 @@ class TopologyEditor {
     std::vector<std::uint8_t> whole;    // per segment
   };
 
-  TetKey tet_key(const Body& b, std::uint32_t tet) const;
+  ElementKey element_key(const Body& b, std::uint32_t e) const;
+  static ElementKey sorted_key(const std::uint32_t* particles, std::uint32_t arity);
   // Writes what changed to the device and the new counts into shape.
   Status commit(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
                 std::span<const std::uint32_t> mass_changed);
   static std::uint64_t edge_key(std::uint32_t a, std::uint32_t b);
+  // Enters slot `slot` of block `k` (b) in the index its kernel uses.
+  void index(std::uint32_t k, const Block& b, std::uint32_t slot);
   // Gives slot `slot` of block `k` to its colour's last constraint.
   void swap_remove(std::uint32_t k, std::uint32_t slot);
-  // The share V_e of the live tets' volume an edge (vertices a, b of body) holds [m^3].
+  // The share of the live elements' measure an edge (vertices a, v of body)
+  // holds: V_e [m^3] (a sixth of each tet's volume) or A_e [m^2] (a third
+  // of each triangle's area), summed in element order as the compile does.
   double edge_share(const Body& b, std::uint32_t a, std::uint32_t v) const;
+  // Hands the mass of `v` (left with no element) to its movable neighbours
+  // through the removed elements, else to the body's nearest live movable
+  // vertex; returns what it could not place. [out] changed: the slots.
+  double hand_off(const Body& b, std::uint32_t v, std::span<const std::uint32_t> removed,
+                  std::vector<std::uint32_t>& changed, double& moved);
   Status upload(Device& device, const XpbdBuffers& buffers, std::span<const std::uint32_t> mass_changed);
 
   std::vector<Block> blocks_;
-  std::vector<Body> bodies_;
-  std::unordered_map<TetKey, std::vector<Slot>, TetKeyHash> tet_slots_;  // volume and FEM constraints
+  std::vector<Body> tets_, sheets_;
+  std::vector<TetMesh> tet_meshes_;  // the tet bodies' rest meshes (collision, current_tets)
+  std::vector<TriMesh> tri_meshes_;  // the tri bodies'
+  std::unordered_map<ElementKey, std::vector<Slot>, ElementKeyHash> element_slots_;  // volume, FEM, area constraints
   std::unordered_map<std::uint64_t, Slot> edge_slots_;                   // distance constraints
+  std::unordered_map<std::uint64_t, Slot> hinge_slots_;                  // dihedral constraints, by their edge
   std::unordered_map<std::uint32_t, Slot> bend_slots_;                   // line bending, by its middle particle
   std::vector<Line> lines_;
   std::vector<double> mass_;                                             // per device slot [kg] (0: immovable)

@@ -15,8 +15,7 @@ Point3 cross(const Point3& a, const Point3& b) {
 }
 double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-template <std::size_t N>
-std::array<double, 2> project(const std::array<Point3, N>& points, const Point3& axis) {
+std::array<double, 2> project(std::span<const Point3> points, const Point3& axis) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Point3& p : points) {
     const double d = dot(p, axis);
@@ -26,68 +25,88 @@ std::array<double, 2> project(const std::array<Point3, N>& points, const Point3&
   return {lo, hi};
 }
 
-std::array<Point3, 4> corners(const TetMesh& mesh, std::uint32_t t, const BodyPositions& x) {
-  const auto& q = mesh.tets[t];
-  return {x.at(q[0]), x.at(q[1]), x.at(q[2]), x.at(q[3])};
+// An element's corners at the current positions (up to 4).
+struct Corners {
+  std::array<Point3, 4> p;
+  std::uint32_t n = 0;
+  [[nodiscard]] std::span<const Point3> span() const { return {p.data(), n}; }
+};
+Corners corners(const ElementView& body, std::uint32_t e, const BodyPositions& x) {
+  Corners c;
+  c.n = body.arity;
+  for (std::uint32_t k = 0; k < body.arity; ++k) c.p[k] = x.at(body.of(e)[k]);
+  return c;
 }
 
 }  // namespace
 
-bool triangle_touches_tet(const std::array<Point3, 3>& tri, const std::array<Point3, 4>& tet) {
+bool triangle_touches_element(const std::array<Point3, 3>& tri, std::span<const Point3> element) {
   // An axis separates when the two projections do not overlap. A zero axis
   // (parallel edges, a degenerate face) separates nothing and is skipped.
   const auto separates = [&](const Point3& axis) {
     if (dot(axis, axis) <= 0.0) return false;
-    const auto a = project(tri, axis), b = project(tet, axis);
+    const auto a = project(tri, axis), b = project(element, axis);
     return a[1] < b[0] || b[1] < a[0];
   };
-  if (separates(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])))) return false;
+  const auto edge = [](std::span<const Point3> q, const int e[2]) { return sub(q[e[1]], q[e[0]]); };
+  const std::uint32_t arity = static_cast<std::uint32_t>(element.size());
+  // The faces' normals.
+  const Point3 n = cross(sub(tri[1], tri[0]), sub(tri[2], tri[0]));
+  if (separates(n)) return false;
   static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-  for (const auto& f : kFaces)
-    if (separates(cross(sub(tet[f[1]], tet[f[0]]), sub(tet[f[2]], tet[f[0]])))) return false;
-  for (int i = 0; i < 3; ++i) {
-    const Point3 e = sub(tri[(i + 1) % 3], tri[i]);
-    for (const auto& k : kTetEdges)
-      if (separates(cross(e, sub(tet[k[1]], tet[k[0]])))) return false;
+  const std::span<const int[3]> faces = arity == 4 ? std::span<const int[3]>(kFaces) : std::span<const int[3]>(&kFaces[3], 1);
+  for (const auto& f : faces)
+    if (separates(cross(sub(element[f[1]], element[f[0]]), sub(element[f[2]], element[f[0]])))) return false;
+  // The edges' cross products.
+  for (const auto& i : kTriangleEdges)
+    for (const auto& k : element_edges(arity))
+      if (separates(cross(edge(tri, i), edge(element, k)))) return false;
+  // The flat sets' in-plane edge normals.
+  for (const auto& i : kTriangleEdges)
+    if (separates(cross(n, edge(tri, i)))) return false;
+  if (arity == 3) {
+    const Point3 m = cross(sub(element[1], element[0]), sub(element[2], element[0]));
+    for (const auto& k : kTriangleEdges)
+      if (separates(cross(m, edge(element, k)))) return false;
   }
   return true;
 }
 
-std::vector<std::uint32_t> tets_cut(const TetMesh& mesh, std::span<const std::uint8_t> alive, const BodyPositions& x,
-                                    const Point3& a0, const Point3& b0, const Point3& a1, const Point3& b1) {
+std::vector<std::uint32_t> elements_cut(const ElementView& body, const BodyPositions& x, const Point3& a0,
+                                        const Point3& b0, const Point3& a1, const Point3& b1) {
   const std::array<Point3, 3> t0{a0, b0, b1}, t1{a0, b1, a1};
-  // The quad's box first: most tets are far from the blade.
+  // The quad's box first: most elements are far from the blade.
   Point3 lo{}, hi{};
   for (int a = 0; a < 3; ++a) {
     lo[a] = std::min({a0[a], b0[a], a1[a], b1[a]});
     hi[a] = std::max({a0[a], b0[a], a1[a], b1[a]});
   }
   std::vector<std::uint32_t> out;
-  for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
-    if (!alive[t]) continue;
-    const auto c = corners(mesh, t, x);
+  for (std::uint32_t e = 0; e < body.size(); ++e) {
+    if (!body.alive[e]) continue;
+    const Corners c = corners(body, e, x);
     bool apart = false;
     for (int a = 0; a < 3 && !apart; ++a) {
-      const double l = std::min({c[0][a], c[1][a], c[2][a], c[3][a]}), h = std::max({c[0][a], c[1][a], c[2][a], c[3][a]});
+      double l = c.p[0][a], h = c.p[0][a];
+      for (std::uint32_t k = 1; k < c.n; ++k) l = std::min(l, c.p[k][a]), h = std::max(h, c.p[k][a]);
       apart = h < lo[a] || l > hi[a];
     }
-    if (!apart && (triangle_touches_tet(t0, c) || triangle_touches_tet(t1, c))) out.push_back(t);
+    if (!apart && (triangle_touches_element(t0, c.span()) || triangle_touches_element(t1, c.span()))) out.push_back(e);
   }
   return out;
 }
 
-std::vector<std::uint32_t> tets_torn(const TetMesh& mesh, std::span<const std::uint8_t> alive, const BodyPositions& x,
-                                     double strain) {
+std::vector<std::uint32_t> elements_torn(const ElementView& body, const BodyPositions& x, double strain) {
   const double limit = (1.0 + strain) * (1.0 + strain);
   std::vector<std::uint32_t> out;
-  for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
-    if (!alive[t]) continue;
-    const auto& q = mesh.tets[t];
-    for (const auto& e : kTetEdges) {
-      const Point3 now = sub(x.at(q[e[1]]), x.at(q[e[0]]));
-      const Point3 rest = sub(mesh.vertices[q[e[1]]], mesh.vertices[q[e[0]]]);
+  for (std::uint32_t e = 0; e < body.size(); ++e) {
+    if (!body.alive[e]) continue;
+    const std::uint32_t* q = body.of(e);
+    for (const auto& k : element_edges(body.arity)) {
+      const Point3 now = sub(x.at(q[k[1]]), x.at(q[k[0]]));
+      const Point3 rest = sub(body.rest[q[k[1]]], body.rest[q[k[0]]]);
       if (dot(now, now) > limit * dot(rest, rest)) {
-        out.push_back(t);
+        out.push_back(e);
         break;
       }
     }
@@ -108,20 +127,19 @@ std::vector<std::uint32_t> segments_torn(const LineBodyDesc& line, std::span<con
   return out;
 }
 
-std::vector<std::uint32_t> tets_burned(const TetMesh& mesh, std::span<const std::uint8_t> alive,
-                                       const BodyPositions& x, const Point3& centre, double radius, double seconds,
-                                       double dwell, std::vector<double>& heat) {
+std::vector<std::uint32_t> elements_burned(const ElementView& body, const BodyPositions& x, const Point3& centre,
+                                           double radius, double seconds, double dwell, std::vector<double>& heat) {
   std::vector<std::uint32_t> out;
-  for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
-    if (!alive[t]) continue;
-    const auto c = corners(mesh, t, x);
+  for (std::uint32_t e = 0; e < body.size(); ++e) {
+    if (!body.alive[e]) continue;
+    const Corners c = corners(body, e, x);
     Point3 m{};
-    for (const Point3& p : c)
-      for (int a = 0; a < 3; ++a) m[a] += 0.25 * p[a];
+    for (std::uint32_t k = 0; k < c.n; ++k)
+      for (int a = 0; a < 3; ++a) m[a] += c.p[k][a] / c.n;
     const Point3 d = sub(m, centre);
     if (dot(d, d) > radius * radius) continue;
-    heat[t] += seconds;
-    if (heat[t] >= dwell) out.push_back(t);
+    heat[e] += seconds;
+    if (heat[e] >= dwell) out.push_back(e);
   }
   return out;
 }
