@@ -8,8 +8,9 @@
 //   - the gallbladder: data/meshes/tet/gallbladder_volumetric.vtk (1,063 tets,
 //     the mesher's order, mm scaled to m), corotational FEM at 20 kPa, held
 //     along its top (the fifth of its height nearest the liver);
-//   - the membrane: a tet slab of 40 x 2 x 20 mm (1 mm cells, 9,600 tets),
-//     50 kPa, lying under the gallbladder. Its far edge is fastened to the
+//   - the membrane: thin tissue (a tri body) of 40 x 20 mm, 1 mm thick (1 mm
+//     cells, 1,600 triangles), 50 kPa, with bending, lying under the
+//     gallbladder. Its far edge is fastened to the
 //     liver bed (pinned); its near edge to the gallbladder: each of those
 //     vertices is attached to a target that follows the nearest gallbladder
 //     vertex every frame (one-way: the membrane follows the organ, and does
@@ -20,9 +21,9 @@
 //     along the gallbladder edge, cutting the membrane free of it.
 //
 // Prints each topology event (what it removed and what it took) and the wall
-// time per frame; writes gallbladder_N.vtu and membrane_N.vtu (the live
-// tets) with gallbladder.pvd and membrane.pvd, and events.csv, the event
-// log, to --out.
+// time per frame; writes gallbladder_N.vtu (its tets) and membrane_N.vtu
+// (the live triangles) with gallbladder.pvd and membrane.pvd, and
+// events.csv, the event log, to --out.
 //
 //   cholecystectomy [--backend auto|cpu|opencl|vulkan] [--out DIR] [--every N (5 frames between outputs)]
 #include <algorithm>
@@ -42,7 +43,7 @@ namespace {
 
 using V3 = std::array<double, 3>;
 constexpr double kFrame = 1.0 / 60.0;  // [s]
-constexpr double kCell = 1e-3;         // the membrane's tets [m]
+constexpr double kCell = 1e-3;         // the membrane's cells [m]
 
 int fail(const std::string& what) {
   std::fprintf(stderr, "cholecystectomy: %s\n", what.c_str());
@@ -78,13 +79,20 @@ int main(int argc, char** argv) {
   for (const auto& v : gallbladder->vertices) g.add(v);
 
   // The membrane under the gallbladder's middle: 40 mm along x, 20 mm
-  // along z from the gallbladder's lowest point towards -z, 2 mm thick.
+  // along z from the gallbladder's lowest point towards -z, 1 mm below it;
+  // two triangles a 1 mm cell.
   const V3 centre{0.5 * (g.lo[0] + g.hi[0]), g.lo[1], 0.5 * (g.lo[2] + g.hi[2])};
-  auto membrane = sinew::make_tet_grid({.nx = 40, .ny = 2, .nz = 20,
-                                        .origin = {centre[0] - 0.02, centre[1] - 2 * kCell, centre[2] - 0.02},
-                                        .cell_size = {kCell, kCell, kCell}});
-  if (!membrane) return fail(membrane.error().message());
   const double near_z = centre[2], far_z = centre[2] - 0.02;
+  sinew::TriMesh membrane;
+  constexpr int kNx = 40, kNz = 20;
+  for (int i = 0; i <= kNx; ++i)
+    for (int k = 0; k <= kNz; ++k) membrane.vertices.push_back({centre[0] - 0.02 + i * kCell, centre[1] - kCell, far_z + k * kCell});
+  for (std::uint32_t i = 0; i < kNx; ++i)
+    for (std::uint32_t k = 0; k < kNz; ++k) {
+      const std::uint32_t a = i * (kNz + 1) + k, b = a + 1, c = a + kNz + 1, d = c + 1;
+      membrane.triangles.push_back({a, b, d});
+      membrane.triangles.push_back({a, d, c});
+    }
 
   sinew::SceneDesc scene;
   scene.solver.time_step = kFrame;
@@ -100,10 +108,14 @@ int main(int argc, char** argv) {
   for (std::uint32_t v = 0; v < organ.mesh.vertices.size(); ++v)
     if (organ.mesh.vertices[v][1] > g.hi[1] - 0.2 * (g.hi[1] - g.lo[1])) organ.pinned.push_back(v);
   scene.tet_bodies.push_back(organ);
-  sinew::TetBodyDesc sheet;
-  sheet.mesh = *membrane;
+  sinew::TriBodyDesc sheet;
+  sheet.mesh = membrane;
   sheet.density = 1050.0;
-  if (auto s = sheet.set_elastic(5e4, 0.3); !s) return fail(s.error().message());
+  sheet.thickness = 1e-3;
+  sheet.distance_compliance = 1.0 / 5e4;  // 50 kPa
+  sheet.area_compliance = 1.0 / 5e4;
+  // No bending constraints: a membrane this thin drapes (and each hinge
+  // costs about as much as its two triangles' area and edges together).
   sheet.velocity_damping = 2.0;
   // The near edge follows the gallbladder: each vertex there attached to a
   // target at its nearest gallbladder vertex (plus their rest offset).
@@ -120,36 +132,46 @@ int main(int argc, char** argv) {
       for (int a = 0; a < 3; ++a) d2 += (organ.mesh.vertices[u][a] - p[a]) * (organ.mesh.vertices[u][a] - p[a]);
       if (d2 < best) best = d2, nearest = u;
     }
-    scene.attachments.push_back({.vertex = {sinew::BodyKind::tet, 1, v},
+    scene.attachments.push_back({.vertex = {sinew::BodyKind::tri, 0, v},
                                  .target = static_cast<std::uint32_t>(scene.targets.size()), .compliance = 0.0});
     scene.targets.push_back(p);
     fastened.emplace_back(v, nearest);
     offset.push_back({p[0] - organ.mesh.vertices[nearest][0], p[1] - organ.mesh.vertices[nearest][1],
                       p[2] - organ.mesh.vertices[nearest][2]});
   }
-  scene.tet_bodies.push_back(sheet);
+  scene.tri_bodies.push_back(sheet);
   auto sim = sinew::Simulation::create(scene, {.backend = backend});
   if (!sim) return fail(sim.error().message());
   const std::uint32_t organ_first = sim->info().tet_body_first_particle[0];
-  const std::uint32_t sheet_first = sim->info().tet_body_first_particle[1];
-  std::printf("cholecystectomy: %s; gallbladder %zu tets, membrane %zu tets (%zu vertices fastened to the "
+  const std::uint32_t sheet_first = sim->info().tri_body_first_particle[0];
+  std::printf("cholecystectomy: %s; gallbladder %zu tets, membrane %zu triangles (%zu vertices fastened to the "
               "gallbladder)\n",
-              sim->device_name().c_str(), organ.mesh.tets.size(), sheet.mesh.tets.size(), fastened.size());
+              sim->device_name().c_str(), organ.mesh.tets.size(), sheet.mesh.triangles.size(), fastened.size());
 
+  std::printf("  %u colours a sweep, %u dispatches and %u barriers a frame\n", sim->info().colors,
+              sim->info().dispatches_per_frame, sim->info().barriers_per_frame);
   std::FILE* log = std::fopen((out + "/events.csv").c_str(), "w");
   if (!log) return fail("cannot write " + out + "/events.csv");
-  std::fprintf(log, "time_s,event,body,tets_removed,vertices_removed,constraints_removed,edges_softened,"
-                    "mass_moved_kg,mass_removed_kg,wall_ms,rebuild_ms\n");
+  std::fprintf(log, "time_s,event,body_kind,body,triangles_removed,vertices_removed,constraints_removed,"
+                    "edges_softened,mass_moved_kg,mass_removed_kg,wall_ms,rebuild_ms\n");
   auto record = [&](double t, const char* what, const sinew::Simulation::TopologyEvent& e) {
-    if (e.tets_removed.empty()) return;
-    std::fprintf(log, "%.4f,%s,%zu,%zu,%zu,%u,%u,%.4g,%.4g,%.3f,%.3f\n", t, what, e.body, e.tets_removed.size(),
-                 e.vertices_removed.size(), e.constraints_removed, e.edges_softened, e.mass_moved, e.mass_removed,
-                 e.wall_ms, e.rebuild_ms);
-    std::printf("  %5.3f s  %-8s %3zu tets, %2zu vertices, %3u constraints removed, %3u edges softened; "
+    if (e.triangles_removed.empty()) return;
+    std::fprintf(log, "%.4f,%s,tri,%zu,%zu,%zu,%u,%u,%.4g,%.4g,%.3f,%.3f\n", t, what, e.body,
+                 e.triangles_removed.size(), e.vertices_removed.size(), e.constraints_removed, e.edges_softened,
+                 e.mass_moved, e.mass_removed, e.wall_ms, e.rebuild_ms);
+    std::printf("  %5.3f s  %-8s %3zu triangles, %2zu vertices, %3u constraints removed, %3u edges softened; "
                 "%.2f ms (rebuild %.2f)\n",
-                t, what, e.tets_removed.size(), e.vertices_removed.size(), e.constraints_removed, e.edges_softened,
-                e.wall_ms, e.rebuild_ms);
+                t, what, e.triangles_removed.size(), e.vertices_removed.size(), e.constraints_removed,
+                e.edges_softened, e.wall_ms, e.rebuild_ms);
   };
+
+  // The strand the cautery burns: the membrane vertex 12 mm right of the
+  // middle, 4 mm from the liver bed (at rest).
+  std::uint32_t strand = 0;
+  for (std::uint32_t v = 0; v < sheet.mesh.vertices.size(); ++v) {
+    const V3& p = sheet.mesh.vertices[v];
+    if (std::abs(p[0] - (centre[0] + 0.012)) < 0.5 * kCell && std::abs(p[2] - (far_z + 4e-3)) < 0.5 * kCell) strand = v;
+  }
 
   const int frames = 150;
   std::vector<float> x;
@@ -170,7 +192,7 @@ int main(int argc, char** argv) {
     // The grasper: closes on the membrane's middle at 0.5 s, lifts 15 mm by 1.5 s.
     if (frame == 30) {
       // Where the membrane's middle hangs now (the mean of its vertices
-      // within 1.5 mm of the middle at rest, through its thickness).
+      // within 1.5 mm of the middle at rest).
       V3 middle{};
       int n = 0;
       for (std::uint32_t v = 0; v < sheet.mesh.vertices.size(); ++v) {
@@ -181,7 +203,7 @@ int main(int argc, char** argv) {
       }
       for (double& c : middle) c /= n;
       jaws.position = middle;
-      auto h = sim->close_grasper(0, jaws, {1.5e-3, 2e-3, 1.5e-3});  // 3 x 3 vertices, through the thickness
+      auto h = sim->close_grasper(0, jaws, {1.5e-3, 2e-3, 1.5e-3});  // 3 x 3 vertices
       if (!h) return fail(h.error().message());
       held = h->size();
       std::printf("  %5.3f s  grasp    %zu particles held\n", t, held);
@@ -189,14 +211,17 @@ int main(int argc, char** argv) {
       jaws.position[1] += 0.015 / 60.0;
       if (auto s = sim->move_grasper(0, jaws); !s) return fail(s.error().message());
     }
-    // Cautery: a 3 mm tip on a strand near the liver edge, 0.8 to 1.2 s.
+    // Cautery: a 3 mm tip held on a strand near the liver edge, 0.8 to
+    // 1.2 s: it touches the membrane where that strand is now (the
+    // membrane sags and swings under the grasper).
     if (t >= 0.8 && t < 1.2) {
-      auto e = sim->cauterize(1, {centre[0] + 0.012, centre[1] - kCell, far_z + 4e-3}, 3e-3, kFrame, 0.1);
+      const float* tip = &x[4 * (std::size_t{sheet_first} + strand)];
+      auto e = sim->cauterize(sinew::BodyKind::tri, 0, {tip[0], tip[1], tip[2]}, 3e-3, kFrame, 0.1);
       if (!e) return fail(e.error().message());
       record(t, "cautery", *e);
     }
     // The blade: from 1.5 s it sweeps along the gallbladder edge, 2 mm from
-    // it, through the membrane's thickness, 2 mm a frame. Each stroke starts
+    // it, across the membrane, 2 mm a frame. Each stroke starts
     // 2 mm back: a stroke cuts what it touches where the tissue is now, and
     // the membrane moves between frames (strokes that only met end to end
     // left uncut tissue that had swung back across the line).
@@ -205,7 +230,7 @@ int main(int argc, char** argv) {
       const double bx = centre[0] - 0.021 + 2e-3 * k, bz = near_z - 2e-3;
       const sinew::Simulation::Blade from{{bx - 2e-3, centre[1] + 5e-3, bz}, {bx - 2e-3, centre[1] - 1e-2, bz}};
       const sinew::Simulation::Blade to{{bx + 2e-3, centre[1] + 5e-3, bz}, {bx + 2e-3, centre[1] - 1e-2, bz}};
-      auto e = sim->cut_body(1, from, to);
+      auto e = sim->cut_body(sinew::BodyKind::tri, 0, from, to);
       if (!e) return fail(e.error().message());
       record(t, "cut", *e);
     }
@@ -217,14 +242,15 @@ int main(int argc, char** argv) {
     for (float c : x)
       if (!std::isfinite(c)) return fail("a position is not finite at " + std::to_string(t) + " s");
     const auto organ_tets = sim->current_tets(0);
-    const auto sheet_tets = sim->current_tets(1);
-    if (!organ_tets || !sheet_tets) return fail("current_tets");
+    const auto sheet_triangles = sim->current_triangles(0);
+    if (!organ_tets || !sheet_triangles) return fail("current_tets, current_triangles");
     const std::span<const float> organ_x(x.data() + 4 * std::size_t{organ_first}, 4 * organ.mesh.vertices.size());
     const std::span<const float> sheet_x(x.data() + 4 * std::size_t{sheet_first}, 4 * sheet.mesh.vertices.size());
     organ_files.push_back(out + "/gallbladder_" + std::to_string(frame) + ".vtu");
     sheet_files.push_back(out + "/membrane_" + std::to_string(frame) + ".vtu");
     if (auto s = sinew::write_vtu(organ_files.back(), organ_x, 4, *organ_tets); !s) return fail(s.error().message());
-    if (auto s = sinew::write_vtu(sheet_files.back(), sheet_x, 4, *sheet_tets); !s) return fail(s.error().message());
+    if (auto s = sinew::write_vtu_triangles(sheet_files.back(), sheet_x, 4, *sheet_triangles); !s)
+      return fail(s.error().message());
     times.push_back(t);
   }
   std::fclose(log);
@@ -233,11 +259,11 @@ int main(int argc, char** argv) {
   // The cut freed the membrane: the gap between the live vertices on the
   // gallbladder's side of the blade's line (rest z > near_z - 2 mm) and
   // those on the liver's side (rest z < near_z - 3 mm), at the end.
-  auto live = sim->current_tets(1);
+  auto live = sim->current_triangles(0);
   if (!live) return fail(live.error().message());
   std::vector<std::uint8_t> used(sheet.mesh.vertices.size(), 0);
-  for (const auto& tet : *live)
-    for (std::uint32_t v : tet) used[v] = 1;
+  for (const auto& triangle : *live)
+    for (std::uint32_t v : triangle) used[v] = 1;
   if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
   double gap = std::numeric_limits<double>::infinity();
   for (std::uint32_t a = 0; a < sheet.mesh.vertices.size(); ++a) {
@@ -252,16 +278,16 @@ int main(int argc, char** argv) {
       gap = std::min(gap, std::sqrt(d2));
     }
   }
-  // And whether any live tets still join the gallbladder's edge to the
-  // liver's (the membrane's pieces, by shared vertices).
+  // And whether any live triangles still join the gallbladder's edge to
+  // the liver's (the membrane's pieces, by shared vertices).
   std::vector<std::uint32_t> root(sheet.mesh.vertices.size());
   for (std::uint32_t v = 0; v < root.size(); ++v) root[v] = v;
   auto find = [&](std::uint32_t v) {
     while (root[v] != v) v = root[v] = root[root[v]];
     return v;
   };
-  for (const auto& tet : *live)
-    for (int k = 1; k < 4; ++k) root[find(tet[k])] = find(tet[0]);
+  for (const auto& triangle : *live)
+    for (int k = 1; k < 3; ++k) root[find(triangle[k])] = find(triangle[0]);
   bool joined = false;
   for (std::uint32_t a = 0; a < root.size() && !joined; ++a) {
     if (!used[a] || sheet.mesh.vertices[a][2] < near_z - 1e-9) continue;  // the gallbladder's edge
@@ -269,10 +295,10 @@ int main(int argc, char** argv) {
       joined = used[b] && sheet.mesh.vertices[b][2] < far_z + 1e-9 && find(a) == find(b);  // the liver's
   }
   std::sort(frame_ms.begin(), frame_ms.end());
-  std::printf("cholecystectomy: membrane %zu of %zu tets left; the gallbladder's edge is %s the liver's; across the "
+  std::printf("cholecystectomy: membrane %zu of %zu triangles left; the gallbladder's edge is %s the liver's; across the "
               "cut the nearest live vertices are %.1f mm apart (1 mm at rest); frame median %.1f ms, slowest %.1f ms; "
               "wrote %zu frames and events.csv to %s\n",
-              live->size(), sheet.mesh.tets.size(), joined ? "still joined to" : "cut free of", 1e3 * gap,
+              live->size(), sheet.mesh.triangles.size(), joined ? "still joined to" : "cut free of", 1e3 * gap,
               frame_ms[frame_ms.size() / 2], frame_ms.back(), times.size(), out.c_str());
   if (joined) return fail("the blade left the membrane joined to the gallbladder");
   return 0;
