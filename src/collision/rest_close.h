@@ -44,6 +44,14 @@ class PairSet {
       if (second_[k] == j) return true;
     return false;
   }
+  /// The pairs, sorted by first primitive (each row in the order given).
+  [[nodiscard]] std::vector<Pair> pairs() const {
+    std::vector<Pair> out;
+    out.reserve(second_.size());
+    for (std::size_t i = 0; i + 1 < first_.size(); ++i)
+      for (std::uint32_t k = first_[i]; k < first_[i + 1]; ++k) out.push_back({static_cast<std::uint32_t>(i), second_[k]});
+    return out;
+  }
   [[nodiscard]] std::size_t size() const { return second_.size(); }
   [[nodiscard]] bool empty() const { return second_.empty(); }
 

@@ -10,8 +10,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <span>
 #include <string>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -59,6 +61,19 @@ Status make(Device& device, std::size_t bytes, const char* label, BufferHandle& 
   return {};
 }
 
+// The runs of `body_of` (one body's primitives are contiguous): per body
+// of `bodies`, its (first, count); count 0 for a body with none.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> body_ranges(const std::vector<std::uint32_t>& body_of,
+                                                                 std::uint32_t bodies) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(bodies, {0u, 0u});
+  for (std::uint32_t k = 0; k < body_of.size(); ++k) {
+    auto& r = ranges[body_of[k]];
+    if (r.second == 0) r.first = k;
+    ++r.second;
+  }
+  return ranges;
+}
+
 }  // namespace
 
 Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& scene, const CompiledScene& compiled,
@@ -71,12 +86,20 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   const auto& device_of = compiled.order.device_of;
   std::uint32_t body = 0;
   mc->body_count_ = static_cast<std::uint32_t>(scene.tet_bodies.size() + scene.tri_bodies.size() + scene.line_bodies.size());
+  mc->movable_.resize(compiled.positions.size());
+  for (std::size_t p = 0; p < compiled.positions.size(); ++p) mc->movable_[p] = compiled.positions[p].w > 0.0f;
+  // With topology changes the boundary comes from the faces' index that
+  // update_topology keeps (the same triangles, in the same order).
+  if (scene.topology_changes) mc->index_tet_faces(scene, compiled);
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b, ++body) {
-    const std::uint32_t first = compiled.tet_body_first_particle[b];
-    for (const auto& f : extract_boundary_surface(scene.tet_bodies[b].mesh).triangles) {
-      for (std::uint32_t v : f) mc->triangles_.push_back(device_of[first + v]);
-      mc->triangle_body_.push_back(body);
+    if (scene.topology_changes) {
+      mc->boundary_triangles(mc->tet_faces_[b], mc->triangles_);
+    } else {
+      const std::uint32_t first = compiled.tet_body_first_particle[b];
+      for (const auto& f : extract_boundary_surface(scene.tet_bodies[b].mesh).triangles)
+        for (std::uint32_t v : f) mc->triangles_.push_back(device_of[first + v]);
     }
+    mc->triangle_body_.resize(mc->triangles_.size() / 3, body);
   }
   for (std::size_t b = 0; b < scene.tri_bodies.size(); ++b, ++body) {
     const std::uint32_t first = compiled.tri_body_first_particle[b];
@@ -92,30 +115,19 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
       mc->segment_body_.push_back(body);
     }
   }
-  // One tree per body: contiguous runs of triangle_body_ / segment_body_.
-  const auto ranges = [](const std::vector<std::uint32_t>& body_of, std::vector<BodyTree>& trees) {
-    for (std::uint32_t k = 0; k < body_of.size(); ++k)
-      if (k == 0 || body_of[k] != body_of[k - 1]) {
+  // One tree per body with primitives: contiguous runs of triangle_body_ / segment_body_.
+  const auto trees_of = [&](const std::vector<std::uint32_t>& body_of, std::vector<BodyTree>& trees) {
+    for (const auto& [first, count] : body_ranges(body_of, mc->body_count_))
+      if (count > 0) {
         trees.emplace_back();
-        trees.back().first = k;
+        trees.back().first = first;
+        trees.back().count = count;
       }
-    for (std::size_t t = 0; t < trees.size(); ++t)
-      trees[t].count = (t + 1 < trees.size() ? trees[t + 1].first : static_cast<std::uint32_t>(body_of.size())) -
-                       trees[t].first;
   };
-  ranges(mc->triangle_body_, mc->triangle_trees_);
-  ranges(mc->segment_body_, mc->segment_trees_);
-  mc->body_of_.assign(compiled.positions.size(), UINT32_MAX);
-  for (std::size_t t = 0; t < mc->triangle_body_.size(); ++t)
-    for (int k = 0; k < 3; ++k) mc->body_of_[mc->triangles_[3 * t + k]] = mc->triangle_body_[t];
-  for (std::size_t t = 0; t < mc->segment_body_.size(); ++t)
-    for (int k = 0; k < 2; ++k) mc->body_of_[mc->segments_[2 * t + k]] = mc->segment_body_[t];
-  mc->ownership_ = collision::triangle_ownership(mc->triangles_);
-  mc->solid_triangles_ = 0;
-  while (mc->solid_triangles_ < mc->triangle_body_.size() && mc->triangle_body_[mc->solid_triangles_] < mc->solid_bodies_)
-    ++mc->solid_triangles_;
+  trees_of(mc->triangle_body_, mc->triangle_trees_);
+  trees_of(mc->segment_body_, mc->segment_trees_);
+  mc->index_primitives();
   if (mc->desc_.self_collision) {
-    mc->index_solid_edges();
     std::vector<float> start(4 * compiled.positions.size());
     for (std::size_t p = 0; p < compiled.positions.size(); ++p) {
       const auto& x = compiled.positions[p];
@@ -123,12 +135,6 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
     }
     if (Status s = mc->find_rest_close(start); !s) return s.error();
   }
-  mc->collidable_ = mc->triangles_;
-  mc->collidable_.insert(mc->collidable_.end(), mc->segments_.begin(), mc->segments_.end());
-  std::sort(mc->collidable_.begin(), mc->collidable_.end());
-  mc->collidable_.erase(std::unique(mc->collidable_.begin(), mc->collidable_.end()), mc->collidable_.end());
-  mc->movable_.resize(compiled.positions.size());
-  for (std::size_t p = 0; p < compiled.positions.size(); ++p) mc->movable_[p] = compiled.positions[p].w > 0.0f;
 
   // A first guess of the room needed (4 contacts per surface vertex, 16
   // colours); before_frame grows both when a frame needs more.
@@ -194,42 +200,176 @@ Status MeshCollision::find_rest_close(std::span<const float> start) {
   return {};
 }
 
-// The solids' surface edges and their two faces, sorted by edge (create).
+// The solid surface triangles around each particle, ascending (a counting
+// sort): an edge's faces are among its lower vertex's.
 void MeshCollision::index_solid_edges() {
-  solid_edges_.clear();
+  solid_first_.assign(movable_.size() + 1, 0);
+  for (std::size_t k = 0; k < 3 * solid_triangles_; ++k) ++solid_first_[std::size_t{triangles_[k]} + 1];
+  for (std::size_t p = 0; p < movable_.size(); ++p) solid_first_[p + 1] += solid_first_[p];
+  solid_around_.resize(3 * solid_triangles_);
+  std::vector<std::uint32_t> next(solid_first_.begin(), solid_first_.end() - 1);
   for (std::uint32_t t = 0; t < solid_triangles_; ++t)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = triangles_[3 * std::size_t{t} + k], b = triangles_[3 * std::size_t{t} + (k + 1) % 3];
-      solid_edges_.push_back({(std::uint64_t{std::min(a, b)} << 32) | std::max(a, b), t});
-    }
-  std::sort(solid_edges_.begin(), solid_edges_.end());
+    for (int k = 0; k < 3; ++k) solid_around_[next[triangles_[3 * std::size_t{t} + k]]++] = t;
 }
 
-// The faces on edge (a, b) of a solid's surface: [first, last) in solid_edges_.
-std::pair<std::size_t, std::size_t> MeshCollision::faces_on(std::uint32_t a, std::uint32_t b) const {
-  const std::uint64_t key = (std::uint64_t{std::min(a, b)} << 32) | std::max(a, b);
-  const auto lo = std::lower_bound(solid_edges_.begin(), solid_edges_.end(), std::pair{key, std::uint32_t{0}});
-  auto hi = lo;
-  while (hi != solid_edges_.end() && hi->first == key) ++hi;
-  return {std::size_t(lo - solid_edges_.begin()), std::size_t(hi - solid_edges_.begin())};
+template <class Visit>
+void MeshCollision::faces_on(std::uint32_t a, std::uint32_t b, Visit visit) const {
+  const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
+  if (std::size_t{lo} + 1 >= solid_first_.size()) return;
+  std::uint32_t last = UINT32_MAX;
+  for (std::uint32_t k = solid_first_[lo]; k < solid_first_[lo + 1]; ++k) {
+    const std::uint32_t t = solid_around_[k];
+    if (t == last) continue;  // a triangle listed twice around lo (a degenerate one)
+    last = t;
+    const std::uint32_t* v = &triangles_[3 * std::size_t{t}];
+    for (int e = 0; e < 3; ++e)  // once per edge of t that is {lo, hi}
+      if (std::min(v[e], v[(e + 1) % 3]) == lo && std::max(v[e], v[(e + 1) % 3]) == hi) visit(t);
+  }
 }
 
 std::uint32_t MeshCollision::solid_face(std::uint32_t a, std::uint32_t b, std::uint32_t c) const {
-  const auto [first, last] = faces_on(a, b);
-  for (std::size_t k = first; k < last; ++k) {
-    const std::uint32_t* v = &triangles_[3 * std::size_t{solid_edges_[k].second}];
-    if (v[0] == c || v[1] == c || v[2] == c) return solid_edges_[k].second;
-  }
-  return UINT32_MAX;
+  std::uint32_t found = UINT32_MAX;
+  faces_on(a, b, [&](std::uint32_t t) {
+    const std::uint32_t* v = &triangles_[3 * std::size_t{t}];
+    if (found == UINT32_MAX && (v[0] == c || v[1] == c || v[2] == c)) found = t;
+  });
+  return found;
 }
 
 bool MeshCollision::solid_edge(std::uint32_t a, std::uint32_t b, float out[3]) const {
-  const auto [first, last] = faces_on(a, b);
-  if (first == last) return false;
+  bool any = false;
   out[0] = out[1] = out[2] = 0.0f;
-  for (std::size_t k = first; k < last; ++k)
-    for (int d = 0; d < 3; ++d) out[d] += face_out_[3 * std::size_t{solid_edges_[k].second} + d];
-  return true;
+  faces_on(a, b, [&](std::uint32_t t) {
+    any = true;
+    for (int d = 0; d < 3; ++d) out[d] += face_out_[3 * std::size_t{t} + d];
+  });
+  return any;
+}
+
+void MeshCollision::index_primitives() {
+  const std::size_t particles = movable_.size();
+  body_of_.assign(particles, UINT32_MAX);
+  for (std::size_t t = 0; t < triangle_body_.size(); ++t)
+    for (int k = 0; k < 3; ++k) body_of_[triangles_[3 * t + k]] = triangle_body_[t];
+  for (std::size_t t = 0; t < segment_body_.size(); ++t)
+    for (int k = 0; k < 2; ++k) body_of_[segments_[2 * t + k]] = segment_body_[t];
+  ownership_ = collision::triangle_ownership(triangles_);
+  solid_triangles_ = 0;
+  while (solid_triangles_ < triangle_body_.size() && triangle_body_[solid_triangles_] < solid_bodies_) ++solid_triangles_;
+  if (desc_.self_collision) index_solid_edges();
+  // Every particle of a primitive, ascending.
+  std::vector<std::uint8_t> used(particles, 0);
+  for (std::uint32_t v : triangles_) used[v] = 1;
+  for (std::uint32_t v : segments_) used[v] = 1;
+  collidable_.clear();
+  for (std::uint32_t p = 0; p < particles; ++p)
+    if (used[p]) collidable_.push_back(p);
+}
+
+namespace {
+
+// As extract_boundary_surface winds them: for a positively oriented tet
+// (a, b, c, d), normals away from the fourth vertex.
+constexpr std::array<std::array<int, 3>, 4> kOutwardFaces{{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+
+// Sorts (key, value) pairs by key, stably: least significant digit first,
+// 11 bits a pass, as many passes as `bits` needs.
+void radix_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& items, int bits) {
+  constexpr int kDigit = 11;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> other(items.size());
+  std::vector<std::uint32_t> count(std::size_t{1} << kDigit);
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    std::fill(count.begin(), count.end(), 0u);
+    for (const auto& item : items) ++count[(item.first >> shift) & ((1u << kDigit) - 1)];
+    std::uint32_t sum = 0;
+    for (std::uint32_t& c : count) sum += std::exchange(c, sum);
+    for (const auto& item : items) other[count[(item.first >> shift) & ((1u << kDigit) - 1)]++] = item;
+    items.swap(other);
+  }
+}
+
+}  // namespace
+
+// Each tet body's faces grouped by their three vertices (a radix sort of
+// the packed sorted triples; a plain sort where they do not fit in 64
+// bits), linked into rings; the boundary is the faces alone in theirs, as
+// extract_boundary_surface finds it. With self-collision, the tets' rest
+// boxes too (update_rest_close).
+void MeshCollision::index_tet_faces(const SceneDesc& scene, const CompiledScene& compiled) {
+  device_of_ = compiled.order.device_of;
+  tri_first_.assign(compiled.tri_body_first_particle.begin(), compiled.tri_body_first_particle.end());
+  line_first_.assign(compiled.line_body_first_particle.begin(), compiled.line_body_first_particle.end());
+  rest_positions_.assign(4 * compiled.positions.size(), 0.0f);
+  for (std::size_t p = 0; p < compiled.positions.size(); ++p) {
+    const auto& x = compiled.positions[p];
+    rest_positions_[4 * p] = x.x, rest_positions_[4 * p + 1] = x.y, rest_positions_[4 * p + 2] = x.z;
+  }
+  tet_faces_.resize(scene.tet_bodies.size());
+  for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
+    TetFaces& f = tet_faces_[b];
+    const TetMesh& mesh = scene.tet_bodies[b].mesh;
+    f.first_particle = compiled.tet_body_first_particle[b];
+    f.tets = mesh.tets;
+    f.alive.assign(f.tets.size(), 1);
+    const std::size_t slots = 4 * f.tets.size();
+    int bits = 1;
+    while (bits < 32 && (std::uint64_t{1} << bits) < mesh.vertices.size()) ++bits;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(slots);
+    std::vector<std::array<std::uint32_t, 3>> triples(3 * bits > 64 ? slots : 0);
+    for (std::uint32_t s = 0; s < slots; ++s) {
+      const auto& tet = f.tets[s / 4];
+      std::array<std::uint32_t, 3> v{tet[kOutwardFaces[s % 4][0]], tet[kOutwardFaces[s % 4][1]],
+                                     tet[kOutwardFaces[s % 4][2]]};
+      std::sort(v.begin(), v.end());
+      if (3 * bits > 64) triples[s] = v;
+      else keys[s] = {(std::uint64_t{v[0]} << (2 * bits)) | (std::uint64_t{v[1]} << bits) | v[2], s};
+    }
+    if (3 * bits > 64) {  // over 2^21 vertices
+      std::vector<std::uint32_t> order(slots);
+      std::iota(order.begin(), order.end(), 0u);
+      std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return triples[x] < triples[y]; });
+      std::uint64_t group = 0;
+      for (std::size_t k = 0; k < slots; ++k) {
+        if (k > 0 && triples[order[k]] != triples[order[k - 1]]) ++group;
+        keys[k] = {group, order[k]};
+      }
+    } else {
+      radix_sort(keys, 3 * bits);
+    }
+    f.twin.resize(slots);
+    f.on_boundary.assign(slots, 0);
+    f.boundary.clear();
+    for (std::size_t k = 0; k < slots;) {
+      std::size_t end = k + 1;
+      while (end < slots && keys[end].first == keys[k].first) ++end;
+      for (std::size_t j = k; j < end; ++j) f.twin[keys[j].second] = keys[j + 1 < end ? j + 1 : k].second;
+      if (end == k + 1) f.on_boundary[keys[k].second] = 1;
+      k = end;
+    }
+    for (std::uint32_t s = 0; s < slots; ++s)
+      if (f.on_boundary[s]) f.boundary.push_back(s);
+    if (desc_.self_collision) {
+      const auto half = static_cast<float>(0.5 * desc_.thickness);
+      std::vector<collision::Aabb> boxes(f.tets.size());
+      for (std::size_t t = 0; t < f.tets.size(); ++t) {
+        collision::Aabb& box = boxes[t];
+        box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+        for (std::uint32_t v : f.tets[t])
+          for (int a = 0; a < 3; ++a) {
+            const float x = rest_positions_[4 * std::size_t{device_of_[f.first_particle + v]} + a];
+            box.lo[a] = std::min(box.lo[a], x - half), box.hi[a] = std::max(box.hi[a], x + half);
+          }
+      }
+      f.rest_tree.build(boxes);
+    }
+  }
+}
+
+void MeshCollision::boundary_triangles(const TetFaces& faces, std::vector<std::uint32_t>& out) const {
+  for (std::uint32_t s : faces.boundary) {
+    const auto& tet = faces.tets[s / 4];
+    for (int k : kOutwardFaces[s % 4]) out.push_back(device_of_[faces.first_particle + tet[std::size_t(k)]]);
+  }
 }
 
 std::uint32_t MeshCollision::rest_close_pairs() const {
@@ -1104,6 +1244,299 @@ Result<std::uint32_t> MeshCollision::append_contacts(Device& device, std::span<c
   appended_slots_ = std::move(slot_of);
   appended_colors_ = std::max(appended_colors_, used_colors);
   return added;
+}
+
+}  // namespace sinew
+
+namespace sinew {
+
+Status MeshCollision::update_topology(Device& device, const SceneDesc& scene,
+                                      std::span<const std::vector<std::uint8_t>* const> tet_alive, bool& changed) {
+  changed = false;
+  const auto tri_bodies = static_cast<std::uint32_t>(scene.tri_bodies.size());
+  if (tet_faces_.size() != solid_bodies_ || tri_first_.size() != tri_bodies ||
+      line_first_.size() != scene.line_bodies.size())
+    return Error(ErrorCode::bad_parameter,
+                 "mesh collision: update_topology needs a MeshCollision made with SceneDesc::topology_changes, "
+                 "for a scene of as many bodies");
+  if (tet_alive.size() != solid_bodies_)
+    return Error(ErrorCode::bad_parameter, "mesh collision: update_topology takes one alive mask per tet body (" +
+                                               std::to_string(solid_bodies_) + ", got " +
+                                               std::to_string(tet_alive.size()) + ")");
+  for (std::uint32_t b = 0; b < solid_bodies_; ++b) {
+    const TetFaces& f = tet_faces_[b];
+    if (tet_alive[b] == nullptr || tet_alive[b]->size() != f.tets.size())
+      return Error(ErrorCode::bad_parameter, "mesh collision: tet body " + std::to_string(b) + "'s alive mask has " +
+                                                 std::to_string(tet_alive[b] ? tet_alive[b]->size() : 0) +
+                                                 " entries for " + std::to_string(f.tets.size()) + " tets");
+    for (std::size_t t = 0; t < f.tets.size(); ++t)
+      if ((*tet_alive[b])[t] && !f.alive[t])
+        return Error(ErrorCode::bad_parameter, "mesh collision: tet " + std::to_string(t) + " of body " +
+                                                   std::to_string(b) + " is alive again");
+  }
+  const auto old_triangles = body_ranges(triangle_body_, body_count_);
+  const auto old_segments = body_ranges(segment_body_, body_count_);
+  // Per triangle body that changed: old local index -> new (remap) and the
+  // new triangles (added, new local indices); its new triangles.
+  std::vector<std::uint8_t> body_changed(body_count_, 0);
+  std::vector<std::vector<std::uint32_t>> remap(solid_bodies_ + tri_bodies), added(solid_bodies_ + tri_bodies);
+  std::vector<std::vector<std::uint32_t>> replaced(body_count_);
+  // Tet bodies: each face of a tet that died since the last call, and the
+  // faces in its ring, is on the boundary when its tet lives and it is the
+  // only live face of its ring (extract_boundary_surface's rule).
+  for (std::uint32_t b = 0; b < solid_bodies_; ++b) {
+    TetFaces& f = tet_faces_[b];
+    const std::vector<std::uint8_t>& now = *tet_alive[b];
+    std::vector<std::uint32_t> touched;
+    for (std::uint32_t t = 0; t < f.tets.size(); ++t)
+      if (f.alive[t] && !now[t]) {
+        f.alive[t] = 0;
+        for (std::uint32_t k = 0; k < 4; ++k) touched.push_back(4 * t + k);
+      }
+    if (touched.empty()) continue;
+    std::vector<std::uint32_t> joined;
+    for (std::uint32_t s : touched) {
+      std::uint32_t live = 0;
+      for (std::uint32_t u = s;;) {
+        live += f.alive[u / 4];
+        if ((u = f.twin[u]) == s) break;
+      }
+      for (std::uint32_t u = s;;) {
+        const std::uint8_t boundary = f.alive[u / 4] && live == 1;
+        if (boundary != f.on_boundary[u]) {
+          f.on_boundary[u] = boundary;
+          if (boundary) joined.push_back(u);
+        }
+        if ((u = f.twin[u]) == s) break;
+      }
+    }
+    std::sort(joined.begin(), joined.end());
+    // The new boundary: the old one's faces still on it, merged with those that joined.
+    std::vector<std::uint32_t> boundary;
+    boundary.reserve(f.boundary.size() + joined.size());
+    remap[b].assign(f.boundary.size(), UINT32_MAX);
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < f.boundary.size(); ++i) {
+      for (; j < joined.size() && joined[j] < f.boundary[i]; ++j) {
+        added[b].push_back(static_cast<std::uint32_t>(boundary.size()));
+        boundary.push_back(joined[j]);
+      }
+      if (!f.on_boundary[f.boundary[i]]) continue;
+      remap[b][i] = static_cast<std::uint32_t>(boundary.size());
+      boundary.push_back(f.boundary[i]);
+    }
+    for (; j < joined.size(); ++j) {
+      added[b].push_back(static_cast<std::uint32_t>(boundary.size()));
+      boundary.push_back(joined[j]);
+    }
+    f.boundary = std::move(boundary);
+    boundary_triangles(f, replaced[b]);
+    body_changed[b] = 1;
+  }
+  // Tri bodies: replaced whole when their triangles differ. The carried
+  // pairs follow the old triangles that are still there in order (a removal
+  // keeps the rest in order); otherwise every triangle counts as new.
+  for (std::uint32_t k = 0; k < tri_bodies; ++k) {
+    const std::uint32_t b = solid_bodies_ + k;
+    std::vector<std::uint32_t>& mine = replaced[b];
+    for (const auto& t : scene.tri_bodies[k].mesh.triangles)
+      for (std::uint32_t v : t) mine.push_back(device_of_[tri_first_[k] + v]);
+    const auto [first, count] = old_triangles[b];
+    const auto old = std::span<const std::uint32_t>(triangles_).subspan(3 * std::size_t{first}, 3 * std::size_t{count});
+    if (std::equal(old.begin(), old.end(), mine.begin(), mine.end())) {
+      mine.clear();
+      continue;
+    }
+    body_changed[b] = 1;
+    const std::size_t n = mine.size() / 3;
+    remap[b].assign(count, UINT32_MAX);
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < count && j < n; ++i)
+      if (std::equal(&old[3 * i], &old[3 * i] + 3, &mine[3 * j])) remap[b][i] = static_cast<std::uint32_t>(j++);
+    if (j < n) remap[b].assign(count, UINT32_MAX);  // not a removal: nothing carried
+    std::vector<std::uint8_t> kept(n, 0);
+    for (std::uint32_t r : remap[b])
+      if (r != UINT32_MAX) kept[r] = 1;
+    for (std::uint32_t t = 0; t < n; ++t)
+      if (!kept[t]) added[b].push_back(t);
+  }
+  // Line bodies: replaced whole when their segments differ.
+  for (std::uint32_t k = 0; k < scene.line_bodies.size(); ++k) {
+    const std::uint32_t b = solid_bodies_ + tri_bodies + k;
+    std::vector<std::uint32_t>& mine = replaced[b];
+    for (const auto& s : scene.line_bodies[k].segments)
+      for (std::uint32_t v : s) mine.push_back(device_of_[line_first_[k] + v]);
+    const auto [first, count] = old_segments[b];
+    const auto old = std::span<const std::uint32_t>(segments_).subspan(2 * std::size_t{first}, 2 * std::size_t{count});
+    if (std::equal(old.begin(), old.end(), mine.begin(), mine.end())) mine.clear();
+    else body_changed[b] = 1;
+  }
+  if (std::find(body_changed.begin(), body_changed.end(), 1) == body_changed.end()) return {};
+  changed = true;
+
+  // The primitives in create()'s order: unchanged bodies copied, changed ones replaced.
+  const auto assemble = [&](const std::vector<std::uint32_t>& indices, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ranges,
+                            std::size_t arity, std::uint32_t from, std::uint32_t to, std::vector<std::uint32_t>& out,
+                            std::vector<std::uint32_t>& body_of) {
+    out.clear();
+    body_of.clear();
+    for (std::uint32_t b = from; b < to; ++b) {
+      if (body_changed[b]) {
+        out.insert(out.end(), replaced[b].begin(), replaced[b].end());
+      } else {
+        const auto [first, count] = ranges[b];
+        out.insert(out.end(), indices.begin() + arity * first, indices.begin() + arity * (first + count));
+      }
+      body_of.resize(out.size() / arity, b);
+    }
+  };
+  std::vector<std::uint32_t> triangles, triangle_body, segments, segment_body;
+  assemble(triangles_, old_triangles, 3, 0, solid_bodies_ + tri_bodies, triangles, triangle_body);
+  assemble(segments_, old_segments, 2, solid_bodies_ + tri_bodies, body_count_, segments, segment_body);
+  triangles_.swap(triangles);
+  triangle_body_.swap(triangle_body);
+  segments_.swap(segments);
+  segment_body_.swap(segment_body);
+
+  // The trees: an unchanged body keeps its own (local indices), a changed
+  // one starts empty and is built in the next before_frame, as after create().
+  const auto retree = [&](const std::vector<std::uint32_t>& body_of, std::vector<BodyTree>& trees,
+                          bool triangles_of) -> Status {
+    std::vector<BodyTree> old(body_count_);
+    for (BodyTree& t : trees) {
+      const std::uint32_t b = triangles_of ? triangle_body[t.first] : segment_body[t.first];  // the old body_of
+      old[b] = std::move(t);
+    }
+    trees.clear();
+    const auto ranges = body_ranges(body_of, body_count_);
+    for (std::uint32_t b = 0; b < body_count_; ++b) {
+      const auto [first, count] = ranges[b];
+      if (count == 0) continue;
+      if (!body_changed[b]) {
+        trees.push_back(std::move(old[b]));
+      } else {
+        trees.emplace_back();
+        if (triangles_of && desc_.self_collision) {
+          trees.back().first = first;
+          trees.back().count = count;
+          if (Status s = update_rest_close(b, trees.back(), old[b].rest_close, remap[b], added[b]); !s) return s;
+        }
+      }
+      trees.back().first = first;
+      trees.back().count = count;
+    }
+    return {};
+  };
+  if (Status s = retree(triangle_body_, triangle_trees_, true); !s) return s;
+  if (Status s = retree(segment_body_, segment_trees_, false); !s) return s;
+  index_primitives();
+
+  // Room for the new surface's particles: the Jacobi schedule's lists of
+  // touched particles hold up to every collidable one.
+  MeshContactBuffers& buffers = buffers_;
+  if (buffers.jacobi && collidable_.size() > buffers.touched_capacity) {
+    buffers.touched_capacity = static_cast<std::uint32_t>(collidable_.size());
+    if (Status s = device.resize_buffer(buffers.touched, std::size_t{buffers.touched_capacity} * 4); !s) return s;
+    if (Status s = device.resize_buffer(buffers.offsets, std::size_t{buffers.touched_capacity + 1} * 4); !s) return s;
+  }
+  if (desc_.continuous)
+    reserve_slots_ = std::max(reserve_slots_, static_cast<std::uint32_t>(segments_.size()));
+  return {};
+}
+
+namespace {
+
+// Every primitive of `tree` whose box overlaps `box`. [out] out, appended.
+void tree_query(const collision::Bvh& tree, const collision::Aabb& box, std::vector<std::uint32_t>& out) {
+  if (tree.empty()) return;
+  const auto& nodes = tree.nodes();
+  std::uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const collision::Bvh::Node& node = nodes[stack[--top]];
+    if (!collision::overlap(node.box, box)) continue;
+    if (node.count > 0) {
+      for (std::uint32_t s = node.first; s < node.first + node.count; ++s)
+        if (collision::overlap(tree.leaf_boxes()[s], box)) out.push_back(tree.order()[s]);
+    } else {
+      stack[top++] = node.left;
+      stack[top++] = node.left + 1;
+    }
+  }
+}
+
+}  // namespace
+
+// A tri body's added triangles are tested against all its triangles up to
+// this many box tests; past it, its pairs are all found afresh.
+constexpr std::size_t kMaxRestTests = std::size_t{1} << 20;
+
+// The carried pairs, then the added triangles' own: each added triangle's
+// rest box (grown by half the thickness, as rest_close_pairs grows them)
+// against the body's tets' rest boxes (a tet body: its faces on the
+// boundary now are the candidates) or the body's triangles' (a tri body),
+// kept when the triangles share no vertex and are closer than the
+// thickness (rest_close_pairs' test, in the same argument order).
+Status MeshCollision::update_rest_close(std::uint32_t body, BodyTree& tree, const collision::PairSet& old,
+                                       std::span<const std::uint32_t> remap, std::span<const std::uint32_t> added) {
+  std::vector<collision::Pair> pairs;
+  for (const auto& [i, j] : old.pairs())
+    if (i < remap.size() && j < remap.size() && remap[i] != UINT32_MAX && remap[j] != UINT32_MAX)
+      pairs.push_back({remap[i], remap[j]});
+  const auto mine = std::span<const std::uint32_t>(triangles_).subspan(std::size_t{tree.first} * 3,
+                                                                       std::size_t{tree.count} * 3);
+  const auto thickness = static_cast<float>(desc_.thickness);
+  if (!added.empty()) {
+    std::vector<std::uint32_t> corners;
+    corners.reserve(3 * added.size());
+    for (std::uint32_t t : added) corners.insert(corners.end(), &mine[3 * std::size_t{t}], &mine[3 * std::size_t{t}] + 3);
+    std::vector<collision::Aabb> boxes;
+    if (Status s = collision::primitive_boxes(rest_positions_, corners, 3, 0.5f * thickness, boxes); !s) return s;
+    const collision::SharesVertexOf<3> shares{mine};
+    // The pair of added triangle k and local triangle `other`, when their
+    // boxes overlap (rest_close_pairs' candidates), kept if close.
+    const auto test = [&](std::size_t k, std::uint32_t other, const collision::Aabb& other_box) {
+      const std::uint32_t i = std::min(added[k], other), j = std::max(added[k], other);
+      if (i == j || !collision::overlap(boxes[k], other_box) || shares(i, j)) return;
+      if (collision::triangle_distance(rest_positions_, &mine[3 * std::size_t{i}], &mine[3 * std::size_t{j}]) <
+          thickness)
+        pairs.push_back({i, j});
+    };
+    if (body < solid_bodies_) {
+      // The boundary faces of the tets whose rest boxes the added
+      // triangle's meets (a face's box lies in its tet's).
+      const TetFaces& f = tet_faces_[body];
+      std::vector<std::uint32_t> tets;
+      std::vector<collision::Aabb> face_box;
+      for (std::size_t k = 0; k < added.size(); ++k) {
+        tets.clear();
+        tree_query(f.rest_tree, boxes[k], tets);
+        for (std::uint32_t tet : tets)
+          for (std::uint32_t s = 4 * tet; s < 4 * tet + 4; ++s) {
+            if (!f.on_boundary[s]) continue;
+            const auto other = static_cast<std::uint32_t>(std::lower_bound(f.boundary.begin(), f.boundary.end(), s) -
+                                                          f.boundary.begin());
+            if (Status st = collision::primitive_boxes(rest_positions_, mine.subspan(3 * std::size_t{other}, 3), 3,
+                                                       0.5f * thickness, face_box);
+                !st)
+              return st;
+            test(k, other, face_box[0]);
+          }
+      }
+    } else if (added.size() * std::size_t{tree.count} <= kMaxRestTests) {
+      std::vector<collision::Aabb> all;
+      if (Status s = collision::primitive_boxes(rest_positions_, mine, 3, 0.5f * thickness, all); !s) return s;
+      for (std::size_t k = 0; k < added.size(); ++k)
+        for (std::uint32_t other = 0; other < tree.count; ++other) test(k, other, all[other]);
+    } else {  // a tri body mostly new: all its pairs found afresh
+      if (Status s = collision::rest_close_pairs(rest_positions_, mine, thickness, pairs); !s) return s;
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  tree.rest_close = collision::PairSet(pairs, tree.count);
+  return {};
 }
 
 }  // namespace sinew

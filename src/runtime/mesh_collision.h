@@ -76,6 +76,32 @@ class MeshCollision {
   /// scene's new topology replaces it).
   Status release(Device& device);
 
+  /// After a topology change (issue 16): brings the collidable primitives
+  /// to what create() would make of the scene now, in place and in the
+  /// same order, touching only the bodies that changed. A tet body's
+  /// boundary is updated from the tets that died since the last call (its
+  /// faces that were on the boundary leave, its faces shared with a live
+  /// tet join, wound outward from that tet); a tri or line body whose
+  /// triangles or segments differ is replaced whole. A changed body's
+  /// rest-close pairs are those of create() (the old pairs carried over,
+  /// the new triangles' found at the starting positions), its trees are
+  /// built anew in the next before_frame; other bodies keep theirs, and
+  /// the device buffers are kept (grown where the Jacobi schedule needs
+  /// room for more particles). Why: a remake costs 20 ms on a 50,400-tet
+  /// block (the boundary of every tet, every triangle's rest-close pairs),
+  /// against the 2 ms a cut may add to its frame.
+  /// [in] tet_alive: per tet body, per tet of the mesh create() was given
+  /// (all alive then), whether it is alive now; tets never come back.
+  /// [in] scene: its tri bodies' triangles and line bodies' segments are
+  /// the live ones; its tet bodies' meshes are not read. [out] changed:
+  /// whether any primitive changed (continuous collision, made from
+  /// segments() and triangles(), is then to be made again). Errors
+  /// (bad_parameter): a MeshCollision not made with
+  /// SceneDesc::topology_changes, masks of the wrong size, or a tet alive
+  /// again; nothing is changed then.
+  Status update_topology(Device& device, const SceneDesc& scene,
+                         std::span<const std::vector<std::uint8_t>* const> tet_alive, bool& changed);
+
   /// [in] mask: per particle, what sutures exempt (suture_exemption.h);
   /// outlives this, read every frame.
   void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }
@@ -216,16 +242,55 @@ class MeshCollision {
   std::vector<collision::Aabb> self_boxes_;  // one body's self tree's, in its leaf order
   std::vector<float> leaf_velocities_;       // one body's velocities gathered in its self tree's leaf order
   std::size_t solid_triangles_ = 0;  // triangles_ [0, solid_triangles_) are the solids' surfaces
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> solid_edges_;  // (edge key, face), sorted
   std::vector<float> vertex_out_;  // per particle of a solid's surface: its area-weighted normal (xyz)
   std::vector<float> face_out_;    // per solid surface triangle: its unit normal (xyz)
   void index_solid_edges();
-  std::pair<std::size_t, std::size_t> faces_on(std::uint32_t a, std::uint32_t b) const;
+  // Calls visit(face) for each solid surface triangle with edge (a, b), ascending.
+  template <class Visit>
+  void faces_on(std::uint32_t a, std::uint32_t b, Visit visit) const;
   // The solid surface triangle (a, b, c), or UINT32_MAX.
   std::uint32_t solid_face(std::uint32_t a, std::uint32_t b, std::uint32_t c) const;
   // [out] out: the sum of the unit normals of the faces on edge (a, b);
   // false if it is no solid's surface edge.
   bool solid_edge(std::uint32_t a, std::uint32_t b, float out[3]) const;
+  // The solid surface triangles around each particle (compressed rows,
+  // ascending): faces_on, solid_face and solid_edge look an edge up there.
+  std::vector<std::uint32_t> solid_first_, solid_around_;
+  // ---- Topology changes (SceneDesc::topology_changes; update_topology).
+  // A tet body's faces: face slot 4 t + f is face f of tet t, wound as
+  // extract_boundary_surface winds it (outward from t).
+  struct TetFaces {
+    std::uint32_t first_particle = 0;                // the body's first particle (scene order)
+    std::vector<std::array<std::uint32_t, 4>> tets;  // the body's tets (body vertex indices)
+    std::vector<std::uint8_t> alive;                 // per tet, as of the last update
+    // Per face slot: the next slot with the same three vertices, a ring
+    // (the slot itself when no other tet has that face).
+    std::vector<std::uint32_t> twin;
+    std::vector<std::uint32_t> boundary;  // the boundary's face slots, ascending (extract_boundary_surface's order)
+    std::vector<std::uint8_t> on_boundary;  // per face slot
+    // The tets' boxes at the starting positions grown by half the
+    // thickness (self-collision only): where a new boundary face finds
+    // the faces it is rest-close to.
+    collision::Bvh rest_tree;
+  };
+  std::vector<TetFaces> tet_faces_;  // per tet body; empty without topology changes
+  std::vector<float> rest_positions_;  // the starting positions (device order, xyzw; w = 0): rest-close pairs
+  std::vector<std::uint32_t> device_of_;  // scene particle -> device particle
+  std::vector<std::uint32_t> tri_first_, line_first_;  // per tri / line body: its first particle (scene order)
+  // Builds tet_faces_ (and rest_positions_, device_of_) from the scene create() was given.
+  void index_tet_faces(const SceneDesc& scene, const CompiledScene& compiled);
+  // The triangles (device particles, 3 each) of tet body `body`'s boundary slots.
+  void boundary_triangles(const TetFaces& faces, std::vector<std::uint32_t>& out) const;
+  // The derived indices after triangles_ or segments_ changed: the trees'
+  // ranges, body_of_, ownership_, the solid faces, collidable_.
+  void index_primitives();
+  // The rest-close pairs of a changed triangle body: `old` (local indices
+  // before the change) carried over through `remap` (old -> new local
+  // index, UINT32_MAX: gone), and those of the triangles `added` (new local
+  // indices) found against the body's tet faces (tet bodies) or all its
+  // triangles (tri bodies) at the starting positions.
+  Status update_rest_close(std::uint32_t body, BodyTree& tree, const collision::PairSet& old,
+                           std::span<const std::uint32_t> remap, std::span<const std::uint32_t> added);
   std::vector<collision::Aabb> boxes_;
   std::vector<collision::Pair> pairs_;
   std::vector<collision::Contact> found_, all_;

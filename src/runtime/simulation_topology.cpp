@@ -56,14 +56,6 @@ Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulat
 }
 
 Status Simulation::Impl::remake_collision() {
-  // Each tet body's live tets: their boundary is the collision surface
-  // (cut faces included, removed tets' faces gone).
-  for (std::size_t b = 0; b < topology->bodies(); ++b) {
-    auto& tets = collision_scene->tet_bodies[b].mesh.tets;
-    tets.clear();
-    for (std::size_t t = 0; t < topology->alive(b).size(); ++t)
-      if (topology->alive(b)[t]) tets.push_back(topology->mesh(b).tets[t]);
-  }
   for (std::size_t b = 0; b < topology->sheets(); ++b) {  // each tri body's live triangles
     auto& triangles = collision_scene->tri_bodies[b].mesh.triangles;
     triangles.clear();
@@ -76,11 +68,14 @@ Status Simulation::Impl::remake_collision() {
     for (std::size_t s = 0; s < topology->whole(b).size(); ++s)
       if (topology->whole(b)[s]) segments.push_back(topology->line(b).segments[s]);
   }
-  auto made = MeshCollision::create(*collision_scene, program_shape, *device);
-  if (!made) return made.error();
-  if (Status s = mesh_collision->release(*device); !s) return s;
-  mesh_collision = std::move(*made);
-  if (continuous)
+  // The collision surface follows in place: each tet body's boundary from
+  // the tets that died, the tri and line bodies that changed replaced (a
+  // whole remake took 20 ms on a 50,400-tet block; MeshCollision::update_topology).
+  std::vector<const std::vector<std::uint8_t>*> alive;
+  for (std::size_t b = 0; b < topology->bodies(); ++b) alive.push_back(&topology->alive(b));
+  bool changed = false;
+  if (Status s = mesh_collision->update_topology(*device, *collision_scene, alive, changed); !s) return s;
+  if (continuous && changed)
     continuous = std::make_unique<ContinuousCollision>(mesh_collision->segments(), mesh_collision->triangles(),
                                                        *mesh_collision, buffers, collision_scene->mesh_collision,
                                                        collision_scene->solver.substeps);
