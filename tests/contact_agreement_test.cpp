@@ -4,6 +4,9 @@
 //  - xpbd_solve_attachment: random particles (some immovable, some exactly on
 //    their target) pulled to static and moving targets, compliances 0 and
 //    not, first and later iterations, the measuring pass;
+//  - xpbd_solve_point_attachment: random triangles' points at random
+//    barycentric weights (on vertices and edges too), some particles or
+//    whole triangles immovable, pulled to static and moving targets;
 //  - xpbd_solve_contacts: random particles near and inside a plane, two
 //    spheres, a capsule, a box, a cylinder, an implicit CSG shape (every
 //    primitive and operation) and two tools (capsules), moving and static,
@@ -314,22 +317,30 @@ TEST_P(Agreement, ContactKernel) {
   }
 }
 
-TEST_P(Agreement, AttachmentKernel) {
-  const unsigned seed = std::random_device{}();
-  SCOPED_TRACE("seed " + std::to_string(seed));
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f), alpha(0.0f, 1e-4f), lam(-1e-2f, 1e-2f);
-  const std::uint32_t targets = 40, first = 3, count = 500 + rng() % 50, total = first + count + 5;
-  std::vector<float> target_data;
-  for (std::uint32_t t = 0; t < targets; ++t) {
+// `n` targets (TargetEntry words) in [-1, 1]^3, every fourth still, the
+// others moving up to 0.1 along each axis.
+std::vector<float> random_targets(std::mt19937& rng, std::uint32_t n) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> words;
+  for (std::uint32_t t = 0; t < n; ++t) {
     TargetEntry e{};
     e.start_x = u(rng), e.start_y = u(rng), e.start_z = u(rng);
     const bool still = t % 4 == 0;
     e.end_x = still ? e.start_x : e.start_x + 0.1f * u(rng);
     e.end_y = still ? e.start_y : e.start_y + 0.1f * u(rng);
     e.end_z = still ? e.start_z : e.start_z + 0.1f * u(rng);
-    append_words(target_data, e);
+    append_words(words, e);
   }
+  return words;
+}
+
+TEST_P(Agreement, AttachmentKernel) {
+  const unsigned seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), alpha(0.0f, 1e-4f), lam(-1e-2f, 1e-2f);
+  const std::uint32_t targets = 40, first = 3, count = 500 + rng() % 50, total = first + count + 5;
+  const std::vector<float> target_data = random_targets(rng, targets);
   for (bool reset : {false, true}) {
     for (bool measure : {false, true}) {
       for (float substep_end : {0.5f, 1.0f}) {
@@ -359,6 +370,60 @@ TEST_P(Agreement, AttachmentKernel) {
         c.params = bytes_of(SolveParams{first, count, 3600.0f, reset ? 1u : 0u, 1.0f / 60.0f, substep_end,
                                         measure ? 1u : 0u, 0});
         const std::string what = std::string("attachment t ") + std::to_string(substep_end) +
+                                 (reset ? " reset" : "") + (measure ? " measure" : "");
+        const auto ref = run_on("cpu", c);
+        const auto gpu = run_on(GetParam(), c);
+        expect_agree(c, ref, gpu, what);
+        report_difference(c, ref, gpu, GetParam() + " " + what);
+      }
+    }
+  }
+}
+
+TEST_P(Agreement, PointAttachmentKernel) {
+  // Random triangles of one colour (some particles immovable, a few
+  // triangles wholly so), points at random barycentric weights (some on a
+  // vertex or an edge), pulled to static and moving targets; a few points
+  // exactly on their still target (C = 0).
+  const unsigned seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), unit(0.0f, 1.0f), alpha(0.0f, 1e-4f), lam(-1e-2f, 1e-2f);
+  const std::uint32_t targets = 40, first = 3, count = 300 + rng() % 50, total = first + count + 5;
+  const std::vector<float> target_data = random_targets(rng, targets);
+  for (bool reset : {false, true}) {
+    for (bool measure : {false, true}) {
+      for (float substep_end : {0.5f, 1.0f}) {
+        std::vector<float> x = random_particles(rng, 3 * total);
+        const std::vector<std::uint32_t> idx = one_colour(rng, total, 3);
+        std::vector<float> data, lambda;
+        for (std::uint32_t i = 0; i < total; ++i) {
+          const std::uint32_t t = rng() % targets;
+          float w[3] = {unit(rng), unit(rng), unit(rng)};
+          if (i % 7 == 0) w[0] = 1.0f, w[1] = w[2] = 0.0f;  // on a vertex
+          if (i % 7 == 1) w[2] = 0.0f;                       // on an edge
+          const float sum = w[0] + w[1] + w[2];
+          for (float& k : w) k /= sum;
+          data.insert(data.end(), {w[0], w[1], w[2], i % 3 == 0 ? 0.0f : alpha(rng), float(t), 0.0f, 0.0f, 0.0f});
+          lambda.push_back(lam(rng));
+          if (i % 13 == 5)  // a wholly immovable triangle
+            for (int k = 0; k < 3; ++k) x[4 * idx[3 * i + k] + 3] = 0.0f;
+          if (i % 11 == 2 && t % 4 == 0) {  // the point exactly on its still target: put the vertex there, w = (1, 0, 0)
+            const float* e = &target_data[t * 8];
+            data[8 * i] = 1.0f, data[8 * i + 1] = data[8 * i + 2] = 0.0f;
+            for (int k = 0; k < 3; ++k) x[4 * idx[3 * i] + k] = e[k];
+          }
+        }
+        KernelCase c{Kernel::xpbd_solve_point_attachment, count, {}, {}};
+        c.bindings.push_back({x, false, 4});
+        c.bindings.push_back({as_words(idx), false});
+        c.bindings.push_back({data, false, 4});
+        c.bindings.push_back({lambda, reset && !measure});
+        c.bindings.push_back({std::vector<float>(total, 0.0f), measure});
+        c.bindings.push_back({target_data, false, 4});
+        c.params = bytes_of(SolveParams{first, count, 3600.0f, reset ? 1u : 0u, 1.0f / 60.0f, substep_end,
+                                        measure ? 1u : 0u, 0});
+        const std::string what = std::string("point attachment t ") + std::to_string(substep_end) +
                                  (reset ? " reset" : "") + (measure ? " measure" : "");
         const auto ref = run_on("cpu", c);
         const auto gpu = run_on(GetParam(), c);

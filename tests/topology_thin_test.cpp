@@ -367,6 +367,116 @@ TEST_P(ThinTopology, MeshCollisionSeesTheHoleCut) {
   EXPECT_LT(lowest(), -0.05) << "the cube did not fall through the hole";
 }
 
+// The point of triangle `t` of tri body 0 at the current positions, at
+// barycentric weights w.
+std::array<double, 3> point_on(const Simulation& sim, const TriMesh& mesh, std::uint32_t t,
+                               const std::array<double, 3>& w) {
+  std::vector<float> x;
+  EXPECT_TRUE(sim.read_positions(x).ok());
+  std::array<double, 3> p{};
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) p[a] += w[k] * x[4 * (sheet_first(sim) + mesh.triangles[t][k]) + a];
+  return p;
+}
+
+TEST_P(ThinTopology, JawsClosingBetweenVerticesHoldTheSurfacePointTheyTouch) {
+  // A coarse membrane (1 cm cells) hangs from its left edge. Jaws of 2 mm
+  // close on the centroid of a triangle at its free end, where no vertex
+  // is within 7 mm: the grasper holds that point through its barycentric
+  // weights (a vertex-only grasper would hold nothing), lifts it 3 cm over
+  // half a second (the point follows the jaws), and lets go (it falls).
+  for (const std::uint32_t point_capacity : {16u, 0u}) {
+    SceneDesc scene = sheet_scene(4, 4, 0.01, left_edge);
+    scene.graspers.push_back({.capacity = 8, .point_capacity = point_capacity, .compliance = 0.0});
+    const TriMesh& mesh = scene.tri_bodies[0].mesh;
+    auto sim = create_or_skip(scene, GetParam());
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
+    run(*sim, 30);
+    const std::uint32_t t = 6 * 2 + 2;  // cell (3, 1)'s first triangle, at the free end
+    const std::array<double, 3> third{1.0 / 3, 1.0 / 3, 1.0 / 3};
+    const std::array<double, 3> start = point_on(*sim, mesh, t, third);
+    Pose jaws{start, {1, 0, 0, 0}};
+    auto held = sim->close_grasper(0, jaws, {0.001, 0.001, 0.001});
+    ASSERT_TRUE(held.ok()) << held.error().message();
+    EXPECT_TRUE(held->empty()) << "no vertex lies between the jaws";
+    auto points = sim->held_points(0);
+    ASSERT_TRUE(points.ok());
+    if (point_capacity == 0) {
+      EXPECT_TRUE(points->empty());
+    } else {
+      ASSERT_EQ(points->size(), 1u);
+      const std::uint32_t first = sheet_first(*sim);
+      std::array<std::uint32_t, 3> expected{first + mesh.triangles[t][0], first + mesh.triangles[t][1],
+                                            first + mesh.triangles[t][2]};
+      EXPECT_EQ((*points)[0].particles, expected);
+      for (double w : (*points)[0].weights) EXPECT_NEAR(w, 1.0 / 3, 1e-5);  // the centroid is the nearest point
+      auto check = SimulationInternals::check_colors(*sim);
+      ASSERT_TRUE(check.ok());
+      EXPECT_EQ(check->conflicts, 0u);
+    }
+    for (int f = 1; f <= 30; ++f) {
+      jaws.position[1] = start[1] + 0.03 * f / 30.0;
+      ASSERT_TRUE(sim->move_grasper(0, jaws).ok());
+      ASSERT_TRUE(sim->step().ok());
+    }
+    run(*sim, 10);
+    const std::array<double, 3> lifted = point_on(*sim, mesh, t, third);
+    std::printf("point_capacity %u: the point rose %.2f mm (the jaws 30 mm)\n", point_capacity,
+                1e3 * (lifted[1] - start[1]));
+    if (point_capacity == 0) {
+      EXPECT_LT(lifted[1], start[1] + 0.01) << "nothing was held, yet the point rose";
+      continue;
+    }
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(lifted[a], jaws.position[a], 1e-3) << "axis " << a;
+    auto released = sim->open_grasper(0);
+    ASSERT_TRUE(released.ok());
+    EXPECT_TRUE(sim->held_points(0)->empty());
+    run(*sim, 20);
+    EXPECT_LT(point_on(*sim, mesh, t, third)[1], lifted[1] - 0.01) << "released, the point did not fall";
+  }
+}
+
+TEST_P(ThinTopology, APointGraspTakesOneTriangleAVertexAndNamesItsCapacity) {
+  // Two flat sheets 2 mm apart, at rest (no gravity). Jaws of 4 mm across
+  // the middle of a cell's diagonal cross both of its triangles in both
+  // sheets: one point per sheet (the two triangles of a cell share the
+  // diagonal's vertices), two in all; a point_capacity of 1 is too small,
+  // and the error says so with nothing held.
+  for (const std::uint32_t point_capacity : {2u, 1u}) {
+    SceneDesc scene = sheet_scene(4, 4, 0.01, [](const Vec3d&) { return false; });
+    scene.gravity = {0.0, 0.0, 0.0};
+    TriBodyDesc upper = scene.tri_bodies[0];
+    for (Vec3d& v : upper.mesh.vertices) v[1] += 0.002;
+    scene.tri_bodies.push_back(upper);
+    scene.graspers.push_back({.capacity = 8, .point_capacity = point_capacity, .compliance = 0.0});
+    auto sim = create_or_skip(scene, GetParam());
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
+    const Pose jaws{{0.015, 0.001, 0.015}, {1, 0, 0, 0}};  // the centre of cell (1, 1), on its diagonal
+    auto held = sim->close_grasper(0, jaws, {0.002, 0.002, 0.002});
+    if (point_capacity == 1) {
+      ASSERT_FALSE(held.ok());
+      EXPECT_EQ(held.error().code(), ErrorCode::capacity_exceeded);
+      EXPECT_NE(held.error().message().find("point_capacity"), std::string::npos) << held.error().message();
+      EXPECT_TRUE(sim->held_points(0)->empty());
+      continue;
+    }
+    ASSERT_TRUE(held.ok()) << held.error().message();
+    auto points = sim->held_points(0);
+    ASSERT_EQ(points->size(), 2u);
+    EXPECT_NE((*points)[0].particles[0] < sim->info().tri_body_first_particle[1],
+              (*points)[1].particles[0] < sim->info().tri_body_first_particle[1])
+        << "one point in each sheet";
+    for (const auto& p : *points) {
+      EXPECT_NEAR(p.weights[0] + p.weights[1] + p.weights[2], 1.0, 1e-12);
+      std::printf("held at weights (%.3f, %.3f, %.3f)\n", p.weights[0], p.weights[1], p.weights[2]);
+    }
+    run(*sim, 10);
+    auto check = SimulationInternals::check_colors(*sim);
+    ASSERT_TRUE(check.ok());
+    EXPECT_EQ(check->conflicts, 0u);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, ThinTopology, ::testing::ValuesIn(backends()), backend_name);
 
 TEST(ThinTopology, ScriptedCutsAgreeAcrossBackends) {

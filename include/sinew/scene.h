@@ -554,6 +554,12 @@ struct MeshCollisionDesc {
 /// every attachment, graspers cannot run with solver.warm_start.
 struct GrasperDesc {
   std::uint32_t capacity = 64;  ///< the most vertices it holds at once, in [1, 2^20]
+  /// The most surface points it holds at once, in [0, 2^20] (0: vertices
+  /// only). A surface triangle that crosses the jaws with none of its
+  /// vertices inside them (a coarse mesh, jaws closing between vertices)
+  /// is held at its point nearest the jaws' centre, through barycentric
+  /// weights (Simulation::close_grasper).
+  std::uint32_t point_capacity = 16;
   double compliance = 0.0;      ///< of each hold [m/N], >= 0 (0: rigid)
 };
 

@@ -275,12 +275,26 @@ class Simulation {
   /// Closes grasper `index` at `pose` [m, unit quaternion (w, x, y, z)]: every
   /// movable particle (of any body) inside the jaws, the box of
   /// `half_extents` [m] (> 0) centred on the pose in its frame, is held
-  /// where it is now, at a point fixed in the grasper's frame. Returns the
-  /// held particles (the user's order, as read_positions). Errors: a bad
-  /// index, pose or box; closed already; more particles than its capacity
-  /// (capacity_exceeded, nothing held).
+  /// where it is now, at a point fixed in the grasper's frame. So is every
+  /// surface triangle (a tet body's boundary face, a tri body's triangle)
+  /// that crosses the box with none of its vertices inside it: at its
+  /// point nearest the pose's position, through its barycentric weights
+  /// (a coarse mesh grasped between its vertices; held_points lists them).
+  /// Of such triangles sharing a vertex only the one whose point is
+  /// nearest is held (a point's vertices move with it; two points on one
+  /// vertex would fight over it within one colour). Returns the held
+  /// particles (the user's order, as read_positions). Errors: a bad index,
+  /// pose or box; closed already; more particles than its capacity, or
+  /// points than its point_capacity (capacity_exceeded, nothing held).
   Result<std::vector<std::uint32_t>> close_grasper(std::size_t index, const Pose& pose,
                                                    const std::array<double, 3>& half_extents);
+  /// A surface point a grasper holds: sum weights[k] x[particles[k]].
+  struct HeldPoint {
+    std::array<std::uint32_t, 3> particles{};  ///< the triangle's particles (user order)
+    std::array<double, 3> weights{};           ///< barycentric, each in [0, 1], summing to 1
+  };
+  /// The surface points grasper `index` holds (none while open). Errors: a bad index.
+  Result<std::vector<HeldPoint>> held_points(std::size_t index) const;
   /// Moves grasper `index` to `pose` by the end of the next frame (its held
   /// particles' targets move across the frame's substeps). Errors: a bad
   /// index or pose.

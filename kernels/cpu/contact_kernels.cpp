@@ -213,6 +213,47 @@ void xpbd_solve_attachment(const void* params, std::byte* const* bindings, std::
   }
 }
 
+void xpbd_solve_point_attachment(const void* params, std::byte* const* bindings, std::uint32_t begin,
+                                 std::uint32_t end) {
+  const auto& p = *static_cast<const SolveParams*>(params);
+  auto* x = reinterpret_cast<float4*>(bindings[0]);
+  const auto* idx = reinterpret_cast<const std::uint32_t*>(bindings[1]);
+  const auto* data = reinterpret_cast<const float4*>(bindings[2]);  // (w0, w1, w2, alpha), (target, 0, 0, 0)
+  auto* lambda = reinterpret_cast<float*>(bindings[3]);
+  auto* residual = reinterpret_cast<float*>(bindings[4]);
+  const auto* targets = reinterpret_cast<const TargetEntry*>(bindings[5]);
+  for (std::uint32_t i = p.first + begin; i < p.first + end; ++i) {
+    const std::uint32_t* q = &idx[3 * std::size_t{i}];
+    const float4 x0 = x[q[0]], x1 = x[q[1]], x2 = x[q[2]];
+    const float4 w = data[2 * std::size_t{i}];
+    const TargetEntry& target = targets[static_cast<std::uint32_t>(data[2 * std::size_t{i} + 1].x)];
+    const float4 goal = lerp3(float4{target.start_x, target.start_y, target.start_z, 0.0f},
+                              float4{target.end_x, target.end_y, target.end_z, 0.0f}, p.substep_end);
+    const float4 point = add_scaled3(add_scaled3(w.x * x0, w.y, x1), w.z, x2);
+    const float4 d = xyz(point - goal);
+    const float c = length3(d);  // zero rest length
+    const float alpha_t = w.w * p.inv_h2;
+    const float lambda_i = p.reset_lambda ? 0.0f : lambda[i];
+    if (p.measure_only) {
+      residual[i] = std::abs(c + alpha_t * lambda_i);  // [m]
+      continue;
+    }
+    const float weight = w.x * w.x * x0.w + w.y * w.y * x1.w + w.z * w.z * x2.w;
+    // On the target the gradient is undefined and C = 0; with every
+    // particle immovable nothing can move.
+    if (!(c > 0.0f) || !(weight > 0.0f)) {
+      lambda[i] = lambda_i;
+      continue;
+    }
+    const float dlambda = (-c - alpha_t * lambda_i) / (weight + alpha_t);
+    const float s = dlambda / c;  // along d: the unit normal's step
+    if (x0.w > 0.0f) x[q[0]] = add_scaled3(x0, x0.w * w.x * s, d);
+    if (x1.w > 0.0f) x[q[1]] = add_scaled3(x1, x1.w * w.y * s, d);
+    if (x2.w > 0.0f) x[q[2]] = add_scaled3(x2, x2.w * w.z * s, d);
+    lambda[i] = lambda_i + dlambda;
+  }
+}
+
 void xpbd_solve_contacts(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float4*>(bindings[0]);

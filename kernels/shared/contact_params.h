@@ -96,7 +96,22 @@
  * data: SINEW_ATTACHMENT_DATA_STRIDE floats: [0] target index, as an exactly
  *   representable float (< 2^24), [1] compliance alpha [m/N].
  * C = |x - target(substep_end)| (zero rest length), gradient (x - target) / C,
- * nothing done where C == 0; residual |C + alpha~ lambda| in metres. */
+ * nothing done where C == 0; residual |C + alpha~ lambda| in metres.
+ *
+ * ------------------------------------------------------------ xpbd_solve_point_attachment
+ * A point inside a triangle held at a target (a grasper's jaws closed on a
+ * surface between vertices; iMSTK's barycentric point-to-point
+ * constraint): arity 3 (the triangle's particles); no two in one colour
+ * share a movable particle. bindings: 0-4 standard (data as float4), then
+ *   5 targets: TargetEntry per target [in].
+ * data: SINEW_POINT_ATTACHMENT_DATA_STRIDE floats: [0-2] the point's
+ *   barycentric weights w_k (sum 1), [3] compliance alpha [m/N], [4] target
+ *   index, as an exactly representable float (< 2^24), [5-7] 0.
+ * C = |p - target(substep_end)| with p = sum w_k x_k (zero rest length),
+ * gradient w_k n for particle k, n = (p - target) / C; Delta lambda =
+ * (-C - alpha~ lambda) / (sum w_k^2 w(x_k) + alpha~), x_k += w(x_k) w_k
+ * Delta lambda n (w(x_k) the inverse mass); nothing done where C == 0 or
+ * every particle is immovable; residual |C + alpha~ lambda| in metres. */
 #ifndef SINEW_CONTACT_PARAMS_H
 #define SINEW_CONTACT_PARAMS_H
 
@@ -127,6 +142,7 @@
 #define SINEW_CONTACT_LAMBDA_PER_COLLIDER 4
 #define SINEW_CONTACT_IMPULSE_FLOAT4S 5
 #define SINEW_ATTACHMENT_DATA_STRIDE 2
+#define SINEW_POINT_ATTACHMENT_DATA_STRIDE 8
 
 #ifdef __cplusplus
 namespace sinew::kernels {

@@ -481,8 +481,11 @@ Status check_scene(const SceneDesc& scene) {
     if (g.capacity < 1 || g.capacity > (1u << 20))
       return Error(ErrorCode::bad_parameter,
                    name + ".capacity must be in [1, 2^20] (got " + std::to_string(g.capacity) + ")");
+    if (g.point_capacity > (1u << 20))
+      return Error(ErrorCode::bad_parameter,
+                   name + ".point_capacity must be in [0, 2^20] (got " + std::to_string(g.point_capacity) + ")");
     if (Status s = non_negative(name + ".compliance", g.compliance); !s) return s;
-    grasper_targets += g.capacity;
+    grasper_targets += std::size_t{g.capacity} + g.point_capacity;
   }
   if (scene.targets.size() + grasper_targets >= (std::size_t{1} << 24))
     return Error(ErrorCode::bad_parameter, "targets and graspers: " + std::to_string(scene.targets.size()) + " + " +

@@ -255,26 +255,47 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
     if (!raw.particles.empty()) out.blocks.push_back(color_and_sort(raw, movable, scene.solver.reorder_particles));
   // Graspers, last in every sweep: a block each, one colour of `capacity`
   // attachment slots, none in use (runtime/graspers.h fills them when the
-  // jaws close); each slot has its own target, after the scene's.
-  for (const GrasperDesc& g : scene.graspers) {
+  // jaws close), and a block of `point_capacity` surface points after it
+  // (xpbd_solve_point_attachment, after the vertices' holds in the solve
+  // order); each slot has its own target, after the scene's.
+  const auto grasper_block = [&](Kernel kernel, std::uint32_t arity, std::uint32_t stride, std::uint32_t capacity,
+                                 double compliance, std::vector<std::uint32_t>& block_of,
+                                 std::vector<std::uint32_t>& first_target_of) {
     ConstraintBlock block;
-    block.kernel = Kernel::xpbd_solve_attachment;
-    block.arity = 1;
-    block.data_stride = SINEW_ATTACHMENT_DATA_STRIDE;
+    block.kernel = kernel;
+    block.arity = arity;
+    block.data_stride = stride;
     block.lambda_stride = 1;
     block.extra_bindings = {SceneBuffer::targets};
-    block.particles.assign(g.capacity, 0);
+    block.particles.assign(std::size_t{capacity} * arity, 0);
     const auto first_target = static_cast<std::uint32_t>(out.targets.size() / (sizeof(kernels::TargetEntry) / 4));
-    for (std::uint32_t i = 0; i < g.capacity; ++i) {
-      block.data.push_back(static_cast<float>(first_target + i));
-      block.data.push_back(static_cast<float>(g.compliance));
+    for (std::uint32_t i = 0; i < capacity; ++i) {
+      std::vector<float> data(stride, 0.0f);
+      if (kernel == Kernel::xpbd_solve_attachment) {
+        data[0] = static_cast<float>(first_target + i), data[1] = static_cast<float>(compliance);
+      } else {  // the weights are written when the jaws close
+        data[3] = static_cast<float>(compliance), data[4] = static_cast<float>(first_target + i);
+      }
+      block.data.insert(block.data.end(), data.begin(), data.end());
       out.targets.insert(out.targets.end(), sizeof(kernels::TargetEntry) / 4, 0.0f);
     }
-    block.color_offsets = {0, g.capacity};
+    block.color_offsets = {0, capacity};
     block.color_counts = {0};
-    out.grasper_block.push_back(static_cast<std::uint32_t>(out.blocks.size()));
-    out.grasper_first_target.push_back(first_target);
+    block_of.push_back(static_cast<std::uint32_t>(out.blocks.size()));
+    first_target_of.push_back(first_target);
     out.blocks.push_back(std::move(block));
+  };
+  for (const GrasperDesc& g : scene.graspers)
+    grasper_block(Kernel::xpbd_solve_attachment, 1, SINEW_ATTACHMENT_DATA_STRIDE, g.capacity, g.compliance,
+                  out.grasper_block, out.grasper_first_target);
+  for (const GrasperDesc& g : scene.graspers) {
+    if (g.point_capacity > 0) {
+      grasper_block(Kernel::xpbd_solve_point_attachment, 3, SINEW_POINT_ATTACHMENT_DATA_STRIDE, g.point_capacity,
+                    g.compliance, out.grasper_point_block, out.grasper_point_first_target);
+    } else {
+      out.grasper_point_block.push_back(UINT32_MAX);
+      out.grasper_point_first_target.push_back(UINT32_MAX);
+    }
   }
   out.positions = std::move(b.positions);
   return out;

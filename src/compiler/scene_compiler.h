@@ -97,8 +97,10 @@ struct CompiledScene {
   bool external_forces = false;
   /// Per SceneDesc::graspers entry: its block (one colour, no constraint in
   /// use until it closes) and its first target (its capacity follow, after
-  /// SceneDesc::targets).
+  /// SceneDesc::targets); and the same for its surface points
+  /// (xpbd_solve_point_attachment; UINT32_MAX for a point_capacity of 0).
   std::vector<std::uint32_t> grasper_block, grasper_first_target;
+  std::vector<std::uint32_t> grasper_point_block, grasper_point_first_target;
   std::vector<std::uint32_t> tet_body_first_particle;
   std::vector<std::uint32_t> tri_body_first_particle;
   std::vector<std::uint32_t> line_body_first_particle;

@@ -38,6 +38,7 @@ inline constexpr Kernel kSolveOrder[] = {
     Kernel::xpbd_solve_dihedral,
     Kernel::xpbd_solve_line_bending,  // threads
     Kernel::xpbd_solve_attachment,    // graspers: after the bodies
+    Kernel::xpbd_solve_point_attachment,  // graspers' points inside triangles
     Kernel::xpbd_solve_contacts,      // colliders and tools: last, they win
 };
 

@@ -44,6 +44,7 @@ Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulat
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
+  if (changed && graspers) graspers->invalidate();
   if (changed && collision_scene)
     if (Status s = remake_collision(); !s) return s.error();
   if (changed) {

@@ -57,7 +57,10 @@ std::uint64_t TopologyEditor::edge_key(std::uint32_t a, std::uint32_t b) {
 TopologyEditor::ElementKey TopologyEditor::sorted_key(const std::uint32_t* particles, std::uint32_t arity) {
   ElementKey k{kNone, kNone, kNone, kNone};
   std::copy_n(particles, arity, k.begin());
-  std::sort(k.begin(), k.begin() + arity);
+  // Insertion sort of at most 4 (std::sort of a run whose length the
+  // compiler cannot bound trips -Warray-bounds).
+  for (std::uint32_t i = 1; i < arity; ++i)
+    for (std::uint32_t j = i; j > 0 && k[j - 1] > k[j]; --j) std::swap(k[j - 1], k[j]);
   return k;
 }
 
