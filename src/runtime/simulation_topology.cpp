@@ -165,7 +165,8 @@ Status Simulation::Impl::tear() {
     for (std::size_t b = 0; b < topology->bodies(kind); ++b) {
       const double strain = topology->tear_strain(kind, b);
       if (!(strain > 0.0)) continue;
-      const auto torn = elements_torn(topology->view(kind, b), {x, topology->first_particle(kind, b)}, strain);
+      const auto torn = elements_torn(topology->view(kind, b), topology->edges(kind, b),
+                                      {x, topology->first_particle(kind, b)}, strain);
       if (torn.empty()) continue;
       auto event = apply_removal(kind, b, torn, false, start);
       if (!event) return event.error();

@@ -141,6 +141,7 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
     b.edge_depth = 1.0;
     b.distance_compliance = desc.distance_compliance;
     b.tear_strain = desc.tear_strain;
+    if (b.tear_strain > 0.0) b.edges = unique_edges({b.rest, b.corners, b.arity, b.alive, b.offsets, b.list});
     e->tets_.push_back(std::move(b));
     e->tet_meshes_.push_back(desc.mesh);
   }
@@ -153,6 +154,7 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
     b.edge_depth = desc.thickness;
     b.distance_compliance = desc.distance_compliance;
     b.tear_strain = desc.tear_strain;
+    if (b.tear_strain > 0.0) b.edges = unique_edges({b.rest, b.corners, b.arity, b.alive, b.offsets, b.list});
     e->sheets_.push_back(std::move(b));
     e->tri_meshes_.push_back(desc.mesh);
   }
@@ -161,7 +163,7 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
 
 ElementView TopologyEditor::view(BodyKind kind, std::size_t body) const {
   const Body& b = of(kind, body);
-  return {b.rest, b.corners, b.arity, b.alive};
+  return {b.rest, b.corners, b.arity, b.alive, b.offsets, b.list};
 }
 
 bool TopologyEditor::tears() const {

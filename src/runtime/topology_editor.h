@@ -86,6 +86,8 @@ class TopologyEditor {
   [[nodiscard]] std::uint32_t first_particle(std::size_t body) const { return tets_[body].first; }
   [[nodiscard]] std::uint32_t first_particle(BodyKind kind, std::size_t body) const { return of(kind, body).first; }
   [[nodiscard]] double tear_strain(BodyKind kind, std::size_t body) const { return of(kind, body).tear_strain; }
+  /// A body's edges, once each (empty unless it tears: tear_strain > 0).
+  [[nodiscard]] const EdgeList& edges(BodyKind kind, std::size_t body) const { return of(kind, body).edges; }
   /// Whether any tet, tri or line body tears (tear_strain > 0).
   [[nodiscard]] bool tears() const;
   /// Seconds each element has been touched by a cautery tip (cauterize).
@@ -128,6 +130,7 @@ class TopologyEditor {
     double mass_density = 0.0;               // per unit measure: density (tets), density x thickness (triangles)
     double edge_depth = 1.0;                 // alpha_e = c_d L^2 / (share x edge_depth): 1 (tets), thickness (triangles)
     double distance_compliance = 0.0, tear_strain = 0.0;
+    EdgeList edges;                          // its edges once each (bodies that tear)
     [[nodiscard]] const std::uint32_t* of(std::size_t e) const { return &corners[e * arity]; }
   };
   static Body make_body(std::uint32_t arity, const std::vector<Vec3d>& rest, std::span<const std::uint32_t> corners,

@@ -121,21 +121,40 @@ std::vector<std::uint32_t> elements_cut(const ElementView& body, const BodyPosit
   return out;
 }
 
-std::vector<std::uint32_t> elements_torn(const ElementView& body, const BodyPositions& x, double strain) {
+EdgeList unique_edges(const ElementView& body) {
+  std::vector<std::array<std::uint32_t, 2>> edges;
+  for (std::uint32_t e = 0; e < body.size(); ++e)
+    for (const auto& k : element_edges(body.arity)) {
+      const std::uint32_t u = body.of(e)[k[0]], v = body.of(e)[k[1]];
+      edges.push_back({std::min(u, v), std::max(u, v)});
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  EdgeList out;
+  out.edges = std::move(edges);
+  for (const auto& [u, v] : out.edges) {
+    const Point3 rest = sub(body.rest[v], body.rest[u]);
+    out.rest2.push_back(dot(rest, rest));
+  }
+  return out;
+}
+
+std::vector<std::uint32_t> elements_torn(const ElementView& body, const EdgeList& edges, const BodyPositions& x,
+                                         double strain) {
   const double limit = (1.0 + strain) * (1.0 + strain);
   std::vector<std::uint32_t> out;
-  for (std::uint32_t e = 0; e < body.size(); ++e) {
-    if (!body.alive[e]) continue;
-    const std::uint32_t* q = body.of(e);
-    for (const auto& k : element_edges(body.arity)) {
-      const Point3 now = sub(x.at(q[k[1]]), x.at(q[k[0]]));
-      const Point3 rest = sub(body.rest[q[k[1]]], body.rest[q[k[0]]]);
-      if (dot(now, now) > limit * dot(rest, rest)) {
-        out.push_back(e);
-        break;
-      }
+  for (std::size_t i = 0; i < edges.edges.size(); ++i) {
+    const auto [u, v] = edges.edges[i];
+    const Point3 now = sub(x.at(v), x.at(u));
+    if (!(dot(now, now) > limit * edges.rest2[i])) continue;
+    for (std::uint32_t k = body.around_first[u]; k < body.around_first[u + 1]; ++k) {
+      const std::uint32_t e = body.around[k];
+      const std::uint32_t* q = body.of(e);
+      if (body.alive[e] && std::find(q, q + body.arity, v) != q + body.arity) out.push_back(e);
     }
   }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 
