@@ -77,9 +77,9 @@ struct FrameStats {
   double max_residual = 0.0;     ///< the largest of those normalised residuals
   double kinetic_energy = 0.0;   ///< sum of m |v|^2 / 2 over movable particles [J]
   /// Total tet volume / rest total - 1 (0 without tet bodies), measured
-  /// inside the bodies' boundary surfaces as the scene was made: after
-  /// topology changes (remove_tets, cuts, tears, cautery) it still measures
-  /// those surfaces, not what is left.
+  /// inside the bodies' boundary surfaces; after topology changes
+  /// (remove_tets, cuts, tears, cautery) the live tets' boundaries and rest
+  /// volume.
   double volume_change = 0.0;
   /// Gauss-Seidel sweeps (iterations) run in the last frame, over all its substeps.
   std::uint64_t sweeps = 0;

@@ -15,14 +15,11 @@
 #include <utility>
 #include <vector>
 
+#include "mesh/tet_faces.h"
 #include "sinew/mesh.h"
 
 namespace sinew {
 namespace {
-
-// For a positively oriented tet (a, b, c, d) these faces have normals that
-// point away from the fourth vertex: (a,c,b), (a,b,d), (a,d,c), (b,c,d).
-constexpr std::array<std::array<int, 3>, 4> kOutwardFaces{{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
 
 using Tri = std::array<std::uint32_t, 3>;
 

@@ -49,7 +49,7 @@ void for_each_reduction(const StatsPlan& plan, Visit visit) {
       visit(Reduction::residual_max, k, scratch.take(reduce_scratch_words(n)), results.take(1));
     }
     visit(Reduction::kinetic_energy, 0, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
-    visit(Reduction::volume, 0, scratch.take(reduce_dd_scratch_words(plan.face_count)), results.take(2));
+    visit(Reduction::volume, 0, scratch.take(reduce_dd_scratch_words(plan.face_capacity)), results.take(2));
   }
   for (std::uint32_t k = 0; k < plan.tools * kToolPairs; ++k)
     visit(Reduction::tool, k, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
@@ -62,12 +62,13 @@ double pair(const std::vector<float>& r, std::uint32_t at) { return double(r[at]
 
 Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
                                   const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
-                                  std::uint32_t tools) {
+                                  std::uint32_t tools, std::uint32_t face_capacity) {
   StatsPlan plan;
   plan.errors = errors;
   plan.tools = tools;
   plan.particles = static_cast<std::uint32_t>(scene.positions.size());
   plan.face_count = errors ? static_cast<std::uint32_t>(faces.size()) : 0u;
+  plan.face_capacity = errors ? std::max(plan.face_count, face_capacity) : 0u;
   for (const ConstraintBlock& block : scene.blocks) {
     plan.block_sizes.push_back(block.size());
     plan.in_use.push_back(block.in_use());
@@ -80,14 +81,15 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
   if (!made) return made.error();
   plan.constants = *made;
   if (Status s = device.write_buffer(plan.constants, 0, constants.data(), constants.size() * 4); !s) return s.error();
-  made = make_words(device, 4 * std::size_t{plan.face_count}, "statistics faces");
+  made = make_words(device, 4 * std::size_t{plan.face_capacity}, "statistics faces");
   if (!made) return made.error();
   plan.faces = *made;
   if (plan.face_count)
     if (Status s = device.write_buffer(plan.faces, 0, faces.data(), faces.size() * sizeof(faces[0])); !s)
       return s.error();
   // One terms buffer, reused in turn by each map kernel and its reduction.
-  const std::uint32_t terms = std::max({2 * plan.particles, 2 * plan.face_count, 2 * SINEW_TOOL_TERMS * plan.particles * tools});
+  const std::uint32_t terms =
+      std::max({2 * plan.particles, 2 * plan.face_capacity, 2 * SINEW_TOOL_TERMS * plan.particles * tools});
   made = make_words(device, terms, "statistics terms");
   if (!made) return made.error();
   plan.terms = *made;
@@ -117,6 +119,27 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
   plan.results = *made;
   plan.read_back.resize(plan.result_words);
   return plan;
+}
+
+Status set_stats_faces(Device& device, StatsPlan& plan, const std::vector<std::array<std::uint32_t, 4>>& faces,
+                       bool& fitted) {
+  fitted = plan.errors && faces.size() <= plan.face_capacity;
+  if (!fitted) return {};
+  const auto count = static_cast<std::uint32_t>(faces.size());
+  if (count > 0)
+    if (Status s = device.write_buffer(plan.faces, 0, faces.data(), faces.size() * sizeof(faces[0])); !s) return s;
+  if (Status s = device.write_buffer(plan.constants, std::size_t{kFaces} * 4, &count, 4); !s) return s;
+  plan.face_count = count;
+  return {};
+}
+
+Status release_stats_plan(Device& device, StatsPlan& plan) {
+  for (BufferHandle* h : {&plan.constants, &plan.faces, &plan.terms, &plan.scratch, &plan.results})
+    if (h->valid()) {
+      if (Status s = device.destroy_buffer(*h); !s) return s;
+      *h = {};
+    }
+  return {};
 }
 
 void append_stats(FrameProgram& program, const StatsPlan& plan, const XpbdBuffers& buffers) {

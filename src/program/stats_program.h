@@ -42,6 +42,9 @@ struct StatsPlan {
   /// residual 0). The Simulation refreshes it when the counts change.
   std::vector<std::uint32_t> in_use;
   std::uint32_t particles = 0, face_count = 0;
+  /// Faces the buffers have room for (>= face_count): set_stats_faces
+  /// changes the faces within it without making the plan again.
+  std::uint32_t face_capacity = 0;
   BufferHandle constants, faces, terms, scratch, results;
   std::uint32_t result_words = 0;
   // Word offsets in `results`:
@@ -54,10 +57,23 @@ struct StatsPlan {
 /// Creates the statistics' buffers. [in] faces: every tet body's boundary
 /// triangles, wound outward, with a particle of the same body (the
 /// reference point r of stats_surface_volume), as particle indices;
-/// errors: SolverSettings::measure_errors; tools: rigid tools.
+/// errors: SolverSettings::measure_errors; tools: rigid tools;
+/// face_capacity: room for that many faces (at least faces.size()).
 Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
                                   const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
-                                  std::uint32_t tools);
+                                  std::uint32_t tools, std::uint32_t face_capacity = 0);
+
+/// Replaces the faces (as make_stats_plan's) when they fit in
+/// face_capacity: one write of the faces and one of their count; the
+/// frame program must be rebuilt (append_stats) to use the new count.
+/// [out] fitted: false when they do not fit (nothing is written; make the
+/// plan again).
+Status set_stats_faces(Device& device, StatsPlan& plan, const std::vector<std::array<std::uint32_t, 4>>& faces,
+                       bool& fitted);
+
+/// Destroys the plan's buffers (before a plan for the scene's new topology
+/// replaces it: its faces changed).
+Status release_stats_plan(Device& device, StatsPlan& plan);
 
 /// Appends the statistics to the end of a frame program (after its last
 /// update of velocities). Nothing when the plan has neither errors nor tools.

@@ -70,8 +70,11 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
                        compiled->order.device_of[first + f[2]],
                        compiled->order.device_of[first + boundary.triangles.front()[0]]});
   }
+  // With topology changes, room for twice the faces: cuts add faces
+  // (refresh_volume writes them without making the plan again).
   auto plan = make_stats_plan(*impl->device, *compiled, faces, impl->measure_errors,
-                              static_cast<std::uint32_t>(impl->contacts.tools.size()));
+                              static_cast<std::uint32_t>(impl->contacts.tools.size()),
+                              scene.topology_changes ? 2 * static_cast<std::uint32_t>(faces.size()) : 0u);
   if (!plan) return plan.error();
   impl->stats_plan = std::move(*plan);
   impl->solver = scene.solver;
@@ -85,6 +88,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     auto editor = TopologyEditor::create(scene, *compiled);
     if (!editor) return editor.error();
     impl->topology = std::move(*editor);
+    if (impl->measure_errors) impl->topology->track_boundaries();  // volume_change after cuts (refresh_volume)
   }
   if (impl->topology && impl->mesh_collision) {
     impl->collision_scene = std::make_unique<SceneDesc>(scene);

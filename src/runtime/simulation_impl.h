@@ -103,6 +103,10 @@ struct Simulation::Impl {
   Result<Simulation::TopologyEvent> apply_removal(BodyKind kind, std::size_t body,
                                                   std::span<const std::uint32_t> elements, bool burn,
                                                   std::chrono::steady_clock::time_point start);
+  /// After tets were removed (with measure_errors): the statistics' faces
+  /// are the tet bodies' live boundaries and rest_volume the live tets',
+  /// so FrameStats::volume_change measures what is left.
+  Status refresh_volume(const Simulation::TopologyEvent& event);
   /// After the editor changed something: the mesh collision made again,
   /// the program rebuilt, the event's times filled in.
   Result<Simulation::TopologyEvent> finish_change(Result<Simulation::TopologyEvent> event, bool changed,

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <string>
 
+#include "math/xpbd_math.h"
+#include "program/stats_program.h"
 #include "runtime/simulation_impl.h"
 #include "runtime/simulation_internals.h"
 #include "runtime/topology_queries.h"
@@ -45,6 +47,8 @@ Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulat
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
   if (changed && graspers) graspers->invalidate();
+  if (changed && measure_errors && event->body_kind == BodyKind::tet)
+    if (Status s = refresh_volume(*event); !s) return s.error();
   if (changed && collision_scene)
     if (Status s = remake_collision(); !s) return s.error();
   if (changed) {
@@ -54,6 +58,35 @@ Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulat
   }
   event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return event;
+}
+
+Status Simulation::Impl::refresh_volume(const Simulation::TopologyEvent& event) {
+  const TetMesh& mesh = topology->mesh(event.body);
+  for (std::uint32_t t : event.tets_removed) {  // as create sums the rest volume
+    const auto at = [&](int k) {
+      const Vec3d& p = mesh.vertices[mesh.tets[t][k]];
+      return kernels::double4{p[0], p[1], p[2], 0.0};
+    };
+    rest_volume -= kernels::tet_volume(at(0), at(1), at(2), at(3));
+  }
+  std::vector<std::array<std::uint32_t, 4>> faces;
+  for (std::size_t b = 0; b < topology->bodies(); ++b) {
+    const auto& boundary = topology->boundary(b);
+    const std::uint32_t first = info.tet_body_first_particle[b];
+    for (const auto& f : boundary)
+      faces.push_back({order.device_of[first + f[0]], order.device_of[first + f[1]], order.device_of[first + f[2]],
+                       order.device_of[first + boundary.front()[0]]});
+  }
+  // Within the plan's room (twice the faces the scene started with, or
+  // had when it last grew) only the faces and their count are written.
+  bool fitted = false;
+  if (Status s = set_stats_faces(*device, stats_plan, faces, fitted); !s || fitted) return s;
+  if (Status s = release_stats_plan(*device, stats_plan); !s) return s;
+  auto plan = make_stats_plan(*device, program_shape, faces, true, static_cast<std::uint32_t>(contacts.tools.size()),
+                              2 * static_cast<std::uint32_t>(faces.size()));
+  if (!plan) return plan.error();
+  stats_plan = std::move(*plan);
+  return {};
 }
 
 Status Simulation::Impl::remake_collision() {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "math/thin_math.h"
+#include "mesh/tet_faces.h"
 #include "math/xpbd_math.h"
 #include "runtime/topology_queries.h"
 
@@ -161,6 +162,56 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
   return e;
 }
 
+void TopologyEditor::track_boundaries() {
+  for (std::size_t i = 0; i < tets_.size(); ++i) {
+    Body& b = tets_[i];
+    b.boundary = extract_boundary_surface(tet_meshes_[i]).triangles;
+    b.boundary_index.clear();
+    for (std::uint32_t k = 0; k < b.boundary.size(); ++k) b.boundary_index[sorted_key(b.boundary[k].data(), 3)] = k;
+  }
+  tracking_ = true;
+}
+
+void TopologyEditor::update_boundary(Body& b, std::span<const std::uint32_t> removed) {
+  for (std::uint32_t t : removed)
+    for (const auto& local : kOutwardFaces) {
+      const std::uint32_t* q = b.of(t);
+      const std::array<std::uint32_t, 3> face{q[local[0]], q[local[1]], q[local[2]]};
+      const ElementKey key = sorted_key(face.data(), 3);
+      // The live tets with this face: around its lowest vertex.
+      std::uint32_t live = 0, owner = 0;
+      for (std::uint32_t k = b.offsets[key[0]]; k < b.offsets[key[0] + 1]; ++k) {
+        const std::uint32_t s = b.list[k];
+        const std::uint32_t* r = b.of(s);
+        if (b.alive[s] && std::find(r, r + 4, key[1]) != r + 4 && std::find(r, r + 4, key[2]) != r + 4)
+          ++live, owner = s;
+      }
+      const auto at = b.boundary_index.find(key);
+      if (live != 1) {
+        if (at == b.boundary_index.end()) continue;
+        const std::uint32_t k = at->second;  // leaves: the last face takes its index
+        b.boundary_index.erase(at);
+        if (k + 1 != b.boundary.size()) {
+          b.boundary[k] = b.boundary.back();
+          b.boundary_index[sorted_key(b.boundary[k].data(), 3)] = k;
+        }
+        b.boundary.pop_back();
+        continue;
+      }
+      for (const auto& other : kOutwardFaces) {  // the owner's face with these vertices, wound outward from it
+        const std::uint32_t* r = b.of(owner);
+        const std::array<std::uint32_t, 3> mine{r[other[0]], r[other[1]], r[other[2]]};
+        if (sorted_key(mine.data(), 3) != key) continue;
+        if (at != b.boundary_index.end()) {
+          b.boundary[at->second] = mine;
+        } else {
+          b.boundary_index[key] = static_cast<std::uint32_t>(b.boundary.size());
+          b.boundary.push_back(mine);
+        }
+      }
+    }
+}
+
 ElementView TopologyEditor::view(BodyKind kind, std::size_t body) const {
   const Body& b = of(kind, body);
   return {b.rest, b.corners, b.arity, b.alive, b.offsets, b.list};
@@ -304,6 +355,7 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
   }
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  if (tracking_ && !tri) update_boundary(b, elements);
 
   // Their edges: a hinge goes with either of its triangles; a distance
   // constraint goes with its last element, or is softer by the share it lost.

@@ -90,6 +90,14 @@ class TopologyEditor {
   [[nodiscard]] const EdgeList& edges(BodyKind kind, std::size_t body) const { return of(kind, body).edges; }
   /// Whether any tet, tri or line body tears (tear_strain > 0).
   [[nodiscard]] bool tears() const;
+  /// Keeps each tet body's boundary surface through removals from now on
+  /// (boundary()); what FrameStats::volume_change measures inside.
+  void track_boundaries();
+  /// Tet body `body`'s live boundary faces, wound outward (body vertex
+  /// indices), in no particular order; empty unless track_boundaries().
+  [[nodiscard]] const std::vector<std::array<std::uint32_t, 3>>& boundary(std::size_t body) const {
+    return tets_[body].boundary;
+  }
   /// Seconds each element has been touched by a cautery tip (cauterize).
   [[nodiscard]] std::vector<double>& heat(BodyKind kind, std::size_t body) { return of(kind, body).heat; }
 
@@ -131,6 +139,11 @@ class TopologyEditor {
     double edge_depth = 1.0;                 // alpha_e = c_d L^2 / (share x edge_depth): 1 (tets), thickness (triangles)
     double distance_compliance = 0.0, tear_strain = 0.0;
     EdgeList edges;                          // its edges once each (bodies that tear)
+    // Tet bodies with track_boundaries(): the boundary faces, wound
+    // outward from their live tet, and each one's index there by its
+    // sorted vertices (a face leaves by giving its index to the last).
+    std::vector<std::array<std::uint32_t, 3>> boundary;
+    std::unordered_map<ElementKey, std::uint32_t, ElementKeyHash> boundary_index;
     [[nodiscard]] const std::uint32_t* of(std::size_t e) const { return &corners[e * arity]; }
   };
   static Body make_body(std::uint32_t arity, const std::vector<Vec3d>& rest, std::span<const std::uint32_t> corners,
@@ -159,6 +172,10 @@ class TopologyEditor {
   // holds: V_e [m^3] (a sixth of each tet's volume) or A_e [m^2] (a third
   // of each triangle's area), summed in element order as the compile does.
   double edge_share(const Body& b, std::uint32_t a, std::uint32_t v) const;
+  // After `removed` tets of tet body b died: each of their faces is on the
+  // boundary when exactly one live tet has it (extract_boundary_surface's
+  // rule), wound outward from that tet.
+  void update_boundary(Body& b, std::span<const std::uint32_t> removed);
   // Hands the mass of `v` (left with no element) to its movable neighbours
   // through the removed elements, else to the body's nearest live movable
   // vertex; returns what it could not place. [out] changed: the slots.
@@ -176,7 +193,8 @@ class TopologyEditor {
   std::unordered_map<std::uint32_t, Slot> bend_slots_;                   // line bending, by its middle particle
   std::vector<Line> lines_;
   std::vector<double> mass_;                                             // per device slot [kg] (0: immovable)
-  bool warm_start_ = false;                                              // SolverSettings::warm_start
+  bool warm_start_ = false;
+  bool tracking_ = false;  // track_boundaries()                                              // SolverSettings::warm_start
 };
 
 }  // namespace sinew
