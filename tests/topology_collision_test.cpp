@@ -9,8 +9,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <iterator>
+#include <map>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "backends/backend.h"
@@ -173,6 +177,160 @@ void expect_updates_match(const std::string& backend, double thickness) {
   bool changed = true;
   ASSERT_TRUE(mc.update_topology(**device, live, masks, changed).ok());
   EXPECT_FALSE(changed);
+  ASSERT_TRUE(mc.release(**device).ok());
+}
+
+// The reference median split (bvh.h): node `index` over `prims`, split at
+// the median by (centroid along the longest axis of the centroids' bounds,
+// index), as a selection would; children numbered as Bvh::build numbers
+// them. [out] sets: per node, its primitives (sorted).
+void median_split(const std::vector<collision::Aabb>& boxes, std::vector<std::uint32_t> prims, std::size_t index,
+                  std::vector<std::vector<std::uint32_t>>& sets) {
+  const auto centroid = [&](std::uint32_t p, int k) { return 0.5f * (boxes[p].lo[k] + boxes[p].hi[k]); };
+  std::vector<std::uint32_t> sorted = prims;
+  std::sort(sorted.begin(), sorted.end());
+  sets[index] = sorted;
+  if (prims.size() <= collision::Bvh::kLeafSize) return;
+  float lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = centroid(prims[0], k);
+  for (std::uint32_t p : prims)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], centroid(p, k)), hi[k] = std::max(hi[k], centroid(p, k));
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  const std::size_t half = prims.size() / 2;
+  std::nth_element(prims.begin(), prims.begin() + half, prims.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return centroid(a, axis) < centroid(b, axis) || (centroid(a, axis) == centroid(b, axis) && a < b);
+  });
+  const std::size_t left = sets.size();
+  sets.resize(left + 2);
+  median_split(boxes, {prims.begin(), prims.begin() + half}, left, sets);
+  median_split(boxes, {prims.begin() + half, prims.end()}, left + 1, sets);
+}
+
+// What a rebuild after a change makes of a cut surface (the block's with
+// tets gone, the membrane's with triangles gone: holes, slits, open
+// borders, non-manifold edges), checked against the definitions: the
+// tree's nodes are the median split's, each node's box the union of its
+// primitives', and each node's cone flags (normal_cones.h) those of a
+// search over shared vertices and edges: connected, flat exactly when
+// narrow, connected and without an open edge (an edge of one triangle
+// only), and culled against another node only when they share a vertex.
+TEST(TopologyCollision, RebuiltTreesAndConesOfACutSurfaceEqualTheirDefinitions) {
+  auto device = create_device({.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(device.ok());
+  const SceneDesc scene = scene_of(1e-3);
+  auto compiled = compile_scene(scene);
+  ASSERT_TRUE(compiled.ok());
+  auto made = MeshCollision::create(scene, *compiled, **device);
+  ASSERT_TRUE(made.ok());
+  MeshCollision& mc = **made;
+  SceneDesc live = scene;
+  std::vector<std::uint8_t> alive(scene.tet_bodies[0].mesh.tets.size(), 1);
+  const std::vector<const std::vector<std::uint8_t>*> masks{&alive};
+  std::vector<float> positions(4 * compiled->positions.size());
+  for (std::size_t p = 0; p < compiled->positions.size(); ++p) {
+    const auto& x = compiled->positions[p];
+    positions[4 * p] = x.x, positions[4 * p + 1] = x.y, positions[4 * p + 2] = x.z;
+  }
+  const float flat_cos = std::cos(collision::NormalCones::kFlatDegrees * 3.14159265358979f / 180.0f);
+  std::uint32_t seed = 777;
+  std::size_t flat_seen = 0, open_seen = 0, culled_seen = 0;
+  for (int round = 0; round < 6; ++round) {
+    const std::size_t run = next(seed) % alive.size();
+    for (std::size_t t = run; t < std::min(alive.size(), run + 10); ++t) alive[t] = 0;
+    auto& triangles = live.tri_bodies[0].mesh.triangles;
+    for (int k = 0; k < 3 && !triangles.empty(); ++k) triangles.erase(triangles.begin() + next(seed) % triangles.size());
+    bool changed = false;
+    ASSERT_TRUE(mc.update_topology(**device, live, masks, changed).ok());
+    ASSERT_TRUE(changed);
+    const std::vector<std::uint32_t>& tris = mc.triangles();
+    std::vector<collision::Aabb> boxes;
+    ASSERT_TRUE(collision::primitive_boxes(positions, tris, 3, 1e-4f, boxes).ok());
+    collision::Bvh tree;
+    tree.build(boxes);
+    std::vector<std::vector<std::uint32_t>> expected(1);
+    std::vector<std::uint32_t> all(boxes.size());
+    for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+    median_split(boxes, all, 0, expected);
+    const auto& nodes = tree.nodes();
+    ASSERT_EQ(nodes.size(), expected.size()) << "round " << round;
+    // Per node: its triangles (sorted), from the tree's leaves up.
+    std::vector<std::vector<std::uint32_t>> sets(nodes.size());
+    for (std::size_t i = nodes.size(); i-- > 0;) {
+      if (nodes[i].count > 0) {
+        sets[i].assign(tree.order().begin() + nodes[i].first, tree.order().begin() + nodes[i].first + nodes[i].count);
+      } else {
+        sets[i] = sets[nodes[i].left];
+        sets[i].insert(sets[i].end(), sets[nodes[i].left + 1].begin(), sets[nodes[i].left + 1].end());
+      }
+      std::sort(sets[i].begin(), sets[i].end());
+      ASSERT_EQ(sets[i], expected[i]) << "round " << round << " node " << i;
+      collision::Aabb box = boxes[sets[i][0]];
+      for (std::uint32_t p : sets[i]) box = collision::merge(box, boxes[p]);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(nodes[i].box.lo[k], box.lo[k]);
+        EXPECT_EQ(nodes[i].box.hi[k], box.hi[k]);
+      }
+    }
+    collision::NormalCones cones;
+    cones.update(tree, tris, positions);
+    // Edge uses over the whole surface, and each triangle's vertices.
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    for (std::size_t t = 0; t < tris.size() / 3; ++t)
+      for (int c = 0; c < 3; ++c) {
+        const std::uint32_t a = tris[3 * t + c], b = tris[3 * t + (c + 1) % 3];
+        ++uses[{std::min(a, b), std::max(a, b)}];
+      }
+    const auto vertices_of = [&](const std::vector<std::uint32_t>& set) {
+      std::vector<std::uint32_t> v;
+      for (std::uint32_t t : set) v.insert(v.end(), &tris[3 * t], &tris[3 * t] + 3);
+      std::sort(v.begin(), v.end());
+      v.erase(std::unique(v.begin(), v.end()), v.end());
+      return v;
+    };
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const auto& set = sets[i];
+      // Connected: a search from the first triangle over shared vertices.
+      std::vector<std::uint8_t> reached(set.size(), 0);
+      std::vector<std::size_t> stack{0};
+      reached[0] = 1;
+      while (!stack.empty()) {
+        const std::size_t a = stack.back();
+        stack.pop_back();
+        for (std::size_t b = 0; b < set.size(); ++b)
+          if (!reached[b] && collision::SharesVertex{tris}(set[a], set[b])) reached[b] = 1, stack.push_back(b);
+      }
+      const bool connected = std::find(reached.begin(), reached.end(), 0) == reached.end();
+      bool open = false;
+      for (std::uint32_t t : set)
+        for (int c = 0; c < 3; ++c) {
+          const std::uint32_t a = tris[3 * t + c], b = tris[3 * t + (c + 1) % 3];
+          open |= uses[{std::min(a, b), std::max(a, b)}] == 1;
+        }
+      ASSERT_EQ(bool(cones.connected()[i]), connected) << "round " << round << " node " << i;
+      const bool narrow = cones.cones()[i].cos >= flat_cos;
+      ASSERT_EQ(bool(cones.flat()[i]), narrow && connected && !open) << "round " << round << " node " << i;
+      flat_seen += cones.flat()[i];
+      open_seen += open;
+    }
+    // Culled pairs of disjoint nodes share a vertex.
+    for (std::size_t a = 0; a < nodes.size(); ++a) {
+      if (!cones.flat()[a]) continue;
+      const auto va = vertices_of(sets[a]);
+      for (std::size_t b = a + 1; b < nodes.size(); ++b) {
+        if (!cones.flat()[b] || !cones.pair(static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b))) continue;
+        std::vector<std::uint32_t> both;
+        const auto vb = vertices_of(sets[b]);
+        std::set_intersection(va.begin(), va.end(), vb.begin(), vb.end(), std::back_inserter(both));
+        EXPECT_FALSE(both.empty()) << "round " << round << " nodes " << a << ", " << b;
+        ++culled_seen;
+      }
+    }
+  }
+  EXPECT_GT(flat_seen, 0u) << "no flat node: the flags were not compared";
+  EXPECT_GT(open_seen, 0u) << "no open edge: the flags were not compared";
+  EXPECT_GT(culled_seen, 0u) << "no culled pair: the pairs were not compared";
   ASSERT_TRUE(mc.release(**device).ok());
 }
 

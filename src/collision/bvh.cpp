@@ -2,9 +2,13 @@
 #include "collision/bvh.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
+#include <iterator>
 #include <string>
+#include <utility>
 
 namespace sinew::collision {
 
@@ -43,6 +47,51 @@ Status primitive_boxes(std::span<const float> positions, std::span<const std::ui
   return {};
 }
 
+namespace {
+
+// A float's bits mapped so that unsigned order is the floats' order (-0
+// taken as +0, so that equal floats get equal keys; no NaN here: the boxes
+// are finite).
+std::uint32_t sortable(float x) {
+  x += 0.0f;
+  std::uint32_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  return (bits & 0x80000000u) != 0 ? ~bits : bits | 0x80000000u;
+}
+
+// [out] order: 0 .. keys.size() - 1 sorted by (keys[i], i): a stable least
+// significant digit radix sort, 11 bits a pass.
+void sort_by_key(const std::vector<std::uint32_t>& keys, std::vector<std::uint32_t>& order,
+                 std::vector<std::uint32_t>& scratch) {
+  constexpr int kDigit = 11;
+  constexpr std::uint32_t kMask = (1u << kDigit) - 1;
+  const std::size_t n = keys.size();
+  order.resize(n);
+  scratch.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
+  std::uint32_t count[1u << kDigit];
+  for (int shift = 0; shift < 32; shift += kDigit) {
+    std::fill(std::begin(count), std::end(count), 0u);
+    for (std::size_t i = 0; i < n; ++i) ++count[(keys[i] >> shift) & kMask];
+    std::uint32_t sum = 0;
+    for (std::uint32_t& c : count) sum += std::exchange(c, sum);
+    for (std::size_t i = 0; i < n; ++i) scratch[count[(keys[order[i]] >> shift) & kMask]++] = order[i];
+    order.swap(scratch);
+  }
+}
+
+}  // namespace
+
+// Per axis, the primitives of every node under construction sorted by
+// (centroid along the axis, index): node [first, first + count) holds the
+// same primitives in all three lists.
+struct Bvh::Presorted {
+  std::vector<float> centroids;                // xyz per primitive
+  std::array<std::vector<std::uint32_t>, 3> by_axis;
+  std::vector<std::uint8_t> right;             // per primitive: in the right child of the node being split
+  std::vector<std::uint32_t> scratch;
+};
+
 void Bvh::build(std::span<const Aabb> boxes) {
   static std::atomic<std::uint64_t> builds{0};
   build_id_ = ++builds;
@@ -51,55 +100,71 @@ void Bvh::build(std::span<const Aabb> boxes) {
   for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
   built_cost_ = 0.0;
   if (boxes.empty()) return;
-  std::vector<float> centroids(3 * boxes.size());
-  for (std::size_t i = 0; i < boxes.size(); ++i)
-    for (int k = 0; k < 3; ++k) centroids[3 * i + std::size_t(k)] = 0.5f * (boxes[i].lo[k] + boxes[i].hi[k]);
-  nodes_.reserve(2 * (boxes.size() / kLeafSize + 1));
+  const std::size_t n = boxes.size();
+  Presorted sorted;
+  sorted.centroids.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) sorted.centroids[3 * i + std::size_t(k)] = 0.5f * (boxes[i].lo[k] + boxes[i].hi[k]);
+  std::vector<std::uint32_t> keys(n);
+  for (int k = 0; k < 3; ++k) {
+    for (std::size_t i = 0; i < n; ++i) keys[i] = sortable(sorted.centroids[3 * i + std::size_t(k)]);
+    sort_by_key(keys, sorted.by_axis[std::size_t(k)], sorted.scratch);
+  }
+  sorted.right.assign(n, 0);
+  nodes_.reserve(2 * (n / kLeafSize + 1));
   nodes_.emplace_back();
-  build_node(boxes, centroids, 0, 0, static_cast<std::uint32_t>(boxes.size()));
-  leaf_boxes_.resize(boxes.size());
-  for (std::size_t k = 0; k < boxes.size(); ++k) leaf_boxes_[k] = boxes[order_[k]];
+  build_node(sorted, 0, 0, static_cast<std::uint32_t>(n));
+  // Each leaf's primitives, in order along x; the nodes' boxes bottom-up.
+  order_.swap(sorted.by_axis[0]);
+  leaf_boxes_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) leaf_boxes_[k] = boxes[order_[k]];
+  refit_nodes();
   built_cost_ = cost();
 }
 
-// Fills node `index` over order_[first, first + count). Children are pushed
-// after their parent, so refit() may walk the nodes backwards.
-void Bvh::build_node(std::span<const Aabb> boxes, const std::vector<float>& centroids, std::uint32_t index,
-                     std::uint32_t first, std::uint32_t count) {
-  Aabb box = boxes[order_[first]];
-  float clo[3], chi[3];
-  for (int k = 0; k < 3; ++k) clo[k] = chi[k] = centroids[3 * std::size_t{order_[first]} + std::size_t(k)];
-  for (std::uint32_t s = first + 1; s < first + count; ++s) {
-    box = merge(box, boxes[order_[s]]);
-    for (int k = 0; k < 3; ++k) {
-      const float c = centroids[3 * std::size_t{order_[s]} + std::size_t(k)];
-      clo[k] = std::min(clo[k], c);
-      chi[k] = std::max(chi[k], c);
-    }
-  }
-  nodes_[index].box = box;
+// Fills node `index` over the slots [first, first + count) of the sorted
+// lists. Children are pushed after their parent, so refit() may walk the
+// nodes backwards. The split: the lower half along the longest axis of the
+// centroids' bounds (the first such axis), ties in the centroid broken by
+// the lower index: the same nodes as a selection of the median (e.g.
+// std::nth_element) by that order would make.
+void Bvh::build_node(Presorted& sorted, std::uint32_t index, std::uint32_t first, std::uint32_t count) {
   if (count <= kLeafSize) {
     nodes_[index].first = first;
     nodes_[index].count = count;
     return;
   }
+  const auto centroid = [&](int k, std::uint32_t slot) {
+    return sorted.centroids[3 * std::size_t{sorted.by_axis[std::size_t(k)][slot]} + std::size_t(k)];
+  };
   int axis = 0;
+  float extent[3];
+  for (int k = 0; k < 3; ++k) extent[k] = centroid(k, first + count - 1) - centroid(k, first);
   for (int k = 1; k < 3; ++k)
-    if (chi[k] - clo[k] > chi[axis] - clo[axis]) axis = k;
+    if (extent[k] > extent[axis]) axis = k;
   const std::uint32_t half = count / 2;
-  auto* begin = order_.data() + first;
-  std::nth_element(begin, begin + half, begin + count, [&](std::uint32_t a, std::uint32_t b) {
-    const float ca = centroids[3 * std::size_t{a} + std::size_t(axis)];
-    const float cb = centroids[3 * std::size_t{b} + std::size_t(axis)];
-    return ca < cb || (ca == cb && a < b);  // a strict order even among equal centroids
-  });
+  const std::vector<std::uint32_t>& along = sorted.by_axis[std::size_t(axis)];
+  for (std::uint32_t s = first; s < first + count; ++s) sorted.right[along[s]] = s >= first + half;
+  // The other two lists split stably: each half stays sorted.
+  for (int k = 0; k < 3; ++k) {
+    if (k == axis) continue;
+    std::uint32_t* list = sorted.by_axis[std::size_t(k)].data() + first;
+    std::uint32_t* spill = sorted.scratch.data();
+    std::uint32_t left = 0, right = 0;
+    for (std::uint32_t s = 0; s < count; ++s) {
+      const std::uint32_t p = list[s];
+      if (sorted.right[p]) spill[right++] = p;
+      else list[left++] = p;
+    }
+    std::copy(spill, spill + right, list + left);
+  }
   const auto left = static_cast<std::uint32_t>(nodes_.size());
   nodes_[index].left = left;
   nodes_[index].count = 0;
   nodes_.emplace_back();
   nodes_.emplace_back();
-  build_node(boxes, centroids, left, first, half);
-  build_node(boxes, centroids, left + 1, first + half, count - half);
+  build_node(sorted, left, first, half);
+  build_node(sorted, left + 1, first + half, count - half);
 }
 
 void Bvh::refit(std::span<const Aabb> boxes) {

@@ -7,6 +7,7 @@
 #include "runtime/suture_exemption.h"
 
 #include "collision/shape_distance.h"
+#include "mesh/tet_faces.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +23,7 @@
 #include "coloring/greedy_coloring.h"
 #include "collision/parallel_pairs.h"
 #include "collision/shape_distance.h"
+#include "mesh/tet_faces.h"
 #include "sinew/mesh.h"
 
 namespace sinew {
@@ -267,10 +269,6 @@ void MeshCollision::index_primitives() {
 }
 
 namespace {
-
-// As extract_boundary_surface winds them: for a positively oriented tet
-// (a, b, c, d), normals away from the fourth vertex.
-constexpr std::array<std::array<int, 3>, 4> kOutwardFaces{{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
 
 // Sorts (key, value) pairs by key, stably: least significant digit first,
 // 11 bits a pass, as many passes as `bits` needs.
