@@ -387,6 +387,8 @@ TEST_P(ThinTopology, JawsClosingBetweenVerticesHoldTheSurfacePointTheyTouch) {
   // half a second (the point follows the jaws), and lets go (it falls).
   for (const std::uint32_t point_capacity : {16u, 0u}) {
     SceneDesc scene = sheet_scene(4, 4, 0.01, left_edge);
+    // Grasper 1 does the work (its slots and targets after grasper 0's).
+    scene.graspers.push_back({.capacity = 4, .point_capacity = 4, .compliance = 1.0});
     scene.graspers.push_back({.capacity = 8, .point_capacity = point_capacity, .compliance = 0.0});
     const TriMesh& mesh = scene.tri_bodies[0].mesh;
     auto sim = create_or_skip(scene, GetParam());
@@ -396,10 +398,11 @@ TEST_P(ThinTopology, JawsClosingBetweenVerticesHoldTheSurfacePointTheyTouch) {
     const std::array<double, 3> third{1.0 / 3, 1.0 / 3, 1.0 / 3};
     const std::array<double, 3> start = point_on(*sim, mesh, t, third);
     Pose jaws{start, {1, 0, 0, 0}};
-    auto held = sim->close_grasper(0, jaws, {0.001, 0.001, 0.001});
+    auto held = sim->close_grasper(1, jaws, {0.001, 0.001, 0.001});
     ASSERT_TRUE(held.ok()) << held.error().message();
     EXPECT_TRUE(held->empty()) << "no vertex lies between the jaws";
-    auto points = sim->held_points(0);
+    EXPECT_TRUE(sim->held_points(0)->empty());
+    auto points = sim->held_points(1);
     ASSERT_TRUE(points.ok());
     if (point_capacity == 0) {
       EXPECT_TRUE(points->empty());
@@ -416,7 +419,7 @@ TEST_P(ThinTopology, JawsClosingBetweenVerticesHoldTheSurfacePointTheyTouch) {
     }
     for (int f = 1; f <= 30; ++f) {
       jaws.position[1] = start[1] + 0.03 * f / 30.0;
-      ASSERT_TRUE(sim->move_grasper(0, jaws).ok());
+      ASSERT_TRUE(sim->move_grasper(1, jaws).ok());
       ASSERT_TRUE(sim->step().ok());
     }
     run(*sim, 10);
@@ -428,9 +431,9 @@ TEST_P(ThinTopology, JawsClosingBetweenVerticesHoldTheSurfacePointTheyTouch) {
       continue;
     }
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(lifted[a], jaws.position[a], 1e-3) << "axis " << a;
-    auto released = sim->open_grasper(0);
+    auto released = sim->open_grasper(1);
     ASSERT_TRUE(released.ok());
-    EXPECT_TRUE(sim->held_points(0)->empty());
+    EXPECT_TRUE(sim->held_points(1)->empty());
     run(*sim, 20);
     EXPECT_LT(point_on(*sim, mesh, t, third)[1], lifted[1] - 0.01) << "released, the point did not fall";
   }

@@ -65,6 +65,7 @@ Graspers::Graspers(const SceneDesc& scene, const CompiledScene& compiled) {
     g.point_block = compiled.grasper_point_block[i];
     g.point_first_target = compiled.grasper_point_first_target[i];
     g.point_capacity = scene.graspers[i].point_capacity;
+    g.compliance = scene.graspers[i].compliance;
     graspers_.push_back(std::move(g));
   }
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
@@ -184,9 +185,11 @@ Result<std::vector<std::uint32_t>> Graspers::close(Device& device, const XpbdBuf
     std::vector<float> data;
     for (std::size_t i = 0; i < points.size(); ++i) {
       for (std::uint32_t p : points[i].particles) triangles.push_back(order.device_of[p]);
-      const float* old = &shape.blocks[g.point_block].data[i * SINEW_POINT_ATTACHMENT_DATA_STRIDE];
+      // The whole slot: the program's shape keeps no constraint data.
+      const std::uint32_t target = g.point_first_target + static_cast<std::uint32_t>(i);
       data.insert(data.end(), {static_cast<float>(points[i].weights[0]), static_cast<float>(points[i].weights[1]),
-                               static_cast<float>(points[i].weights[2]), old[3], old[4], 0.0f, 0.0f, 0.0f});
+                               static_cast<float>(points[i].weights[2]), static_cast<float>(g.compliance),
+                               static_cast<float>(target), 0.0f, 0.0f, 0.0f});
       set_target(g.point_first_target + static_cast<std::uint32_t>(i), place(pose, point_offsets[i]));
     }
     const BlockBuffers& b = buffers.blocks[g.point_block];

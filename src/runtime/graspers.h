@@ -79,6 +79,7 @@ class Graspers {
   struct Grasper {
     std::uint32_t block = 0, first_target = 0, capacity = 0;
     std::uint32_t point_block = UINT32_MAX, point_first_target = 0, point_capacity = 0;
+    double compliance = 0.0;  // GrasperDesc::compliance [m/N]
     bool closed = false;
     std::vector<std::uint32_t> held;                // user particles
     std::vector<Simulation::HeldPoint> points;      // surface points
