@@ -277,13 +277,18 @@ class MeshCollision {
   std::vector<float> rest_positions_;  // the starting positions (device order, xyzw; w = 0): rest-close pairs
   std::vector<std::uint32_t> device_of_;  // scene particle -> device particle
   std::vector<std::uint32_t> tri_first_, line_first_;  // per tri / line body: its first particle (scene order)
+  // update_topology's scratch for the ownership it carries over (kept: a
+  // fresh 120 kB of rows paid its page faults at every cut).
+  std::vector<std::array<std::uint32_t, 6>> owner_scratch_;
+  std::vector<std::uint8_t> dirty_;  // per particle, 0 between calls
   // Builds tet_faces_ (and rest_positions_, device_of_) from the scene create() was given.
   void index_tet_faces(const SceneDesc& scene, const CompiledScene& compiled);
   // The triangles (device particles, 3 each) of tet body `body`'s boundary slots.
   void boundary_triangles(const TetFaces& faces, std::vector<std::uint32_t>& out) const;
   // The derived indices after triangles_ or segments_ changed: the trees'
-  // ranges, body_of_, ownership_, the solid faces, collidable_.
-  void index_primitives();
+  // ranges, body_of_, ownership_ (unless `ownership` is false: the caller
+  // brought it up to date), the solid faces, collidable_.
+  void index_primitives(bool ownership = true);
   // The rest-close pairs of a changed triangle body: `old` (local indices
   // before the change) carried over through `remap` (old -> new local
   // index, UINT32_MAX: gone), and those of the triangles `added` (new local
