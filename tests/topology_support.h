@@ -36,6 +36,30 @@ inline std::vector<std::uint32_t> take_random(std::vector<std::uint32_t>& live, 
   return take;
 }
 
+// Adds an 8 mm cube of 2 x 2 x 2 cells (300 kPa edge network) with its
+// lowest corner at `origin` [m] to `scene`, and turns mesh collision on
+// (0.5 mm, no self-collision): something to rest on a surface a change cuts.
+inline void add_resting_cube(SceneDesc& scene, const Vec3d& origin) {
+  TetBodyDesc cube;
+  cube.mesh = *make_tet_grid({.nx = 2, .ny = 2, .nz = 2, .origin = origin, .cell_size = {4e-3, 4e-3, 4e-3}});
+  cube.density = 1000.0;
+  EXPECT_TRUE(cube.set_elastic(3e5, 0.3).ok());
+  scene.tet_bodies.push_back(cube);
+  scene.mesh_collision.enabled = true;
+  scene.mesh_collision.thickness = 5e-4;
+  scene.mesh_collision.self_collision = false;
+}
+
+// The lowest y [m] of tet body `body`'s vertices now.
+inline double lowest_y(const Simulation& sim, const SceneDesc& scene, std::size_t body) {
+  std::vector<float> x;
+  EXPECT_TRUE(sim.read_positions(x).ok());
+  double y = 1.0;
+  for (std::uint32_t v = 0; v < scene.tet_bodies[body].mesh.vertices.size(); ++v)
+    y = std::min(y, double(x[4 * (sim.info().tet_body_first_particle[body] + v) + 1]));
+  return y;
+}
+
 // Colours valid, no constraint naming a removed vertex (of the body whose
 // vertex 0 is particle `first`), and the total mass (if > 0).
 inline void expect_consistent(const Simulation& sim, std::uint32_t first,

@@ -320,24 +320,10 @@ TEST_P(Topology, MeshCollisionSeesTheNewSurface) {
   // its floor (the new faces), not stay on the faces of the tets that are
   // gone, nor fall through the floor.
   SceneDesc scene = pad(6, 3, 6, [](const Vec3d& p) { return p[1] < 1e-9; });
-  TetBodyDesc cube;
-  cube.mesh = *make_tet_grid({.nx = 2, .ny = 2, .nz = 2, .origin = {0.011, 0.0155, 0.011}, .cell_size = {4e-3, 4e-3, 4e-3}});
-  cube.density = 1000.0;
-  ASSERT_TRUE(cube.set_elastic(3e5, 0.3).ok());
-  scene.tet_bodies.push_back(cube);
-  scene.mesh_collision.enabled = true;
-  scene.mesh_collision.thickness = 5e-4;
-  scene.mesh_collision.self_collision = false;
+  add_resting_cube(scene, {0.011, 0.0155, 0.011});
   auto sim = create_or_skip(scene, GetParam());
   ASSERT_TRUE(sim.ok()) << sim.error().message();
-  auto lowest = [&] {
-    std::vector<float> x;
-    EXPECT_TRUE(sim->read_positions(x).ok());
-    double y = 1.0;
-    for (std::uint32_t v = 0; v < scene.tet_bodies[1].mesh.vertices.size(); ++v)
-      y = std::min(y, double(x[4 * (sim->info().tet_body_first_particle[1] + v) + 1]));
-    return y;
-  };
+  auto lowest = [&] { return lowest_y(*sim, scene, 1); };
   run(*sim, 20);
   EXPECT_GT(lowest(), 0.015);  // resting on the block's top (15 mm)
   const TetMesh& block = scene.tet_bodies[0].mesh;

@@ -331,24 +331,10 @@ TEST_P(ThinTopology, MeshCollisionSeesTheHoleCut) {
   SceneDesc scene = sheet_scene(8, 8, kCell, [&](const Vec3d& p) {
     return p[0] < 1e-9 || p[2] < 1e-9 || p[0] > side - 1e-9 || p[2] > side - 1e-9;
   });
-  TetBodyDesc cube;
-  cube.mesh = *make_tet_grid({.nx = 2, .ny = 2, .nz = 2, .origin = {0.016, 0.001, 0.016}, .cell_size = {4e-3, 4e-3, 4e-3}});
-  cube.density = 1000.0;
-  ASSERT_TRUE(cube.set_elastic(3e5, 0.3).ok());
-  scene.tet_bodies.push_back(cube);
-  scene.mesh_collision.enabled = true;
-  scene.mesh_collision.thickness = 5e-4;
-  scene.mesh_collision.self_collision = false;
+  add_resting_cube(scene, {0.016, 0.001, 0.016});
   auto sim = create_or_skip(scene, GetParam());
   ASSERT_TRUE(sim.ok()) << sim.error().message();
-  auto lowest = [&] {
-    std::vector<float> x;
-    EXPECT_TRUE(sim->read_positions(x).ok());
-    double y = 1.0;
-    for (std::uint32_t v = 0; v < cube.mesh.vertices.size(); ++v)
-      y = std::min(y, double(x[4 * (sim->info().tet_body_first_particle[0] + v) + 1]));
-    return y;
-  };
+  auto lowest = [&] { return lowest_y(*sim, scene, 0); };
   run(*sim, 20);
   const double resting = lowest();
   EXPECT_GT(resting, -0.005) << "the cube fell through the whole sheet";

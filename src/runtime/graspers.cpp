@@ -84,15 +84,13 @@ const std::vector<std::uint32_t>& Graspers::surface(const TopologyEditor* topolo
   for (std::size_t b = 0; b < tet_meshes_.size(); ++b) {
     TetMesh live;
     live.vertices = tet_meshes_[b].vertices;
-    for (std::size_t t = 0; t < tet_meshes_[b].tets.size(); ++t)
-      if (!topology || topology->alive(b)[t]) live.tets.push_back(tet_meshes_[b].tets[t]);
+    live.tets = topology ? topology->live_tets(b) : tet_meshes_[b].tets;
     for (const auto& f : extract_boundary_surface(live).triangles)
       for (std::uint32_t v : f) surface_.push_back(tet_first_[b] + v);
   }
   for (std::size_t b = 0; b < tri_meshes_.size(); ++b)
-    for (std::size_t t = 0; t < tri_meshes_[b].triangles.size(); ++t)
-      if (!topology || topology->sheet_alive(b)[t])
-        for (std::uint32_t v : tri_meshes_[b].triangles[t]) surface_.push_back(tri_first_[b] + v);
+    for (const auto& f : topology ? topology->live_triangles(b) : tri_meshes_[b].triangles)
+      for (std::uint32_t v : f) surface_.push_back(tri_first_[b] + v);
   surface_stale_ = false;
   return surface_;
 }

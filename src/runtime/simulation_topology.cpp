@@ -90,12 +90,8 @@ Status Simulation::Impl::refresh_volume(const Simulation::TopologyEvent& event) 
 }
 
 Status Simulation::Impl::remake_collision() {
-  for (std::size_t b = 0; b < topology->sheets(); ++b) {  // each tri body's live triangles
-    auto& triangles = collision_scene->tri_bodies[b].mesh.triangles;
-    triangles.clear();
-    for (std::size_t t = 0; t < topology->sheet_alive(b).size(); ++t)
-      if (topology->sheet_alive(b)[t]) triangles.push_back(topology->sheet_mesh(b).triangles[t]);
-  }
+  for (std::size_t b = 0; b < topology->sheets(); ++b)  // each tri body's live triangles
+    collision_scene->tri_bodies[b].mesh.triangles = topology->live_triangles(b);
   for (std::size_t b = 0; b < topology->line_bodies(); ++b) {  // and each line body's whole segments
     auto& segments = collision_scene->line_bodies[b].segments;
     segments.clear();
@@ -224,21 +220,13 @@ const std::vector<Simulation::TopologyEvent>& Simulation::last_tears() const { r
 Result<std::vector<std::array<std::uint32_t, 4>>> Simulation::current_tets(std::size_t body) const {
   if (Status s = need_topology(impl_->topology, "current_tets"); !s) return s.error();
   if (Status s = check_body(*impl_->topology, BodyKind::tet, body); !s) return s.error();
-  const TopologyEditor& e = *impl_->topology;
-  std::vector<std::array<std::uint32_t, 4>> tets;
-  for (std::size_t t = 0; t < e.alive(body).size(); ++t)
-    if (e.alive(body)[t]) tets.push_back(e.mesh(body).tets[t]);
-  return tets;
+  return impl_->topology->live_tets(body);
 }
 
 Result<std::vector<std::array<std::uint32_t, 3>>> Simulation::current_triangles(std::size_t body) const {
   if (Status s = need_topology(impl_->topology, "current_triangles"); !s) return s.error();
   if (Status s = check_body(*impl_->topology, BodyKind::tri, body); !s) return s.error();
-  const TopologyEditor& e = *impl_->topology;
-  std::vector<std::array<std::uint32_t, 3>> triangles;
-  for (std::size_t t = 0; t < e.sheet_alive(body).size(); ++t)
-    if (e.sheet_alive(body)[t]) triangles.push_back(e.sheet_mesh(body).triangles[t]);
-  return triangles;
+  return impl_->topology->live_triangles(body);
 }
 
 Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const Simulation& sim) {

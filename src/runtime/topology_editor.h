@@ -77,13 +77,17 @@ class TopologyEditor {
   /// Tet body `body`'s rest mesh and which of its tets are alive.
   [[nodiscard]] const TetMesh& mesh(std::size_t body) const { return tet_meshes_[body]; }
   [[nodiscard]] const std::vector<std::uint8_t>& alive(std::size_t body) const { return tets_[body].alive; }
-  /// Tri body `body`'s rest mesh and which of its triangles are alive.
-  [[nodiscard]] const TriMesh& sheet_mesh(std::size_t body) const { return tri_meshes_[body]; }
-  [[nodiscard]] const std::vector<std::uint8_t>& sheet_alive(std::size_t body) const { return sheets_[body].alive; }
   /// A tet or tri body's elements, for topology_queries.h.
   [[nodiscard]] ElementView view(BodyKind kind, std::size_t body) const;
+  /// Tet body `body`'s live tets and tri body `body`'s live triangles (the
+  /// mesh's vertex indices, in mesh order).
+  [[nodiscard]] std::vector<std::array<std::uint32_t, 4>> live_tets(std::size_t body) const {
+    return live_of(tet_meshes_[body].tets, tets_[body].alive);
+  }
+  [[nodiscard]] std::vector<std::array<std::uint32_t, 3>> live_triangles(std::size_t body) const {
+    return live_of(tri_meshes_[body].triangles, sheets_[body].alive);
+  }
   /// The user-order particle of the body's vertex 0.
-  [[nodiscard]] std::uint32_t first_particle(std::size_t body) const { return tets_[body].first; }
   [[nodiscard]] std::uint32_t first_particle(BodyKind kind, std::size_t body) const { return of(kind, body).first; }
   [[nodiscard]] double tear_strain(BodyKind kind, std::size_t body) const { return of(kind, body).tear_strain; }
   /// A body's edges, once each (empty unless it tears: tear_strain > 0).
@@ -102,6 +106,13 @@ class TopologyEditor {
   [[nodiscard]] std::vector<double>& heat(BodyKind kind, std::size_t body) { return of(kind, body).heat; }
 
  private:
+  template <class Element>
+  static std::vector<Element> live_of(const std::vector<Element>& elements, const std::vector<std::uint8_t>& alive) {
+    std::vector<Element> out;
+    for (std::size_t e = 0; e < elements.size(); ++e)
+      if (alive[e]) out.push_back(elements[e]);
+    return out;
+  }
   struct Block {
     Kernel kernel = Kernel::count_;
     std::uint32_t arity = 0, data_stride = 0, lambda_stride = 0;
