@@ -6,12 +6,18 @@
 // registry) get ranges of groups and do each group's work in order, so the
 // CPU reference of a scan or a sort is plain sequential code per group.
 // Indirect dispatches read their count from the counter word when they run.
+// Each member's share of a dispatch follows its measured speed (Shares); a
+// program with nothing worth sharing, or that the team runs no faster than
+// one thread (measured: WidthChoice), runs on the calling thread alone.
 // The kernels (kernels/cpu) are plain scalar code and the test oracle for
 // the GPU ones.
 #include "backends/cpu/cpu_device.h"
+#include "backends/cpu/cpu_sharing.h"
 #include "backends/cpu/cpu_team.h"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <string>
 #include <thread>
 
@@ -134,16 +140,24 @@ struct CpuProgram {
   FrameProgram source;            // kept to resolve again after a buffer is resized
   std::uint64_t resolved_at = 0;  // the device's resize generation the pointers are from
   std::vector<CpuStep> steps;
+  bool alone = false;  // nothing in it worth sharing: never wakes the team
+  WidthChoice width;
   std::vector<const std::uint32_t*> counter_words;
 };
 
 class CpuDevice final : public Device {
  public:
-  CpuDevice(int threads, bool simd) : threads_(threads), simd_(simd), team_(static_cast<unsigned>(threads)) {}
+  CpuDevice(int threads, bool simd, bool adaptive)
+      : simd_(simd),
+        adaptive_(adaptive),
+        team_(static_cast<unsigned>(threads)),
+        shares_(team_.members()),
+        busy_(team_.members()) {}
 
   std::string backend_name() const override { return "cpu"; }
   std::string device_name() const override {
-    return "CPU reference (" + std::to_string(threads_) + (threads_ == 1 ? " thread" : " threads") +
+    const unsigned threads = team_.members();
+    return "CPU reference (" + std::to_string(threads) + (threads == 1 ? " thread" : " threads") +
            (simd_ ? ", AVX2)" : ", scalar)");
   }
 
@@ -222,10 +236,22 @@ class CpuDevice final : public Device {
       CpuDevice* device;
       const std::vector<CpuStep>* steps;
     } job{this, &p.steps};
-    team_.run([](void* context, unsigned member) {
-      const Job& j = *static_cast<const Job*>(context);
-      j.device->run_steps(*j.steps, member);
-    }, &job);
+    const bool on_team = !p.alone && (!adaptive_ || p.width.next_on_team());
+    const auto start = std::chrono::steady_clock::now();
+    if (on_team) {
+      for (Busy& b : busy_) b.ns = 0.0;
+      team_.run([](void* context, unsigned member) {
+        const Job& j = *static_cast<const Job*>(context);
+        j.device->run_steps(*j.steps, member);
+      }, &job);
+      double busy[Shares::kMaxMembers];
+      for (unsigned m = 0; m < team_.members(); ++m) busy[m] = busy_[m].ns;
+      shares_.update(busy);
+    } else {
+      run_alone(p.steps);
+    }
+    if (!p.alone && adaptive_)
+      p.width.record(on_team, std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count());
     counters_.resize(p.counter_words.size());
     for (std::size_t c = 0; c < counters_.size(); ++c) counters_[c] = *p.counter_words[c];
     submitted_ = program.id;
@@ -299,8 +325,7 @@ class CpuDevice final : public Device {
       } else if (!c.indirect) {
         const std::uint64_t items = c.group_size > 0 ? (std::uint64_t{c.count} + c.group_size - 1) / c.group_size
                                                      : c.count;
-        c.solo = team_.members() == 1 ||
-                 items * c.cost_ns * (c.group_size > 0 ? c.group_size : 1) < kSerialBelowNs;
+        c.solo = items * c.cost_ns * (c.group_size > 0 ? c.group_size : 1) < kSerialBelowNs;
       }
       if (c.indirect && !steps.empty()) {
         const CpuStep& before = steps.back();
@@ -310,6 +335,10 @@ class CpuDevice final : public Device {
       }
       steps.push_back(c);
     }
+    // Indirect dispatches are never solo (their count is known only when
+    // they run), so a program of solo steps alone has nothing to share.
+    p.alone = team_.members() == 1 ||
+              std::all_of(steps.begin(), steps.end(), [](const CpuStep& s) { return s.solo; });
     p.steps = std::move(steps);
     p.counter_words.clear();
     for (const Counter& c : p.source.counters()) p.counter_words.push_back(words(c.buffer, c.word));
@@ -369,9 +398,29 @@ class CpuDevice final : public Device {
         if (member == 0) s.fn(s.params, s.bindings, 0, items);
         continue;
       }
-      const auto begin = static_cast<std::uint32_t>(std::uint64_t{items} * member / members);
-      const auto end = static_cast<std::uint32_t>(std::uint64_t{items} * (member + 1) / members);
-      if (begin < end) s.fn(s.params, s.bindings, begin, end);
+      const auto [begin, end] = shares_.range(items, member);
+      if (begin < end) {
+        const auto t0 = std::chrono::steady_clock::now();
+        s.fn(s.params, s.bindings, begin, end);
+        busy_[member].ns += std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
+      }
+    }
+  }
+
+  // A program on the calling thread alone: every step whole, in order.
+  static void run_alone(const std::vector<CpuStep>& steps) {
+    for (const CpuStep& s : steps) {
+      switch (s.kind) {
+        case CpuStep::Kind::fill: std::fill_n(s.target, s.words, s.value); break;
+        case CpuStep::Kind::copy: std::copy_n(s.source, s.words, s.target); break;
+        case CpuStep::Kind::dispatch: {
+          std::uint32_t items = s.indirect ? std::min(*s.indirect, s.count) : s.count;
+          if (s.group_size > 0)
+            items = static_cast<std::uint32_t>((std::uint64_t{items} + s.group_size - 1) / s.group_size);
+          if (items > 0) s.fn(s.params, s.bindings, 0, items);
+          break;
+        }
+      }
     }
   }
 
@@ -388,9 +437,14 @@ class CpuDevice final : public Device {
     return (*b)->data.get() + offset;
   }
 
-  int threads_;
   bool simd_;
-  CpuTeam team_;  // runs every program, threads_ members
+  bool adaptive_;  // DeviceOptions::cpu_adaptive_team
+  CpuTeam team_;   // runs every program worth sharing
+  Shares shares_;  // each member's part of a shared dispatch
+  struct alignas(64) Busy {
+    double ns = 0.0;  // a member's time in its shares during the run [ns]
+  };
+  std::vector<Busy> busy_;
   std::vector<HostBuffer> buffers_;
   std::vector<std::size_t> sizes_;  // bytes per buffer id, 0 when destroyed (check_program)
   std::uint64_t generation_ = 0;     // bumped by every resize and destroy
@@ -405,10 +459,13 @@ Result<std::unique_ptr<Device>> make_cpu_device(const DeviceOptions& options) {
   if (options.threads < 0)
     return Error(ErrorCode::bad_parameter, "DeviceOptions.threads must be >= 0 (0 = all hardware threads), got " +
                                                std::to_string(options.threads));
+  if (options.threads > int(Shares::kMaxMembers))
+    return Error(ErrorCode::bad_parameter, "DeviceOptions.threads must be <= " + std::to_string(Shares::kMaxMembers) +
+                                               ", got " + std::to_string(options.threads));
   const int threads =
-      options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+      options.threads > 0 ? options.threads : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, int(Shares::kMaxMembers));
   const bool simd = options.cpu_simd && kernels::cpu_has_avx2();
-  return std::unique_ptr<Device>(std::make_unique<CpuDevice>(threads, simd));
+  return std::unique_ptr<Device>(std::make_unique<CpuDevice>(threads, simd, options.cpu_adaptive_team));
 }
 
 }  // namespace sinew

@@ -45,6 +45,12 @@ struct DeviceOptions {
   /// first GPU, else the first device.
   std::string device = "";
   int threads = 0;               ///< cpu: worker threads; 0 = all hardware threads
+  /// cpu: true (default) times each program on all threads and on one, and
+  /// runs it on one where the team is no faster (too little work, or the
+  /// other cores busy with other processes), trying the team again now and
+  /// then; false: every program worth sharing runs on all threads. Results
+  /// are bitwise the same either way.
+  bool cpu_adaptive_team = true;
   bool cpu_simd = true;          ///< cpu: use the AVX2 solves where the CPU has AVX2 (bitwise
                                  ///< equal to the scalar reference kernels, only faster)
   bool quiet = false;            ///< true: do not print the one-line fallback notice of "auto"
