@@ -10,9 +10,12 @@
 // vertex order (organ_step's settings: 10 substeps x 1 iteration), and two
 // blocks colliding (mesh contacts, the tests' scene).
 //
-// Each round steps each configuration `--frames` frames back to back after
-// one unmeasured frame, with a pause before it long enough for every other
-// configuration's idle workers to fall asleep. Reports per configuration
+// Each configuration first steps `--warmup` frames unmeasured (the adaptive
+// choice times the team and one thread in its first runs: what is measured
+// is the steady state). Then each round steps each configuration
+// `--frames` frames back to back after one unmeasured frame, with a pause
+// before it long enough for every other configuration's idle workers to
+// fall asleep. Reports per configuration
 // the median and 90th percentile of the frame time over all rounds, and
 // the speedup over 1 thread: the median over rounds of the ratio of the
 // round's median frame times (paired, so a drift of the machine's speed
@@ -22,7 +25,7 @@
 // (the "second core is busy" case; the 1-thread time is then also measured
 // beside it).
 //
-//   bench_scaling [--rounds R] [--frames F] [--threads N] [--busy] [--quick] [--only NAME]
+//   bench_scaling [--rounds R] [--frames F] [--warmup W] [--threads N] [--busy] [--quick] [--only NAME]
 //                 [--csv FILE]
 //   e.g. bench_scaling --csv benchmarks/results/scaling_2026-11-28.csv
 // Prints a table and, with --csv, writes one row per scene and configuration:
@@ -139,13 +142,14 @@ pid_t start_spinner() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int rounds = 15, frames = 4, threads = 0;
+  int rounds = 15, frames = 4, warmup = 10, threads = 0;
   bool busy = false, quick = false;
   std::string csv, only;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--rounds" && i + 1 < argc) rounds = std::atoi(argv[++i]);
     else if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
+    else if (a == "--warmup" && i + 1 < argc) warmup = std::atoi(argv[++i]);
     else if (a == "--threads" && i + 1 < argc) threads = std::atoi(argv[++i]);
     else if (a == "--busy") busy = true;
     else if (a == "--quick") quick = true;
@@ -153,13 +157,13 @@ int main(int argc, char** argv) {
     else if (a == "--csv" && i + 1 < argc) csv = argv[++i];
     else {
       std::fprintf(stderr,
-                   "usage: bench_scaling [--rounds R] [--frames F] [--threads N] [--busy] [--quick] [--only NAME] "
-                   "[--csv FILE]\n");
+                   "usage: bench_scaling [--rounds R] [--frames F] [--warmup W] [--threads N] [--busy] [--quick] "
+                   "[--only NAME] [--csv FILE]\n");
       return a == "--help" ? 0 : 2;
     }
   }
-  if (rounds < 1 || frames < 1) {
-    std::fprintf(stderr, "bench_scaling: --rounds and --frames must be >= 1\n");
+  if (rounds < 1 || frames < 1 || warmup < 0) {
+    std::fprintf(stderr, "bench_scaling: --rounds and --frames must be >= 1, --warmup >= 0\n");
     return 2;
   }
   const Config configs[] = {{"1_thread", 1, true}, {"adaptive", threads, true}, {"team", threads, false}};
@@ -190,6 +194,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), sim.error().message().c_str());
         return 1;
       }
+      for (int f = 0; f < warmup; ++f)
+        if (Status s = sim->step(); !s) {
+          std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), s.error().message().c_str());
+          return 1;
+        }
       sims.push_back(std::move(*sim));
     }
     std::vector<std::vector<double>> times(std::size(configs));

@@ -59,6 +59,13 @@ TEST(WidthChoice, FollowsTheMachineWhenASecondCoreIsBusyThenFreeAgain) {
   EXPECT_TRUE(w.team);
 }
 
+TEST(WidthChoice, ATeamOnlyAFewPercentFasterRunsAlone) {
+  WidthChoice w;
+  const int team = team_runs(w, 1 + WidthChoice::kTrials + 1000, 970.0, 1000.0);
+  EXPECT_FALSE(w.team);
+  EXPECT_LE(team, 1 + int(WidthChoice::kTrials) / 2 + 1000 / int(WidthChoice::kMaxBackoff) + 5);
+}
+
 TEST(WidthChoice, OneSlowTeamRunDoesNotFlipIt) {
   WidthChoice w;
   team_runs(w, 100, 550.0, 1000.0);

@@ -17,14 +17,18 @@ namespace sinew {
 // chosen by timing both. On a quiet machine the team wins wherever the
 // work is big enough; when another process keeps a core busy, the members
 // take turns on the other core and the team loses; a body of a few hundred
-// constraints is faster alone at any time. The first kTrials runs after a
+// constraints is faster alone at any time. The team must be faster by
+// kMargin to be chosen: a team that saves a few percent on average loses
+// as much in its slow frames, and one thread never pays for the other's
+// interruptions. The first kTrials runs after a
 // warm-up alternate the two; from then on the program runs on the faster,
 // and tries the other now and then: one alone run in kRecheck while on the
 // team (keeps the alone time current), one team run after a backoff that
 // doubles from kFirstBackoff to kMaxBackoff while the team keeps losing (so
 // a lost try costs at most one run in kMaxBackoff).
 struct WidthChoice {
-  static constexpr std::uint32_t kTrials = 6, kRecheck = 32, kFirstBackoff = 4, kMaxBackoff = 64;
+  static constexpr std::uint32_t kTrials = 8, kRecheck = 32, kFirstBackoff = 4, kMaxBackoff = 64;
+  static constexpr double kMargin = 0.95;  // the team runs if its time < kMargin x the alone time
   double team_ns = 0.0, alone_ns = 0.0;  // recent wall times of a run [ns]
   std::uint32_t runs = 0;
   std::uint32_t since = 0;  // runs on the chosen width since the last try of the other
@@ -41,7 +45,7 @@ struct WidthChoice {
     if (run <= kTrials) {
       double& e = on_team ? team_ns : alone_ns;
       e = e == 0.0 ? ns : e + (ns - e) / 2;
-      if (run == kTrials) team = team_ns <= alone_ns;
+      if (run == kTrials) team = team_ns < kMargin * alone_ns;
       return;
     }
     if (on_team == team) {
@@ -50,7 +54,7 @@ struct WidthChoice {
       double& e = on_team ? team_ns : alone_ns;
       e += (ns - e) / (on_team ? 8 : 4);
       ++since;
-      if (team && team_ns > alone_ns) {
+      if (team && team_ns >= kMargin * alone_ns) {
         team = false;
         since = 0;
       }
@@ -59,7 +63,7 @@ struct WidthChoice {
     since = 0;  // a try of the other width
     if (on_team) {
       team_ns = ns;
-      if (ns < alone_ns) {
+      if (ns < kMargin * alone_ns) {
         team = true;
         backoff = kFirstBackoff;
       } else {
@@ -67,7 +71,7 @@ struct WidthChoice {
       }
     } else {
       alone_ns = ns;
-      if (ns < team_ns) team = false;
+      if (team_ns >= kMargin * ns) team = false;
     }
   }
 };
