@@ -57,18 +57,32 @@ enum class SolveStop {
 /// They are reduced on the device at the end of the frame's program, in a
 /// fixed order and about 48-bit precision, so every backend reports the
 /// same numbers and only a few words come back (read_back_bytes).
+/// One stage of the frame (a feature of the runtime: "colliders and tools",
+/// "mesh collision", "continuous collision", "sutures", "solve",
+/// "statistics", "tearing", ...; only those the scene uses).
+struct StageProfile {
+  std::string name;
+  double ms = 0.0;  ///< wall time of the stage's work in the last step() [ms]
+};
+
 struct FrameStats {
   std::uint64_t frame = 0;  ///< frames done
   double time = 0.0;        ///< simulated time [s]
   double wall_ms = 0.0;     ///< wall time of the last step() [ms]: the frame program (solve and the
                             ///< reductions of the statistics) run and waited for, and measure_ms
   double measure_ms = 0.0;  ///< of which reading back and combining the statistics [ms]
-  std::uint64_t read_back_bytes = 0;  ///< bytes the host read from the device in the last step()
-                                      ///< (with mesh collision: the positions too, 16 per particle,
-                                      ///< and 32 per contact when a tool has face contacts; with
-                                      ///< continuous collision, 32 per particle per substep and 16 per
-                                      ///< particle per repair round more; with needles,
-                                      ///< 32 per particle and 96 per suture row)
+  /// Read-backs of all particles' positions by the frame's stages (mesh
+  /// collision, sutures, tearing share one, read at most once between two
+  /// changes of the positions; 0 in a frame that needs none). Continuous
+  /// collision's reads inside the solve are not among them (read_back_bytes
+  /// counts them).
+  std::uint32_t position_reads = 0;
+  std::uint64_t read_back_bytes = 0;  ///< bytes the host read from the device in the last step():
+                                      ///< the statistics' few words; with mesh collision, needles or
+                                      ///< tearing, the positions once (16 per particle, position_reads);
+                                      ///< 32 per contact when a tool has face contacts; 96 per suture
+                                      ///< row; with continuous collision, 32 per particle per substep
+                                      ///< and 16 per particle per repair round more
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,
   /// rest volume, ...): 0 when the xPBD system is solved exactly. Contact
@@ -128,6 +142,9 @@ struct FrameStats {
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;
+  /// The frame's stages in the order they run, each with its wall time in
+  /// the last step() (their sum is within wall_ms).
+  std::vector<StageProfile> stages;
 };
 
 class Simulation {
@@ -376,9 +393,12 @@ class Simulation {
   /// Its device, e.g. "CPU reference (2 threads, AVX2)" or "Vulkan: NVIDIA H100 (discrete GPU, ...)".
   [[nodiscard]] std::string device_name() const;
 
+  /// The library's own state behind a Simulation (src/runtime/simulation_impl.h; incomplete here, named so
+  /// that the frame's stages, src/runtime/stages/, can refer to it).
+  struct Impl;
+
  private:
   friend struct SimulationInternals;  // the library's own access (src/runtime/simulation_internals.h)
-  struct Impl;
   explicit Simulation(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

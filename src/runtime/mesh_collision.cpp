@@ -493,8 +493,12 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
   if (have_start) start_positions_.swap(positions_);
   positions_.resize(particles * 4);
   velocities_.resize(particles * 4);
-  if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
-  read_back_bytes_ += positions_.size() * 4;
+  if (mirror_) {
+    if (Status s = mirror_->copy_to(device, scene_buffers.position, particles * 4, positions_); !s) return s;
+  } else {
+    if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
+    read_back_bytes_ += positions_.size() * 4;
+  }
   if (have_start) {
     const auto inv_dt = static_cast<float>(1.0 / time_step_);
     for (std::size_t k = 0; k < positions_.size(); ++k)

@@ -30,6 +30,7 @@
 #include "collision/rest_close.h"
 #include "compiler/scene_compiler.h"
 #include "program/xpbd_program.h"
+#include "runtime/positions_mirror.h"
 #include "runtime/tool_contacts.h"
 #include "sinew/scene.h"
 
@@ -105,6 +106,8 @@ class MeshCollision {
   /// [in] mask: per particle, what sutures exempt (suture_exemption.h);
   /// outlives this, read every frame.
   void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }
+  /// Reads the positions through the frame's shared mirror (null: on its own).
+  void set_positions_mirror(PositionsMirror* mirror) { mirror_ = mirror; }
   /// Particles of the scene (device order).
   [[nodiscard]] std::size_t particles() const { return movable_.size(); }
   /// The collidable primitives (device particles): every line body's
@@ -233,6 +236,7 @@ class MeshCollision {
   double margin_ = 0.0;
   double violation_ = 0.0;
   bool fresh_ = false;  // positions_ and velocities_ hold the device's current state
+  PositionsMirror* mirror_ = nullptr;
   Status read_back(Device& device, const XpbdBuffers& scene_buffers);
   // Per-frame scratch, kept to avoid reallocating.
   std::vector<float> positions_, start_positions_, velocities_, speed_;

@@ -13,6 +13,7 @@
 #include "math/xpbd_math.h"
 #include "program/xpbd_program.h"
 #include "runtime/simulation_impl.h"
+#include "runtime/stages/stages.h"
 
 namespace sinew {
 
@@ -110,6 +111,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->continuous = std::make_unique<ContinuousCollision>(
         impl->mesh_collision->segments(), impl->mesh_collision->triangles(), *impl->mesh_collision, impl->buffers,
         scene.mesh_collision, scene.solver.substeps);
+  if (impl->mesh_collision) impl->mesh_collision->set_positions_mirror(&impl->positions_mirror);
+  if (impl->sutures) impl->sutures->set_positions_mirror(&impl->positions_mirror);
   if (impl->sutures) {  // a thread runs through its punctures: no contacts may push it out there
     if (impl->mesh_collision) impl->mesh_collision->set_suture_exemption(impl->sutures->exemption());
     if (impl->continuous) impl->continuous->set_suture_exemption(impl->sutures->exemption());
@@ -125,6 +128,17 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   } else if (Status s = impl->prepare_program(*compiled); !s) {
     return s.error();
   }
+
+  // The frame's stages, in the order they run: one line per feature.
+  Impl& im = *impl;
+  if (compiled->external_forces) im.add_stage(make_forces_stage(im));
+  im.add_stage(make_tools_stage(im));
+  if (im.mesh_collision) im.add_stage(make_mesh_collision_stage(im));
+  if (im.sutures) im.add_stage(make_sutures_stage(im));
+  if (im.continuous) im.add_stage(make_continuous_stage(im));
+  im.add_stage(make_solve_stage(im));
+  im.add_stage(make_statistics_stage(im));
+  if (im.topology && im.topology->tears()) im.add_stage(make_tearing_stage(im));
 
   SceneInfo& info = impl->info;
   info.particles = static_cast<std::uint32_t>(compiled->positions.size());
@@ -173,72 +187,33 @@ Status Simulation::Impl::rebuild_program() {
   return {};
 }
 
+void Simulation::Impl::add_stage(std::unique_ptr<FrameStage> stage) {
+  stats.stages.push_back({std::string(stage->name()), 0.0});
+  stages.push_back(std::move(stage));
+}
+
+// A frame: every stage's hooks, phase by phase (runtime/frame_stage.h), each
+// phase in the stages' order, each stage timed.
 Status Simulation::step() {
+  Impl& im = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  if (Status s = impl_->begin_frame_forces(); !s) return s;
-  if (Status s = impl_->before_frame(); !s) return s;
-  if (impl_->mesh_collision) {
-    bool grew = false;
-    if (Status s = impl_->mesh_collision->before_frame(*impl_->device, impl_->buffers, impl_->collider_shapes(),
-                                                               impl_->tool_shapes(true), impl_->tool_shapes(false), grew);
-        !s)
-      return s;
-    if (grew)
-      if (Status s = impl_->rebuild_program(); !s) return s;
-    impl_->stats.mesh_contacts = impl_->mesh_collision->contacts();
-    impl_->stats.mesh_contact_colors = impl_->mesh_collision->colors();
-    impl_->stats.collision_margin = impl_->mesh_collision->margin();
-  }
-  const auto collided = std::chrono::steady_clock::now();
-  impl_->stats.collision_ms = std::chrono::duration<double, std::milli>(collided - start).count();
-  if (impl_->sutures)
-    if (Status s = impl_->sutures->before_frame(*impl_->device, impl_->buffers); !s) return s;
-  const auto sutured = std::chrono::steady_clock::now();
-  impl_->stats.suture_ms = std::chrono::duration<double, std::milli>(sutured - collided).count();
-  if (impl_->stepper) {
-    if (impl_->continuous) impl_->continuous->begin_frame(impl_->frame_capsules());
-    if (Status s = impl_->stepper->run_frame(*impl_->device, impl_->stats, impl_->continuous.get()); !s) return s;
-    if (const ContinuousCollision* c = impl_->continuous.get()) {
-      impl_->stats.ccd_hits = c->hits();
-      impl_->stats.ccd_repairs = c->repairs();
-      impl_->stats.ccd_reverted = c->reverted();
-      impl_->stats.ccd_carried = c->carried();
-      impl_->stats.ccd_forced = c->forced();
-      impl_->stats.ccd_ms = c->wall_ms();
+  FrameContext frame{*im.device, im.stats};
+  for (StageProfile& p : im.stats.stages) p.ms = 0.0;
+  im.positions_mirror.begin_frame();
+  using Hook = Status (FrameStage::*)(FrameContext&);
+  for (Hook hook : {&FrameStage::before_frame, &FrameStage::solve, &FrameStage::after_solve, &FrameStage::after_frame})
+    for (std::size_t i = 0; i < im.stages.size(); ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      if (Status s = (im.stages[i].get()->*hook)(frame); !s) return s;
+      im.stats.stages[i].ms += ms_since(t0);
     }
-  } else {
-    if (Status s = impl_->device->run_program(impl_->prepared); !s) return s;
-    if (Status s = impl_->device->last_run_times(impl_->stats.device); !s) return s;
-    impl_->stats.sweeps = std::uint64_t(impl_->substeps) * std::uint64_t(impl_->iterations);
-  }
-  if (impl_->mesh_collision) {
-    if (Status s = impl_->mesh_collision->after_frame(*impl_->device, impl_->buffers); !s) return s;
-    impl_->stats.contact_violation = impl_->mesh_collision->violation();
-  }
-  if (impl_->sutures) {
-    const auto solved = std::chrono::steady_clock::now();
-    if (Status s = impl_->sutures->after_frame(*impl_->device, impl_->buffers, impl_->time_step / impl_->substeps,
-                                               impl_->time_step);
-        !s)
-      return s;
-    impl_->stats.suture_ms +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - solved).count();
-  }
-  const auto ran = std::chrono::steady_clock::now();
-  if (Status s = read_stats(*impl_->device, impl_->stats_plan, impl_->device_stats); !s) return s;
-  impl_->stats.read_back_bytes = std::uint64_t{impl_->stats_plan.result_words} * 4 +
-                                 (impl_->stepper ? impl_->stepper->read_back_bytes() : 0) +
-                                 (impl_->mesh_collision ? impl_->mesh_collision->read_back_bytes() : 0) +
-                                 (impl_->continuous ? impl_->continuous->read_back_bytes() : 0) +
-                                 (impl_->sutures ? impl_->sutures->read_back_bytes() : 0);
-  if (Status s = impl_->after_frame(); !s) return s;
-  if (impl_->measure_errors) impl_->measure(impl_->stats);
-  if (Status s = impl_->tear(); !s) return s;  // the next frame runs without what tore (last_tears)
+  im.stats.read_back_bytes = im.positions_mirror.bytes();
+  for (const auto& stage : im.stages) im.stats.read_back_bytes += stage->read_back_bytes();
+  im.stats.position_reads = im.positions_mirror.reads();
   const auto end = std::chrono::steady_clock::now();
-  impl_->stats.frame += 1;
-  impl_->stats.time = static_cast<double>(impl_->stats.frame) * impl_->time_step;
-  impl_->stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
-  impl_->stats.measure_ms = std::chrono::duration<double, std::milli>(end - ran).count();
+  im.stats.frame += 1;
+  im.stats.time = static_cast<double>(im.stats.frame) * im.time_step;
+  im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
   return {};
 }
 
@@ -306,6 +281,16 @@ Status Simulation::Impl::read_in_user_order(BufferHandle buffer, std::vector<flo
   return {};
 }
 
+Status Simulation::Impl::positions_in_user_order(std::vector<float>& xyzw) {
+  const std::size_t n = order.user_of.size();
+  xyzw.resize(n * 4);
+  std::vector<float>& slots = device_order_scratch;
+  if (Status s = positions_mirror.copy_to(*device, buffers.position, n * 4, slots); !s) return s;
+  for (std::size_t slot = 0; slot < n; ++slot)
+    std::copy_n(&slots[slot * 4], 4, &xyzw[std::size_t{order.user_of[slot]} * 4]);
+  return {};
+}
+
 Status Simulation::read_positions(std::vector<float>& xyzw) const {
   return impl_->read_in_user_order(impl_->buffers.position, xyzw);
 }
@@ -324,5 +309,8 @@ std::string Simulation::device_name() const { return impl_->device->device_name(
 const Device& SimulationInternals::device(const Simulation& sim) { return *sim.impl_->device; }
 const FrameProgram& SimulationInternals::program(const Simulation& sim) { return sim.impl_->program; }
 double SimulationInternals::frame_length(const Simulation& sim) { return sim.impl_->solver.time_step; }
+void SimulationInternals::add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage) {
+  sim.impl_->add_stage(std::move(stage));
+}
 
 }  // namespace sinew

@@ -12,6 +12,8 @@
 #include "program/stats_program.h"
 #include "program/xpbd_program.h"
 #include "runtime/contact_state.h"
+#include "runtime/frame_stage.h"
+#include "runtime/positions_mirror.h"
 #include "runtime/tool_contacts.h"
 #include "runtime/continuous_collision.h"
 #include "runtime/mesh_collision.h"
@@ -25,6 +27,14 @@ namespace sinew {
 
 struct Simulation::Impl {
   std::unique_ptr<Device> device;
+  // The frame's stages in the order they run (runtime/frame_stage.h,
+  // registered in Simulation::create); stats.stages holds their profiles
+  // in the same order.
+  std::vector<std::unique_ptr<FrameStage>> stages;
+  void add_stage(std::unique_ptr<FrameStage> stage);
+  // The positions as read back for the stages that need them on the host
+  // (runtime/positions_mirror.h): at most once between two changes.
+  PositionsMirror positions_mirror;
   XpbdBuffers buffers;
   FrameProgram program;
   ProgramHandle prepared;
@@ -42,6 +52,8 @@ struct Simulation::Impl {
   ParticleOrder order;
   mutable std::vector<float> device_order_scratch;
   Status read_in_user_order(BufferHandle buffer, std::vector<float>& xyzw) const;
+  /// The positions in the user's order, through the mirror (the stages' read of this frame).
+  Status positions_in_user_order(std::vector<float>& xyzw);
   // The errors and the tools' reaction, reduced on the device at the end of
   // each frame (stats_program.h) and read back as a few words.
   StatsPlan stats_plan;

@@ -4,9 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "backends/backend.h"
+#include "runtime/frame_stage.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -15,6 +17,9 @@ struct SimulationInternals {
   static const Device& device(const Simulation& sim);
   static const FrameProgram& program(const Simulation& sim);
   static double frame_length(const Simulation& sim);  ///< SolverSettings::time_step [s]
+  /// Appends a stage to the frame: in every phase it runs after the
+  /// scene's own, and FrameStats::stages gains its profile.
+  static void add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage);
   /// The colouring checker (scenes with topology_changes): every block's
   /// colours in use, read back from the device, and the particles they
   /// share. conflicts: movable particles (inverse mass > 0 on the device)

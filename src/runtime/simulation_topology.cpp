@@ -46,6 +46,7 @@ Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulat
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
+  if (changed) positions_mirror.changed();  // a removal hands mass on: the positions' w
   if (changed && graspers) graspers->invalidate();
   if (changed && measure_errors && event->body_kind == BodyKind::tet)
     if (Status s = refresh_volume(*event); !s) return s.error();
@@ -189,7 +190,7 @@ Status Simulation::Impl::tear() {
   if (!topology || !topology->tears()) return {};
   auto start = std::chrono::steady_clock::now();  // each event's time: its query and change (the first's: the read-back too)
   std::vector<float> x;
-  if (Status s = read_in_user_order(buffers.position, x); !s) return s;
+  if (Status s = positions_in_user_order(x); !s) return s;
   for (BodyKind kind : {BodyKind::tet, BodyKind::tri})
     for (std::size_t b = 0; b < topology->bodies(kind); ++b) {
       const double strain = topology->tear_strain(kind, b);

@@ -42,6 +42,7 @@
 #include "compiler/scene_compiler.h"
 #include "math/vec3.h"
 #include "program/xpbd_program.h"
+#include "runtime/positions_mirror.h"
 #include "runtime/rigid_tool.h"
 #include "sinew/simulation.h"
 
@@ -73,6 +74,8 @@ class Sutures {
   /// Before a frame: reads the positions, finds the tips' contacts,
   /// uploads the needles and the rows.
   Status before_frame(Device& device, const XpbdBuffers& scene_buffers);
+  /// Reads the positions through the frame's shared mirror (null: on its own).
+  void set_positions_mirror(PositionsMirror* mirror) { mirror_ = mirror; }
   /// After it: reads the rows back, makes and ends punctures. [in] h: the
   /// substep [s]; frame: the frame's length [s].
   Status after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame);
@@ -137,6 +140,8 @@ class Sutures {
   std::vector<Needle> needles_;
   std::vector<std::uint32_t> slots_;  // the threads' vertices' device slots
   std::vector<float> positions_;      // device order, xyzw, the last read
+  PositionsMirror* mirror_ = nullptr;
+  Status read_positions(Device& device, const XpbdBuffers& scene_buffers);
   std::vector<std::uint8_t> exempt_;  // per particle: kSutureThread, kSutureHole (suture_exemption.h)
   void mark_exemption();
   SutureBuffers buffers_;

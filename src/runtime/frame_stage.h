@@ -1,0 +1,54 @@
+// frame_stage.h — the frame as a list of stages. Each feature of the
+// runtime (external forces, tools, mesh collision, continuous collision,
+// needles and sutures, the solve, the statistics, tearing) is one stage;
+// Simulation::step() runs the stages' hooks phase by phase, each phase in
+// the order the stages were registered, and times every stage.
+//
+// The shape follows Box2D v3's step context (b2StepContext: what one step
+// shares, passed to each stage of the solver) and Jolt's step listeners
+// (PhysicsStepListener: a feature joins the update by registering one
+// object): a new feature is one stage file and one registration line
+// (Simulation::create in simulation.cpp).
+//
+// The phases of a frame, in order:
+//   before_frame  upload what moved, find contacts (tools, mesh collision, sutures, CCD's frame capsules)
+//   solve         the frame's device programs (only the solve stage)
+//   after_solve   read back what the solve produced, then the statistics
+//   after_frame   act on the statistics (tools' reactions, errors), tear
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string_view>
+
+#include "backends/backend.h"
+#include "sinew/simulation.h"
+
+namespace sinew {
+
+/// What the stages of one frame share. The device and the scene's buffers
+/// stay the Simulation's; the statistics are the frame's being made.
+struct FrameContext {
+  Device& device;
+  FrameStats& stats;
+};
+
+class FrameStage {
+ public:
+  virtual ~FrameStage() = default;
+  /// The stage's name in FrameStats::stages ("mesh collision", ...).
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  virtual Status before_frame(FrameContext&) { return {}; }
+  virtual Status solve(FrameContext&) { return {}; }
+  virtual Status after_solve(FrameContext&) { return {}; }
+  virtual Status after_frame(FrameContext&) { return {}; }
+  /// Bytes the stage read back from the device in the last frame.
+  [[nodiscard]] virtual std::uint64_t read_back_bytes() const { return 0; }
+};
+
+/// Milliseconds since `start` (a stage's own figures in FrameStats).
+inline double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace sinew

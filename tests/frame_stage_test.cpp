@@ -1,0 +1,159 @@
+// frame_stage_test.cpp — the frame as stages (src/runtime/frame_stage.h):
+// a stage added to a scene runs in every phase in the order registered,
+// after the scene's own, and is profiled; its error stops the frame; its
+// read-back counts; a scene lists only the stages it uses.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mesh_contact_support.h"
+#include "suture_scenes.h"
+#include "runtime/simulation_internals.h"
+#include "test_support.h"
+
+namespace sinew {
+namespace {
+
+// A stage that writes "<name>.<phase>" to a shared log; it checks what the
+// scene's own stages did before it in the same phase.
+class LogStage final : public FrameStage {
+ public:
+  LogStage(std::string name, std::vector<std::string>& log) : name_(std::move(name)), log_(log) {}
+  std::string_view name() const override { return name_; }
+  Status before_frame(FrameContext&) override { return note("before_frame"); }
+  Status solve(FrameContext& frame) override {
+    solved_sweeps = frame.stats.sweeps;  // the solve stage ran before this one
+    return note("solve");
+  }
+  Status after_solve(FrameContext&) override { return note("after_solve"); }
+  Status after_frame(FrameContext&) override {
+    if (sleep_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(sleep_ms));
+    if (fail) return Error(ErrorCode::bad_parameter, name_ + " refused the frame");
+    return note("after_frame");
+  }
+  std::uint64_t read_back_bytes() const override { return bytes; }
+
+  int sleep_ms = 0;
+  bool fail = false;
+  std::uint64_t bytes = 0;
+  std::uint64_t solved_sweeps = 0;
+
+ private:
+  Status note(const char* phase) {
+    log_.push_back(name_ + "." + phase);
+    return {};
+  }
+  std::string name_;
+  std::vector<std::string>& log_;
+};
+
+SceneDesc hanging_block() {
+  SceneDesc scene;
+  scene.solver = {.time_step = 1.0 / 60.0, .substeps = 2, .iterations = 3};
+  TetBodyDesc body;
+  body.mesh = *make_tet_grid({.nx = 3, .ny = 2, .nz = 2, .origin = {0, 0, 0}, .cell_size = {0.01, 0.01, 0.01}});
+  EXPECT_TRUE(body.set_elastic(2e4, 0.3).ok());
+  body.pinned = {0};
+  scene.tet_bodies.push_back(body);
+  return scene;
+}
+
+std::vector<std::string> names(const FrameStats& stats) {
+  std::vector<std::string> out;
+  for (const StageProfile& p : stats.stages) out.push_back(p.name);
+  return out;
+}
+
+TEST(FrameStage, AnAddedStageRunsEveryPhaseInOrderAndIsProfiled) {
+  auto sim = Simulation::create(hanging_block(), {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  std::vector<std::string> log;
+  auto a = std::make_unique<LogStage>("a", log);
+  auto b = std::make_unique<LogStage>("b", log);
+  LogStage* first = a.get();
+  b->sleep_ms = 3;
+  b->bytes = 1000;
+  SimulationInternals::add_stage(*sim, std::move(a));
+  SimulationInternals::add_stage(*sim, std::move(b));
+  ASSERT_TRUE(sim->step().ok());
+  EXPECT_EQ(log, (std::vector<std::string>{"a.before_frame", "b.before_frame", "a.solve", "b.solve", "a.after_solve",
+                                           "b.after_solve", "a.after_frame", "b.after_frame"}));
+  EXPECT_EQ(first->solved_sweeps, 2u * 3u) << "the scene's solve runs before a stage added after it";
+  const FrameStats& stats = sim->last_frame();
+  EXPECT_EQ(names(stats), (std::vector<std::string>{"colliders and tools", "solve", "statistics", "a", "b"}));
+  EXPECT_GE(stats.stages[4].ms, 3.0);
+  EXPECT_LT(stats.stages[3].ms, stats.stages[4].ms);
+  double sum = 0.0;
+  for (const StageProfile& p : stats.stages) sum += p.ms;
+  EXPECT_LE(sum, stats.wall_ms);
+  EXPECT_GT(stats.stages[1].ms, 0.0) << "the solve is timed";
+  EXPECT_GE(stats.read_back_bytes, 1000u) << "a stage's read-back counts";
+  // The profile is of the last frame, not a sum.
+  log.clear();
+  ASSERT_TRUE(sim->step().ok());
+  EXPECT_EQ(log.size(), 8u);
+  EXPECT_LT(sim->last_frame().stages[4].ms, 6.0 + 50.0);
+}
+
+TEST(FrameStage, AStagesErrorStopsTheFrameWithItsMessage) {
+  auto sim = Simulation::create(hanging_block(), {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  std::vector<std::string> log;
+  auto stage = std::make_unique<LogStage>("gate", log);
+  stage->fail = true;
+  SimulationInternals::add_stage(*sim, std::move(stage));
+  const Status s = sim->step();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message().find("gate refused the frame"), std::string::npos) << s.error().message();
+  EXPECT_EQ(sim->last_frame().frame, 0u) << "a failed frame is not counted";
+}
+
+TEST(FrameStage, AScenesStagesAreOnlyThoseItUses) {
+  auto plain = Simulation::create(hanging_block(), {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(plain.ok()) << plain.error().message();
+  EXPECT_EQ(names(plain->last_frame()), (std::vector<std::string>{"colliders and tools", "solve", "statistics"}));
+
+  auto contact = Simulation::create(test::dropped_blocks_scene(ContactSchedule::colored), {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(contact.ok()) << contact.error().message();
+  ASSERT_TRUE(contact->step().ok());
+  EXPECT_EQ(names(contact->last_frame()),
+            (std::vector<std::string>{"colliders and tools", "mesh collision", "solve", "statistics"}));
+  EXPECT_GT(contact->last_frame().stages[1].ms, 0.0);
+
+  SceneDesc forced = hanging_block();
+  forced.external_forces = true;
+  auto with_forces = Simulation::create(forced, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(with_forces.ok()) << with_forces.error().message();
+  EXPECT_EQ(names(with_forces->last_frame()).front(), "forces");
+}
+
+// Mesh collision and needles both need the positions on the host, after the
+// solve and (the needles) before the next frame: the stages share one
+// read-back a frame.
+TEST(FrameStage, ThePositionsAreReadBackOnceAFrame) {
+  SceneDesc scene = test::SuturePads::scene();
+  scene.mesh_collision.enabled = true;
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const std::uint64_t position_bytes = std::uint64_t{sim->info().particles} * 16;
+  for (int f = 0; f < 12; ++f) {
+    ASSERT_TRUE(test::SuturePads::drive(*sim, f).ok());
+    ASSERT_TRUE(sim->step().ok());
+    const FrameStats& stats = sim->last_frame();
+    // The first frame also reads the starting positions (nothing has read them before).
+    EXPECT_EQ(stats.position_reads, f == 0 ? 2u : 1u) << "frame " << f;
+    EXPECT_GE(stats.read_back_bytes, position_bytes) << "frame " << f;
+    // Each stage reading its own would be three times the positions (mesh
+    // collision after the solve, the needles before and after it); the
+    // first frame also reads the starting velocities.
+    EXPECT_LT(stats.read_back_bytes, (f == 0 ? 3 : 1) * position_bytes + position_bytes / 2) << "frame " << f;
+  }
+  EXPECT_EQ(names(sim->last_frame()),
+            (std::vector<std::string>{"colliders and tools", "mesh collision", "sutures", "solve", "statistics"}));
+}
+
+}  // namespace
+}  // namespace sinew
