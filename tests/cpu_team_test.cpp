@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "test_support.h"
@@ -43,6 +44,20 @@ TEST(CpuTeam, PositionsAreBitwiseTheSameOnAnyThreadCount) {
         << "1 thread vs run " << r << " (2 or 3 threads, adaptive or always the team)";
   // It sagged: the comparison is of a moving body, not of the rest state.
   EXPECT_LT(result[0][4 * (body.mesh.vertices.size() - 1) + 1], 0.035f);
+}
+
+// More threads than the team can hold is a named error, not std::terminate
+// (it was: a thread per member, created without a cap).
+TEST(CpuTeam, TooManyThreadsIsANamedError) {
+  SceneDesc scene;
+  TetBodyDesc body;
+  body.mesh = *make_tet_grid({.nx = 1, .ny = 1, .nz = 1, .origin = {0, 0, 0}, .cell_size = {0.01, 0.01, 0.01}});
+  scene.tet_bodies.push_back(body);
+  auto sim = Simulation::create(scene, {.backend = "cpu", .threads = 100000, .quiet = true});
+  ASSERT_FALSE(sim.ok());
+  EXPECT_EQ(sim.error().code(), ErrorCode::bad_parameter);
+  EXPECT_NE(sim.error().message().find("DeviceOptions.threads must be <= 256"), std::string::npos)
+      << sim.error().message();
 }
 
 }  // namespace

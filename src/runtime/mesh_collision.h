@@ -308,6 +308,60 @@ class MeshCollision {
   std::vector<std::uint32_t> kept_, contact_particles_, table_, upload_particles_;
   std::vector<float> upload_coefficients_, upload_normals_;
   std::vector<std::uint32_t> upload_offsets_, upload_touched_, upload_slots_, compact_offsets_;  // Jacobi
+  // The runs of `body_of` (one body's primitives are contiguous): per body
+  // of `bodies`, its (first, count); count 0 for a body with none.
+  static std::vector<std::pair<std::uint32_t, std::uint32_t>> body_ranges(const std::vector<std::uint32_t>& body_of,
+                                                                          std::uint32_t bodies);
+  // ---- The frame's detection (before_frame; mesh_collision_detect.cpp).
+  // speed_ per collidable particle; [out] fastest. Errors: a non-finite velocity.
+  Status measure_speeds(float& fastest);
+  void mean_velocities();   // mean_velocity_
+  void outward_normals();   // vertex_out_, face_out_ (self-collision with solids)
+  // Grows each primitive's box along its corners' velocities (less `mean`) over 2 dt.
+  void sweep(std::span<const std::uint32_t> corners, int arity, std::span<const float> velocities,
+             const double mean[3], std::vector<collision::Aabb>& boxes) const;
+  // The trees refitted to the frame's boxes (grown by `half`), degraded ones rebuilt.
+  Status refit_triangle_trees(float half);
+  Status refit_segment_trees(float half);
+  Status fit(std::span<const std::uint32_t> indices, int arity, std::span<const std::uint32_t> body_of,
+             std::vector<BodyTree>& trees, float half);
+  Status gather_body(BodyTree& body, std::span<const std::uint32_t> indices, int arity);
+  Status gather(std::span<const std::uint32_t> indices, int arity, std::vector<BodyTree>& trees);
+  void rebuild_degraded(std::vector<BodyTree>& trees);
+  // The narrow phase's filters: a solid's two sides facing across air, and
+  // every condition a contact of the frame meets (within `common` plus its
+  // closing speed's share).
+  bool across_air(const collision::Contact& c) const;
+  bool wanted_contact(const collision::Contact& c, double common) const;
+  Status check_pairs(float reach, float fastest) const;  // pairs_ within kMaxPairs
+  // The frame's contacts between the meshes into all_ (before prune).
+  Status detect_contacts(double common, float reach, float fastest);
+  // ---- Scheduling and upload (mesh_collision_schedule.cpp).
+  Status schedule_contacts(Device& device, bool& grew);
+  std::uint32_t keep_movable();  // kept_, contact_particles_, contact_count_
+  Status make_room(Device& device, std::uint32_t count, bool& grew);
+  Status assign_slots(Device& device, std::uint32_t count, std::vector<std::uint32_t>& slot_of, bool& grew);
+  void fill_upload(std::uint32_t count, std::span<const std::uint32_t> slot_of);
+  Status upload_jacobi(Device& device);
+  Status upload_contacts(Device& device, std::uint32_t count);
+  // ---- update_topology's steps (mesh_collision_topology.cpp).
+  struct TopologyChange {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> old_triangles, old_segments;  // body_ranges before
+    std::vector<std::uint8_t> body_changed;  // per body
+    // Per triangle body that changed: old local index -> new (remap) and the
+    // new triangles (added, new local indices); per changed body, its new
+    // primitives (replaced, device particles).
+    std::vector<std::vector<std::uint32_t>> remap, added, replaced;
+  };
+  Status tets_died(std::span<const std::vector<std::uint8_t>* const> tet_alive,
+                   std::vector<std::vector<std::uint32_t>>& died) const;
+  void update_tet_boundaries(const std::vector<std::vector<std::uint32_t>>& died, TopologyChange& change);
+  void compare_tri_bodies(const SceneDesc& scene, TopologyChange& change);
+  void compare_line_bodies(const SceneDesc& scene, TopologyChange& change);
+  Status retree(const std::vector<std::uint32_t>& body_of, const std::vector<std::uint32_t>& old_body_of,
+                std::vector<BodyTree>& trees, bool triangles_of, const TopologyChange& change);
+  void carry_ownership(const TopologyChange& change, const std::vector<std::uint32_t>& triangles,
+                       std::uint32_t triangle_bodies);
 };
 
 }  // namespace sinew
