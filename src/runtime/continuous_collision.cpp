@@ -145,11 +145,87 @@ void ContinuousSearch::fit(std::span<const float> start, std::span<const float> 
   else tree.update(boxes_);
 }
 
-Status ContinuousSearch::find(std::span<const float> start, std::span<const float> end,
-                              std::vector<Contact>& hits, std::span<const Capsule> capsules,
-                              std::span<const std::uint32_t> carried) {
-  hits.clear();
-  queries_ = 0;
+namespace {
+
+// A touch found by a query: the weights of the two primitives' points
+// (edge-edge: (1 - s, s, 1 - t, t); vertex-face: (1, wa, wb, wc)), the
+// normal of the plane they meet in, the first point minus the second at the
+// start, and how that difference moved.
+struct Touch {
+  double w[4];
+  Point plane, apart, moved;
+};
+
+// Edge (m[0], m[1]) against edge (m[2], m[3]), given as motions; [out]
+// touch. Counts the query in `queries`.
+Result<bool> touch_edges(const Motion* m, double separation, Touch& touch, std::uint64_t& queries) {
+  ccd::Settings settings;
+  settings.min_separation = separation;
+  ++queries;
+  const auto hit = ccd::edge_edge(m[0], m[1], m[2], m[3], settings);
+  if (Status s = check_query(hit); !s) return s.error();
+  if (!hit->touch) return false;
+  // The touching points: the closest points at the time returned (the
+  // hit's own parameters are only its box's corner, up to a box's width off).
+  const double t = hit->time;
+  const auto st = kernels::proximity::closest_between_segments(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
+  touch.w[0] = 1.0 - st.s, touch.w[1] = st.s, touch.w[2] = 1.0 - st.t, touch.w[3] = st.t;
+  touch.plane = cross(sub(lerp(m[1], t), lerp(m[0], t)), sub(lerp(m[3], t), lerp(m[2], t)));
+  touch.apart = sub(weighted({m, 2}, {touch.w, 2}, 0.0), weighted({m + 2, 2}, {touch.w + 2, 2}, 0.0));
+  touch.moved = sub(sub(weighted({m, 2}, {touch.w, 2}, 1.0), weighted({m + 2, 2}, {touch.w + 2, 2}, 1.0)), touch.apart);
+  return true;
+}
+
+// Vertex m[0] against triangle m[1..3].
+Result<bool> touch_vertex_face(const Motion* m, double separation, Touch& touch, std::uint64_t& queries) {
+  ccd::Settings settings;
+  settings.min_separation = separation;
+  ++queries;
+  const auto hit = ccd::vertex_face(m[0], m[1], m[2], m[3], settings);
+  if (Status s = check_query(hit); !s) return s.error();
+  if (!hit->touch) return false;
+  const double t = hit->time;
+  const auto w = kernels::proximity::closest_on_triangle(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
+  touch.w[0] = 1.0, touch.w[1] = w.wa, touch.w[2] = w.wb, touch.w[3] = w.wc;
+  touch.plane = cross(sub(lerp(m[2], t), lerp(m[1], t)), sub(lerp(m[3], t), lerp(m[1], t)));
+  touch.apart = sub(m[0][0], weighted({m + 1, 3}, {touch.w + 1, 3}, 0.0));
+  touch.moved = sub(sub(m[0][1], weighted({m + 1, 3}, {touch.w + 1, 3}, 1.0)), touch.apart);
+  return true;
+}
+
+void motions_of(std::span<const float> start, std::span<const float> end, std::span<const std::uint32_t> particles,
+                Motion* m) {
+  for (std::size_t k = 0; k < particles.size(); ++k) m[k] = motion_of(start, end, particles[k]);
+}
+
+Contact contact_of(Contact::Kind kind, std::array<std::uint32_t, 4> v, const Touch& touch) {
+  Contact c;
+  c.kind = kind;
+  c.v = v;
+  for (int k = 0; k < 4; ++k) c.w[k] = static_cast<float>(touch.w[k]);
+  c.normal = contact_normal(touch.plane, touch.apart, touch.moved);
+  return c;
+}
+
+// The touch of tissue `p` (arity 2 or 3) with capsule c, as a shape_face hit.
+Contact capsule_contact(std::span<const std::uint32_t> p, std::uint32_t c, const double* w, const Touch& t) {
+  Contact hit;
+  hit.kind = Contact::Kind::shape_face;
+  if (p.size() == 3) {
+    hit.v = {p[0], p[0], p[1], p[2]};
+    hit.w = {0.0f, float(w[0]), float(w[1]), float(w[2])};
+  } else {
+    hit.v = {p[0], p[0], p[1], p[1]};
+    hit.w = {0.0f, float(w[0]), 0.0f, float(w[1])};
+  }
+  hit.normal = contact_normal(t.plane, t.apart, t.moved);
+  hit.shape = c;
+  return hit;
+}
+
+}  // namespace
+
+Status ContinuousSearch::check_finite(std::span<const float> start, std::span<const float> end) const {
   // Every vertex of a segment or triangle, once (a NaN would fail every
   // box test silently).
   for (const auto* list : {&segments_, &triangle_vertices_})
@@ -158,58 +234,15 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
         if (!std::isfinite(start[std::size_t{p} * 4 + a]) || !std::isfinite(end[std::size_t{p} * 4 + a]))
           return Error(ErrorCode::bad_parameter, "continuous collision: particle " + std::to_string(p) +
                                                      " (device order) has a non-finite position");
-  // Edge (a0, a1) against edge (b0, b1), given as motions; [out] s, t the
-  // touching points' parameters, plane the normal of the plane the edges
-  // meet in, apart the first point minus the second at the start.
-  struct Touch {
-    double w[4];  // weights: edge-edge (1 - s, s, 1 - t, t); vertex-face (1, wa, wb, wc)
-    Point plane, apart, moved;
-  };
-  const auto edges = [&](const Motion* m, double separation, Touch& touch) -> Result<bool> {
-    ccd::Settings settings;
-    settings.min_separation = separation;
-    ++queries_;
-    const auto hit = ccd::edge_edge(m[0], m[1], m[2], m[3], settings);
-    if (Status s = check_query(hit); !s) return s.error();
-    if (!hit->touch) return false;
-    // The touching points: the closest points at the time returned (the
-    // hit's own parameters are only its box's corner, up to a box's width off).
-    const double t = hit->time;
-    const auto st = kernels::proximity::closest_between_segments(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
-    touch.w[0] = 1.0 - st.s, touch.w[1] = st.s, touch.w[2] = 1.0 - st.t, touch.w[3] = st.t;
-    touch.plane = cross(sub(lerp(m[1], t), lerp(m[0], t)), sub(lerp(m[3], t), lerp(m[2], t)));
-    touch.apart = sub(weighted({m, 2}, {touch.w, 2}, 0.0), weighted({m + 2, 2}, {touch.w + 2, 2}, 0.0));
-    touch.moved = sub(sub(weighted({m, 2}, {touch.w, 2}, 1.0), weighted({m + 2, 2}, {touch.w + 2, 2}, 1.0)), touch.apart);
-    return true;
-  };
-  // Vertex m[0] against triangle m[1..3].
-  const auto vertex_face = [&](const Motion* m, double separation, Touch& touch) -> Result<bool> {
-    ccd::Settings settings;
-    settings.min_separation = separation;
-    ++queries_;
-    const auto hit = ccd::vertex_face(m[0], m[1], m[2], m[3], settings);
-    if (Status s = check_query(hit); !s) return s.error();
-    if (!hit->touch) return false;
-    const double t = hit->time;
-    const auto w = kernels::proximity::closest_on_triangle(at(m[0], t), at(m[1], t), at(m[2], t), at(m[3], t));
-    touch.w[0] = 1.0, touch.w[1] = w.wa, touch.w[2] = w.wb, touch.w[3] = w.wc;
-    touch.plane = cross(sub(lerp(m[2], t), lerp(m[1], t)), sub(lerp(m[3], t), lerp(m[1], t)));
-    touch.apart = sub(m[0][0], weighted({m + 1, 3}, {touch.w + 1, 3}, 0.0));
-    touch.moved = sub(sub(m[0][1], weighted({m + 1, 3}, {touch.w + 1, 3}, 1.0)), touch.apart);
-    return true;
-  };
-  const auto motions = [&](std::span<const std::uint32_t> particles, Motion* m) {
-    for (std::size_t k = 0; k < particles.size(); ++k) m[k] = motion_of(start, end, particles[k]);
-  };
-  const auto add = [&](Contact::Kind kind, std::array<std::uint32_t, 4> v, const Touch& touch) {
-    Contact c;
-    c.kind = kind;
-    c.v = v;
-    for (int k = 0; k < 4; ++k) c.w[k] = static_cast<float>(touch.w[k]);
-    c.normal = contact_normal(touch.plane, touch.apart, touch.moved);
-    hits.push_back(c);
-  };
+  return {};
+}
 
+Status ContinuousSearch::find(std::span<const float> start, std::span<const float> end,
+                              std::vector<Contact>& hits, std::span<const Capsule> capsules,
+                              std::span<const std::uint32_t> carried) {
+  hits.clear();
+  queries_ = 0;
+  if (Status s = check_finite(start, end); !s) return s;
   if (!segments_.empty()) {
     fit(start, end, segments_, 2, segment_tree_);
     segment_boxes_ = boxes_;
@@ -226,139 +259,150 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
     grow(boxes_, reach);
     segment_reach_tree_.build(boxes_);
   }
+  if (!segments_.empty())
+    if (Status s = thread_against_thread(start, end, hits); !s) return s;
+  if (!segments_.empty() && !triangles_.empty())
+    if (Status s = thread_against_surfaces(start, end, hits); !s) return s;
+  if (!capsules.empty())
+    if (Status s = capsules_against_tissue(start, end, hits, capsules, carried, surfaces, reach); !s) return s;
+  collision::sort_unique_contacts(hits);
+  return {};
+}
+
+Status ContinuousSearch::thread_against_thread(std::span<const float> start, std::span<const float> end,
+                                               std::vector<Contact>& hits) {
   Touch touch;
-  // Thread against thread.
-  if (!segments_.empty()) {
-    collision::self_overlapping_pairs(segment_tree_, collision::SharesVertexOf<2>{segments_}, pairs_);
-    for (const collision::Pair& pr : pairs_) {
-      const std::uint32_t* a = &segments_[std::size_t{pr.first} * 2];
-      const std::uint32_t* b = &segments_[std::size_t{pr.second} * 2];
-      const std::uint32_t p[4] = {a[0], a[1], b[0], b[1]};
+  collision::self_overlapping_pairs(segment_tree_, collision::SharesVertexOf<2>{segments_}, pairs_);
+  for (const collision::Pair& pr : pairs_) {
+    const std::uint32_t* a = &segments_[std::size_t{pr.first} * 2];
+    const std::uint32_t* b = &segments_[std::size_t{pr.second} * 2];
+    const std::uint32_t p[4] = {a[0], a[1], b[0], b[1]};
+    if (!moves(start, end, p)) continue;
+    Motion m[4];
+    motions_of(start, end, p, m);
+    auto hit = touch_edges(m, 0.0, touch, queries_);
+    if (!hit) return hit.error();
+    if (*hit) hits.push_back(contact_of(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch));
+  }
+  return {};
+}
+
+// Thread against surfaces: each end against the face, the segment against its edges.
+Status ContinuousSearch::thread_against_surfaces(std::span<const float> start, std::span<const float> end,
+                                                 std::vector<Contact>& hits) {
+  Touch touch;
+  collision::overlapping_pairs(segment_reach_tree_, triangle_tree_, pairs_);
+  for (const collision::Pair& pr : pairs_) {
+    const std::uint32_t* s = &segments_[std::size_t{pr.first} * 2];
+    const std::uint32_t* t = &triangles_[std::size_t{pr.second} * 3];
+    bool shared = false;  // a thread tied into a surface: its own triangles are its neighbours
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 3; ++j) shared |= s[i] == t[j];
+    if (shared) continue;
+    const std::uint32_t joined[5] = {s[0], s[1], t[0], t[1], t[2]};
+    if (suture_exempt(exempt_, joined)) continue;  // the thread runs through a puncture here
+    for (int i = 0; i < 2; ++i) {
+      const std::uint32_t p[4] = {s[i], t[0], t[1], t[2]};
       if (!moves(start, end, p)) continue;
       Motion m[4];
-      motions(p, m);
-      auto hit = edges(m, 0.0, touch);
+      motions_of(start, end, p, m);
+      auto hit = touch_vertex_face(m, 0.0, touch, queries_);
       if (!hit) return hit.error();
-      if (*hit) add(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch);
+      if (*hit) hits.push_back(contact_of(Contact::Kind::vertex_triangle, {p[0], p[1], p[2], p[3]}, touch));
+    }
+    for (int j = 0; j < 3; ++j) {
+      const std::uint32_t p[4] = {s[0], s[1], t[j], t[(j + 1) % 3]};
+      if (!moves(start, end, p)) continue;
+      Motion m[4];
+      motions_of(start, end, p, m);
+      auto hit = touch_edges(m, 0.0, touch, queries_);
+      if (!hit) return hit.error();
+      if (*hit) hits.push_back(contact_of(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch));
     }
   }
-  // Thread against surfaces: each end against the face, the segment against its edges.
-  if (!segments_.empty() && !triangles_.empty()) {
-    collision::overlapping_pairs(segment_reach_tree_, triangle_tree_, pairs_);
-    for (const collision::Pair& pr : pairs_) {
-      const std::uint32_t* s = &segments_[std::size_t{pr.first} * 2];
-      const std::uint32_t* t = &triangles_[std::size_t{pr.second} * 3];
-      bool shared = false;  // a thread tied into a surface: its own triangles are its neighbours
-      for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 3; ++j) shared |= s[i] == t[j];
-      if (shared) continue;
-      const std::uint32_t joined[5] = {s[0], s[1], t[0], t[1], t[2]};
-      if (suture_exempt(exempt_, joined)) continue;  // the thread runs through a puncture here
-      for (int i = 0; i < 2; ++i) {
-        const std::uint32_t p[4] = {s[i], t[0], t[1], t[2]};
-        if (!moves(start, end, p)) continue;
-        Motion m[4];
-        motions(p, m);
-        auto hit = vertex_face(m, 0.0, touch);
-        if (!hit) return hit.error();
-        if (*hit) add(Contact::Kind::vertex_triangle, {p[0], p[1], p[2], p[3]}, touch);
-      }
-      for (int j = 0; j < 3; ++j) {
-        const std::uint32_t p[4] = {s[0], s[1], t[j], t[(j + 1) % 3]};
-        if (!moves(start, end, p)) continue;
-        Motion m[4];
-        motions(p, m);
-        auto hit = edges(m, 0.0, touch);
-        if (!hit) return hit.error();
-        if (*hit) add(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch);
-      }
+  return {};
+}
+
+// Capsules' axes against the threads and the surfaces. The tissue is the
+// first primitive (its weights first), the axis the second.
+Status ContinuousSearch::capsules_against_tissue(std::span<const float> start, std::span<const float> end,
+                                                 std::vector<Contact>& hits, std::span<const Capsule> capsules,
+                                                 std::span<const std::uint32_t> carried, bool surfaces,
+                                                 double reach) {
+  capsule_boxes_.resize(capsules.size());
+  for (std::size_t i = 0; i < capsules.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      double lo = capsules[i].ends[0][0][a], hi = lo;
+      for (const Motion& e : capsules[i].ends)
+        for (const Point& x : e) lo = std::min(lo, x[a]), hi = std::max(hi, x[a]);
+      // Widened by the stray and rounded outwards to float.
+      capsule_boxes_[i].lo[a] = std::nextafter(static_cast<float>(lo - capsules[i].stray), -INFINITY);
+      capsule_boxes_[i].hi[a] = std::nextafter(static_cast<float>(hi + capsules[i].stray), INFINITY);
+    }
+  capsule_tree_.build(capsule_boxes_);
+  if (surfaces) {
+    boxes_ = capsule_boxes_;
+    grow(boxes_, reach);
+    capsule_reach_tree_.build(boxes_);
+  }
+  if (Status s = capsule_against(start, end, hits, capsules, carried, segment_tree_, capsule_tree_, segments_, 2); !s)
+    return s;
+  if (surfaces)
+    if (Status s = capsule_against(start, end, hits, capsules, carried, triangle_tree_, capsule_reach_tree_,
+                                   triangles_, 3);
+        !s)
+      return s;
+  return {};
+}
+
+Status ContinuousSearch::capsule_against(std::span<const float> start, std::span<const float> end,
+                                         std::vector<Contact>& hits, std::span<const Capsule> capsules,
+                                         std::span<const std::uint32_t> carried, const collision::Bvh& tree,
+                                         const collision::Bvh& capsule_tree,
+                                         const std::vector<std::uint32_t>& indices, int arity) {
+  if (indices.empty()) return {};
+  // Whether capsule c carries all of the particles (they cannot cross it).
+  const auto all_carried = [&](std::span<const std::uint32_t> particles, std::uint32_t c) {
+    if (carried.empty()) return false;
+    for (std::uint32_t p : particles)
+      if (carried[p] != c) return false;
+    return true;
+  };
+  Touch touch;
+  collision::overlapping_pairs(tree, capsule_tree, pairs_);
+  for (const collision::Pair& pr : pairs_) {
+    const Capsule& cap = capsules[pr.second];
+    const std::span<const std::uint32_t> p(&indices[std::size_t{pr.first} * arity], std::size_t(arity));
+    if (all_carried(p, pr.second)) continue;
+    Motion m[4];
+    const Motion& a0 = cap.ends[0];
+    const Motion& a1 = cap.ends[1];
+    if (a0[0] == a0[1] && a1[0] == a1[1] && !moves(start, end, p)) continue;  // neither moves
+    // The tissue's edges against the axis.
+    for (int j = 0; j < (arity == 3 ? 3 : 1); ++j) {
+      m[0] = motion_of(start, end, p[j]), m[1] = motion_of(start, end, p[(j + 1) % arity]);
+      m[2] = a0, m[3] = a1;
+      auto hit = touch_edges(m, cap.stray, touch, queries_);
+      if (!hit) return hit.error();
+      if (!*hit) continue;
+      double w[3] = {0.0, 0.0, 0.0};
+      w[j] = touch.w[0], w[(j + 1) % arity] = touch.w[1];
+      hits.push_back(capsule_contact(p, pr.second, w, touch));
+    }
+    if (arity != 3) continue;
+    // The axis' ends against the face: the touch's normal is the face's,
+    // towards the side the face came from (from the axis to the face).
+    for (const Motion& tip : {a0, a1}) {
+      m[0] = tip;
+      for (int k = 0; k < 3; ++k) m[k + 1] = motion_of(start, end, p[k]);
+      auto hit = touch_vertex_face(m, cap.stray, touch, queries_);
+      if (!hit) return hit.error();
+      if (!*hit) continue;
+      touch.apart = {-touch.apart[0], -touch.apart[1], -touch.apart[2]};
+      touch.moved = {-touch.moved[0], -touch.moved[1], -touch.moved[2]};
+      hits.push_back(capsule_contact(p, pr.second, touch.w + 1, touch));
     }
   }
-  // Capsules' axes against the threads and the surfaces. The tissue is the
-  // first primitive (its weights first), the axis the second.
-  if (!capsules.empty()) {
-    capsule_boxes_.resize(capsules.size());
-    for (std::size_t i = 0; i < capsules.size(); ++i)
-      for (int a = 0; a < 3; ++a) {
-        double lo = capsules[i].ends[0][0][a], hi = lo;
-        for (const Motion& e : capsules[i].ends)
-          for (const Point& x : e) lo = std::min(lo, x[a]), hi = std::max(hi, x[a]);
-        // Widened by the stray and rounded outwards to float.
-        capsule_boxes_[i].lo[a] = std::nextafter(static_cast<float>(lo - capsules[i].stray), -INFINITY);
-        capsule_boxes_[i].hi[a] = std::nextafter(static_cast<float>(hi + capsules[i].stray), INFINITY);
-      }
-    capsule_tree_.build(capsule_boxes_);
-    if (surfaces) {
-      boxes_ = capsule_boxes_;
-      grow(boxes_, reach);
-      capsule_reach_tree_.build(boxes_);
-    }
-    // Whether capsule c carries all of the particles (they cannot cross it).
-    const auto all_carried = [&](std::span<const std::uint32_t> particles, std::uint32_t c) {
-      if (carried.empty()) return false;
-      for (std::uint32_t p : particles)
-        if (carried[p] != c) return false;
-      return true;
-    };
-    // The touch of tissue `p` (arity 2 or 3) with capsule c, as a shape_face hit.
-    const auto add_capsule = [&](std::span<const std::uint32_t> p, std::uint32_t c, const double* w, const Touch& t) {
-      Contact hit;
-      hit.kind = Contact::Kind::shape_face;
-      if (p.size() == 3) {
-        hit.v = {p[0], p[0], p[1], p[2]};
-        hit.w = {0.0f, float(w[0]), float(w[1]), float(w[2])};
-      } else {
-        hit.v = {p[0], p[0], p[1], p[1]};
-        hit.w = {0.0f, float(w[0]), 0.0f, float(w[1])};
-      }
-      hit.normal = contact_normal(t.plane, t.apart, t.moved);
-      hit.shape = c;
-      hits.push_back(hit);
-    };
-    const auto against = [&](const collision::Bvh& tree, const collision::Bvh& capsule_tree,
-                             const std::vector<std::uint32_t>& indices, int arity) -> Status {
-      if (indices.empty()) return {};
-      collision::overlapping_pairs(tree, capsule_tree, pairs_);
-      for (const collision::Pair& pr : pairs_) {
-        const Capsule& cap = capsules[pr.second];
-        const std::span<const std::uint32_t> p(&indices[std::size_t{pr.first} * arity], std::size_t(arity));
-        if (all_carried(p, pr.second)) continue;
-        Motion m[4];
-        const Motion& a0 = cap.ends[0];
-        const Motion& a1 = cap.ends[1];
-        if (a0[0] == a0[1] && a1[0] == a1[1] && !moves(start, end, p)) continue;  // neither moves
-        // The tissue's edges against the axis.
-        for (int j = 0; j < (arity == 3 ? 3 : 1); ++j) {
-          m[0] = motion_of(start, end, p[j]), m[1] = motion_of(start, end, p[(j + 1) % arity]);
-          m[2] = a0, m[3] = a1;
-          auto hit = edges(m, cap.stray, touch);
-          if (!hit) return hit.error();
-          if (!*hit) continue;
-          double w[3] = {0.0, 0.0, 0.0};
-          w[j] = touch.w[0], w[(j + 1) % arity] = touch.w[1];
-          add_capsule(p, pr.second, w, touch);
-        }
-        if (arity != 3) continue;
-        // The axis' ends against the face: the touch's normal is the face's,
-        // towards the side the face came from (from the axis to the face).
-        for (const Motion& tip : {a0, a1}) {
-          m[0] = tip;
-          for (int k = 0; k < 3; ++k) m[k + 1] = motion_of(start, end, p[k]);
-          auto hit = vertex_face(m, cap.stray, touch);
-          if (!hit) return hit.error();
-          if (!*hit) continue;
-          touch.apart = {-touch.apart[0], -touch.apart[1], -touch.apart[2]};
-          touch.moved = {-touch.moved[0], -touch.moved[1], -touch.moved[2]};
-          add_capsule(p, pr.second, touch.w + 1, touch);
-        }
-      }
-      return {};
-    };
-    if (Status s = against(segment_tree_, capsule_tree_, segments_, 2); !s) return s;
-    if (surfaces)
-      if (Status s = against(triangle_tree_, capsule_reach_tree_, triangles_, 3); !s) return s;
-  }
-  collision::sort_unique_contacts(hits);
   return {};
 }
 

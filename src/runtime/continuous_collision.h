@@ -119,6 +119,20 @@ class ContinuousSearch {
   double drift(std::span<const float> start, std::span<const float> end) const;
   std::vector<collision::Pair> pairs_;
   std::uint64_t queries_ = 0;
+  // find()'s steps: the positions checked, then the threads against each
+  // other, the threads against the surfaces, the capsules against both.
+  Status check_finite(std::span<const float> start, std::span<const float> end) const;
+  Status thread_against_thread(std::span<const float> start, std::span<const float> end,
+                               std::vector<collision::Contact>& hits);
+  Status thread_against_surfaces(std::span<const float> start, std::span<const float> end,
+                                 std::vector<collision::Contact>& hits);
+  Status capsules_against_tissue(std::span<const float> start, std::span<const float> end,
+                                 std::vector<collision::Contact>& hits, std::span<const Capsule> capsules,
+                                 std::span<const std::uint32_t> carried, bool surfaces, double reach);
+  Status capsule_against(std::span<const float> start, std::span<const float> end,
+                         std::vector<collision::Contact>& hits, std::span<const Capsule> capsules,
+                         std::span<const std::uint32_t> carried, const collision::Bvh& tree,
+                         const collision::Bvh& capsule_tree, const std::vector<std::uint32_t>& indices, int arity);
   const std::vector<std::uint8_t>* exempt_ = nullptr;
   void fit(std::span<const float> start, std::span<const float> end, std::span<const std::uint32_t> indices,
            int arity, collision::Bvh& tree);
