@@ -84,18 +84,22 @@ TEST(FrameStage, AnAddedStageRunsEveryPhaseInOrderAndIsProfiled) {
   EXPECT_EQ(first->solved_sweeps, 2u * 3u) << "the scene's solve runs before a stage added after it";
   const FrameStats& stats = sim->last_frame();
   EXPECT_EQ(names(stats), (std::vector<std::string>{"colliders and tools", "solve", "statistics", "a", "b"}));
-  EXPECT_GE(stats.stages[4].ms, 3.0);
-  EXPECT_LT(stats.stages[3].ms, stats.stages[4].ms);
-  double sum = 0.0;
-  for (const StageProfile& p : stats.stages) sum += p.ms;
-  EXPECT_LE(sum, stats.wall_ms);
+  // Each stage's time is measured inside the frame's: at least b's sleep,
+  // and all of them within wall_ms.
+  const auto timed_within_the_frame = [](const FrameStats& s) {
+    double sum = 0.0;
+    for (const StageProfile& p : s.stages) sum += p.ms;
+    return s.stages[4].ms >= 3.0 && sum <= s.wall_ms;
+  };
+  EXPECT_TRUE(timed_within_the_frame(stats));
   EXPECT_GT(stats.stages[1].ms, 0.0) << "the solve is timed";
   EXPECT_GE(stats.read_back_bytes, 1000u) << "a stage's read-back counts";
-  // The profile is of the last frame, not a sum.
+  // The profile is of the last frame: a sum over two frames would pass the
+  // second frame's wall time.
   log.clear();
   ASSERT_TRUE(sim->step().ok());
   EXPECT_EQ(log.size(), 8u);
-  EXPECT_LT(sim->last_frame().stages[4].ms, 6.0 + 50.0);
+  EXPECT_TRUE(timed_within_the_frame(sim->last_frame()));
 }
 
 TEST(FrameStage, AStagesErrorStopsTheFrameWithItsMessage) {

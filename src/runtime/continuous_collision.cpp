@@ -269,20 +269,31 @@ Status ContinuousSearch::find(std::span<const float> start, std::span<const floa
   return {};
 }
 
+// Two primitives of the threads and surfaces, `p` as edge-edge (a0, a1, b0,
+// b1) or vertex-triangle (v, t0, t1, t2): a query unless none of them
+// moves, and its touch as a contact of `kind`.
+Status ContinuousSearch::test_primitives(std::span<const float> start, std::span<const float> end,
+                                         std::array<std::uint32_t, 4> p, Contact::Kind kind,
+                                         std::vector<Contact>& hits) {
+  if (!moves(start, end, p)) return {};
+  Motion m[4];
+  motions_of(start, end, p, m);
+  Touch touch;
+  auto hit = kind == Contact::Kind::edge_edge ? touch_edges(m, 0.0, touch, queries_)
+                                              : touch_vertex_face(m, 0.0, touch, queries_);
+  if (!hit) return hit.error();
+  if (*hit) hits.push_back(contact_of(kind, p, touch));
+  return {};
+}
+
 Status ContinuousSearch::thread_against_thread(std::span<const float> start, std::span<const float> end,
                                                std::vector<Contact>& hits) {
-  Touch touch;
   collision::self_overlapping_pairs(segment_tree_, collision::SharesVertexOf<2>{segments_}, pairs_);
   for (const collision::Pair& pr : pairs_) {
     const std::uint32_t* a = &segments_[std::size_t{pr.first} * 2];
     const std::uint32_t* b = &segments_[std::size_t{pr.second} * 2];
-    const std::uint32_t p[4] = {a[0], a[1], b[0], b[1]};
-    if (!moves(start, end, p)) continue;
-    Motion m[4];
-    motions_of(start, end, p, m);
-    auto hit = touch_edges(m, 0.0, touch, queries_);
-    if (!hit) return hit.error();
-    if (*hit) hits.push_back(contact_of(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch));
+    if (Status s = test_primitives(start, end, {a[0], a[1], b[0], b[1]}, Contact::Kind::edge_edge, hits); !s)
+      return s;
   }
   return {};
 }
@@ -290,7 +301,6 @@ Status ContinuousSearch::thread_against_thread(std::span<const float> start, std
 // Thread against surfaces: each end against the face, the segment against its edges.
 Status ContinuousSearch::thread_against_surfaces(std::span<const float> start, std::span<const float> end,
                                                  std::vector<Contact>& hits) {
-  Touch touch;
   collision::overlapping_pairs(segment_reach_tree_, triangle_tree_, pairs_);
   for (const collision::Pair& pr : pairs_) {
     const std::uint32_t* s = &segments_[std::size_t{pr.first} * 2];
@@ -301,24 +311,14 @@ Status ContinuousSearch::thread_against_surfaces(std::span<const float> start, s
     if (shared) continue;
     const std::uint32_t joined[5] = {s[0], s[1], t[0], t[1], t[2]};
     if (suture_exempt(exempt_, joined)) continue;  // the thread runs through a puncture here
-    for (int i = 0; i < 2; ++i) {
-      const std::uint32_t p[4] = {s[i], t[0], t[1], t[2]};
-      if (!moves(start, end, p)) continue;
-      Motion m[4];
-      motions_of(start, end, p, m);
-      auto hit = touch_vertex_face(m, 0.0, touch, queries_);
-      if (!hit) return hit.error();
-      if (*hit) hits.push_back(contact_of(Contact::Kind::vertex_triangle, {p[0], p[1], p[2], p[3]}, touch));
-    }
-    for (int j = 0; j < 3; ++j) {
-      const std::uint32_t p[4] = {s[0], s[1], t[j], t[(j + 1) % 3]};
-      if (!moves(start, end, p)) continue;
-      Motion m[4];
-      motions_of(start, end, p, m);
-      auto hit = touch_edges(m, 0.0, touch, queries_);
-      if (!hit) return hit.error();
-      if (*hit) hits.push_back(contact_of(Contact::Kind::edge_edge, {p[0], p[1], p[2], p[3]}, touch));
-    }
+    for (int i = 0; i < 2; ++i)
+      if (Status st = test_primitives(start, end, {s[i], t[0], t[1], t[2]}, Contact::Kind::vertex_triangle, hits);
+          !st)
+        return st;
+    for (int j = 0; j < 3; ++j)
+      if (Status st = test_primitives(start, end, {s[0], s[1], t[j], t[(j + 1) % 3]}, Contact::Kind::edge_edge, hits);
+          !st)
+        return st;
   }
   return {};
 }

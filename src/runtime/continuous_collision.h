@@ -44,6 +44,7 @@
 // substep's start.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -122,6 +123,8 @@ class ContinuousSearch {
   // find()'s steps: the positions checked, then the threads against each
   // other, the threads against the surfaces, the capsules against both.
   Status check_finite(std::span<const float> start, std::span<const float> end) const;
+  Status test_primitives(std::span<const float> start, std::span<const float> end, std::array<std::uint32_t, 4> p,
+                         collision::Contact::Kind kind, std::vector<collision::Contact>& hits);
   Status thread_against_thread(std::span<const float> start, std::span<const float> end,
                                std::vector<collision::Contact>& hits);
   Status thread_against_surfaces(std::span<const float> start, std::span<const float> end,
