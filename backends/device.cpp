@@ -19,6 +19,7 @@
 #include "accelerator_params.h"
 #include "bvh_params.h"
 #include "ccd_params.h"
+#include "fluid_coupling_params.h"
 #include "level_set_params.h"
 #include "narrow_phase_params.h"
 #include "mesh_contact_params.h"

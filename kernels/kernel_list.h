@@ -105,6 +105,9 @@
   SINEW_KERNEL(pbf_predict, 4, PbfParams, 0)                                    \
   SINEW_KERNEL(pbf_lambda, 6, PbfParams, 0)                                     \
   SINEW_KERNEL(pbf_delta, 6, PbfParams, 0)                                      \
-  SINEW_KERNEL(pbf_finish, 9, PbfParams, 0)
+  SINEW_KERNEL(pbf_finish, 9, PbfParams, 0)                                     \
+  /* a fluid coupled with its scene's tissue (kernels/shared/fluid_coupling_params.h) */ \
+  SINEW_KERNEL(fluid_boundary_follow, 7, FluidCouplingParams, 0)                \
+  SINEW_KERNEL(fluid_forces_on_tissue, 6, FluidCouplingParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

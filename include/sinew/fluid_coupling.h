@@ -44,7 +44,12 @@ struct CoupledSurface {
   std::uint32_t first_particle = 0;
 };
 
-class FluidCoupling {
+/// Deprecated: a scene's fluid is SceneDesc::fluid (sinew/scene.h), run on
+/// the Simulation's device as a stage of its frame with the same coupling
+/// (the very floats on the CPU backend) and no read-back of the tissue.
+/// Kept for one release.
+class [[deprecated("describe the fluid in SceneDesc::fluid (sinew/scene.h) and reach it through Simulation::fluid()")]]
+FluidCoupling {
  public:
   /// Samples the surfaces at the fluid's spacing, appends the samples to
   /// desc.boundary (after the fixed boundary it holds, which stays put),

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "sinew/fluid.h"
 #include "sinew/level_set.h"
 #include "sinew/mesh.h"
 #include "sinew/result.h"
@@ -563,6 +564,42 @@ struct GrasperDesc {
   double compliance = 0.0;      ///< of each hold [m/N], >= 0 (0: rigid)
 };
 
+/// A tissue surface that holds the scene's fluid and is pushed by it
+/// (SceneDesc::fluid): sampled at the fluid's spacing with boundary
+/// particles that follow the surface's vertices (Akinci et al., TOG 31(4),
+/// 2012; sample_surface), whose push from the fluid goes back to those
+/// vertices as forces.
+struct FluidSurfaceDesc {
+  BodyKind body_kind = BodyKind::tet;  ///< tet or tri
+  std::size_t body = 0;                ///< index among the scene's bodies of that kind
+  /// Triangles over the body's mesh vertices (e.g. the part of its boundary
+  /// that faces the fluid); empty: a tet body's whole boundary surface
+  /// (extract_boundary_surface), a tri body's triangles. Sampled once, at
+  /// Simulation::create, on the rest mesh: cuts do not resample them.
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+/// A fluid that runs with the scene, on the Simulation's device, as one
+/// stage of its frame (Simulation::fluid()). Each frame, on the device and
+/// without the host: the surfaces' boundary particles move to the tissue's
+/// positions and velocities at the frame's start, the fluid takes the
+/// frame's steps (SolverSettings::time_step / FluidSettings::time_step of
+/// them, a whole number), and the impulse J the fluid gave each boundary
+/// particle over them becomes a constant force J / frame on its triangle's
+/// vertices (by its barycentric weights) for the tissue's frame. So the
+/// tissue gains in its frame the momentum the fluid lost to it (up to float
+/// rounding; what lands on pinned or kinematic vertices goes to the fixed
+/// world). The coupling is explicit, one frame apart: stable while the
+/// fluid's push moves the surface by much less than a spacing per frame.
+/// Host reads per frame: the fluid's counts and fastest speed (28 bytes).
+struct SceneFluidDesc {
+  /// The fluid (FluidDesc): its particles, fixed boundary, emitters and
+  /// sinks. Its `device` is not used (the scene's runs it); its
+  /// moving_boundary and boundary_forces are set when there are surfaces.
+  FluidDesc fluid;
+  std::vector<FluidSurfaceDesc> surfaces;  ///< may be empty: a fluid held by its fixed boundary only
+};
+
 struct SceneDesc {
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
   SolverSettings solver;
@@ -589,6 +626,10 @@ struct SceneDesc {
   /// host copy of every constraint block (what a removal patches) and the
   /// tet and tri bodies' adjacency; without it those calls are errors.
   bool topology_changes = false;
+  /// A fluid coupled with the tissue (SceneFluidDesc); none by default. A
+  /// fluid with surfaces gives the scene its force buffer (as
+  /// external_forces = true does).
+  std::optional<SceneFluidDesc> fluid;
 };
 
 /// Checks every parameter of a scene; the first problem found is returned,

@@ -13,10 +13,12 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "sinew/device.h"
 #include "sinew/scene.h"
+#include "sinew/scene_fluid.h"
 
 namespace sinew {
 
@@ -145,6 +147,8 @@ struct FrameStats {
   /// The frame's stages in the order they run, each with its wall time in
   /// the last step() (their sum is within wall_ms).
   std::vector<StageProfile> stages;
+  /// The wall time [ms] of stage `name` in the last step() (0 when the scene has no such stage).
+  [[nodiscard]] double stage_ms(std::string_view name) const;
 };
 
 class Simulation {
@@ -385,6 +389,11 @@ class Simulation {
     std::uint32_t refused_degenerate = 0, refused_inverted = 0, refused_angle = 0;
   };
   Result<NeedleState> needle_state(std::size_t index) const;
+
+  /// The scene's fluid (SceneDesc::fluid; sinew/scene_fluid.h): its
+  /// particles, counts, emitters and sinks. Calls on it are errors when
+  /// the scene has none.
+  [[nodiscard]] SceneFluid fluid();
 
   [[nodiscard]] const SceneInfo& info() const;
   [[nodiscard]] const FrameStats& last_frame() const;

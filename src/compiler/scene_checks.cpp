@@ -7,6 +7,7 @@
 
 #include "contact_params.h"
 #include "math/vec3.h"
+#include "compiler/scene_compiler.h"
 #include "sinew/scene.h"
 
 namespace sinew {
@@ -446,6 +447,7 @@ Status check_scene(const SceneDesc& scene) {
   if (Status s = check_all(scene.colliders, "colliders", check_collider); !s) return s;
   if (Status s = check_all(scene.tools, "tools", check_tool); !s) return s;
   if (Status s = check_mesh_collision(scene); !s) return s;
+  if (Status s = check_scene_fluid(scene); !s) return s;
   for (std::size_t i = 0; i < scene.needles.size(); ++i)
     if (Status s = check_needle(scene, scene.needles[i], "needles[" + std::to_string(i) + "]"); !s) return s;
   if (!scene.needles.empty() && scene.solver.chebyshev_rho > 0.0)

@@ -187,7 +187,8 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
   SceneBuilder b;
   b.substep = scene.solver.time_step / scene.solver.substeps;
   CompiledScene out;
-  out.external_forces = scene.external_forces;
+  // A fluid on the tissue's surfaces pushes it through the force buffer.
+  out.external_forces = scene.external_forces || (scene.fluid && !scene.fluid->surfaces.empty());
   for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i) {
     out.tet_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
     if (Status s = add_tet_body(b, scene.tet_bodies[i], "tet_bodies[" + std::to_string(i) + "]"); !s) return s.error();

@@ -153,6 +153,11 @@ Status add_line_bending(SceneBuilder& b, const LineBodyDesc& body, std::uint32_t
 /// compile_contacts.cpp: colliders, tools, attachments (after all bodies).
 Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out);
 
+/// SceneDesc::fluid's parameters beyond FluidDesc's (the surfaces' bodies
+/// and triangles, the frame a whole number of fluid steps); part of
+/// check_scene (fluid_checks.cpp).
+Status check_scene_fluid(const SceneDesc& scene);
+
 /// Checks (check_scene) and compiles a scene. Errors name the parameter.
 Result<CompiledScene> compile_scene(const SceneDesc& scene);
 

@@ -73,6 +73,17 @@ class SphSolver {
   [[nodiscard]] std::uint32_t capacity() const { return capacity_; }
   [[nodiscard]] double particle_mass() const { return mass_; }
   [[nodiscard]] const kernels::SphParams& params() const { return params_; }
+  /// The boundary's device arrays, float4 per boundary particle (invalid
+  /// handles without moving_boundary, boundary_forces): what a stage
+  /// coupling the fluid with tissue on the same device writes (positions,
+  /// velocities) and reads (impulses) instead of set_boundary and
+  /// read_boundary_impulses.
+  [[nodiscard]] BufferHandle boundary_position_buffer() const { return boundary_position_; }
+  [[nodiscard]] BufferHandle boundary_velocity_buffer() const { return boundary_velocity_; }
+  [[nodiscard]] BufferHandle impulse_buffer() const { return impulse_; }
+  /// Bytes step() reads back after its steps: the count, the state's five
+  /// words and the fastest speed.
+  static constexpr std::uint64_t kStepReadBytes = 28;
 
  private:
   explicit SphSolver(Device& device) : device_(device) {}

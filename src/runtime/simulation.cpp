@@ -80,6 +80,11 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   impl->stats_plan = std::move(*plan);
   impl->solver = scene.solver;
   impl->gravity = scene.gravity;
+  if (scene.fluid) {
+    auto fluid = SceneFluid::State::create(scene, *compiled, *impl->device, impl->buffers);
+    if (!fluid) return fluid.error();
+    impl->fluid = std::move(*fluid);
+  }
   if (scene.mesh_collision.enabled) {
     auto mesh_collision = MeshCollision::create(scene, *compiled, *impl->device);
     if (!mesh_collision) return mesh_collision.error();
@@ -132,6 +137,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   // The frame's stages, in the order they run: one line per feature.
   Impl& im = *impl;
   if (compiled->external_forces) im.add_stage(make_forces_stage(im));
+  if (im.fluid) im.add_stage(make_fluid_stage(im));
   im.add_stage(make_tools_stage(im));
   if (im.mesh_collision) im.add_stage(make_mesh_collision_stage(im));
   if (im.sutures) im.add_stage(make_sutures_stage(im));
@@ -259,6 +265,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
 // frame program would cost every frame of every such scene.)
 Status Simulation::Impl::begin_frame_forces() {
   const bool stale = forces_on_device && !forces_for_next_frame;
+  host_forces_this_frame = forces_for_next_frame;
   forces_for_next_frame = false;  // this frame consumes them
   if (!stale) return {};
   std::fill(force_scratch.begin(), force_scratch.end(), kernels::float4{0.0f, 0.0f, 0.0f, 0.0f});
@@ -290,6 +297,14 @@ Status Simulation::Impl::positions_in_user_order(std::vector<float>& xyzw) {
     std::copy_n(&slots[slot * 4], 4, &xyzw[std::size_t{order.user_of[slot]} * 4]);
   return {};
 }
+
+double FrameStats::stage_ms(std::string_view name) const {
+  for (const StageProfile& stage : stages)
+    if (stage.name == name) return stage.ms;
+  return 0.0;
+}
+
+SceneFluid Simulation::fluid() { return SceneFluid(impl_->fluid.get()); }
 
 Status Simulation::read_positions(std::vector<float>& xyzw) const {
   return impl_->read_in_user_order(impl_->buffers.position, xyzw);

@@ -21,6 +21,7 @@
 #include "runtime/graspers.h"
 #include "runtime/sutures.h"
 #include "runtime/topology_editor.h"
+#include "runtime/scene_fluid.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -67,9 +68,13 @@ struct Simulation::Impl {
   std::vector<kernels::float4> force_scratch;
   bool forces_for_next_frame = false;
   bool forces_on_device = false;
+  bool host_forces_this_frame = false;  ///< the frame being run has a call's forces (the fluid adds to them)
   /// Before a frame's program: the forces of the last frame's call, if no
   /// call since set the coming frame's, are reset to zero.
   Status begin_frame_forces();
+
+  // SceneDesc::fluid (scene_fluid.h; null without): destroyed before the device.
+  std::unique_ptr<SceneFluid::State> fluid;
 
   // Contacts between meshes (mesh_collision.h; null when the scene has
   // none). The program is rebuilt when they outgrow it (or the topology
