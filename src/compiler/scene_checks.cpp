@@ -5,18 +5,22 @@
 #include <sstream>
 #include <string>
 
+#include "compiler/device_ranges.h"
 #include "contact_params.h"
 #include "math/vec3.h"
 #include "sinew/scene.h"
 
 namespace sinew {
-namespace {
 
-std::string str(double v) {
+std::string number_text(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
 }
+
+namespace {
+
+std::string str(double v) { return number_text(v); }
 
 Status positive(const std::string& name, double v) {
   if (!std::isfinite(v) || v <= 0.0)
@@ -496,7 +500,9 @@ Status check_scene(const SceneDesc& scene) {
   for (std::size_t i = 0; i < scene.attachments.size(); ++i)
     if (Status s = check_attachment(scene, scene.attachments[i], "attachments[" + std::to_string(i) + "]"); !s)
       return s;
-  return {};
+  // Last, on values known finite: what the device makes of them in float,
+  // and the caps on a frame's work (device_ranges.h).
+  return check_device_ranges(scene);
 }
 
 }  // namespace sinew
