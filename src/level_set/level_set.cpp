@@ -151,7 +151,8 @@ Result<LevelSet> LevelSet::from_mesh(const TriMesh& surface, const LevelSetSetti
       if (!std::isfinite(c))
         return Error(ErrorCode::bad_parameter,
                      std::string(call) + ": vertex " + std::to_string(v) + " is not finite");
-      if (Status s = level_set::float_finite(call, "vertex " + std::to_string(v), c); !s) return s.error();
+      if (!(std::abs(c) <= std::numeric_limits<float>::max()))  // named only then: this runs per vertex
+        return level_set::float_finite(call, "vertex " + std::to_string(v), c).error();
       lo[k] = v == 0 ? c : std::min(lo[k], c);
       hi[k] = v == 0 ? c : std::max(hi[k], c);
     }
