@@ -73,7 +73,10 @@ TEST(LevelSetBounds, AnOpenSoupIsRefusedByItsEdges) {
     for (int v = 0; v < 3; ++v) soup.vertices.push_back({u(rng), u(rng), u(rng)});
     soup.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
   }
-  expect_error(LevelSet::from_mesh(soup, LevelSetSettings{}), ErrorCode::bad_parameter, "60000 open edges");
+  const Result<LevelSet> refused = LevelSet::from_mesh(soup, LevelSetSettings{});
+  expect_error(refused, ErrorCode::bad_parameter, "60000 open edges");
+  // Judged by its edges: the crossing search did not run.
+  expect_error(refused, ErrorCode::bad_parameter, "crossings not searched for");
 }
 
 TEST(LevelSetBounds, ACutSweptAcrossTheWorldIsNamed) {

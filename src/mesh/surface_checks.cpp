@@ -20,8 +20,9 @@
 // take 42 s and 2 GB). The crossing search tests each overlapping pair as
 // the traversal finds it (no pair list is stored) and stops with
 // capacity_exceeded after kPairsPerTriangle pairs per triangle (at least
-// kMinPairBudget): a closed organ surface tests a few per triangle, a pile
-// of overlapping closed shells millions.
+// kMinPairBudget): the data's organ and bone surfaces test 0.01-0.05 per
+// triangle (measured 2026-11-28: Liver 1366 pairs for 30726 triangles,
+// tibia 624 for 59456), a pile of overlapping closed shells millions.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -158,7 +159,7 @@ Result<SurfaceReport> check_closed_surface(const TriMesh& surface) {
                  "check_closed_surface: more than " + std::to_string(budget) + " pairs of overlapping triangles (" +
                      std::to_string(kPairsPerTriangle) + " per triangle, at least " + std::to_string(kMinPairBudget) +
                      ") to test for crossings on a surface of " + std::to_string(triangles) +
-                     " triangles; a closed organ surface has a few per triangle (overlapping shells?)");
+                     " triangles; a closed organ surface has under one per triangle (overlapping shells?)");
   report.crossings_tested = true;
   return report;
 }
