@@ -229,6 +229,7 @@ TEST(SceneDeviceRange, CompliancesInfiniteInFloatAreNamed) {
   expect_error([](SceneDesc& s) { s.tet_bodies[0].distance_compliance = 1e300; }, "tet_bodies[0].distance_compliance");
   expect_error([](SceneDesc& s) { s.tet_bodies[0].volume_compliance = 1e300; }, "tet_bodies[0].volume_compliance");
   expect_error([](SceneDesc& s) { s.line_bodies[0].compliance = 1e300; }, "line_bodies[0].compliance");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].stiffness_damping = 1e300; }, "tet_bodies[0].stiffness_damping");
   // Finite in float as given, but not scaled by the element (c L^2 / V)
   // over h^2 (alpha~, what the device solves with).
   expect_error([](SceneDesc& s) { s.tet_bodies[0].distance_compliance = 1e36, s.solver.time_step = 1e-3; },

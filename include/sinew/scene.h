@@ -363,7 +363,8 @@ struct SolverSettings {
   /// time_step / substeps, 1/h and 1/h^2 must be finite, non-zero floats
   /// (e.g. 1e300 or 1e-300 is an error naming solver.time_step), and so
   /// must every compliance alpha the device stores (after scaling by its
-  /// element, e.g. c L^2 / V) and alpha / h^2, gravity, h g and h^2 g, and
+  /// element, e.g. c L^2 / V) and alpha / h^2, each stiffness_damping over
+  /// h, gravity and h g (and a frame's move dt^2 g at most 1e12 m), and
   /// every particle's inverse mass (a density so large that it rounds to
   /// 0, which would pin the particle, is an error naming the body).
   double time_step = 1.0 / 60.0;

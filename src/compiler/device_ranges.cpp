@@ -76,6 +76,20 @@ Status check_device_ranges(const SceneDesc& scene) {
                                                  "move over a frame, time_step^2 g, at most " + str(kMaxFrameMove) +
                                                  " m");
   }
+  // Constraint damping: the device's gamma = tau / h (xpbd_program.cpp).
+  const auto damping = [&](const std::string& owner, double tau) -> Status {
+    if (std::isfinite(static_cast<float>(tau / scene.solver.time_step * scene.solver.substeps))) return {};
+    return Error(ErrorCode::bad_parameter, owner + ".stiffness_damping = " + str(tau) +
+                                               ": over the substep h (" + str(step->h) +
+                                               " s) it must be finite in float32, the device's precision");
+  };
+  for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i)
+    if (Status s = damping("tet_bodies[" + std::to_string(i) + "]", scene.tet_bodies[i].stiffness_damping); !s) return s;
+  for (std::size_t i = 0; i < scene.tri_bodies.size(); ++i)
+    if (Status s = damping("tri_bodies[" + std::to_string(i) + "]", scene.tri_bodies[i].stiffness_damping); !s) return s;
+  for (std::size_t i = 0; i < scene.line_bodies.size(); ++i)
+    if (Status s = damping("line_bodies[" + std::to_string(i) + "]", scene.line_bodies[i].stiffness_damping); !s)
+      return s;
   // The compliances stored as they are (scaled ones: at compile time).
   const auto each = [&](const std::string& owner, double alpha, const char* field = ".compliance") {
     return check_device_compliance(owner, field, alpha, *step);
