@@ -77,26 +77,21 @@ Status check_device_ranges(const SceneDesc& scene) {
                                                  " m");
   }
   // Constraint damping: the device's gamma = tau / h (xpbd_program.cpp).
-  const auto damping = [&](const std::string& owner, double tau) -> Status {
+  const auto damping = [&](const auto& body, const std::string& owner) -> Status {
+    const double tau = body.stiffness_damping;
     if (std::isfinite(static_cast<float>(tau / scene.solver.time_step * scene.solver.substeps))) return {};
     return Error(ErrorCode::bad_parameter, owner + ".stiffness_damping = " + str(tau) +
                                                ": over the substep h (" + str(step->h) +
                                                " s) it must be finite in float32, the device's precision");
   };
-  for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i)
-    if (Status s = damping("tet_bodies[" + std::to_string(i) + "]", scene.tet_bodies[i].stiffness_damping); !s) return s;
-  for (std::size_t i = 0; i < scene.tri_bodies.size(); ++i)
-    if (Status s = damping("tri_bodies[" + std::to_string(i) + "]", scene.tri_bodies[i].stiffness_damping); !s) return s;
-  for (std::size_t i = 0; i < scene.line_bodies.size(); ++i)
-    if (Status s = damping("line_bodies[" + std::to_string(i) + "]", scene.line_bodies[i].stiffness_damping); !s)
-      return s;
+  if (Status s = check_all(scene.tet_bodies, "tet_bodies", damping); !s) return s;
+  if (Status s = check_all(scene.tri_bodies, "tri_bodies", damping); !s) return s;
+  if (Status s = check_all(scene.line_bodies, "line_bodies", damping); !s) return s;
   // The compliances stored as they are (scaled ones: at compile time).
   const auto each = [&](const std::string& owner, double alpha, const char* field = ".compliance") {
     return check_device_compliance(owner, field, alpha, *step);
   };
-  for (std::size_t i = 0; i < scene.line_bodies.size(); ++i) {
-    const LineBodyDesc& b = scene.line_bodies[i];
-    const std::string name = "line_bodies[" + std::to_string(i) + "]";
+  const auto line = [&](const LineBodyDesc& b, const std::string& name) -> Status {
     if (Status s = each(name, b.compliance); !s) return s;
     if (b.bending_compliance >= 0.0)
       if (Status s = each(name, b.bending_compliance, ".bending_compliance"); !s) return s;
@@ -104,24 +99,19 @@ Status check_device_ranges(const SceneDesc& scene) {
       if (!finite_float(1.0 / b.masses[v]) || !(static_cast<float>(1.0 / b.masses[v]) > 0.0f))
         return Error(ErrorCode::bad_parameter, name + ".masses[" + std::to_string(v) + "] = " + str(b.masses[v]) +
                                                    " kg: its inverse must be a finite, non-zero float32");
-  }
-  for (std::size_t i = 0; i < scene.tri_bodies.size(); ++i)
-    if (scene.tri_bodies[i].bending_compliance >= 0.0)
-      if (Status s = each("tri_bodies[" + std::to_string(i) + "]", scene.tri_bodies[i].bending_compliance,
-                          ".bending_compliance");
-          !s)
-        return s;
-  for (std::size_t i = 0; i < scene.colliders.size(); ++i)
-    if (Status s = each("colliders[" + std::to_string(i) + "]", scene.colliders[i].compliance); !s) return s;
-  for (std::size_t i = 0; i < scene.tools.size(); ++i)
-    if (Status s = each("tools[" + std::to_string(i) + "]", scene.tools[i].compliance); !s) return s;
-  for (std::size_t i = 0; i < scene.needles.size(); ++i)
-    if (Status s = each("needles[" + std::to_string(i) + "]", scene.needles[i].compliance); !s) return s;
-  for (std::size_t i = 0; i < scene.attachments.size(); ++i)
-    if (Status s = each("attachments[" + std::to_string(i) + "]", scene.attachments[i].compliance); !s)
-      return s;
-  for (std::size_t i = 0; i < scene.graspers.size(); ++i)
-    if (Status s = each("graspers[" + std::to_string(i) + "]", scene.graspers[i].compliance); !s) return s;
+    return {};
+  };
+  if (Status s = check_all(scene.line_bodies, "line_bodies", line); !s) return s;
+  const auto bending = [&](const TriBodyDesc& b, const std::string& name) {
+    return b.bending_compliance >= 0.0 ? each(name, b.bending_compliance, ".bending_compliance") : Status();
+  };
+  if (Status s = check_all(scene.tri_bodies, "tri_bodies", bending); !s) return s;
+  const auto compliance = [&](const auto& item, const std::string& name) { return each(name, item.compliance); };
+  if (Status s = check_all(scene.colliders, "colliders", compliance); !s) return s;
+  if (Status s = check_all(scene.tools, "tools", compliance); !s) return s;
+  if (Status s = check_all(scene.needles, "needles", compliance); !s) return s;
+  if (Status s = check_all(scene.attachments, "attachments", compliance); !s) return s;
+  if (Status s = check_all(scene.graspers, "graspers", compliance); !s) return s;
   if (scene.mesh_collision.enabled)
     if (Status s = each("mesh_collision", scene.mesh_collision.compliance); !s) return s;
   return {};

@@ -7,11 +7,20 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "sinew/result.h"
 #include "sinew/scene.h"
 
 namespace sinew {
+
+/// `check(item, "name[i]")` on each item of `items`; the first error.
+template <class T, class Check>
+Status check_all(const std::vector<T>& items, const std::string& name, Check&& check) {
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (Status s = check(items[i], name + "[" + std::to_string(i) + "]"); !s) return s;
+  return {};
+}
 
 /// `v` as the scene checks' messages print it (scene_checks.cpp).
 std::string number_text(double v);

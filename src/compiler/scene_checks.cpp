@@ -337,13 +337,6 @@ Status check_attachment(const SceneDesc& scene, const AttachmentDesc& a, const s
   return non_negative(name + ".compliance", a.compliance);
 }
 
-template <class T, class Check>
-Status check_all(const std::vector<T>& items, const std::string& name, Check&& check) {
-  for (std::size_t i = 0; i < items.size(); ++i)
-    if (Status s = check(items[i], name + "[" + std::to_string(i) + "]"); !s) return s;
-  return {};
-}
-
 Status check_mesh_collision(const SceneDesc& scene) {
   const MeshCollisionDesc& c = scene.mesh_collision;
   if (!c.enabled) return {};
