@@ -35,7 +35,7 @@ namespace sinew {
 
 /// What a level set is built with.
 struct LevelSetSettings {
-  double voxel_size = 5e-4;     ///< edge of a cubic voxel [m], > 0
+  double voxel_size = 5e-4;     ///< edge of a cubic voxel [m], >= 1.5e-5 (OpenVDB's smallest) and within float32
   double exterior_band = 1.5e-3;  ///< exact distances this far outside the surface [m], >= voxel_size
   /// ... and this far inside [m], >= voxel_size; +infinity fills the whole
   /// inside (every voxel inside is stored: a solid that will be cut).
@@ -72,11 +72,26 @@ struct CutReport {
 
 /// A signed distance field on a sparse grid, in its own frame (the frame of
 /// the surface or shape it was built from). Copies share the grid (cheap).
+///
+/// Bounds every factory and cut checks first (issue 39), so that no input
+/// overflows or runs without end: every length and coordinate within
+/// float32's range (the device samples in float; e.g. a cube of 1e39 m is
+/// bad_parameter); every voxel index, the shape's box grown by the
+/// exterior band over voxel_size, within +-2^30 (bad_parameter: move the
+/// shape nearer the origin or use a larger voxel); at most 2^30 voxels
+/// visited by one call (capacity_exceeded): a sphere's or box's whole
+/// grown box, a surface's bands (about its area / h^2 voxels per layer) or
+/// its whole box when the inside is filled, a cut's swept box; a cut
+/// places a capsule or box at most 2^20 times (capacity_exceeded).
+/// Whatever OpenVDB still throws becomes an error (bad_parameter, or
+/// out_of_memory for an allocation): no call throws.
 class LevelSet {
  public:
   /// From a closed triangle surface [m]. Errors (bad_parameter): settings
   /// out of range, a surface that is not closed (check_closed_surface; the
-  /// message gives the counts), an empty surface, a non-finite vertex.
+  /// message gives the counts), an empty surface, a non-finite vertex;
+  /// capacity_exceeded from check_closed_surface's pair bound; and the
+  /// bounds above.
   static Result<LevelSet> from_mesh(const TriMesh& surface, const LevelSetSettings& settings);
   /// A sphere of `radius` [m] > 0 about `centre` [m].
   static Result<LevelSet> sphere(const std::array<double, 3>& centre, double radius, const LevelSetSettings& settings);

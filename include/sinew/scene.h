@@ -360,9 +360,17 @@ struct NeedleDesc {
 /// runs `iterations` Gauss-Seidel sweeps over all constraints (colour by
 /// colour) and updates velocities (Macklin et al., "Small Steps", 2019).
 struct SolverSettings {
-  double time_step = 1.0 / 60.0;  ///< frame length [s], > 0
-  int substeps = 1;               ///< >= 1
-  int iterations = 5;             ///< >= 1
+  /// Frame length [s], > 0. The device computes in float32: h =
+  /// time_step / substeps, 1/h and 1/h^2 must be finite, non-zero floats
+  /// (e.g. 1e300 or 1e-300 is an error naming solver.time_step), and so
+  /// must every compliance alpha the device stores (after scaling by its
+  /// element, e.g. c L^2 / V) and alpha / h^2, each stiffness_damping over
+  /// h, gravity and h g (and a frame's move dt^2 g at most 1e12 m), and
+  /// every particle's inverse mass (a density so large that it rounds to
+  /// 0, which would pin the particle, is an error naming the body).
+  double time_step = 1.0 / 60.0;
+  int substeps = 1;               ///< >= 1, <= 10,000 (a bound on a frame's work)
+  int iterations = 5;             ///< >= 1, <= 10,000; substeps x iterations <= 1,000,000 sweeps a frame
   /// Measure the frame's errors (FrameStats): costs one store per
   /// constraint in the last sweep and a read-back of the residuals,
   /// velocities and positions after each frame.
@@ -388,8 +396,9 @@ struct SolverSettings {
   /// tolerance must be ~1/20 of the body's strain under its load (about
   /// rho g L / E): see the README's stiffness table. 0: fixed mode.
   double residual_tolerance = 0.0;
-  /// Residual mode: the most sweeps per substep, >= iterations; rounded up
-  /// to iterations plus a whole number of check_interval.
+  /// Residual mode: the most sweeps per substep, >= iterations, <= 100,000
+  /// (and substeps x max_iterations <= 1,000,000); rounded up to
+  /// iterations plus a whole number of check_interval.
   int max_iterations = 200;
   /// Residual mode: sweeps between two residual checks, >= 1. Each check
   /// costs about one sweep's reads plus a round trip to the device.

@@ -192,7 +192,9 @@ class Simulation {
   /// first frame without a call after one (resetting them).
   /// Needs SceneDesc::external_forces (else an error naming it). Errors
   /// (bad_parameter): a span whose size is not 3 x particles, a non-finite
-  /// value (naming the particle); the forces set before stay then.
+  /// value, or one whose velocity over a frame (time_step f / m) or move
+  /// (time_step^2 f / m) is not finite in float32, the device's precision
+  /// (naming the particle); the forces set before stay then.
   Status set_particle_forces(std::span<const float> xyz);
 
   /// Cuts level-set collider `index` (ColliderShape::level_set, built with

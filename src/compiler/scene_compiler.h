@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "backends/kernel.h"
+#include "compiler/device_ranges.h"
 #include "compiler/particle_order.h"
 #include "math/vec4.h"
 #include "sinew/scene.h"
@@ -122,6 +123,7 @@ struct SceneBuilder {
   std::vector<std::pair<std::uint32_t, const std::vector<Vec3d>*>> initial;
 
   double substep = 0.0;  ///< h [s], for the velocity damping factors
+  DeviceStep step;       ///< h and 1/h^2 as the device's floats, for check_device_compliance
   /// Appends vertices as particles of mass 0 and velocity damping `k`
   /// [1/s] (factor exp(-k h) per substep); returns the first one's index.
   std::uint32_t add_vertices(const std::vector<Vec3d>& vertices, double velocity_damping);

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "compiler/device_ranges.h"
 #include "compiler/scene_compiler.h"
 #include "math/xpbd_math.h"
 #include "program/xpbd_program.h"
@@ -43,7 +44,10 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   auto buffers = upload_scene(*impl->device, *compiled);
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
-  if (compiled->external_forces) impl->force_scratch.resize(compiled->positions.size());
+  if (compiled->external_forces) {
+    impl->force_scratch.resize(compiled->positions.size());
+    for (const kernels::float4& p : compiled->positions) impl->force_inverse_mass.push_back(p.w);
+  }
   if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
   impl->order = compiled->order;
   impl->scene_targets = scene.targets.size();
@@ -246,7 +250,23 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
               << f[2] << " N)";
       return Error(ErrorCode::bad_parameter, message.str());
     }
-    im.force_scratch[im.order.device_of[u]] = kernels::float4{f[0], f[1], f[2], 0.0f};
+    // What the device makes of it in float (issue 39): the velocity a
+    // frame's substeps add, dt f / m (h f / m each), and the move it makes,
+    // dt^2 f / m, bounded as gravity's is (compiler/device_ranges.h).
+    const std::uint32_t slot = im.order.device_of[u];
+    const float dt = static_cast<float>(im.time_step), w = im.force_inverse_mass[slot];
+    for (int k = 0; k < 3; ++k) {
+      const float dv = dt * (f[k] * w);
+      if (!std::isfinite(dv) || !(std::abs(dt * dv) <= kMaxFrameMove)) {
+        std::ostringstream message;
+        message << call << ": the force on particle " << u << " (" << f[0] << ", " << f[1] << ", " << f[2]
+                << " N) is too large: the velocity h f / m it adds over a frame (inverse mass " << w
+                << " 1/kg, time_step " << im.time_step << " s) must be finite in float32, the device's precision, "
+                << "and the move time_step^2 f / m at most " << kMaxFrameMove << " m";
+        return Error(ErrorCode::bad_parameter, message.str());
+      }
+    }
+    im.force_scratch[slot] = kernels::float4{f[0], f[1], f[2], 0.0f};
   }
   if (n == 0) return {};
   if (Status s = im.device->write_buffer(im.buffers.external_force, 0, im.force_scratch.data(),

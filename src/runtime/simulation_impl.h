@@ -66,6 +66,9 @@ struct Simulation::Impl {
   // so a call allocates nothing); whether a call set the coming frame's,
   // and whether the device buffer holds a call's (nonzero) forces.
   std::vector<kernels::float4> force_scratch;
+  // ... and each particle's float inverse mass (device order), to check
+  // the impulse h f / m a force makes in float (set_particle_forces).
+  std::vector<float> force_inverse_mass;
   bool forces_for_next_frame = false;
   bool forces_on_device = false;
   bool host_forces_this_frame = false;  ///< the frame being run has a call's forces (the fluid adds to them)
