@@ -154,6 +154,11 @@ TEST(FrameStage, ThePositionsAreReadBackOnceAFrame) {
     // collision after the solve, the needles before and after it); the
     // first frame also reads the starting velocities.
     EXPECT_LT(stats.read_back_bytes, (f == 0 ? 3 : 1) * position_bytes + position_bytes / 2) << "frame " << f;
+    // Each stage's figures are its profile's counters.
+    EXPECT_EQ(stats.counter("mesh collision", "contacts"), double(stats.mesh_contacts)) << "frame " << f;
+    EXPECT_EQ(stats.counter("mesh collision", "violation_m"), stats.contact_violation) << "frame " << f;
+    EXPECT_EQ(stats.counter("sutures", "host_ms"), stats.suture_ms) << "frame " << f;
+    EXPECT_EQ(stats.counter("mesh collision", "no such counter"), 0.0);
   }
   EXPECT_EQ(names(sim->last_frame()),
             (std::vector<std::string>{"colliders and tools", "mesh collision", "sutures", "solve", "statistics"}));

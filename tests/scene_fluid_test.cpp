@@ -231,6 +231,30 @@ TEST(SceneFluid, AFrameReadsBackOnlyTheFluidsCounts) {
   EXPECT_EQ(sim->fluid().stats()->steps, 40u);  // 2 frames of 20 steps of 50 us
 }
 
+TEST(SceneFluid, AnEmitterPastTheCapacityEndsAWholeFrameAndIsNamed) {
+  // A source pouring into the cup with room for 2 particles more: the frame
+  // that outgrows it completes (the tissue steps, the frame counts) and
+  // step() says capacity_exceeded, naming the particles.
+  SceneDesc scene = cup_scene(true, {0, -9.81, 0}, fluid_block(2, 2, 2, {3 * kS, 2 * kS, 3 * kS}));
+  scene.fluid->fluid.capacity = 10;
+  scene.fluid->fluid.emitters.push_back(
+      {.centre = {4 * kS, 4 * kS, 4 * kS}, .direction = {0, -1, 0}, .radius = 1.5 * kS, .flow_rate = 2e-6});
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  Status s;
+  int frames = 0;
+  while (s.ok() && frames < 50) {
+    s = sim->step();
+    ++frames;
+  }
+  ASSERT_FALSE(s.ok()) << "the source outgrew the capacity within 50 frames";
+  EXPECT_EQ(s.error().code(), ErrorCode::capacity_exceeded) << s.error().message();
+  EXPECT_NE(s.error().message().find("sph particles"), std::string::npos) << s.error().message();
+  EXPECT_EQ(sim->last_frame().frame, std::uint64_t(frames)) << "the frame that overflowed completed";
+  EXPECT_EQ(sim->fluid().stats()->particles, 10u);
+  EXPECT_EQ(sim->last_frame().counter("fluid", "particles"), 10.0);
+}
+
 TEST(SceneFluid, BadFluidScenesAreNamed) {
   const auto fails_with = [](const SceneDesc& scene, const char* words) {
     auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});

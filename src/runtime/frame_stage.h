@@ -31,6 +31,10 @@ namespace sinew {
 struct FrameContext {
   Device& device;
   FrameStats& stats;
+  /// An error that leaves the frame whole (a fluid's emitter past its
+  /// capacity made what fit): the other stages run, the frame completes,
+  /// and step() returns it at the end.
+  Status deferred;
 };
 
 class FrameStage {
@@ -42,6 +46,8 @@ class FrameStage {
   virtual Status solve(FrameContext&) { return {}; }
   virtual Status after_solve(FrameContext&) { return {}; }
   virtual Status after_frame(FrameContext&) { return {}; }
+  /// After the frame: the stage's own figures into its profile (StageProfile::set).
+  virtual void report(StageProfile&) const {}
   /// Bytes the stage read back from the device in the last frame.
   [[nodiscard]] virtual std::uint64_t read_back_bytes() const { return 0; }
 };

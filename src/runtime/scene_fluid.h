@@ -37,7 +37,7 @@ struct SceneFluid::State {
   Device& device;
   std::unique_ptr<SphSolver> solver;
   SceneFluidInfo info;
-  Status pending;  ///< a capacity error of this frame's steps, reported when the frame is done
+  Status pending;  ///< a capacity error of this frame's steps, returned by step() when the frame is done
   std::uint64_t read_back_bytes = 0;  ///< in the last frame
 
  private:

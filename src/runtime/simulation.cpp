@@ -3,6 +3,7 @@
 #include "sinew/simulation.h"
 #include "runtime/simulation_internals.h"
 
+#include <atomic>
 #include <chrono>
 #include <algorithm>
 #include <cmath>
@@ -41,6 +42,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
 
   auto impl = std::make_unique<Impl>();
   impl->device = std::move(*device);
+  static std::atomic<std::uint32_t> simulations{0};  // ids name their Simulation by this
+  impl->serial = ++simulations;
   auto buffers = upload_scene(*impl->device, *compiled);
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
@@ -105,7 +108,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->collision_scene->attachments.clear();  // what MeshCollision does not read
     impl->collision_scene->targets.clear();
   }
-  if (!scene.graspers.empty()) impl->graspers = std::make_unique<Graspers>(scene, *compiled);
+  if (!scene.graspers.empty()) impl->graspers = std::make_unique<GrasperHolds>(scene, *compiled);
   if (impl->mesh_collision || impl->topology || impl->graspers) {  // programs rebuilt while the scene runs start from this
     impl->program_shape = *compiled;
     for (ConstraintBlock& block : impl->program_shape.blocks) block.data = {};
@@ -207,7 +210,7 @@ void Simulation::Impl::add_stage(std::unique_ptr<FrameStage> stage) {
 Status Simulation::step() {
   Impl& im = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  FrameContext frame{*im.device, im.stats};
+  FrameContext frame{*im.device, im.stats, {}};
   for (StageProfile& p : im.stats.stages) p.ms = 0.0;
   im.positions_mirror.begin_frame();
   using Hook = Status (FrameStage::*)(FrameContext&);
@@ -219,12 +222,13 @@ Status Simulation::step() {
     }
   im.stats.read_back_bytes = im.positions_mirror.bytes();
   for (const auto& stage : im.stages) im.stats.read_back_bytes += stage->read_back_bytes();
+  for (std::size_t i = 0; i < im.stages.size(); ++i) im.stages[i]->report(im.stats.stages[i]);
   im.stats.position_reads = im.positions_mirror.reads();
   const auto end = std::chrono::steady_clock::now();
   im.stats.frame += 1;
   im.stats.time = static_cast<double>(im.stats.frame) * im.time_step;
   im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
-  return {};
+  return frame.deferred;
 }
 
 Status Simulation::set_particle_forces(std::span<const float> xyz) {
@@ -316,6 +320,23 @@ Status Simulation::Impl::positions_in_user_order(std::vector<float>& xyzw) {
   for (std::size_t slot = 0; slot < n; ++slot)
     std::copy_n(&slots[slot * 4], 4, &xyzw[std::size_t{order.user_of[slot]} * 4]);
   return {};
+}
+
+void StageProfile::set(std::string_view counter, double value) {
+  for (Counter& c : counters)
+    if (c.name == counter) {
+      c.value = value;
+      return;
+    }
+  counters.push_back({std::string(counter), value});
+}
+
+double FrameStats::counter(std::string_view stage, std::string_view counter) const {
+  for (const StageProfile& p : stages)
+    if (p.name == stage)
+      for (const StageProfile::Counter& c : p.counters)
+        if (c.name == counter) return c.value;
+  return 0.0;
 }
 
 double FrameStats::stage_ms(std::string_view name) const {

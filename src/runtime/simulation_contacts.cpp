@@ -306,7 +306,7 @@ Status Simulation::apply_tool_force(std::size_t index, const std::array<double, 
   return {};
 }
 
-Result<Simulation::ToolState> Simulation::tool_state(std::size_t index) const {
+Result<ToolState> Simulation::tool_state(std::size_t index) const {
   const std::vector<ToolBody>& tools = impl_->contacts.tools;
   if (Status s = check_index("tool_state", "tool", index, tools.size()); !s) return s.error();
   const ToolBody& b = tools[index];
@@ -342,7 +342,7 @@ Status Simulation::apply_needle_force(std::size_t index, const std::array<double
   return impl_->sutures->apply_force(index, force, torque);
 }
 
-Result<Simulation::NeedleState> Simulation::needle_state(std::size_t index) const {
+Result<NeedleState> Simulation::needle_state(std::size_t index) const {
   if (Status s = check_index("needle_state", "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s)
     return s.error();
   return impl_->sutures->state(index);

@@ -28,6 +28,8 @@ namespace sinew {
 
 struct Simulation::Impl {
   std::unique_ptr<Device> device;
+  /// This Simulation's number, unique in the process: the `scene` of its ids (sinew/ids.h).
+  std::uint32_t serial = 0;
   // The frame's stages in the order they run (runtime/frame_stage.h,
   // registered in Simulation::create); stats.stages holds their profiles
   // in the same order.
@@ -110,26 +112,26 @@ struct Simulation::Impl {
   /// made again from the live tets.
   Status remake_collision();
   // SceneDesc::graspers (null without).
-  std::unique_ptr<Graspers> graspers;
+  std::unique_ptr<GrasperHolds> graspers;
   // SceneDesc::topology_changes: the host copy of the constraints that
   // removals patch (null without), and the last step's tears.
   std::unique_ptr<TopologyEditor> topology;
-  std::vector<Simulation::TopologyEvent> tears;
+  std::vector<TopologyEvent> tears;
   /// After a frame: removes the tets, triangles and segments stretched
   /// past their body's tear_strain.
   Status tear();
   /// Removes elements of a tet or tri body (topology_editor.h), rebuilds
   /// the program and times the whole change from `start`.
-  Result<Simulation::TopologyEvent> apply_removal(BodyKind kind, std::size_t body,
+  Result<TopologyEvent> apply_removal(BodyKind kind, std::size_t body,
                                                   std::span<const std::uint32_t> elements, bool burn,
                                                   std::chrono::steady_clock::time_point start);
   /// After tets were removed (with measure_errors): the statistics' faces
   /// are the tet bodies' live boundaries and rest_volume the live tets',
   /// so FrameStats::volume_change measures what is left.
-  Status refresh_volume(const Simulation::TopologyEvent& event);
+  Status refresh_volume(const TopologyEvent& event);
   /// After the editor changed something: the mesh collision made again,
   /// the program rebuilt, the event's times filled in.
-  Result<Simulation::TopologyEvent> finish_change(Result<Simulation::TopologyEvent> event, bool changed,
+  Result<TopologyEvent> finish_change(Result<TopologyEvent> event, bool changed,
                                                   std::chrono::steady_clock::time_point start);
 
   // simulation_contacts.cpp: host copies of the collider and target

@@ -13,6 +13,10 @@
 #include "runtime/simulation_internals.h"
 #include "runtime/topology_queries.h"
 
+// cut_body and cauterize by BodyKind are deprecated for users; the tet
+// overloads here forward to them.
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+
 namespace sinew {
 
 namespace {
@@ -35,14 +39,14 @@ Status check_body(const TopologyEditor& editor, BodyKind kind, std::size_t body)
 
 }  // namespace
 
-Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(BodyKind kind, std::size_t body,
+Result<TopologyEvent> Simulation::Impl::apply_removal(BodyKind kind, std::size_t body,
                                                                  std::span<const std::uint32_t> elements, bool burn,
                                                                  std::chrono::steady_clock::time_point start) {
   return finish_change(topology->remove(*device, buffers, program_shape, kind, body, elements, burn),
                        !elements.empty(), start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulation::TopologyEvent> event,
+Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> event,
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
@@ -61,7 +65,7 @@ Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulat
   return event;
 }
 
-Status Simulation::Impl::refresh_volume(const Simulation::TopologyEvent& event) {
+Status Simulation::Impl::refresh_volume(const TopologyEvent& event) {
   const TetMesh& mesh = topology->mesh(event.body);
   for (std::uint32_t t : event.tets_removed) {  // as create sums the rest volume
     const auto at = [&](int k) {
@@ -117,20 +121,20 @@ Status Simulation::Impl::remake_collision() {
   return {};
 }
 
-Result<Simulation::TopologyEvent> Simulation::remove_tets(std::size_t body, std::span<const std::uint32_t> tets) {
+Result<TopologyEvent> Simulation::remove_tets(std::size_t body, std::span<const std::uint32_t> tets) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_tets"); !s) return s.error();
   return impl_->apply_removal(BodyKind::tet, body, tets, false, start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::remove_triangles(std::size_t body,
+Result<TopologyEvent> Simulation::remove_triangles(std::size_t body,
                                                                std::span<const std::uint32_t> triangles) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_triangles"); !s) return s.error();
   return impl_->apply_removal(BodyKind::tri, body, triangles, false, start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::remove_segments(std::size_t body,
+Result<TopologyEvent> Simulation::remove_segments(std::size_t body,
                                                               std::span<const std::uint32_t> segments) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_segments"); !s) return s.error();
@@ -139,11 +143,11 @@ Result<Simulation::TopologyEvent> Simulation::remove_segments(std::size_t body,
                               !segments.empty(), start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
+Result<TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
   return cut_body(BodyKind::tet, body, from, to);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cut_body(BodyKind kind, std::size_t body, const Blade& from,
+Result<TopologyEvent> Simulation::cut_body(BodyKind kind, std::size_t body, const Blade& from,
                                                        const Blade& to) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "cut_body"); !s) return s.error();
@@ -158,12 +162,12 @@ Result<Simulation::TopologyEvent> Simulation::cut_body(BodyKind kind, std::size_
   return impl_->apply_removal(kind, body, cut, false, start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cauterize(std::size_t body, const std::array<double, 3>& centre,
+Result<TopologyEvent> Simulation::cauterize(std::size_t body, const std::array<double, 3>& centre,
                                                         double radius, double seconds, double dwell_time) {
   return cauterize(BodyKind::tet, body, centre, radius, seconds, dwell_time);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cauterize(BodyKind kind, std::size_t body,
+Result<TopologyEvent> Simulation::cauterize(BodyKind kind, std::size_t body,
                                                         const std::array<double, 3>& centre, double radius,
                                                         double seconds, double dwell_time) {
   const auto start = std::chrono::steady_clock::now();
@@ -216,7 +220,7 @@ Status Simulation::Impl::tear() {
   return {};
 }
 
-const std::vector<Simulation::TopologyEvent>& Simulation::last_tears() const { return impl_->tears; }
+const std::vector<TopologyEvent>& Simulation::last_tears() const { return impl_->tears; }
 
 Result<std::vector<std::array<std::uint32_t, 4>>> Simulation::current_tets(std::size_t body) const {
   if (Status s = need_topology(impl_->topology, "current_tets"); !s) return s.error();

@@ -486,9 +486,9 @@ void Sutures::mark_exemption() {
   }
 }
 
-Simulation::NeedleState Sutures::state(std::size_t index) const {
+NeedleState Sutures::state(std::size_t index) const {
   const Needle& n = needles_[index];
-  Simulation::NeedleState out;
+  NeedleState out;
   out.position = n.position_start;
   out.rotation = n.rotation_start;
   out.velocity = n.body.velocity;
@@ -502,7 +502,7 @@ Simulation::NeedleState Sutures::state(std::size_t index) const {
   for (const Row& r : n.rows) {
     if (r.words[0] == SINEW_SUTURE_TIP) out.pushing = true;
     if (r.words[0] != SINEW_SUTURE_PUNCTURE && r.words[0] != SINEW_SUTURE_THREAD) continue;
-    Simulation::Puncture p;
+    Puncture p;
     p.body_kind = surfaces_[r.surface].kind;
     p.body = surfaces_[r.surface].body;
     p.triangle = r.triangle;

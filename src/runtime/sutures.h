@@ -80,7 +80,7 @@ class Sutures {
   /// substep [s]; frame: the frame's length [s].
   Status after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame);
 
-  [[nodiscard]] Simulation::NeedleState state(std::size_t index) const;
+  [[nodiscard]] NeedleState state(std::size_t index) const;
   /// Per particle (device order), what the sutures exempt from mesh
   /// collision and CCD (suture_exemption.h); updated after every frame.
   [[nodiscard]] const std::vector<std::uint8_t>* exemption() const { return &exempt_; }

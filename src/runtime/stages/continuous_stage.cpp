@@ -29,6 +29,15 @@ class ContinuousStage final : public FrameStage {
     return {};
   }
 
+  void report(StageProfile& profile) const override {
+    const ContinuousCollision& c = *sim_.continuous;
+    profile.set("hits", c.hits());
+    profile.set("repairs", c.repairs());
+    profile.set("reverted", c.reverted());
+    profile.set("carried", c.carried());
+    profile.set("forced", c.forced());
+  }
+
   std::uint64_t read_back_bytes() const override { return sim_.continuous->read_back_bytes(); }
 
  private:

@@ -1,7 +1,7 @@
 // fluid_stage.cpp — SceneDesc::fluid as a stage (runtime/scene_fluid.h):
 // the fluid's frame before the tissue's, on the same device, its forces in
 // the tissue's force buffer; an emitter that outgrew the capacity is
-// reported once the tissue's frame is done.
+// reported once the frame is done (FrameContext::deferred).
 #include "runtime/stages/stages.h"
 
 namespace sinew {
@@ -12,8 +12,15 @@ class FluidStage final : public FrameStage {
   explicit FluidStage(Simulation::Impl& sim) : sim_(sim) {}
   std::string_view name() const override { return "fluid"; }
   // After the forces stage: whether the host set forces for this frame.
-  Status before_frame(FrameContext&) override { return sim_.fluid->run_frame(sim_.host_forces_this_frame); }
-  Status after_frame(FrameContext&) override { return sim_.fluid->pending; }
+  Status before_frame(FrameContext& frame) override {
+    if (Status s = sim_.fluid->run_frame(sim_.host_forces_this_frame); !s) return s;
+    if (!sim_.fluid->pending) frame.deferred = sim_.fluid->pending;
+    return {};
+  }
+  void report(StageProfile& profile) const override {
+    profile.set("particles", sim_.fluid->solver->stats().particles);
+    profile.set("steps", sim_.fluid->info.steps_per_frame);
+  }
   std::uint64_t read_back_bytes() const override { return sim_.fluid->read_back_bytes; }
 
  private:

@@ -37,6 +37,14 @@ class MeshCollisionStage final : public FrameStage {
     return {};
   }
 
+  void report(StageProfile& profile) const override {
+    const MeshCollision& collision = *sim_.mesh_collision;
+    profile.set("contacts", collision.contacts());
+    profile.set("colors", collision.colors());
+    profile.set("margin_m", collision.margin());
+    profile.set("violation_m", collision.violation());
+  }
+
   std::uint64_t read_back_bytes() const override { return sim_.mesh_collision->read_back_bytes(); }
 
  private:
