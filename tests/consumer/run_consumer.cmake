@@ -4,6 +4,8 @@
 #         -DWORK_DIR=... -DCONFIG=... [-DCXX=... -DGENERATOR=...] -P run_consumer.cmake
 #  install:      cmake --install BUILD_DIR --prefix PREFIX (a fresh PREFIX)
 #  find_package: configure, build and run this folder's project against PREFIX
+#                (no build type, or Debug: unoptimised, to compile fast, and
+#                a configuration the installed Release library must serve)
 #  pkg_config:   compile and run main.cpp with the flags of
 #                `pkg-config --cflags --libs --static sinew`; skipped
 #                (SINEW_CONSUMER_SKIPPED, see the test's SKIP_REGULAR_EXPRESSION)
@@ -25,15 +27,15 @@ elseif(STEP STREQUAL "find_package")
   set(build "${WORK_DIR}/find_package")
   file(REMOVE_RECURSE "${build}")
   run("configure" ${CMAKE_COMMAND} -S "${CMAKE_CURRENT_LIST_DIR}" -B "${build}" -G "${GENERATOR}"
-      "-DCMAKE_CXX_COMPILER=${CXX}" "-DCMAKE_PREFIX_PATH=${PREFIX}" -DCMAKE_BUILD_TYPE=Release)
+      "-DCMAKE_CXX_COMPILER=${CXX}" "-DCMAKE_PREFIX_PATH=${PREFIX}" -DCMAKE_BUILD_TYPE=)
   # The package found must be the one just installed, not another sinew.
   file(STRINGS "${build}/CMakeCache.txt" found REGEX "^sinew_DIR:")
   string(FIND "${found}" "${PREFIX}/" at)
   if(NOT at GREATER 0)
     message(FATAL_ERROR "consumer: found ${found}, not the package under ${PREFIX}")
   endif()
-  run("build" ${CMAKE_COMMAND} --build "${build}" --config Release)
-  find_program(consumer consumer PATHS "${build}" "${build}/Release" NO_DEFAULT_PATH REQUIRED)
+  run("build" ${CMAKE_COMMAND} --build "${build}" --config Debug)
+  find_program(consumer consumer PATHS "${build}" "${build}/Debug" NO_DEFAULT_PATH REQUIRED)
   run("run" "${consumer}")
 
 elseif(STEP STREQUAL "pkg_config")
@@ -66,7 +68,7 @@ elseif(STEP STREQUAL "pkg_config")
   file(REMOVE_RECURSE "${build}")
   file(MAKE_DIRECTORY "${build}")
   # The run path finds a shared libsinew (harmless for a static one).
-  run("compile and link" "${CXX}" -std=c++20 -O2 "-DSINEW_CONSUMER_EXPECTED_VERSION=\"${version}\""
+  run("compile and link" "${CXX}" -std=c++20 "-DSINEW_CONSUMER_EXPECTED_VERSION=\"${version}\""
       "${CMAKE_CURRENT_LIST_DIR}/main.cpp" ${flags} "-Wl,-rpath,${libdir}" -o "${build}/consumer")
   run("run" "${build}/consumer")
 
