@@ -7,7 +7,8 @@
 #                (no build type, or Debug: unoptimised, to compile fast, and
 #                a configuration the installed Release library must serve)
 #  pkg_config:   compile and run main.cpp with the flags of
-#                `pkg-config --cflags --libs --static sinew`; skipped
+#                `pkg-config --cflags --libs [--static] sinew` (--static
+#                for a static libsinew); skipped
 #                (SINEW_CONSUMER_SKIPPED, see the test's SKIP_REGULAR_EXPRESSION)
 #                where pkg-config is not installed
 cmake_minimum_required(VERSION 3.25)
@@ -51,7 +52,14 @@ elseif(STEP STREQUAL "pkg_config")
   endif()
   get_filename_component(pc_dir "${pc_files}" DIRECTORY)
   set(ENV{PKG_CONFIG_PATH} "${pc_dir}")
-  foreach(query "--cflags;--libs;--static" "--modversion" "--variable=libdir")
+  # --static (Libs.private, Requires.private) for a static libsinew; a
+  # shared one carries its dependencies itself.
+  set(link "--libs")
+  file(GLOB static_library "${PREFIX}/*/libsinew.a" "${PREFIX}/*/*/libsinew.a")
+  if(static_library)
+    list(APPEND link "--static")
+  endif()
+  foreach(query "--cflags;${link}" "--modversion" "--variable=libdir")
     execute_process(COMMAND ${pkg_config} ${query} sinew RESULT_VARIABLE result
                     OUTPUT_VARIABLE out OUTPUT_STRIP_TRAILING_WHITESPACE)
     if(NOT result EQUAL 0)
@@ -62,7 +70,8 @@ elseif(STEP STREQUAL "pkg_config")
   list(GET answers 0 flags)
   list(GET answers 1 version)
   list(GET answers 2 libdir)
-  message(STATUS "pkg-config --cflags --libs --static sinew: ${flags}")
+  string(REPLACE ";" " " query "${link}")
+  message(STATUS "pkg-config --cflags ${query} sinew: ${flags}")
   separate_arguments(flags UNIX_COMMAND "${flags}")
   set(build "${WORK_DIR}/pkg_config")
   file(REMOVE_RECURSE "${build}")
