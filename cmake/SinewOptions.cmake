@@ -29,10 +29,8 @@ if(SINEW_OPENVDB)
   # so look for the headers and libraries directly.
   find_path(SINEW_OPENVDB_INCLUDE_DIR openvdb/openvdb.h)
   find_path(SINEW_NANOVDB_INCLUDE_DIR nanovdb/NanoVDB.h)
-  find_library(SINEW_OPENVDB_LIBRARY openvdb)
-  # OpenVDB's headers convert halves inline through Imath (libimath-dev, a
-  # dependency of libopenvdb-dev), so the program links it too.
-  find_library(SINEW_IMATH_LIBRARY NAMES Imath Imath-3_1)
+  # The libraries (OpenVDB's and Imath's, libimath-dev) as sinew::openvdb.
+  include(${CMAKE_CURRENT_LIST_DIR}/SinewOpenVDBLibraries.cmake)
   set(_sinew_openvdb_ok FALSE)
   if(SINEW_OPENVDB_INCLUDE_DIR AND SINEW_NANOVDB_INCLUDE_DIR AND SINEW_OPENVDB_LIBRARY AND SINEW_IMATH_LIBRARY)
     set(_sinew_openvdb_ok TRUE)
