@@ -54,3 +54,20 @@ function(sinew_set_warnings target)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
 endfunction()
+
+# libFuzzer: clang's -fsanitize=fuzzer must compile and link a target.
+if(SINEW_FUZZ)
+  set(_sinew_fuzz_ok FALSE)
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    include(CheckCXXSourceCompiles)
+    set(CMAKE_REQUIRED_FLAGS "-fsanitize=fuzzer,address,undefined")
+    set(CMAKE_REQUIRED_LINK_OPTIONS "-fsanitize=fuzzer,address,undefined")
+    check_cxx_source_compiles(
+      "#include <cstddef>\n#include <cstdint>\nextern \"C\" int LLVMFuzzerTestOneInput(const std::uint8_t*, std::size_t) { return 0; }"
+      SINEW_HAVE_LIBFUZZER)
+    unset(CMAKE_REQUIRED_FLAGS)
+    unset(CMAKE_REQUIRED_LINK_OPTIONS)
+    set(_sinew_fuzz_ok ${SINEW_HAVE_LIBFUZZER})
+  endif()
+  sinew_optional(SINEW_FUZZ _sinew_fuzz_ok "clang with libFuzzer (-DCMAKE_CXX_COMPILER=clang++)")
+endif()

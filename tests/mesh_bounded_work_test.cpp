@@ -63,6 +63,24 @@ TEST(MeshBoundedWork, AnOpenSoupIsJudgedByItsEdgesAlone) {
   EXPECT_FALSE(report->closed());
 }
 
+// Found by fuzz_gmsh: two tets on the same four vertices share all their
+// faces, so their boundary has no triangle; the crossing search then read
+// the root of a tree of no boxes.
+TEST(MeshBoundedWork, ASurfaceWithoutTrianglesIsNotClosed) {
+  TetMesh twins;
+  twins.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  twins.tets = {{0, 1, 2, 3}, {1, 0, 3, 2}};
+  ASSERT_TRUE(check_tet_mesh(twins).ok());
+  const TriMesh boundary = extract_boundary_surface(twins);
+  EXPECT_TRUE(boundary.triangles.empty());
+  for (const TriMesh& empty : {boundary, TriMesh{}}) {
+    const Result<SurfaceReport> report = check_closed_surface(empty);
+    ASSERT_TRUE(report.ok()) << report.error().message();
+    EXPECT_FALSE(report->crossings_tested);
+    EXPECT_FALSE(report->closed());
+  }
+}
+
 TEST(MeshBoundedWork, OneClosedTetrahedronIsSearchedAndClosed) {
   const Result<SurfaceReport> report = check_closed_surface(piled_tetrahedra(1));
   ASSERT_TRUE(report.ok()) << report.error().message();

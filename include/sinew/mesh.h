@@ -70,7 +70,8 @@ struct SurfaceReport {
 /// two triangles crossing (pairs sharing a vertex are not tested). [out]
 /// the counts. Work: the edge counts (n log n in the triangles) decide
 /// first; a surface they show open, non-manifold, misoriented or
-/// degenerate is not searched for crossings (crossings_tested = false).
+/// degenerate is not searched for crossings (crossings_tested = false);
+/// nor is a surface without triangles, which bounds nothing (not closed).
 /// The crossing search tests the pairs of triangles whose boxes overlap,
 /// at most 64 per triangle (and at least 2^20 in all): the data's organ
 /// and bone surfaces test under 0.05 per triangle. Errors: capacity_exceeded when

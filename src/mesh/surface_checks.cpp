@@ -125,6 +125,11 @@ Result<SurfaceReport> check_closed_surface(const TriMesh& surface) {
   // whatever crosses; the crossing search would only cost time.
   if (report.open_edges + report.nonmanifold_edges + report.misoriented_edges + report.degenerate_triangles > 0)
     return report;
+  // No triangle at all (e.g. the boundary of two tets on the same four
+  // vertices): it bounds nothing, and a tree of no boxes has no root to
+  // search from (the traversal read past an empty node array: issue 39's
+  // fuzzing, tests/fuzz/corpus/gmsh/regress_empty_boundary.msh).
+  if (boxes.empty()) return report;
   collision::Bvh tree;
   tree.build(boxes);
   const std::uint64_t triangles = boxes.size();
