@@ -201,7 +201,7 @@ Status Simulation::Impl::rebuild_program() {
 }
 
 void Simulation::Impl::add_stage(std::unique_ptr<FrameStage> stage) {
-  stats.stages.push_back({std::string(stage->name()), 0.0});
+  stats.stages.push_back({std::string(stage->name()), 0.0, {}});
   stages.push_back(std::move(stage));
 }
 
