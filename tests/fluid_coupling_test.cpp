@@ -30,12 +30,7 @@ struct Scene {
 
 Scene cup_scene(bool pinned, std::array<double, 3> gravity) {
   Scene s;
-  TetBodyDesc body;
-  body.mesh = fluid_cup();
-  EXPECT_TRUE(body.set_elastic(2e5, 0.3).ok());
-  if (pinned)
-    for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
-      if (body.mesh.vertices[v][1] < 1e-9) body.pinned.push_back(v);
+  TetBodyDesc body = fluid_cup_body(pinned);
   s.surface = extract_boundary_surface(body.mesh);
   s.scene.tet_bodies.push_back(std::move(body));
   s.scene.gravity = gravity;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sinew/mesh.h"
+#include "sinew/scene.h"
 
 namespace sinew::test {
 
@@ -28,6 +29,17 @@ inline TetMesh fluid_cup() {
     carved.tets.push_back(t);
   }
   return drop_unused_vertices(carved);
+}
+
+/// The cup as a tet body of 200 kPa (nu 0.3), pinned at its base when `pinned`.
+inline TetBodyDesc fluid_cup_body(bool pinned) {
+  TetBodyDesc body;
+  body.mesh = fluid_cup();
+  EXPECT_TRUE(body.set_elastic(2e5, 0.3).ok());
+  if (pinned)
+    for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
+      if (body.mesh.vertices[v][1] < 1e-9) body.pinned.push_back(v);
+  return body;
 }
 
 /// nx x ny x nz particles a spacing apart, the first cell's corner at `lo` [m].

@@ -29,12 +29,7 @@ constexpr double kS = kCupCell;
 SceneDesc cup_scene(bool pinned, std::array<double, 3> gravity, std::vector<std::array<double, 3>> fluid,
                     std::array<double, 3> velocity = {}) {
   SceneDesc scene;
-  TetBodyDesc body;
-  body.mesh = fluid_cup();
-  EXPECT_TRUE(body.set_elastic(2e5, 0.3).ok());
-  if (pinned)
-    for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
-      if (body.mesh.vertices[v][1] < 1e-9) body.pinned.push_back(v);
+  TetBodyDesc body = fluid_cup_body(pinned);
   scene.tet_bodies.push_back(std::move(body));
   scene.gravity = gravity;
   scene.solver.time_step = 1e-3;
