@@ -1,5 +1,5 @@
 // sinew/ccd.h — continuous collision detection of two primitives moving
-// linearly within a step (issue 13): a vertex against a triangle, an edge
+// linearly within a step (docs/collision.md): a vertex against a triangle, an edge
 // against an edge. Never a false negative: when the primitives touch (come
 // within the minimum separation) at some time of the step, the query says
 // so, and the time it returns is never later than the first touch.

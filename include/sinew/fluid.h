@@ -31,7 +31,7 @@
 
 namespace sinew {
 
-/// The solver (README, "SPH fluid", has the measured comparison).
+/// The solver (docs/fluids.md, "SPH fluid", has the measured comparison).
 enum class FluidMethod {
   /// Weakly compressible SPH (Becker and Teschner 2007): pressure from
   /// density by Tait's equation, explicit steps bound by the speed of sound.

@@ -1,5 +1,5 @@
 // sinew/fluid_coupling.h — two-way coupling of a fluid (sinew/fluid.h) with
-// tissue (sinew/simulation.h), issue 15 part 3: the tissue's surfaces are
+// tissue (sinew/simulation.h): the tissue's surfaces are
 // sampled with boundary particles that follow them (Akinci et al., TOG
 // 31(4), 2012), so tissue holds fluid in a cavity; the fluid pushes back on
 // those particles and that push, spread to the surfaces' vertices by the

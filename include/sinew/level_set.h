@@ -1,4 +1,4 @@
-// level_set.h — signed distance fields on a sparse grid (issue 14): bone and
+// level_set.h — signed distance fields on a sparse grid (docs/level_sets.md): bone and
 // tools as narrow-band level sets built from closed triangle surfaces or
 // analytic shapes, sampled (value and gradient, trilinear) on the host and
 // inside every backend's kernels.
@@ -73,7 +73,7 @@ struct CutReport {
 /// A signed distance field on a sparse grid, in its own frame (the frame of
 /// the surface or shape it was built from). Copies share the grid (cheap).
 ///
-/// Bounds every factory and cut checks first (issue 39), so that no input
+/// Bounds every factory and cut checks first, so that no input
 /// overflows or runs without end: every length and coordinate within
 /// float32's range (the device samples in float; e.g. a cube of 1e39 m is
 /// bad_parameter); every voxel index, the shape's box grown by the

@@ -57,7 +57,7 @@ struct SurfaceReport {
   std::uint64_t intersecting_pairs = 0;
   /// Whether the crossing search ran: false when the edge and triangle
   /// counts already show the surface does not bound a solid (the search
-  /// would only cost time: issue 39).
+  /// would only cost time).
   bool crossings_tested = false;
   [[nodiscard]] bool closed() const {
     return open_edges == 0 && nonmanifold_edges == 0 && misoriented_edges == 0 && degenerate_triangles == 0 &&

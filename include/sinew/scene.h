@@ -37,7 +37,7 @@ namespace sinew {
 /// stvk and corotational need nu > 0 (lambda > 0; Simulation::create names
 /// poisson_ratio otherwise). neo_hookean needs small steps: its shear acts
 /// explicitly, so keep h sqrt(mu / rho) / (edge length) below ~0.2 (above
-/// ~0.75 it is unstable); see README, "FEM materials".
+/// ~0.75 it is unstable); see docs/tissue.md, "FEM materials".
 enum class TetMaterial { none, neo_hookean, stvk, corotational };
 
 /// A volumetric body simulated on a tet mesh with xPBD constraints.
@@ -271,7 +271,7 @@ enum class ToolShape {
 /// penalty_stiffness pi R delta^2. The penalty at the start of a frame
 /// drives the frame (explicit): stable while sqrt(k / M) time_step < 2 for
 /// the contact's stiffness k = dF/d delta (2 penalty_stiffness pi R delta
-/// for that sphere) and the tool's mass M; README, "Level sets", sizes it.
+/// for that sphere) and the tool's mass M; docs/level_sets.md sizes it.
 /// Particles deeper in the tool than its level set's interior band (zero
 /// gradient) are not pushed out: build a tool's level set with the inside
 /// filled. Continuous collision (MeshCollisionDesc::continuous) sweeps
@@ -307,11 +307,11 @@ enum class NeedleDrive {
   /// reaction of one frame acts on it in the next. Drive it through a
   /// virtual coupling that also holds its orientation (a needle pushed
   /// along its axis balances on its tip like a pencil); the gains' bounds
-  /// are in the README, "Needles and sutures".
+  /// are in docs/needles.md.
   force,
 };
 
-/// A suture needle (issue 13, part 4): a rigid curve, a polyline in its own
+/// A suture needle (docs/needles.md): a rigid curve, a polyline in its own
 /// frame from its tail (curve.front()) to its tip (curve.back()), moved
 /// kinematically (Simulation::set_needle_pose) or by force
 /// (Simulation::apply_needle_force; `drive`), its substeps interpolating
@@ -331,8 +331,7 @@ enum class NeedleDrive {
 /// thread instead, which slides through it with friction; the thread's last
 /// vertex is a knot that stops at the puncture. Punctures of a triangle
 /// that is degenerate or inverted (its tet turned inside out) are refused
-/// (NeedleState::refused). Details and limits: README, "Needles and
-/// sutures".
+/// (NeedleState::refused). Details and limits: docs/needles.md.
 struct NeedleDesc {
   std::vector<std::array<double, 3>> curve;             ///< [m] in the needle's frame, tail to tip, >= 2 points, no zero-length segment
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< initial [m]
@@ -394,7 +393,7 @@ struct SolverSettings {
   /// measures the residuals and reduces them on the device, and the host
   /// reads back 3 words per constraint block. For statics within ~5% the
   /// tolerance must be ~1/20 of the body's strain under its load (about
-  /// rho g L / E): see the README's stiffness table. 0: fixed mode.
+  /// rho g L / E): see docs/tissue.md's stiffness table. 0: fixed mode.
   double residual_tolerance = 0.0;
   /// Residual mode: the most sweeps per substep, >= iterations, <= 100,000
   /// (and substeps x max_iterations <= 1,000,000); rounded up to
@@ -437,7 +436,7 @@ struct SolverSettings {
   /// first chebyshev_delay of a substep, positions AND lambdas are
   /// extrapolated (Wang, SIGGRAPH Asia 2015, eq. 12) with omega_k from rho.
   /// Too large a rho oscillates or diverges, too small gains little (see
-  /// the README's stiffness section for measured values). Works in fixed
+  /// docs/tissue.md's stiffness section for measured values). Works in fixed
   /// and residual mode; costs one pass over positions and lambdas per sweep.
   /// Not with warm_start (an error): together they diverged on the tests'
   /// stiff cantilever.
@@ -461,20 +460,20 @@ struct SolverSettings {
 /// Contacts are found once per frame, at its start, and stay valid for the
 /// whole frame: every pair of primitives closer than thickness + margin is
 /// a contact, the margin covering how far the surfaces can move within the
-/// frame (README, "Mesh collision"). Each contact keeps the first
+/// frame (docs/collision.md, "Mesh collision"). Each contact keeps the first
 /// primitive on its side of the separating plane through the second's
 /// closest point, `thickness` away from it, so surfaces that start a frame
 /// apart cannot pass through each other as long as no particle moves more
 /// than half the margin within it. Redundant contacts are pruned: a
 /// vertex keeps its nearest against another body, a triangle its 3
-/// nearest immovable vertices, an edge its 4 nearest edges (README, "Mesh
+/// nearest immovable vertices, an edge its 4 nearest edges (docs/collision.md, "Mesh
 /// collision"). Contacts are solved after the bodies'
 /// constraints in every sweep, scheduled by `schedule`.
 ///
 /// Not yet: with the Chebyshev accelerator (an error names the setting),
 /// and on the device (the host finds the contacts; GPU backends read the
 /// positions back once per frame).
-/// How the contacts between meshes are scheduled within a sweep (README,
+/// How the contacts between meshes are scheduled within a sweep (docs/collision.md,
 /// "Mesh collision", compares them):
 ///  - colored: coloured on the host every frame so that no two contacts of
 ///    a colour share a movable particle, one dispatch per colour
@@ -507,13 +506,13 @@ struct MeshCollisionDesc {
   /// every triangle normal at the frame's start within 30 degrees of one
   /// axis (normal cones, Volino and Magnenat-Thalmann 1994). It assumes no
   /// patch winds over itself like a helical ramp; turn it off for scenes
-  /// that may form one (README, mesh collision).
+  /// that may form one (docs/collision.md, mesh collision).
   bool self_culling = true;
   /// The meshes' triangles and thread segments meet the rigid tools
   /// (ToolDesc) too, as they meet the colliders, and their reaction joins
   /// the vertices' on the tool: a thin tool pressed between a coarse
   /// mesh's vertices is held. Off: only vertices meet tools, as without
-  /// mesh collision. Measured (README, "Mesh collision"): a 20 g tool on a
+  /// mesh collision. Measured (docs/collision.md, "Mesh collision"): a 20 g tool on a
   /// virtual coupling in a 2 cm membrane cell is held with faces and passes
   /// through without; a heavy tool (10^4 times a particle) dropped onto a
   /// soft 5 mm block at 20 substeps rests without faces but bounces and
@@ -523,7 +522,7 @@ struct MeshCollisionDesc {
   double static_friction = 0.3;   ///< >= 0
   double dynamic_friction = 0.2;  ///< >= 0, <= static_friction
 
-  /// Continuous collision detection (issue 13, part 3): after every
+  /// Continuous collision detection (docs/collision.md): after every
   /// substep's sweeps the host tests the motion the primitives made in it,
   /// from the substep's start to its end, linearly, with the CCD queries of
   /// sinew/ccd.h (no false negatives):
@@ -544,7 +543,7 @@ struct MeshCollisionDesc {
   /// thread, however fast they move, provided the scene starts with none
   /// through another; the one exception, counted in FrameStats::ccd_forced,
   /// is a tool forcing tissue it carries or pinned tissue through other
-  /// tissue (README, "Continuous collision detection"). Costs a read-back
+  /// tissue (docs/collision.md, "Continuous collision detection"). Costs a read-back
   /// of the positions per substep. Needs ContactSchedule::colored, and
   /// a line body, or a tool or capsule collider and a surface. Surfaces
   /// against surfaces are not tested continuously (the frame's contacts

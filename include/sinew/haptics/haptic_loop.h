@@ -54,7 +54,7 @@ struct HapticLoopSettings {
   /// sleep state first. Off by default: it makes every idle CPU spin
   /// (power, heat), and in a VM whose host caps its CPU time the spinning
   /// vCPUs use up the cap and the host pauses the whole VM (measured here:
-  /// 35 ms pauses every 100 ms; benchmarks/README.md). Turn it on for a
+  /// 35 ms pauses every 100 ms; docs/benchmarks.md). Turn it on for a
   /// dedicated machine. Needs write access to the device (root); what was
   /// obtained is reported in SchedulingReport::cpu_latency.
   bool zero_cpu_latency = false;

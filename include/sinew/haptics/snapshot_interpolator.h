@@ -21,7 +21,7 @@
 // at once (microseconds apart) would multiply the extrapolated speed by
 // frame time / D. Interpolating costs one physics frame of latency
 // in the loop tool -> device -> tool: the coupled tool is stable when the
-// physics frame is short against the tool's coupled period (README).
+// physics frame is short against the tool's coupled period (docs/haptics.md).
 #pragma once
 
 #include <cstdint>
