@@ -191,8 +191,10 @@ enum class ColliderShape { plane, sphere, capsule, box, cylinder, implicit, leve
 /// normal is the gradient of the primitive that decides the value).
 /// At most 64 nodes, at most 8 values on the stack at once.
 enum class ImplicitOp { half_space, sphere, capsule, box, cylinder, torus, unite, intersect, subtract };
+/// One node of an implicit collider's postfix expression: a primitive with
+/// its pose and size, or an operation on the two values before it.
 struct ImplicitNode {
-  ImplicitOp op = ImplicitOp::sphere;
+  ImplicitOp op = ImplicitOp::sphere;  ///< the primitive, or the operation
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< primitive's origin in the collider's frame [m]
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
   double radius = 0.0;                                  ///< sphere, capsule, cylinder, torus (major) [m], > 0
@@ -484,9 +486,10 @@ struct SolverSettings {
 ///    per sweep however many colours the contacts would need.
 enum class ContactSchedule { colored, jacobi };
 
+/// Contacts between the bodies' meshes and within them (SceneDesc::mesh_collision; docs/collision.md).
 struct MeshCollisionDesc {
-  bool enabled = false;
-  ContactSchedule schedule = ContactSchedule::colored;
+  bool enabled = false;                                 ///< off: no mesh contacts at all
+  ContactSchedule schedule = ContactSchedule::colored;  ///< how the contacts are solved within a sweep
   /// The distance the surfaces keep from each other [m], > 0. Also the
   /// tissue's collision thickness in self-contact.
   double thickness = 1e-3;
@@ -608,18 +611,21 @@ struct SceneFluidDesc {
   std::vector<FluidSurfaceDesc> surfaces;  ///< may be empty: a fluid held by its fixed boundary only
 };
 
+/// A whole scene: its bodies, colliders, tools, interactions and solver
+/// settings, in SI units. Simulation::create checks it (errors name the
+/// field, e.g. "tet_bodies[0].density") and compiles it onto a device.
 struct SceneDesc {
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
-  SolverSettings solver;
-  std::vector<TetBodyDesc> tet_bodies;
-  std::vector<TriBodyDesc> tri_bodies;
-  std::vector<LineBodyDesc> line_bodies;
-  std::vector<ColliderDesc> colliders;
+  SolverSettings solver;                   ///< time step, substeps, iterations, residual mode
+  std::vector<TetBodyDesc> tet_bodies;     ///< volumetric tissue (tet meshes)
+  std::vector<TriBodyDesc> tri_bodies;     ///< thin tissue: membranes, vessel walls (triangle meshes)
+  std::vector<LineBodyDesc> line_bodies;   ///< threads (polylines)
+  std::vector<ColliderDesc> colliders;     ///< kinematic shapes (Tools::collider reaches them by index)
   std::vector<std::array<double, 3>> targets;       ///< initial kinematic target positions [m]
-  std::vector<AttachmentDesc> attachments;
-  std::vector<ToolDesc> tools;
-  std::vector<NeedleDesc> needles;
-  std::vector<GrasperDesc> graspers;
+  std::vector<AttachmentDesc> attachments; ///< vertices held to targets
+  std::vector<ToolDesc> tools;             ///< rigid tools driven by force
+  std::vector<NeedleDesc> needles;         ///< suture needles and their threads
+  std::vector<GrasperDesc> graspers;       ///< graspers (Graspers closes them)
   MeshCollisionDesc mesh_collision;  ///< contacts between the bodies' meshes (off by default)
   /// Forces on single particles, set by the host before each frame
   /// (Simulation::set_particle_forces; e.g. a fluid's pressure on tissue,
