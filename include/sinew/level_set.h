@@ -46,8 +46,8 @@ struct LevelSetSettings {
 /// `radius` about the origin), a drill (capsule: the segment +-half_height
 /// along y swollen by `radius`) or a saw (box of `half_extents`).
 struct CutterShape {
-  enum class Kind { sphere, capsule, box };
-  Kind kind = Kind::sphere;
+  enum class Kind { sphere, capsule, box };  ///< burr, drill, saw
+  Kind kind = Kind::sphere;                  ///< which shape
   double radius = 1.5e-3;                               ///< sphere, capsule [m], > 0
   double half_height = 0.0;                             ///< capsule [m], >= 0
   std::array<double, 3> half_extents{1e-3, 1e-3, 1e-3};  ///< box [m], > 0
@@ -56,14 +56,14 @@ struct CutterShape {
 /// A rigid pose: the frame's origin [m] and its rotation, a unit quaternion
 /// (w, x, y, z), in the level set's frame.
 struct Pose {
-  std::array<double, 3> position{0.0, 0.0, 0.0};
-  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 3> position{0.0, 0.0, 0.0};       ///< the origin [m]
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
 };
 
 /// What one cut changed.
 struct CutReport {
   double removed_volume = 0.0;      ///< [m^3], measured on the grid (see LevelSet::cut)
-  std::uint64_t changed_voxels = 0;
+  std::uint64_t changed_voxels = 0;  ///< voxels whose value changed
   std::uint32_t changed_leaves = 0;  ///< 8^3-voxel blocks of the grid
   /// Byte ranges (offset, size) of the NanoVDB grid that changed: what a
   /// device's copy needs (update_level_set, src/level_set/device_level_set.h).
@@ -99,9 +99,9 @@ class LevelSet {
   static Result<LevelSet> box(const std::array<double, 3>& lo, const std::array<double, 3>& hi,
                               const LevelSetSettings& settings);
 
-  [[nodiscard]] double voxel_size() const;
-  [[nodiscard]] double exterior_band() const;
-  [[nodiscard]] double interior_band() const;
+  [[nodiscard]] double voxel_size() const;     ///< the voxels' edge [m]
+  [[nodiscard]] double exterior_band() const;  ///< how far outside distances are exact [m]
+  [[nodiscard]] double interior_band() const;  ///< how far inside distances are exact [m] (infinity: the whole inside)
   /// The box of the stored voxels [m] (lo then hi).
   [[nodiscard]] std::array<double, 6> bounds() const;
   /// Stored voxels (active and inactive, in allocated leaves).

@@ -230,8 +230,9 @@ struct ColliderDesc {
 
 /// Which body a vertex belongs to.
 enum class BodyKind { tet, tri, line };
+/// One vertex of one body of the scene.
 struct VertexRef {
-  BodyKind body_kind = BodyKind::tet;
+  BodyKind body_kind = BodyKind::tet;  ///< the kind of body
   std::uint32_t body = 0;    ///< index into the scene's bodies of that kind
   std::uint32_t vertex = 0;  ///< vertex of that body
 };
@@ -241,7 +242,7 @@ struct VertexRef {
 /// points moved between frames with Simulation::set_target and interpolated
 /// across the substeps; several attachments may share one target.
 struct AttachmentDesc {
-  VertexRef vertex;
+  VertexRef vertex;           ///< the vertex held
   std::uint32_t target = 0;   ///< index into SceneDesc::targets
   double compliance = 0.0;    ///< [m/N], >= 0
 };
