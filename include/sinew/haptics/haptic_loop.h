@@ -40,6 +40,8 @@ namespace sinew::haptics {
 /// at 1 kHz), 2.5 GiB of TickRecords.
 inline constexpr std::size_t kMaxTelemetryCapacity = std::size_t{1} << 24;
 
+/// How a HapticLoop runs: its rate, scheduling, telemetry, and the
+/// coupling, watchdog and interpolation it renders force with.
 struct HapticLoopSettings {
   /// Tick rate [Hz], 1..1e6. At least 1 Hz: the period is an int64 count
   /// of nanoseconds (and twice it the missed-deadline threshold), which a
@@ -60,9 +62,9 @@ struct HapticLoopSettings {
   bool zero_cpu_latency = false;
   std::size_t telemetry_capacity = 1u << 16;  ///< ticks kept in the telemetry ring (the newest), 1..kMaxTelemetryCapacity
   unsigned snapshot_read_attempts = 4;        ///< bounded seqlock retries per tick, >= 1
-  CouplingParams coupling;
-  WatchdogParams watchdog;
-  InterpolationParams interpolation;
+  CouplingParams coupling;            ///< the virtual coupling and force limits
+  WatchdogParams watchdog;            ///< when stale state fades the force out
+  InterpolationParams interpolation;  ///< how the tool's state is interpolated between snapshots
   /// Called once on the loop thread before its first tick (outside the
   /// tick: it may allocate); e.g. to mark the thread for an allocation counter.
   std::function<void()> on_thread_start;
@@ -114,6 +116,11 @@ struct HapticCounters {
   std::uint64_t snapshots_received = 0;
 };
 
+/// The haptic servo loop: each tick samples the device, interpolates the
+/// tool's published state, renders the coupling force through the safety
+/// filters and commands it, on its own thread (start) or called from a
+/// device SDK's scheduler (tick). A tick allocates nothing, takes no lock
+/// and does no I/O.
 class HapticLoop {
  public:
   /// Checks the settings and preallocates everything a tick uses. The
@@ -133,6 +140,7 @@ class HapticLoop {
   /// Stops the thread and the device (the device is commanded zero force;
   /// a later start() ramps the force up again through the watchdog). Idempotent.
   void stop() noexcept;
+  /// Whether the loop thread runs.
   [[nodiscard]] bool running() const { return running_.load(std::memory_order_acquire); }
   /// What the loop thread obtained; filled by start().
   [[nodiscard]] const SchedulingReport& scheduling() const { return scheduling_; }
@@ -147,6 +155,7 @@ class HapticLoop {
   /// SDK callback should stop calling tick() before the telemetry is copied.
   TickRecord tick() noexcept;
 
+  /// The loop's counters so far (ticks, clamps, stale ticks, ...).
   [[nodiscard]] HapticCounters counters() const;
   /// [out] out: the telemetry ring, oldest first (at most telemetry_capacity
   /// ticks). Only while the loop thread is not running and no tick() is in
@@ -154,6 +163,7 @@ class HapticLoop {
   /// ring is written without locks; a lock-free guard keeps an externally
   /// driven tick() (SDK servo callback) and the copy apart.
   Status copy_telemetry(std::vector<TickRecord>& out) const;
+  /// The settings it was created with.
   [[nodiscard]] const HapticLoopSettings& settings() const { return settings_; }
   /// The newest rendered tool state (loop thread / manual ticker only).
   [[nodiscard]] const RenderedTool& rendered_tool() const { return tool_; }

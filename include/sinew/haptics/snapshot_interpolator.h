@@ -31,6 +31,7 @@
 
 namespace sinew::haptics {
 
+/// How the loop interpolates and extrapolates the tool's snapshots.
 struct InterpolationParams {
   /// How far past the newest snapshot the state may be extrapolated [s], >= 0.
   double extrapolation_horizon = 0.010;
