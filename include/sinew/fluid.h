@@ -127,8 +127,10 @@ struct FluidParticle {
   /// Ids are 31 bits: a step() that could pass 2^31 is refused
   /// (capacity_exceeded) before it runs.
   std::uint32_t id = 0;
-  std::array<float, 3> position{}, velocity{};  ///< [m], [m/s]
-  float density = 0.0f, pressure = 0.0f;        ///< [kg/m^3], [Pa] from the last step's start
+  std::array<float, 3> position{};  ///< [m]
+  std::array<float, 3> velocity{};  ///< [m/s]
+  float density = 0.0f;             ///< [kg/m^3], from the last step's start
+  float pressure = 0.0f;            ///< [Pa], from the last step's start
 };
 
 /// Counts after the last step() (read back with it: 6 words).

@@ -46,7 +46,8 @@ struct LevelSetSettings {
 /// `radius` about the origin), a drill (capsule: the segment +-half_height
 /// along y swollen by `radius`) or a saw (box of `half_extents`).
 struct CutterShape {
-  enum class Kind { sphere, capsule, box };  ///< burr, drill, saw
+  /// burr, drill, saw
+  enum class Kind { sphere, capsule, box };
   Kind kind = Kind::sphere;                  ///< which shape
   double radius = 1.5e-3;                               ///< sphere, capsule [m], > 0
   double half_height = 0.0;                             ///< capsule [m], >= 0
@@ -158,6 +159,7 @@ class LevelSet {
 
   struct Impl;  ///< opaque outside sinew (src/level_set/level_set_impl.h)
   explicit LevelSet(std::shared_ptr<Impl> impl);
+  /// The library's own view of the grid (opaque outside sinew).
   [[nodiscard]] const Impl& internals() const { return *impl_; }
 
  private:

@@ -157,7 +157,7 @@ TriMesh extract_boundary_surface(const TetMesh& mesh);
 
 /// A per-vertex field written to VTU: 1 (scalar) or 3 (vector) components.
 struct VertexField {
-  std::string name;
+  std::string name;               ///< the field's name in the file
   int components = 1;             ///< 1 or 3
   std::span<const float> values;  ///< vertex_count * components values
 };

@@ -141,9 +141,9 @@ struct TriBodyDesc {
   std::vector<Vec3d> initial_vertices;    ///< start positions [m] if not the rest shape (empty: rest)
   double thickness = 1e-3;                ///< [m], > 0
   double density = 1000.0;                ///< [kg/m^3], > 0
-  bool distance_constraints = true;
+  bool distance_constraints = true;       ///< stretch: one distance constraint per edge
   double distance_compliance = 1e-5;      ///< c_d [1/Pa], >= 0
-  bool area_constraints = true;
+  bool area_constraints = true;           ///< one area constraint per triangle
   double area_compliance = 1e-5;          ///< c_a [1/Pa], >= 0
   double bending_compliance = -1.0;       ///< [1/(N m)], >= 0; < 0: no bending constraints
   std::vector<std::uint32_t> pinned;      ///< vertices held fixed
@@ -210,7 +210,7 @@ struct ImplicitNode {
 /// between frames with Simulation::set_collider_pose; it is interpolated
 /// across the frame's substeps.
 struct ColliderDesc {
-  ColliderShape shape = ColliderShape::plane;
+  ColliderShape shape = ColliderShape::plane;  ///< which shape; the fields below it uses
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< [m]
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
   double radius = 0.0;                                  ///< sphere, capsule, cylinder [m], > 0
@@ -281,7 +281,7 @@ enum class ToolShape {
 /// capsule tools only: a level-set tool meets particles and faces at the
 /// substeps' poses.
 struct ToolDesc {
-  ToolShape shape = ToolShape::capsule;
+  ToolShape shape = ToolShape::capsule;  ///< a capsule, or a level set's shape
   double radius = 0.005;                                ///< capsule [m], > 0
   double half_height = 0.05;                            ///< capsule [m], >= 0
   /// ToolShape::level_set: the signed distance field in the tool's frame
@@ -294,8 +294,8 @@ struct ToolDesc {
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< initial [m]
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< initial unit quaternion (w, x, y, z)
   bool gravity = true;                                  ///< whether gravity acts on the tool
-  double static_friction = 0.3;
-  double dynamic_friction = 0.2;
+  double static_friction = 0.3;                         ///< of its contacts, >= 0
+  double dynamic_friction = 0.2;                        ///< of its contacts, >= 0, <= static_friction
   double compliance = 0.0;                              ///< of its contacts [m/N]
 };
 
@@ -347,7 +347,7 @@ struct NeedleDesc {
   int thread = -1;
   double thread_static_friction = 0.3;   ///< of the thread sliding through a puncture, >= 0
   double thread_dynamic_friction = 0.2;  ///< >= 0, <= thread_static_friction
-  NeedleDrive drive = NeedleDrive::kinematic;
+  NeedleDrive drive = NeedleDrive::kinematic;  ///< posed by the caller, or moved by force
   // ---- A force-driven needle's body (drive = force; ignored otherwise).
   // The needle's frame has its origin at the centre of mass and its axes
   // along the principal axes of inertia; the defaults are those of a needle
