@@ -80,7 +80,9 @@ struct SchedulingReport {
   int cpu = -1;            ///< pinned CPU obtained (-1: none)
   std::string error;       ///< why the request failed ("" when it did not)
   std::string cpu_latency = "not requested";  ///< the PM QoS request: "0 us held", or why not
+  /// Whether a real-time policy (SCHED_FIFO or SCHED_RR) was obtained.
   [[nodiscard]] bool realtime() const { return policy == "SCHED_FIFO" || policy == "SCHED_RR"; }
+  /// One line saying what was requested and obtained.
   [[nodiscard]] std::string describe() const;
 };
 
@@ -98,22 +100,22 @@ struct TickRecord {
   Vec3 force{};                  ///< commanded to the device [N]
   double gain = 0.0;             ///< watchdog gain
   std::uint32_t flags = 0;       ///< TickFlags
-  std::uint32_t device_buttons = 0;
+  std::uint32_t device_buttons = 0;  ///< the device's buttons, one bit each
 };
 
 /// Counters, readable from any thread while the loop runs.
 struct HapticCounters {
-  std::uint64_t ticks = 0;
+  std::uint64_t ticks = 0;             ///< ticks run
   std::uint64_t missed_deadlines = 0;  ///< tick-to-tick intervals > 2 periods
   std::uint64_t skipped_slots = 0;     ///< periods skipped to catch up after a long stall
   std::uint64_t non_finite = 0;        ///< ticks whose raw force/torque had NaN/Inf
-  std::uint64_t clamped = 0;
-  std::uint64_t slew_limited = 0;
-  std::uint64_t stale_ticks = 0;
+  std::uint64_t clamped = 0;           ///< ticks whose force or torque was clamped
+  std::uint64_t slew_limited = 0;      ///< ticks whose force or torque change was limited
+  std::uint64_t stale_ticks = 0;       ///< ticks with stale tool or device state
   std::uint64_t stalls = 0;            ///< fresh -> stale transitions
   std::uint64_t snapshot_read_failures = 0;  ///< ticks whose bounded seqlock read gave up
   std::uint64_t device_failures = 0;   ///< ticks without a device sample
-  std::uint64_t snapshots_received = 0;
+  std::uint64_t snapshots_received = 0;  ///< new snapshots read from the channel
 };
 
 /// The haptic servo loop: each tick samples the device, interpolates the
