@@ -22,8 +22,10 @@
 // Events are returned, for a renderer to update its meshes
 // (current_tets, current_triangles). Elements are never renumbered or
 // reused: naming one that was removed is an error ("was removed
-// already"). Errors in the arguments change nothing; a device error
-// during a change leaves the Simulation unusable.
+// already"). Errors in the arguments change nothing. A device error
+// during a change is returned by name and the Simulation steps on (its
+// program is rebuilt at the next step), but the change may be partly
+// applied on the device.
 #pragma once
 
 #include <array>
