@@ -155,7 +155,8 @@ struct Profile {
     }
   }
   void print(int frames, double total_wall_ms) const {
-    std::printf("profile (mean per frame over %d frames, %.3f ms in all):\n", frames, total_wall_ms / frames);
+    std::printf("profile: %.3f ms per frame on average over %d frames (%.1f ms in all); per stage, and its counters in the last frame:\n",
+                total_wall_ms / frames, frames, total_wall_ms);
     for (const std::string& name : order) {
       std::printf("  %-16s %9.3f ms", name.c_str(), total_ms.at(name) / frames);
       for (const auto& c : last_counters.at(name)) std::printf("  %s %g", c.name.c_str(), c.value);

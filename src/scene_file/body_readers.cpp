@@ -218,8 +218,10 @@ void read_elastic(Object& o, Body& body) {
   eo.read("poisson_ratio", poisson, true);
   eo.finish();
   if (o.ctx().failed()) return;
-  if (Status s = body.set_elastic(young, poisson); !s)
-    o.ctx().fail(ErrorCode::bad_parameter, o.path("elastic"), s.error().message());
+  if (Status s = body.set_elastic(young, poisson); !s) {
+    const auto [path, rule] = split_scene_message(s.error().message());
+    o.ctx().fail(ErrorCode::bad_parameter, o.path("elastic") + path, rule);
+  }
 }
 
 }  // namespace

@@ -169,7 +169,7 @@ void Object::read(const std::string& key, std::array<double, 4>& out, bool requi
   if (const Json* v = member(*this, key, required)) read_doubles(*v, path(key), *ctx_, out);
 }
 
-std::string scene_message_as_path(const std::string& message) {
+std::pair<std::string, std::string> split_scene_message(const std::string& message) {
   // The leading name: identifiers joined by '.', each with [index] suffixes.
   std::size_t i = 0;
   std::string path;
@@ -180,15 +180,15 @@ std::string scene_message_as_path(const std::string& message) {
     path += "/" + message.substr(start, i - start);
     while (i < message.size() && message[i] == '[') {
       const std::size_t close = message.find(']', i);
-      if (close == std::string::npos) return message;
+      if (close == std::string::npos) return {"", message};
       path += "/" + message.substr(i + 1, close - i - 1);
       i = close + 1;
     }
     if (i < message.size() && message[i] == '.') ++i;
     else break;
   }
-  if (path.empty() || i >= message.size() || message[i] != ' ') return message;
-  return path + ":" + message.substr(i);
+  if (path.empty() || i >= message.size() || message[i] != ' ') return {"", message};
+  return {path, message.substr(i + 1)};
 }
 
 }  // namespace sinew::scene_file

@@ -128,9 +128,10 @@ bool read_enum(const Json& v, const std::string& path, Context& ctx,
   return false;
 }
 
-/// check_scene's "tet_bodies[0].density must be > 0 (got -1)" as
-/// "/tet_bodies/0/density: must be > 0 (got -1)": the file's keys are the
-/// SceneDesc's field names, so its names are the file's paths.
-std::string scene_message_as_path(const std::string& message);
+/// check_scene's "tet_bodies[0].density must be > 0 (got -1)" as the path
+/// "/tet_bodies/0/density" and the rule "must be > 0 (got -1)": the file's
+/// keys are the SceneDesc's field names, so its names are the file's
+/// paths. A message that starts otherwise: an empty path and the message.
+std::pair<std::string, std::string> split_scene_message(const std::string& message);
 
 }  // namespace sinew::scene_file

@@ -48,8 +48,10 @@ void name_bodies(SceneFile& file, BodyKind kind, std::size_t count, const char* 
 // check_scene's verdict as the file's error.
 void check(const SceneDesc& scene, Context& ctx) {
   if (ctx.failed()) return;
-  if (Status s = check_scene(scene); !s)
-    ctx.fail(s.error().code(), "", scene_file::scene_message_as_path(s.error().message()));
+  if (Status s = check_scene(scene); !s) {
+    const auto [path, rule] = scene_file::split_scene_message(s.error().message());
+    ctx.fail(s.error().code(), path, rule);
+  }
 }
 
 Result<SceneFile> read_document(const Json& doc, const scene_file::Where& where) {
