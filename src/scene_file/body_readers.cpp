@@ -219,7 +219,7 @@ void read_elastic(Object& o, Body& body) {
   eo.finish();
   if (o.ctx().failed()) return;
   if (Status s = body.set_elastic(young, poisson); !s) {
-    const auto [path, rule] = split_scene_message(s.error().message());
+    const auto [path, rule] = split_scene_message(s.error().message(), {"youngs_modulus", "poisson_ratio"});
     o.ctx().fail(ErrorCode::bad_parameter, o.path("elastic") + path, rule);
   }
 }

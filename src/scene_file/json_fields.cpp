@@ -1,6 +1,7 @@
 // json_fields.cpp — typed reads with JSON-path errors (json_fields.h).
 #include "scene_file/json_fields.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <limits>
@@ -169,7 +170,12 @@ void Object::read(const std::string& key, std::array<double, 4>& out, bool requi
   if (const Json* v = member(*this, key, required)) read_doubles(*v, path(key), *ctx_, out);
 }
 
-std::pair<std::string, std::string> split_scene_message(const std::string& message) {
+const std::initializer_list<std::string_view> kSceneRoots = {
+    "gravity", "solver", "tet_bodies", "tri_bodies", "line_bodies", "colliders", "targets", "attachments",
+    "tools", "needles", "graspers", "mesh_collision", "external_forces", "topology_changes", "fluid"};
+
+std::pair<std::string, std::string> split_scene_message(const std::string& message,
+                                                        std::initializer_list<std::string_view> roots) {
   // The leading name: identifiers joined by '.', each with [index] suffixes.
   std::size_t i = 0;
   std::string path;
@@ -177,6 +183,8 @@ std::pair<std::string, std::string> split_scene_message(const std::string& messa
     const std::size_t start = i;
     while (i < message.size() && (std::isalnum(static_cast<unsigned char>(message[i])) || message[i] == '_')) ++i;
     if (i == start) break;
+    if (path.empty() && std::find(roots.begin(), roots.end(), std::string_view(message).substr(start, i - start)) == roots.end())
+      return {"", message};
     path += "/" + message.substr(start, i - start);
     while (i < message.size() && message[i] == '[') {
       const std::size_t close = message.find(']', i);

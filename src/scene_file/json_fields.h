@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -131,7 +132,11 @@ bool read_enum(const Json& v, const std::string& path, Context& ctx,
 /// check_scene's "tet_bodies[0].density must be > 0 (got -1)" as the path
 /// "/tet_bodies/0/density" and the rule "must be > 0 (got -1)": the file's
 /// keys are the SceneDesc's field names, so its names are the file's
-/// paths. A message that starts otherwise: an empty path and the message.
-std::pair<std::string, std::string> split_scene_message(const std::string& message);
+/// paths. Only a name starting with one of `roots` is a path ("the scene
+/// has no bodies" is not); otherwise: an empty path and the message.
+std::pair<std::string, std::string> split_scene_message(const std::string& message,
+                                                        std::initializer_list<std::string_view> roots);
+/// The SceneDesc's fields: the roots of check_scene's names.
+extern const std::initializer_list<std::string_view> kSceneRoots;
 
 }  // namespace sinew::scene_file

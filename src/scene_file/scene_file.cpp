@@ -49,7 +49,7 @@ void name_bodies(SceneFile& file, BodyKind kind, std::size_t count, const char* 
 void check(const SceneDesc& scene, Context& ctx) {
   if (ctx.failed()) return;
   if (Status s = check_scene(scene); !s) {
-    const auto [path, rule] = scene_file::split_scene_message(s.error().message());
+    const auto [path, rule] = scene_file::split_scene_message(s.error().message(), scene_file::kSceneRoots);
     ctx.fail(s.error().code(), path, rule);
   }
 }
