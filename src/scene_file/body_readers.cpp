@@ -148,7 +148,12 @@ void read_tet_mesh_source(const Json& v, const std::string& path, const Where& w
   }
   if (const Json* r = o.find("remove")) {
     remove_tets(*r, o.path("remove"), ctx, out);
-    out = drop_unused_vertices(out);
+    // Vertices left without a tet are dropped (and the rest renumbered in
+    // the order the tets use them); a mesh that uses them all keeps its numbering.
+    std::vector<bool> used(out.vertices.size(), false);
+    for (const auto& t : out.tets)
+      for (std::uint32_t i : t) used[i] = true;
+    if (std::find(used.begin(), used.end(), false) != used.end()) out = drop_unused_vertices(out);
   }
   o.finish();
   if (!ctx.failed() && scale != 1.0) scale_mesh(out, scale);
