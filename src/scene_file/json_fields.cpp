@@ -44,7 +44,7 @@ bool read_double(const Json& v, const std::string& path, Context& ctx, double& o
     return false;
   }
   const double d = v.get<double>();
-  // A literal like 1e999 parses to infinity.
+  // (JSON text cannot hold one: the parser refuses 1e999; checked all the same.)
   if (!std::isfinite(d)) {
     ctx.fail(ErrorCode::bad_parameter, path, "must be finite");
     return false;

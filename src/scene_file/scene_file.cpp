@@ -127,10 +127,11 @@ Result<SceneFile> parse_scene_json(std::string_view json, const std::filesystem:
   Json doc;
   try {
     doc = Json::parse(json.begin(), json.end(), nullptr, true, false);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // parse_error, and out_of_range for a number beyond a double (1e999).
     return Error(ErrorCode::bad_input_file, std::string("not valid JSON: ") + e.what());
-  } catch (const std::exception& e) {
-    return Error(ErrorCode::bad_input_file, std::string("not readable JSON: ") + e.what());
+  } catch (const std::bad_alloc&) {
+    return Error(ErrorCode::out_of_memory, "out of memory parsing the scene");
   }
   try {
     return read_document(doc, {base_dir});
