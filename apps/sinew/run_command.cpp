@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -122,6 +123,10 @@ class Progress {
   Progress(int frames, bool terminal) : frames_(frames), terminal_(terminal) {}
   void update(int frame, double mean_ms) {
     if (!terminal_) return;
+    // Redrawn at most ten times a second (a fast scene makes thousands of frames a second).
+    const auto now = std::chrono::steady_clock::now();
+    if (drawn_ && frame < frames_ && now - last_draw_ < std::chrono::milliseconds(100)) return;
+    last_draw_ = now;
     constexpr int kWidth = 30;
     const int filled = static_cast<int>(double(kWidth) * frame / frames_);
     std::fprintf(stdout, "\r[%s%s] %d/%d frames, %.2f ms/frame", std::string(filled, '#').c_str(),
@@ -139,6 +144,7 @@ class Progress {
   int frames_;
   bool terminal_;
   bool drawn_ = false;
+  std::chrono::steady_clock::time_point last_draw_{};
 };
 
 // The mean wall time per stage over the run, and each stage's counters
