@@ -86,7 +86,11 @@ TEST(SceneFile, ErrorsNameTheJsonPathAndTheRule) {
   EXPECT_EQ(error_of(block_scene(R"(, "material": "jelly")")),
             "/tet_bodies/0/material: must be one of \"none\", \"neo_hookean\", \"stvk\", \"corotational\" (got \"jelly\")");
   EXPECT_EQ(error_of(R"({"solver": {"substeps": 2.5}})"), "/solver/substeps: must be a whole number (got 2.5)");
-  EXPECT_EQ(error_of(R"({"tet_bodies": [{"mesh": {"file": "no_such_mesh.node"}}]})").rfind("/tet_bodies/0/mesh/file: ", 0), 0u);
+  EXPECT_EQ(error_of(R"({"tet_bodies": [{"mesh": {"file": "no_such_mesh.node"}}]})"),
+            "/tet_bodies/0/mesh/file: " + (kScenes / "no_such_mesh.node").string() + " is not a readable file");
+  // A folder (or a device, a pipe) is not read: nothing waits on it.
+  EXPECT_EQ(error_of(R"({"tri_bodies": [{"mesh": {"file": "schema"}}]})"),
+            "/tri_bodies/0/mesh/file: " + (kScenes / "schema").string() + " is not a readable file");
   EXPECT_EQ(error_of(R"({"tet_bodies": [{"mesh": {"vertices": [[0,0,0]], "tets": [[0, 1, 2, 3]]}}]})"),
             "/tet_bodies/0/mesh/tets/0/1: vertex 1 is out of range (there are 1)");
   EXPECT_EQ(error_of(R"({"line_bodies": [{"vertices": [[0,0,0],[1,0,0]], "mass": 1}],

@@ -25,11 +25,6 @@ bool read_box(const Json& v, const std::string& path, Context& ctx, Box& out) {
   return !ctx.failed();
 }
 
-// A file name relative to the scene file's folder; absolute ones stay.
-std::filesystem::path resolve(const Where& where, const std::string& name) {
-  const std::filesystem::path p(name);
-  return p.is_absolute() ? p : where.base_dir / p;
-}
 
 // Reading a mesh file failed: the reader's message, under the key's path.
 void mesh_file_error(Context& ctx, const std::string& path, const Error& e) {
@@ -52,8 +47,8 @@ void read_grid(const Json& v, const std::string& path, Context& ctx, TetMesh& ou
     if (cells[a] < 1 || cells[a] > 4096)
       ctx.fail(ErrorCode::bad_parameter, o.path("cells") + "/" + std::to_string(a), "must be in [1, 4096]");
   // A bound on the file's work: a typo must not ask for 10^11 tets.
-  if (!ctx.failed() && double(cells[0]) * double(cells[1]) * double(cells[2]) > 1e7)
-    ctx.fail(ErrorCode::bad_parameter, o.path("cells"), "makes more than 10^7 cells");
+  if (!ctx.failed() && double(cells[0]) * double(cells[1]) * double(cells[2]) > 1e6)
+    ctx.fail(ErrorCode::bad_parameter, o.path("cells"), "makes more than 10^6 cells (6 million tets)");
   if (ctx.failed()) return;
   grid.nx = static_cast<int>(cells[0]), grid.ny = static_cast<int>(cells[1]), grid.nz = static_cast<int>(cells[2]);
   o.read("origin", grid.origin);
@@ -135,7 +130,9 @@ void read_tet_mesh_source(const Json& v, const std::string& path, const Where& w
     std::string file;
     o.read("file", file);
     if (ctx.failed()) return;
-    auto mesh = read_tet_mesh(resolve(where, file));
+    const std::filesystem::path p = resolve_file(where, file, o.path("file"), ctx);
+    if (ctx.failed()) return;
+    auto mesh = read_tet_mesh(p);
     if (!mesh) return mesh_file_error(ctx, o.path("file"), mesh.error());
     out = std::move(*mesh);
   } else if (const Json* g = o.find("grid")) {
@@ -170,7 +167,9 @@ void read_tri_mesh_source(const Json& v, const std::string& path, const Where& w
     std::string file;
     o.read("file", file);
     if (ctx.failed()) return;
-    auto mesh = read_stl(resolve(where, file));
+    const std::filesystem::path p = resolve_file(where, file, o.path("file"), ctx);
+    if (ctx.failed()) return;
+    auto mesh = read_stl(p);
     if (!mesh) return mesh_file_error(ctx, o.path("file"), mesh.error());
     out = std::move(*mesh);
   } else {
@@ -230,6 +229,16 @@ void read_elastic(Object& o, Body& body) {
 }
 
 }  // namespace
+
+std::filesystem::path resolve_file(const Where& where, const std::string& name, const std::string& path,
+                                   Context& ctx) {
+  const std::filesystem::path p = std::filesystem::path(name).is_absolute() ? std::filesystem::path(name)
+                                                                             : where.base_dir / name;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(p, ec))
+    ctx.fail(ErrorCode::bad_input_file, path, p.string() + " is not a readable file");
+  return p;
+}
 
 void read_tet_body(const Json& v, const std::string& path, const Where& where, Context& ctx, TetBodyDesc& out,
                    std::string& name) {

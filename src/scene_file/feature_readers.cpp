@@ -49,7 +49,8 @@ void read_level_set(const Json& v, const std::string& path, const Where& where, 
     std::string file;
     o.read("file", file);
     if (ctx.failed()) return;
-    const std::filesystem::path p = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : where.base_dir / file;
+    const std::filesystem::path p = resolve_file(where, file, o.path("file"), ctx);
+    if (ctx.failed()) return;
     auto surface = read_stl(p);
     if (!surface) return ctx.fail(ErrorCode::bad_input_file, o.path("file"), surface.error().message());
     if (scale != 1.0) scale_mesh(*surface, scale);

@@ -17,6 +17,12 @@ struct Where {
   std::filesystem::path base_dir;
 };
 
+/// A file the document names: relative to the scene file's folder
+/// (absolute ones stay), and a regular file (not a folder, a device or a
+/// pipe a read would wait on), else an error at `path`.
+std::filesystem::path resolve_file(const Where& where, const std::string& name, const std::string& path,
+                                   Context& ctx);
+
 // body_readers.cpp
 void read_tet_body(const Json& v, const std::string& path, const Where& where, Context& ctx, TetBodyDesc& out,
                    std::string& name);
