@@ -99,6 +99,11 @@ TEST(SceneFile, ErrorsNameTheJsonPathAndTheRule) {
   EXPECT_EQ(error_of(R"({"run": {"frames": 0}})"), "/run/frames: must be >= 1");
   EXPECT_EQ(error_of("[1, 2]"), "/: must be an object (got an array of 2)");
   EXPECT_EQ(error_of("{\"tet_bodies\": [").rfind("not valid JSON: ", 0), 0u);
+  // The fluid's keys are in "fluid" itself (SceneFluidDesc::fluid's).
+  EXPECT_EQ(error_of(block_scene().substr(0, block_scene().size() - 1) +
+                     R"(, "fluid": {"settings": {"time_step": 0.003}, "capacity": 10}})"),
+            "/fluid/settings/time_step: the scene's frame (solver.time_step 0.01 s) is not a whole number of fluid "
+            "steps of 0.003 s");
   // An empty scene is check_scene's error, at the root.
   EXPECT_EQ(error_of("{}").rfind("/: ", 0), 0u);
 }

@@ -195,8 +195,11 @@ std::pair<std::string, std::string> split_scene_message(const std::string& messa
     if (i < message.size() && message[i] == '.') ++i;
     else break;
   }
-  if (path.empty() || i >= message.size() || message[i] != ' ') return {"", message};
-  return {path, message.substr(i + 1)};
+  if (path.empty() || i >= message.size() || (message[i] != ' ' && message[i] != ':')) return {"", message};
+  // The file holds SceneFluidDesc::fluid's keys in "fluid" itself.
+  if (path.rfind("/fluid/fluid/", 0) == 0) path.erase(0, 6);
+  const std::size_t rule = message.find_first_not_of(": ", i);
+  return {path, rule == std::string::npos ? std::string() : message.substr(rule)};
 }
 
 }  // namespace sinew::scene_file
