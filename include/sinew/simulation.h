@@ -96,12 +96,19 @@ struct FrameStats {
   /// collision's reads inside the solve are not among them (read_back_bytes
   /// counts them).
   std::uint32_t position_reads = 0;
-  std::uint64_t read_back_bytes = 0;  ///< bytes the host read from the device in the last step():
-                                      ///< the statistics' few words; with mesh collision, needles or
-                                      ///< tearing, the positions once (16 per particle, position_reads);
-                                      ///< 32 per contact when a tool has face contacts; 96 per suture
-                                      ///< row; with continuous collision, 32 per particle per substep
-                                      ///< and 16 per particle per repair round more
+  /// Bytes the host read from the device in the last step(), as the device
+  /// counted them (every backend alike): the statistics' few words; with
+  /// mesh collision, needles or tearing, the positions once (16 per
+  /// particle, position_reads); 32 per contact when a tool has face
+  /// contacts; 96 per suture row; with continuous collision, 32 per
+  /// particle per substep and 16 per particle per repair round more. Each
+  /// stage's share is its profile's counter "read_bytes".
+  std::uint64_t read_back_bytes = 0;
+  std::uint32_t host_reads = 0;  ///< read-backs (round trips) in the last step()
+  /// Times the last step() blocked on the device: every read-back, and
+  /// every wait for a submitted program (each stage's share: its counter
+  /// "host_waits"). A frame that ran wholly on the device would wait once.
+  std::uint32_t host_waits = 0;
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,
   /// rest volume, ...): 0 when the xPBD system is solved exactly. Contact

@@ -81,9 +81,6 @@ class SphSolver {
   [[nodiscard]] BufferHandle boundary_position_buffer() const { return boundary_position_; }
   [[nodiscard]] BufferHandle boundary_velocity_buffer() const { return boundary_velocity_; }
   [[nodiscard]] BufferHandle impulse_buffer() const { return impulse_; }
-  /// Bytes step() reads back after its steps: the count, the state's five
-  /// words and the fastest speed.
-  static constexpr std::uint64_t kStepReadBytes = 28;
 
  private:
   explicit SphSolver(Device& device) : device_(device) {}
