@@ -56,6 +56,8 @@ void fill_box(const Json& v, const std::string& path, double spacing, Context& c
   }
   // A bound on the file's work (FluidDesc::capacity is bounded likewise).
   if (total > 1e7) return ctx.fail(ErrorCode::bad_parameter, path, "makes more than 10^7 particles");
+  // An empty box fills nothing (and must not walk the other axes' cells).
+  if (total == 0.0) return;
   for (long long i = 0; i < n[0]; ++i)
     for (long long j = 0; j < n[1]; ++j)
       for (long long k = 0; k < n[2]; ++k)
