@@ -153,6 +153,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   im.add_stage(make_statistics_stage(im));
   if (im.topology && im.topology->tears()) im.add_stage(make_tearing_stage(im));
 
+  impl->init_state_buffers(*compiled);
+
   SceneInfo& info = impl->info;
   info.particles = static_cast<std::uint32_t>(compiled->positions.size());
   for (const ConstraintBlock& block : compiled->blocks) {
@@ -228,6 +230,7 @@ Status Simulation::step() {
   im.stats.frame += 1;
   im.stats.time = static_cast<double>(im.stats.frame) * im.time_step;
   im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
+  if (Status s = im.check_divergence(); !s) return s;
   return frame.deferred;
 }
 
@@ -245,7 +248,9 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
                                                " particles, so it needs " + std::to_string(3 * n) +
                                                " (x, y, z per particle)");
   // Checked and staged before anything is uploaded: on an error the forces
-  // set before stay.
+  // set before stay. force_energy: sum |f|^2 / (2 m), the divergence
+  // check's bound on the energy they add (sinew/divergence.h).
+  double force_energy = 0.0;
   for (std::size_t u = 0; u < n; ++u) {
     const float* f = &xyz[3 * u];
     if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2])) {
@@ -271,6 +276,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
       }
     }
     im.force_scratch[slot] = kernels::float4{f[0], f[1], f[2], 0.0f};
+    if (w > 0.0f) force_energy += (double(f[0]) * f[0] + double(f[1]) * f[1] + double(f[2]) * f[2]) * w / 2.0;
   }
   if (n == 0) return {};
   if (Status s = im.device->write_buffer(im.buffers.external_force, 0, im.force_scratch.data(),
@@ -279,6 +285,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
     return s;
   im.forces_for_next_frame = true;
   im.forces_on_device = true;
+  im.history.next_force_speed = im.time_step * std::sqrt(force_energy);
   return {};
 }
 
@@ -290,6 +297,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
 Status Simulation::Impl::begin_frame_forces() {
   const bool stale = forces_on_device && !forces_for_next_frame;
   host_forces_this_frame = forces_for_next_frame;
+  history.force_speed = forces_for_next_frame ? history.next_force_speed : 0.0;
   forces_for_next_frame = false;  // this frame consumes them
   if (!stale) return {};
   std::fill(force_scratch.begin(), force_scratch.end(), kernels::float4{0.0f, 0.0f, 0.0f, 0.0f});

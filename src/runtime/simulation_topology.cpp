@@ -50,6 +50,7 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
+  if (changed) ++shape_generation;  // a saved state does not hold the topology (simulation_state.cpp)
   if (changed) positions_mirror.changed();  // a removal hands mass on: the positions' w
   if (changed && graspers) graspers->invalidate();
   if (changed && measure_errors && event->body_kind == BodyKind::tet)

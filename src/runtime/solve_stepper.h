@@ -63,6 +63,11 @@ class SolveStepper {
   /// Bytes the residual checks of the last frame read back.
   [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
 
+  /// Whether the next frame warm-starts (false after a substep the time
+  /// budget stopped); a saved state carries it (Simulation::save_state).
+  [[nodiscard]] bool warm() const { return warm_; }
+  void set_warm(bool warm) { warm_ = warm; }
+
  private:
   Status build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
                const std::array<double, 3>& gravity, const StatsPlan& stats, SweepExtras extras);
