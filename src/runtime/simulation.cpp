@@ -376,5 +376,6 @@ double SimulationInternals::frame_length(const Simulation& sim) { return sim.imp
 void SimulationInternals::add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage) {
   sim.impl_->add_stage(std::move(stage));
 }
+BufferHandle SimulationInternals::velocity_buffer(const Simulation& sim) { return sim.impl_->buffers.velocity; }
 
 }  // namespace sinew

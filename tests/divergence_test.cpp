@@ -1,0 +1,188 @@
+// divergence_test.cpp — the divergence checks (sinew/divergence.h) on every
+// backend: a healthy run is never flagged; a kinematic target thrown 10 m in
+// one frame (a haptic device's glitch) is energy growth the frame's loads
+// cannot explain; NaN velocities are non-finite; each policy does what it
+// says: report (and log), stop with ErrorCode::diverged, roll back bitwise to
+// the last good frame.
+#include <limits>
+
+#include "robustness_scenes.h"
+#include "runtime/simulation_internals.h"
+#include "sinew/log.h"
+
+namespace sinew {
+namespace {
+
+using test::drive;
+using test::same_bits;
+using test::snapshot;
+
+class DivergenceTest : public test::BackendTest {
+ protected:
+  void TearDown() override { set_log_callback({}); }
+  // Captures the log's warnings while the test runs.
+  void capture_log() {
+    set_log_callback([this](LogLevel level, std::string_view text) {
+      if (level == LogLevel::warning) warnings_.emplace_back(text);
+    });
+  }
+  std::vector<std::string> warnings_;
+};
+
+// The glitch: the target jumps 10 m away for one frame.
+void throw_target(Simulation& sim) {
+  auto target = sim.tools().target(0);
+  ASSERT_TRUE(target.ok());
+  SINEW_ASSERT_OK(sim.tools().set_position(*target, {10.04, 0.02, 0.02}));
+}
+
+// Every movable particle's velocity NaN, written before the frame's solve.
+class BreakVelocities final : public FrameStage {
+ public:
+  BreakVelocities(BufferHandle velocity, std::uint32_t particles) : velocity_(velocity), particles_(particles) {}
+  std::string_view name() const override { return "break velocities"; }
+  Status before_frame(FrameContext& frame) override {
+    if (!armed) return {};
+    armed = false;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<float> v(4 * std::size_t{particles_}, nan);
+    for (std::size_t p = 0; p < particles_; ++p) v[4 * p + 3] = 1.0f;  // w: the damping factor
+    return frame.device.write_buffer(velocity_, 0, v.data(), v.size() * sizeof(float));
+  }
+  bool armed = false;
+
+ private:
+  BufferHandle velocity_;
+  std::uint32_t particles_;
+};
+
+TEST_P(DivergenceTest, HealthyRunIsNeverFlagged) {
+  auto sim = test::create_or_skip(test::robustness_block(), GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  for (int f = 1; f <= 60; ++f) {
+    drive(*sim, f);
+    SINEW_ASSERT_OK(sim->step());
+    const DivergenceReport& d = sim->last_frame().divergence;
+    ASSERT_EQ(d.kind, Divergence::none) << "frame " << f << ": kinetic energy " << sim->last_frame().kinetic_energy
+                                        << " J, bound " << d.energy_bound << " J";
+    EXPECT_GT(d.energy_bound, sim->last_frame().kinetic_energy);
+  }
+  EXPECT_EQ(sim->last_frame().divergence.diverged_frames, 0u);
+}
+
+TEST_P(DivergenceTest, ThrownTargetIsReportedAsEnergyGrowthAndLogged) {
+  auto sim = test::create_or_skip(test::robustness_block(), GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  capture_log();
+  for (int f = 1; f <= 3; ++f) {
+    drive(*sim, f);
+    SINEW_ASSERT_OK(sim->step());
+  }
+  throw_target(*sim);
+  SINEW_ASSERT_OK(sim->step());  // report: the frame stands
+  const FrameStats& stats = sim->last_frame();
+  EXPECT_EQ(stats.divergence.kind, Divergence::energy_growth);
+  EXPECT_GT(stats.kinetic_energy, stats.divergence.energy_bound);
+  EXPECT_FALSE(stats.divergence.rolled_back);
+  EXPECT_EQ(stats.frame, 4u);
+  EXPECT_EQ(stats.divergence.diverged_frames, 1u);
+  ASSERT_EQ(warnings_.size(), 1u);
+  EXPECT_NE(warnings_[0].find("frame 4 diverged (energy_growth)"), std::string::npos) << warnings_[0];
+}
+
+TEST_P(DivergenceTest, NonFiniteVelocitiesAreReported) {
+  auto sim = test::create_or_skip(test::robustness_block(), GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  auto stage = std::make_unique<BreakVelocities>(SimulationInternals::velocity_buffer(*sim), sim->info().particles);
+  BreakVelocities& breaker = *stage;
+  SimulationInternals::add_stage(*sim, std::move(stage));
+  capture_log();
+  drive(*sim, 1);
+  SINEW_ASSERT_OK(sim->step());
+  EXPECT_EQ(sim->last_frame().divergence.kind, Divergence::none);
+  breaker.armed = true;
+  drive(*sim, 2);
+  SINEW_ASSERT_OK(sim->step());
+  EXPECT_EQ(sim->last_frame().divergence.kind, Divergence::non_finite);
+  ASSERT_FALSE(warnings_.empty());
+  EXPECT_NE(warnings_.back().find("non_finite"), std::string::npos) << warnings_.back();
+}
+
+TEST_P(DivergenceTest, StopReturnsANamedError) {
+  auto sim = test::create_or_skip(test::robustness_block(), GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::stop}));
+  capture_log();
+  drive(*sim, 1);
+  SINEW_ASSERT_OK(sim->step());
+  throw_target(*sim);
+  const Status s = sim->step();
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().code(), ErrorCode::diverged);
+  EXPECT_NE(s.error().message().find("energy_growth"), std::string::npos) << s.error().message();
+  EXPECT_EQ(sim->last_frame().divergence.kind, Divergence::energy_growth);
+  EXPECT_EQ(warnings_.size(), 1u);
+}
+
+TEST_P(DivergenceTest, RollBackRestoresTheLastGoodFrameBitwise) {
+  const SceneDesc scene = test::robustness_block();
+  // The run that never diverged, frames 1..8.
+  auto plain = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(plain.ok()) << plain.error().message();
+  std::vector<test::Snapshot> expected(9);
+  for (int f = 1; f <= 8; ++f) {
+    drive(*plain, f);
+    SINEW_ASSERT_OK(plain->step());
+    expected[f] = snapshot(*plain);
+  }
+
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::roll_back}));
+  capture_log();
+  for (int f = 1; f <= 5; ++f) {
+    drive(*sim, f);
+    SINEW_ASSERT_OK(sim->step());
+  }
+  throw_target(*sim);  // frame 6 diverges
+  SINEW_ASSERT_OK(sim->step());
+  const FrameStats& stats = sim->last_frame();
+  EXPECT_EQ(stats.divergence.kind, Divergence::energy_growth);
+  EXPECT_TRUE(stats.divergence.rolled_back);
+  EXPECT_EQ(stats.divergence.rolled_back_to, 5u);
+  EXPECT_EQ(stats.frame, 5u);
+  EXPECT_TRUE(same_bits(snapshot(*sim), expected[5])) << "rolled back to frame 5, on " << GetParam();
+  ASSERT_EQ(warnings_.size(), 1u);
+  EXPECT_NE(warnings_[0].find("rolled back to frame 5"), std::string::npos) << warnings_[0];
+  // The scene continues from frame 5 as if frame 6 had never gone wrong.
+  for (int f = 6; f <= 8; ++f) {
+    drive(*sim, f);
+    SINEW_ASSERT_OK(sim->step());
+    EXPECT_EQ(sim->last_frame().divergence.kind, Divergence::none);
+    EXPECT_TRUE(same_bits(snapshot(*sim), expected[f])) << "frame " << f << " after the roll-back, on " << GetParam();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, DivergenceTest, ::testing::ValuesIn(test::backends()), test::backend_name);
+
+TEST(DivergenceSettings, BadSettingsAreNamedErrors) {
+  auto sim = Simulation::create(test::robustness_block(), {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const std::pair<DivergenceSettings, const char*> bad[] = {
+      {{.energy_growth = 1.0}, "energy_growth"},
+      {{.energy_growth = std::numeric_limits<double>::infinity()}, "energy_growth"},
+      {{.floor_speed = -1.0}, "floor_speed"},
+      {{.max_volume_change = 0.0}, "max_volume_change"},
+      {{.checkpoint_every = 0}, "checkpoint_every"},
+  };
+  for (const auto& [settings, field] : bad) {
+    const Status s = sim->set_divergence_settings(settings);
+    ASSERT_FALSE(s.ok()) << field;
+    EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
+    EXPECT_NE(s.error().message().find(field), std::string::npos) << s.error().message();
+  }
+  EXPECT_EQ(sim->divergence_settings().on_divergence, OnDivergence::report);  // unchanged
+}
+
+}  // namespace
+}  // namespace sinew
