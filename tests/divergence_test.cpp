@@ -1,7 +1,8 @@
 // divergence_test.cpp — the divergence checks (sinew/divergence.h) on every
 // backend: a healthy run is never flagged; a kinematic target thrown 10 m in
 // one frame (a haptic device's glitch) is energy growth the frame's loads
-// cannot explain; NaN velocities are non-finite; each policy does what it
+// cannot explain; NaN velocities are non-finite; inverted tets are counted
+// as the host counts them; each policy does what it
 // says: report (and log), stop with ErrorCode::diverged, roll back bitwise to
 // the last good frame.
 #include <limits>
@@ -163,6 +164,47 @@ TEST_P(DivergenceTest, RollBackRestoresTheLastGoodFrameBitwise) {
   }
 }
 
+// A block started mirrored (every tet inside out), held only by very soft
+// volume constraints, so it is still inverted after a frame.
+SceneDesc inside_out_block() {
+  SceneDesc scene;
+  TetBodyDesc body;
+  body.mesh = test::box_mesh(3, 2, 2, 0.01);
+  body.distance_constraints = false;
+  body.volume_compliance = 1.0;
+  for (Vec3d v : body.mesh.vertices) body.initial_vertices.push_back({v[0], -v[1], v[2]});
+  scene.tet_bodies.push_back(body);
+  scene.gravity = {0.0, 0.0, 0.0};
+  scene.solver.substeps = 1;
+  scene.solver.iterations = 1;
+  return scene;
+}
+
+TEST_P(DivergenceTest, InvertedTetsAreCountedAsTheHostCountsThem) {
+  const SceneDesc scene = inside_out_block();
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  // Checked alone: the volume check (the total volume is negative) would come first.
+  SINEW_ASSERT_OK(sim->set_divergence_settings({.max_volume_change = 10.0, .max_inverted_fraction = 0.5}));
+  SINEW_ASSERT_OK(sim->step());
+  std::vector<float> x;
+  SINEW_ASSERT_OK(sim->read_positions(x));
+  const TetMesh& mesh = scene.tet_bodies[0].mesh;
+  std::uint32_t inverted = 0;
+  for (const auto& t : mesh.tets) {  // the rest winding of each tet is positive (make_tet_grid)
+    double e[3][3];
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) e[k][c] = double(x[4 * t[k + 1] + c]) - double(x[4 * t[0] + c]);
+    const double six_v = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                         e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                         e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    inverted += six_v < 0.0;
+  }
+  EXPECT_GT(inverted, mesh.tets.size() / 2);  // the scene is what the test needs
+  EXPECT_EQ(sim->last_frame().inverted_tets, inverted);
+  EXPECT_EQ(sim->last_frame().divergence.kind, Divergence::inverted);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, DivergenceTest, ::testing::ValuesIn(test::backends()), test::backend_name);
 
 TEST(DivergenceSettings, BadSettingsAreNamedErrors) {
@@ -173,6 +215,7 @@ TEST(DivergenceSettings, BadSettingsAreNamedErrors) {
       {{.energy_growth = std::numeric_limits<double>::infinity()}, "energy_growth"},
       {{.floor_speed = -1.0}, "floor_speed"},
       {{.max_volume_change = 0.0}, "max_volume_change"},
+      {{.max_inverted_fraction = 1.5}, "max_inverted_fraction"},
       {{.checkpoint_every = 0}, "checkpoint_every"},
   };
   for (const auto& [settings, field] : bad) {

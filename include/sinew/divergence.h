@@ -4,8 +4,8 @@
 // at the frame's end (FrameStats: kinetic energy, residuals, volume change;
 // a few words, no extra read-back) for three signs that the solve blew up:
 // a non-finite value, kinetic energy that grew beyond what the frame's
-// external loads can supply, and tet bodies whose total volume collapsed
-// or turned inside out. A diverged frame is reported in FrameStats::divergence
+// external loads can supply, tet bodies whose total volume collapsed or
+// doubled, and many tets turned inside out. A diverged frame is reported in FrameStats::divergence
 // and as a warning through the log callback (sinew/log.h); the policy
 // (DivergenceSettings::on_divergence) then either leaves it at that, stops
 // with an ErrorCode::diverged error, or rolls the scene back to the last
@@ -25,15 +25,17 @@ enum class Divergence : std::uint8_t {
   non_finite,     ///< kinetic energy, a residual or the volume change is NaN or infinite
   energy_growth,  ///< kinetic energy grew beyond DivergenceSettings' bound (FrameStats::divergence.energy_bound)
   volume,         ///< the tet bodies' total volume changed by more than max_volume_change
+  inverted,       ///< more than max_inverted_fraction of the live tets are inverted (FrameStats::inverted_tets)
 };
 
-/// The name of a Divergence: "none", "non_finite", "energy_growth", "volume".
+/// The name of a Divergence: "none", "non_finite", "energy_growth", "volume", "inverted".
 constexpr const char* divergence_name(Divergence d) {
   switch (d) {
     case Divergence::none: return "none";
     case Divergence::non_finite: return "non_finite";
     case Divergence::energy_growth: return "energy_growth";
     case Divergence::volume: return "volume";
+    case Divergence::inverted: return "inverted";
   }
   return "unknown";
 }
@@ -68,6 +70,10 @@ struct DivergenceSettings {
   /// The largest |FrameStats::volume_change| of a healthy frame, > 0 (1: the tet bodies' total volume
   /// reached zero or doubled).
   double max_volume_change = 1.0;
+  /// The largest fraction of the live tets that may be inverted in a healthy frame, in [0, 1] (stable
+  /// Neo-Hookean and corotational materials recover from a few inverted tets; an exploding body inverts
+  /// many).
+  double max_inverted_fraction = 0.25;
   /// roll_back: save the state of every n-th good frame (>= 1) to roll back to; each save reads the
   /// particles' positions, velocities and multipliers back from the device (Simulation::save_state).
   std::uint32_t checkpoint_every = 1;

@@ -116,6 +116,10 @@ struct FrameStats {
   /// (remove_tets, cuts, tears, cautery) the live tets' boundaries and rest
   /// volume.
   double volume_change = 0.0;
+  /// Tets whose signed volume is negative at the frame's end (turned inside
+  /// out), over the tet bodies' live tets; reduced on the device with the
+  /// errors (0 with measure_errors off).
+  std::uint32_t inverted_tets = 0;
   /// Gauss-Seidel sweeps (iterations) run in the last frame, over all its substeps.
   std::uint64_t sweeps = 0;
   /// How the sweeps ended; in residual mode the worst substep's reason

@@ -26,12 +26,13 @@ double energy_bound(const Simulation::Impl& im) {
   return std::max(margin * margin, h.movable_mass / 2.0 * floor_speed * floor_speed);
 }
 
-Divergence diagnose(const FrameStats& f, double bound, double max_volume_change) {
+Divergence diagnose(const FrameStats& f, double bound, const DivergenceSettings& settings, std::uint64_t live_tets) {
   if (!std::isfinite(f.kinetic_energy) || !std::isfinite(f.residual_rms) || !std::isfinite(f.max_residual) ||
       !std::isfinite(f.volume_change))
     return Divergence::non_finite;
   if (f.kinetic_energy > bound) return Divergence::energy_growth;
-  if (std::abs(f.volume_change) > max_volume_change) return Divergence::volume;
+  if (std::abs(f.volume_change) > settings.max_volume_change) return Divergence::volume;
+  if (double(f.inverted_tets) > settings.max_inverted_fraction * double(live_tets)) return Divergence::inverted;
   return Divergence::none;
 }
 
@@ -45,7 +46,8 @@ Status Simulation::Impl::check_divergence() {
   report.energy_bound = 0.0;
   if (!measure_errors) return {};  // nothing measured, nothing to check (documented)
   report.energy_bound = energy_bound(*this);
-  report.kind = diagnose(stats, report.energy_bound, divergence.max_volume_change);
+  report.kind = diagnose(stats, report.energy_bound, divergence,
+                         stats_plan.tet_list.size() - std::uint64_t{stats_plan.removed_tets});
   if (report.kind == Divergence::none) {
     history.last_energy = stats.kinetic_energy;
     if (divergence.on_divergence == OnDivergence::roll_back && stats.frame % divergence.checkpoint_every == 0)
@@ -57,7 +59,8 @@ Status Simulation::Impl::check_divergence() {
   message.precision(6);
   message << "frame " << stats.frame << " diverged (" << divergence_name(report.kind) << "): kinetic energy "
           << stats.kinetic_energy << " J (allowed " << report.energy_bound << " J), volume change "
-          << stats.volume_change << ", RMS residual " << stats.residual_rms;
+          << stats.volume_change << ", " << stats.inverted_tets << " inverted tets, RMS residual "
+          << stats.residual_rms;
   switch (divergence.on_divergence) {
     case OnDivergence::report:
       log_message(LogLevel::warning, message.str());
@@ -94,6 +97,8 @@ Status Simulation::set_divergence_settings(const DivergenceSettings& settings) {
   if (!(settings.floor_speed >= 0.0) || !std::isfinite(settings.floor_speed))
     return bad("floor_speed", "must be a finite number >= 0 [m/s]", settings.floor_speed);
   if (!(settings.max_volume_change > 0.0)) return bad("max_volume_change", "must be > 0", settings.max_volume_change);
+  if (!(settings.max_inverted_fraction >= 0.0 && settings.max_inverted_fraction <= 1.0))
+    return bad("max_inverted_fraction", "must be in [0, 1]", settings.max_inverted_fraction);
   if (settings.checkpoint_every == 0) return bad("checkpoint_every", "must be >= 1", 0.0);
   Impl& im = *impl_;
   if (settings.on_divergence == OnDivergence::roll_back)

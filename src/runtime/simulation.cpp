@@ -27,6 +27,7 @@ void Simulation::Impl::measure(FrameStats& out) const {
   out.max_residual = d.residual_max;
   out.kinetic_energy = d.kinetic_energy;
   out.volume_change = rest_volume > 0.0 ? d.volume / rest_volume - 1.0 : 0.0;
+  out.inverted_tets = d.inverted_tets;
 }
 
 Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -61,15 +62,25 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   // Every tet body's boundary (wound outward) with one particle of the body
   // as the reference point: its volume on the device (stats_surface_volume).
   std::vector<std::array<std::uint32_t, 4>> faces;
+  // Every tet, wound with a positive rest volume: the inverted tets' count
+  // (stats_inverted_tets; FrameStats::inverted_tets).
+  std::vector<std::array<std::uint32_t, 4>> tets;
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
     const TetMesh& mesh = scene.tet_bodies[b].mesh;
     const std::uint32_t first = compiled->tet_body_first_particle[b];
+    impl->stats_tet_first.push_back(static_cast<std::uint32_t>(tets.size()));
     for (const auto& t : mesh.tets) {
       const auto at = [&](int k) {
         const Vec3d& p = mesh.vertices[t[k]];
         return kernels::double4{p[0], p[1], p[2], 0.0};
       };
-      impl->rest_volume += kernels::tet_volume(at(0), at(1), at(2), at(3));
+      const double volume = kernels::tet_volume(at(0), at(1), at(2), at(3));
+      impl->rest_volume += volume;
+      if (!impl->measure_errors) continue;
+      std::array<std::uint32_t, 4> d;
+      for (int k = 0; k < 4; ++k) d[k] = compiled->order.device_of[first + t[k]];
+      if (volume < 0.0) std::swap(d[2], d[3]);
+      tets.push_back(d);
     }
     if (!impl->measure_errors) continue;
     const TriMesh boundary = extract_boundary_surface(mesh);
@@ -82,7 +93,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   // (refresh_volume writes them without making the plan again).
   auto plan = make_stats_plan(*impl->device, *compiled, faces, impl->measure_errors,
                               static_cast<std::uint32_t>(impl->contacts.tools.size()),
-                              scene.topology_changes ? 2 * static_cast<std::uint32_t>(faces.size()) : 0u);
+                              scene.topology_changes ? 2 * static_cast<std::uint32_t>(faces.size()) : 0u,
+                              std::move(tets));
   if (!plan) return plan.error();
   impl->stats_plan = std::move(*plan);
   impl->solver = scene.solver;

@@ -62,6 +62,7 @@ struct Simulation::Impl {
   // The errors and the tools' reaction, reduced on the device at the end of
   // each frame (stats_program.h) and read back as a few words.
   StatsPlan stats_plan;
+  std::vector<std::uint32_t> stats_tet_first;  ///< per tet body, its first tet in stats_plan.tet_list
   DeviceStats device_stats;
 
   void measure(FrameStats& stats) const;

@@ -68,6 +68,9 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
 
 Status Simulation::Impl::refresh_volume(const TopologyEvent& event) {
   const TetMesh& mesh = topology->mesh(event.body);
+  std::vector<std::uint32_t> removed;  // in the statistics' tet list: no longer counted as inverted
+  for (std::uint32_t t : event.tets_removed) removed.push_back(stats_tet_first[event.body] + t);
+  if (Status s = clear_stats_tets(*device, stats_plan, removed); !s) return s;
   for (std::uint32_t t : event.tets_removed) {  // as create sums the rest volume
     const auto at = [&](int k) {
       const Vec3d& p = mesh.vertices[mesh.tets[t][k]];
@@ -89,7 +92,7 @@ Status Simulation::Impl::refresh_volume(const TopologyEvent& event) {
   if (Status s = set_stats_faces(*device, stats_plan, faces, fitted); !s || fitted) return s;
   if (Status s = release_stats_plan(*device, stats_plan); !s) return s;
   auto plan = make_stats_plan(*device, program_shape, faces, true, static_cast<std::uint32_t>(contacts.tools.size()),
-                              2 * static_cast<std::uint32_t>(faces.size()));
+                              2 * static_cast<std::uint32_t>(faces.size()), stats_plan.tet_list);
   if (!plan) return plan.error();
   stats_plan = std::move(*plan);
   return {};
