@@ -164,6 +164,51 @@ TEST_P(DivergenceTest, RollBackRestoresTheLastGoodFrameBitwise) {
   }
 }
 
+TEST_P(DivergenceTest, RollBackAfterATopologyChangeKeepsTheChange) {
+  auto sim = test::create_or_skip(test::robustness_block(/*topology=*/true), GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::roll_back}));
+  capture_log();
+  for (int f = 1; f <= 3; ++f) {
+    drive(*sim, f);
+    SINEW_ASSERT_OK(sim->step());
+  }
+  auto body = sim->topology().tet_body(0);
+  ASSERT_TRUE(body.ok());
+  const std::vector<std::uint32_t> hole{40, 41, 42, 43, 44, 45};
+  ASSERT_TRUE(sim->topology().remove_tets(*body, hole).ok());
+  const test::Snapshot changed = snapshot(*sim);
+  throw_target(*sim);
+  SINEW_ASSERT_OK(sim->step());  // frame 4 diverges: back to frame 3 with the hole
+  EXPECT_TRUE(sim->last_frame().divergence.rolled_back);
+  EXPECT_EQ(sim->last_frame().frame, 3u);
+  EXPECT_TRUE(same_bits(snapshot(*sim), changed));
+  auto tets = sim->topology().current_tets(*body);
+  ASSERT_TRUE(tets.ok());
+  EXPECT_EQ(tets->size(), 96u - hole.size());
+}
+
+TEST_P(DivergenceTest, NeoHookeanPastItsCourantLimitIsFlagged) {
+  // The test block stiffened to E = 1 MPa and stepped in one substep per
+  // 60 Hz frame: Courant number ~33, far past the ~0.75 at which a body at
+  // rest blows up (README, "FEM materials").
+  SceneDesc scene = test::robustness_block();
+  ASSERT_TRUE(scene.tet_bodies[0].set_material(TetMaterial::neo_hookean, 1e6, 0.3).ok());
+  scene.solver.substeps = 1;
+  scene.solver.iterations = 1;
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  capture_log();
+  int flagged = 0;
+  for (int f = 1; f <= 120 && !flagged; ++f) {
+    SINEW_ASSERT_OK(sim->step());
+    if (sim->last_frame().divergence.kind != Divergence::none) flagged = f;
+  }
+  ASSERT_GT(flagged, 0) << "120 frames past the Courant limit and no divergence found; kinetic energy "
+                        << sim->last_frame().kinetic_energy << " J";
+  EXPECT_FALSE(warnings_.empty());
+}
+
 // A block started mirrored (every tet inside out), held only by very soft
 // volume constraints, so it is still inverted after a frame.
 SceneDesc inside_out_block() {

@@ -38,6 +38,17 @@ Divergence diagnose(const FrameStats& f, double bound, const DivergenceSettings&
 
 }  // namespace
 
+// A checkpoint that cannot be saved (a grasper closed since the policy was
+// set) is no reason to fail the frame: the last one stays, and the first
+// failure in a row is logged.
+void Simulation::Impl::checkpoint() {
+  const Status saved = save_state(last_good, "roll-back checkpoint");
+  if (!saved && !checkpoint_failed)
+    log_message(LogLevel::warning, saved.error().message() + "; a roll-back goes to frame " +
+                                       std::to_string(last_good.frame()) + " until a checkpoint succeeds");
+  checkpoint_failed = !saved;
+}
+
 Status Simulation::Impl::check_divergence() {
   DivergenceReport& report = stats.divergence;
   report.kind = Divergence::none;
@@ -51,7 +62,7 @@ Status Simulation::Impl::check_divergence() {
   if (report.kind == Divergence::none) {
     history.last_energy = stats.kinetic_energy;
     if (divergence.on_divergence == OnDivergence::roll_back && stats.frame % divergence.checkpoint_every == 0)
-      return save_state(last_good, "step (saving the last good frame)");
+      checkpoint();
     return {};
   }
   ++report.diverged_frames;

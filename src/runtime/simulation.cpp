@@ -228,12 +228,17 @@ Status Simulation::step() {
   for (StageProfile& p : im.stats.stages) p.ms = 0.0;
   im.positions_mirror.begin_frame();
   using Hook = Status (FrameStage::*)(FrameContext&);
+  im.stepping = true;
   for (Hook hook : {&FrameStage::before_frame, &FrameStage::solve, &FrameStage::after_solve, &FrameStage::after_frame})
     for (std::size_t i = 0; i < im.stages.size(); ++i) {
       const auto t0 = std::chrono::steady_clock::now();
-      if (Status s = (im.stages[i].get()->*hook)(frame); !s) return s;
+      if (Status s = (im.stages[i].get()->*hook)(frame); !s) {
+        im.stepping = false;
+        return s;
+      }
       im.stats.stages[i].ms += ms_since(t0);
     }
+  im.stepping = false;
   im.stats.read_back_bytes = im.positions_mirror.bytes();
   for (const auto& stage : im.stages) im.stats.read_back_bytes += stage->read_back_bytes();
   for (std::size_t i = 0; i < im.stages.size(); ++i) im.stages[i]->report(im.stats.stages[i]);

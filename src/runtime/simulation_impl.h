@@ -186,6 +186,10 @@ struct Simulation::Impl {
     double force_speed = 0.0;       ///< the same for the frame being run
   } history;
   SavedState last_good;  ///< OnDivergence::roll_back: the last good frame's state
+  bool checkpoint_failed = false;
+  bool stepping = false;  ///< inside step()'s stages (a topology change there is a tear)
+  /// Saves last_good (OnDivergence::roll_back): after a good frame, and after a topology change between frames.
+  void checkpoint();
   /// After a frame: the checks, the log and the policy (divergence_check.cpp).
   Status check_divergence();
 };

@@ -62,6 +62,9 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
     if (Status s = rebuild_program(); !s) return s.error();
     event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
   }
+  // Between frames the changed scene is the one to roll back to (a saved
+  // state holds no topology); a tear, inside a frame, waits for the frame's verdict.
+  if (changed && !stepping && divergence.on_divergence == OnDivergence::roll_back) checkpoint();
   event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return event;
 }
