@@ -75,10 +75,7 @@ TEST_P(DivergenceTest, ThrownTargetIsReportedAsEnergyGrowthAndLogged) {
   auto sim = test::create_or_skip(test::robustness_block(), GetParam());
   ASSERT_TRUE(sim.ok()) << sim.error().message();
   capture_log();
-  for (int f = 1; f <= 3; ++f) {
-    drive(*sim, f);
-    SINEW_ASSERT_OK(sim->step());
-  }
+  test::run(*sim, 1, 3);
   throw_target(*sim);
   SINEW_ASSERT_OK(sim->step());  // report: the frame stands
   const FrameStats& stats = sim->last_frame();
@@ -141,10 +138,7 @@ TEST_P(DivergenceTest, RollBackRestoresTheLastGoodFrameBitwise) {
   ASSERT_TRUE(sim.ok()) << sim.error().message();
   SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::roll_back}));
   capture_log();
-  for (int f = 1; f <= 5; ++f) {
-    drive(*sim, f);
-    SINEW_ASSERT_OK(sim->step());
-  }
+  test::run(*sim, 1, 5);
   throw_target(*sim);  // frame 6 diverges
   SINEW_ASSERT_OK(sim->step());
   const FrameStats& stats = sim->last_frame();
@@ -169,10 +163,7 @@ TEST_P(DivergenceTest, RollBackAfterATopologyChangeKeepsTheChange) {
   ASSERT_TRUE(sim.ok()) << sim.error().message();
   SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::roll_back}));
   capture_log();
-  for (int f = 1; f <= 3; ++f) {
-    drive(*sim, f);
-    SINEW_ASSERT_OK(sim->step());
-  }
+  test::run(*sim, 1, 3);
   auto body = sim->topology().tet_body(0);
   ASSERT_TRUE(body.ok());
   const std::vector<std::uint32_t> hole{40, 41, 42, 43, 44, 45};

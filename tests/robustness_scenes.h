@@ -72,6 +72,14 @@ inline void drive(Simulation& sim, int f) {
   }
 }
 
+/// Steps frames [from, to] with drive's inputs.
+inline void run(Simulation& sim, int from, int to) {
+  for (int f = from; f <= to; ++f) {
+    drive(sim, f);
+    SINEW_ASSERT_OK(sim.step());
+  }
+}
+
 /// Positions and velocities, read back (for a bitwise comparison).
 struct Snapshot {
   std::vector<float> x, v;

@@ -11,7 +11,7 @@
 namespace sinew {
 namespace {
 
-using test::drive;
+using test::run;
 using test::same_bits;
 using test::snapshot;
 using test::Snapshot;
@@ -21,14 +21,6 @@ class SavedStateTest : public test::BackendTest {};
 std::string tmp_path(const std::string& name) {
   std::filesystem::create_directories(SINEW_TEST_TMP_DIR);
   return std::string(SINEW_TEST_TMP_DIR) + "/" + name;
-}
-
-// Steps frames [from, to] with the scene's inputs.
-void run(Simulation& sim, int from, int to) {
-  for (int f = from; f <= to; ++f) {
-    drive(sim, f);
-    SINEW_ASSERT_OK(sim.step());
-  }
 }
 
 TEST_P(SavedStateTest, RestoreThenStepIsBitwiseTheUninterruptedRun) {
