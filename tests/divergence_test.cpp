@@ -220,6 +220,7 @@ TEST_P(DivergenceTest, InvertedTetsAreCountedAsTheHostCountsThem) {
   const SceneDesc scene = inside_out_block();
   auto sim = test::create_or_skip(scene, GetParam());
   ASSERT_TRUE(sim.ok()) << sim.error().message();
+  capture_log();
   // Checked alone: the volume check (the total volume is negative) would come first.
   SINEW_ASSERT_OK(sim->set_divergence_settings({.max_volume_change = 10.0, .max_inverted_fraction = 0.5}));
   SINEW_ASSERT_OK(sim->step());
