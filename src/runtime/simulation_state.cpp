@@ -165,6 +165,7 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
   stats.frame = frame;
   stats.time = static_cast<double>(frame) * time_step;
   positions_mirror.changed();
+  if (mesh_collision) mesh_collision->positions_changed();
   tears.clear();
   return {};
 }
