@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "fluid_cup.h"
 #include "robustness_scenes.h"
 #include "thread_scenes.h"
 
@@ -121,6 +122,34 @@ TEST_P(SavedStateTest, RestoreWithContinuousCollisionIsBitwise) {
   SceneDesc scene = test::LinkedRings::scene(/*continuous=*/true);
   scene.gravity = {0.0, -9.81, 0.0};
   expect_restore_bitwise(scene, GetParam(), 10, 25);
+}
+
+TEST_P(SavedStateTest, RestoreWithAFluidIsBitwise) {
+  // Fluid poured into the tissue cup of the fluid tests, coupled both ways:
+  // the fluid's particles, their grid and counts are in the state.
+  const SceneDesc scene = test::cup_scene(true, {0, -9.81, 0},
+                                          test::fluid_block(4, 3, 4, {2 * test::kCupCell, 1.5 * test::kCupCell,
+                                                                      2 * test::kCupCell}));
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  for (int f = 1; f <= 20; ++f) SINEW_ASSERT_OK(sim->step());
+  SavedState state;
+  SINEW_ASSERT_OK(sim->save_state(state));
+  std::vector<FluidParticle> saved_fluid;
+  SINEW_ASSERT_OK(sim->fluid().read(saved_fluid));
+  for (int f = 21; f <= 40; ++f) SINEW_ASSERT_OK(sim->step());
+  std::vector<FluidParticle> fluid40, again;
+  SINEW_ASSERT_OK(sim->fluid().read(fluid40));
+  const Snapshot tissue40 = snapshot(*sim);
+  SINEW_ASSERT_OK(sim->restore_state(state));
+  for (int f = 21; f <= 40; ++f) SINEW_ASSERT_OK(sim->step());
+  SINEW_ASSERT_OK(sim->fluid().read(again));
+  EXPECT_TRUE(same_bits(snapshot(*sim), tissue40)) << "the tissue, on " << GetParam();
+  ASSERT_EQ(again.size(), fluid40.size());
+  ASSERT_EQ(saved_fluid.size(), fluid40.size());
+  EXPECT_NE(std::memcmp(saved_fluid.data(), fluid40.data(), fluid40.size() * sizeof(FluidParticle)), 0);  // it moved
+  EXPECT_EQ(std::memcmp(again.data(), fluid40.data(), fluid40.size() * sizeof(FluidParticle)), 0)
+      << "the fluid, on " << GetParam();
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, SavedStateTest, ::testing::ValuesIn(test::backends()), test::backend_name);

@@ -4,8 +4,9 @@
 // What it holds: the particles' positions, previous positions and
 // velocities, every constraint's multiplier (lambda) and residual, the
 // particle forces set for the next frame, the colliders' and kinematic
-// targets' poses, the rigid tools' motion and reactions, the frame count
-// and the divergence checks' history. Restoring it into the Simulation it
+// targets' poses, the rigid tools' motion and reactions, a fluid's
+// particles, grid, counts and emitters, the frame count and the divergence
+// checks' history. Restoring it into the Simulation it
 // came from, or into a new Simulation made from the same SceneDesc on the
 // same backend, and stepping gives bitwise the positions of the run that
 // was never interrupted.
@@ -16,7 +17,7 @@
 // same topology: restoring across a topology change (a cut, tear,
 // cautery or removal made after the save, or before it in another
 // Simulation) is an error that says so. Not saved yet, so save_state is an
-// error that names them: a scene's fluid, needles, and a closed grasper.
+// error that names them: needles and sutures, and a closed grasper's hold.
 //
 // File format, version 1 (all integers little-endian as the host writes
 // them, which the byte-order word checks):

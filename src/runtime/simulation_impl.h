@@ -169,6 +169,8 @@ struct Simulation::Impl {
     const char* name = "";
   };
   std::vector<StateBuffer> state_buffers;
+  /// state_buffers and the fluid's (sph_solver.h), in the order a state holds them.
+  [[nodiscard]] std::vector<StateBuffer> saved_buffers() const;
   /// Fills state_buffers and the divergence checks' scene figures (history) from the compiled scene.
   void init_state_buffers(const CompiledScene& compiled);
   Status save_state(SavedState& out, const char* call);

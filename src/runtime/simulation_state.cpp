@@ -1,18 +1,21 @@
 // simulation_state.cpp — Simulation::save_state and restore_state
 // (sinew/saved_state.h): the device buffers that carry from frame to frame
-// and the host state of the frame's stages, written in one order into the
-// versioned format of runtime/state_format.h and read back in the same one.
+// (the scene's own, and its fluid's) and the host state of the frame's
+// stages, written in one order into the versioned format of
+// runtime/state_format.h and read back in the same one.
 //
 // Why bitwise: a frame's result depends only on the device buffers listed
-// in Impl::state_buffers, the colliders' and targets' host copies (uploaded
-// before the frame), the rigid tools' state, the particle forces' flags and
-// the residual stepper's warm start; all are restored exactly, and the
+// in Impl::saved_buffers, the colliders' and targets' host copies (uploaded
+// before the frame), the rigid tools' state, the particle forces' flags,
+// the residual stepper's warm start and the fluid's counts; all are
+// restored exactly (and the mesh collision reads the positions again), and the
 // scene's constant data (constraint data, level-set grids) is checked to be
 // unchanged through shape_generation.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
+#include "fluid/sph_solver.h"
 #include "runtime/simulation_impl.h"
 #include "runtime/state_format.h"
 
@@ -39,7 +42,6 @@ Status check_saveable(const Simulation::Impl& im, const char* call) {
     return Error(ErrorCode::bad_parameter,
                  std::string(call) + ": " + what + " is not part of a saved state yet, so this scene cannot be saved");
   };
-  if (im.fluid) return unsupported("a fluid (SceneDesc::fluid)");
   if (im.sutures) return unsupported("a needle (SceneDesc::needles)");
   if (im.graspers)
     for (std::size_t g = 0; g < im.graspers->count(); ++g)
@@ -75,8 +77,19 @@ void Simulation::Impl::init_state_buffers(const CompiledScene& compiled) {
                                (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
+std::vector<Simulation::Impl::StateBuffer> Simulation::Impl::saved_buffers() const {
+  std::vector<StateBuffer> all = state_buffers;
+  if (fluid) {  // the fluid's, asked for each time: its grid may have grown
+    std::vector<std::pair<BufferHandle, std::size_t>> sized;
+    fluid->solver->state_buffers(sized);
+    for (const auto& [buffer, bytes] : sized) all.push_back({buffer, bytes, "fluid buffer"});
+  }
+  return all;
+}
+
 Status Simulation::Impl::save_state(SavedState& out, const char* call) {
   if (Status s = check_saveable(*this, call); !s) return s;
+  const std::vector<StateBuffer> saved = saved_buffers();
   state_format::Writer w(out.bytes);
   w.begin();
   w.value(stats.frame);  // first: SavedState::frame() reads it
@@ -86,8 +99,8 @@ Status Simulation::Impl::save_state(SavedState& out, const char* call) {
   w.value(history.last_energy);
   w.value(history.next_force_speed);
   w.value(stats.divergence.diverged_frames);
-  w.value(static_cast<std::uint64_t>(state_buffers.size()));
-  for (const StateBuffer& b : state_buffers)
+  w.value(static_cast<std::uint64_t>(saved.size()));
+  for (const StateBuffer& b : saved)
     if (Status s = device->read_buffer(b.buffer, 0, w.reserve_array(b.bytes), b.bytes); !s) return s;
   w.array(std::span<const float>(colliders));
   w.array(std::span<const float>(targets));
@@ -95,6 +108,10 @@ Status Simulation::Impl::save_state(SavedState& out, const char* call) {
   w.value(dirty);
   w.value(static_cast<std::uint64_t>(contacts.tools.size()));
   for (const ToolBody& t : contacts.tools) tool_fields(t, [&](const auto& v) { w.value(v); });
+  if (fluid) {
+    w.value(fluid->solver->host_state());
+    w.array(std::span<const FluidEmitter>(fluid->solver->emitter_settings()));
+  }
   w.finish();
   return {};
 }
@@ -104,12 +121,13 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
   if (Status s = state_format::open(state.bytes, what, payload); !s) return s;
   if (Status s = check_saveable(*this, what.c_str()); !s) return s;
   state_format::Reader r(payload, what);
+  const std::vector<StateBuffer> saved = saved_buffers();
   // Read and checked whole before anything changes: a bad state leaves the Simulation as it was.
-  std::uint64_t frame = 0, generation = 0, diverged = 0, saved_buffers = 0, tools = 0;
+  std::uint64_t frame = 0, generation = 0, diverged = 0, buffer_count = 0, tools = 0;
   std::uint8_t flags[3] = {}, dirty[2] = {};
   double last_energy = 0.0, next_force_speed = 0.0;
   for (Status s : {r.value(frame), r.value(generation), r.value(flags), r.value(last_energy),
-                   r.value(next_force_speed), r.value(diverged), r.value(saved_buffers)})
+                   r.value(next_force_speed), r.value(diverged), r.value(buffer_count)})
     if (!s) return s;
   if (generation != shape_generation)
     return Error(ErrorCode::bad_parameter,
@@ -117,12 +135,11 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
                      " changes of the scene's shape (topology changes and level-set cuts), this Simulation has had " +
                      std::to_string(shape_generation) +
                      "; a saved state does not hold the topology, so it cannot be restored across such a change");
-  if (saved_buffers != state_buffers.size())
-    return r.mismatch("device buffers", saved_buffers, state_buffers.size());
-  std::vector<std::vector<std::byte>> contents(state_buffers.size());
-  for (std::size_t i = 0; i < state_buffers.size(); ++i) {
-    contents[i].resize(state_buffers[i].bytes);
-    if (Status s = r.array_into(contents[i].data(), state_buffers[i].bytes, state_buffers[i].name); !s) return s;
+  if (buffer_count != saved.size()) return r.mismatch("device buffers", buffer_count, saved.size());
+  std::vector<std::vector<std::byte>> contents(saved.size());
+  for (std::size_t i = 0; i < saved.size(); ++i) {
+    contents[i].resize(saved[i].bytes);
+    if (Status s = r.array_into(contents[i].data(), saved[i].bytes, saved[i].name); !s) return s;
   }
   std::vector<float> saved_colliders, saved_targets;
   if (Status s = r.array(saved_colliders, colliders.size(), "colliders (floats)"); !s) return s;
@@ -140,11 +157,22 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
       if (read_tools) read_tools = r.value(v);
     });
   if (!read_tools) return read_tools;
+  SphSolver::HostState fluid_host;
+  std::vector<FluidEmitter> emitters;
+  if (fluid) {
+    if (Status s = r.value(fluid_host); !s) return s;
+    const std::size_t n = fluid->solver->emitter_settings().size();
+    if (Status s = r.array(emitters, n, "fluid emitters"); !s) return s;
+    if (emitters.size() != n) return r.mismatch("fluid emitters", emitters.size(), n);
+  }
   if (!r.done()) return Error(ErrorCode::bad_input_file, what + ": the saved state has bytes past its end");
 
-  for (std::size_t i = 0; i < state_buffers.size(); ++i)
-    if (Status s = device->write_buffer(state_buffers[i].buffer, 0, contents[i].data(), contents[i].size()); !s)
-      return s;
+  for (std::size_t i = 0; i < saved.size(); ++i)
+    if (Status s = device->write_buffer(saved[i].buffer, 0, contents[i].data(), contents[i].size()); !s) return s;
+  if (fluid) {
+    fluid->solver->set_host_state(fluid_host);
+    fluid->solver->emitter_settings() = std::move(emitters);
+  }
   colliders = std::move(saved_colliders);
   targets = std::move(saved_targets);
   if (!colliders.empty())
