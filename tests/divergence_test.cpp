@@ -2,9 +2,10 @@
 // backend: a healthy run is never flagged; a kinematic target thrown 10 m in
 // one frame (a haptic device's glitch) is energy growth the frame's loads
 // cannot explain; NaN velocities are non-finite; inverted tets are counted
-// as the host counts them; each policy does what it
-// says: report (and log), stop with ErrorCode::diverged, roll back bitwise to
-// the last good frame.
+// as the host counts them; a Neo-Hookean block past its Courant limit is
+// found; each policy does what it says: report (and log), stop with
+// ErrorCode::diverged, roll back bitwise to the last good frame (also after
+// a frame that failed half-way, and keeping a topology change made before).
 #include <limits>
 
 #include "robustness_scenes.h"
@@ -55,6 +56,19 @@ class BreakVelocities final : public FrameStage {
  private:
   BufferHandle velocity_;
   std::uint32_t particles_;
+};
+
+// A stage that fails once after the solve, when armed: a device error in
+// the middle of a frame, after the positions changed.
+class FailOnce final : public FrameStage {
+ public:
+  std::string_view name() const override { return "fail once"; }
+  Status after_solve(FrameContext&) override {
+    if (!armed) return {};
+    armed = false;
+    return Error(ErrorCode::device_lost, "the device stopped (test)");
+  }
+  bool armed = false;
 };
 
 TEST_P(DivergenceTest, HealthyRunIsNeverFlagged) {
@@ -156,6 +170,37 @@ TEST_P(DivergenceTest, RollBackRestoresTheLastGoodFrameBitwise) {
     EXPECT_EQ(sim->last_frame().divergence.kind, Divergence::none);
     EXPECT_TRUE(same_bits(snapshot(*sim), expected[f])) << "frame " << f << " after the roll-back, on " << GetParam();
   }
+}
+
+TEST_P(DivergenceTest, FailedFrameRollsBackAndTheSceneGoesOn) {
+  const SceneDesc scene = test::robustness_block();
+  auto plain = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(plain.ok()) << plain.error().message();
+  std::vector<test::Snapshot> expected(7);
+  for (int f = 1; f <= 6; ++f) {
+    drive(*plain, f);
+    SINEW_ASSERT_OK(plain->step());
+    expected[f] = snapshot(*plain);
+  }
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  auto stage = std::make_unique<FailOnce>();
+  FailOnce& failing = *stage;
+  SimulationInternals::add_stage(*sim, std::move(stage));
+  SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::roll_back}));
+  capture_log();
+  test::run(*sim, 1, 4);
+  failing.armed = true;
+  drive(*sim, 5);
+  const Status failed = sim->step();
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.error().code(), ErrorCode::device_lost);
+  EXPECT_NE(failed.error().message().find("rolled back to frame 4"), std::string::npos) << failed.error().message();
+  EXPECT_EQ(sim->last_frame().frame, 4u);
+  EXPECT_TRUE(same_bits(snapshot(*sim), expected[4])) << "on " << GetParam();
+  ASSERT_EQ(warnings_.size(), 1u);
+  test::run(*sim, 5, 6);  // usable: the frames the failure interrupted, as if it never happened
+  EXPECT_TRUE(same_bits(snapshot(*sim), expected[6])) << "on " << GetParam();
 }
 
 TEST_P(DivergenceTest, RollBackAfterATopologyChangeKeepsTheChange) {

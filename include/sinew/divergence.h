@@ -45,7 +45,8 @@ enum class OnDivergence : std::uint8_t {
   report,     ///< step() succeeds; FrameStats::divergence says what happened
   stop,       ///< step() returns ErrorCode::diverged; the diverged state stays (restore_state can undo it)
   roll_back,  ///< the scene goes back to the last good frame (FrameStats::divergence.rolled_back_to) and
-              ///< step() succeeds: the next step() runs that frame's successor again
+              ///< step() succeeds: the next step() runs that frame's successor again. A frame that fails
+              ///< (a device error) rolls back too, and step() returns its error, saying so
 };
 
 /// The divergence checks and their policy (Simulation::set_divergence_settings).

@@ -1,7 +1,7 @@
 // divergence_check.cpp — after every frame, the checks of sinew/divergence.h
 // on the statistics the device reduced (no extra read-back), the warning
 // through the log callback, and the policy: report, stop, or roll back to
-// the last good frame's saved state.
+// the last good frame's saved state (also after a frame that failed).
 #include <cmath>
 #include <sstream>
 
@@ -94,6 +94,20 @@ Status Simulation::Impl::check_divergence() {
     }
   }
   return {};
+}
+
+Status Simulation::Impl::after_failed_frame(const Error& error) {
+  if (divergence.on_divergence != OnDivergence::roll_back || last_good.bytes.empty()) return error;
+  // The half-done frame's buffers are overwritten by the last good frame's;
+  // a device that no longer works fails here too, and both errors are said.
+  if (Status s = restore_state(last_good, "step (rolling back after an error)"); !s)
+    return Error(error.code(), error.message() + "; rolling back failed too: " + s.error().message());
+  stats.divergence.kind = Divergence::none;
+  stats.divergence.rolled_back = true;
+  stats.divergence.rolled_back_to = stats.frame;
+  const std::string message = error.message() + "; rolled back to frame " + std::to_string(stats.frame);
+  log_message(LogLevel::warning, message);
+  return Error(error.code(), message);
 }
 
 Status Simulation::set_divergence_settings(const DivergenceSettings& settings) {

@@ -234,7 +234,7 @@ Status Simulation::step() {
       const auto t0 = std::chrono::steady_clock::now();
       if (Status s = (im.stages[i].get()->*hook)(frame); !s) {
         im.stepping = false;
-        return s;
+        return im.after_failed_frame(s.error());
       }
       im.stats.stages[i].ms += ms_since(t0);
     }

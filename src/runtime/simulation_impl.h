@@ -194,6 +194,9 @@ struct Simulation::Impl {
   void checkpoint();
   /// After a frame: the checks, the log and the policy (divergence_check.cpp).
   Status check_divergence();
+  /// A frame a stage failed (a device error): with OnDivergence::roll_back
+  /// the scene goes back to the last good frame; the error is returned either way.
+  Status after_failed_frame(const Error& error);
 };
 
 
