@@ -71,6 +71,20 @@ class FailOnce final : public FrameStage {
   bool armed = false;
 };
 
+// The run that never went wrong: its snapshot after each frame 1..frames
+// (index 0 unused; fewer on a failure, which the caller's size check reports).
+std::vector<test::Snapshot> uninterrupted(const SceneDesc& scene, const std::string& backend, int frames) {
+  std::vector<test::Snapshot> out(1);
+  auto plain = test::create_or_skip(scene, backend);
+  if (!plain.ok()) return out;
+  for (int f = 1; f <= frames; ++f) {
+    drive(*plain, f);
+    if (!plain->step().ok()) return out;
+    out.push_back(snapshot(*plain));
+  }
+  return out;
+}
+
 TEST_P(DivergenceTest, HealthyRunIsNeverFlagged) {
   auto sim = test::create_or_skip(test::robustness_block(), GetParam());
   ASSERT_TRUE(sim.ok()) << sim.error().message();
@@ -138,15 +152,8 @@ TEST_P(DivergenceTest, StopReturnsANamedError) {
 
 TEST_P(DivergenceTest, RollBackRestoresTheLastGoodFrameBitwise) {
   const SceneDesc scene = test::robustness_block();
-  // The run that never diverged, frames 1..8.
-  auto plain = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(plain.ok()) << plain.error().message();
-  std::vector<test::Snapshot> expected(9);
-  for (int f = 1; f <= 8; ++f) {
-    drive(*plain, f);
-    SINEW_ASSERT_OK(plain->step());
-    expected[f] = snapshot(*plain);
-  }
+  const std::vector<test::Snapshot> expected = uninterrupted(scene, GetParam(), 8);
+  ASSERT_EQ(expected.size(), 9u);
 
   auto sim = test::create_or_skip(scene, GetParam());
   ASSERT_TRUE(sim.ok()) << sim.error().message();
@@ -174,14 +181,8 @@ TEST_P(DivergenceTest, RollBackRestoresTheLastGoodFrameBitwise) {
 
 TEST_P(DivergenceTest, FailedFrameRollsBackAndTheSceneGoesOn) {
   const SceneDesc scene = test::robustness_block();
-  auto plain = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(plain.ok()) << plain.error().message();
-  std::vector<test::Snapshot> expected(7);
-  for (int f = 1; f <= 6; ++f) {
-    drive(*plain, f);
-    SINEW_ASSERT_OK(plain->step());
-    expected[f] = snapshot(*plain);
-  }
+  const std::vector<test::Snapshot> expected = uninterrupted(scene, GetParam(), 6);
+  ASSERT_EQ(expected.size(), 7u);
   auto sim = test::create_or_skip(scene, GetParam());
   ASSERT_TRUE(sim.ok()) << sim.error().message();
   auto stage = std::make_unique<FailOnce>();
