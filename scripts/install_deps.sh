@@ -12,6 +12,7 @@ packages=(
   libopenvdb-dev libnanovdb-dev libboost-dev                   # level sets
   libembree-dev                       # CPU broad phase
   gnuplot-nox                         # plots in the reports
+  doxygen                             # API reference (cmake --build build --target docs; optional)
 )
 
 missing=()

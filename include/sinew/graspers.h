@@ -29,7 +29,7 @@ class Graspers {
  public:
   /// The id of grasper `index` (SceneDesc::graspers). Errors: an index past them.
   [[nodiscard]] Result<GrasperId> grasper(std::size_t index) const;
-  [[nodiscard]] std::size_t count() const;
+  [[nodiscard]] std::size_t count() const;  ///< the scene's graspers
 
   /// Closes `grasper` at `pose` [m, unit quaternion (w, x, y, z)]: every
   /// movable particle (of any body) inside the jaws, the box of
@@ -53,6 +53,7 @@ class Graspers {
   /// The surface points `grasper` holds (none while open).
   [[nodiscard]] Result<std::vector<HeldPoint>> held_points(GrasperId grasper) const;
 
+  /// A view of `sim` (Simulation::graspers() makes one).
   explicit Graspers(Simulation* sim) : sim_(sim) {}
 
  private:

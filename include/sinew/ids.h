@@ -24,7 +24,9 @@ template <class Tag>
 struct Id {
   std::uint32_t index = std::numeric_limits<std::uint32_t>::max();  ///< among the scene's objects of the kind
   std::uint32_t scene = 0;  ///< the Simulation it belongs to (a number unique in the process; 0: none)
+  /// Whether it names nothing (a default id).
   [[nodiscard]] bool is_null() const { return scene == 0; }
+  /// Equal when they name the same object of the same Simulation.
   friend bool operator==(const Id&, const Id&) = default;
 };
 

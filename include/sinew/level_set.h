@@ -1,4 +1,4 @@
-// level_set.h — signed distance fields on a sparse grid (issue 14): bone and
+// level_set.h — signed distance fields on a sparse grid (docs/level_sets.md): bone and
 // tools as narrow-band level sets built from closed triangle surfaces or
 // analytic shapes, sampled (value and gradient, trilinear) on the host and
 // inside every backend's kernels.
@@ -46,8 +46,9 @@ struct LevelSetSettings {
 /// `radius` about the origin), a drill (capsule: the segment +-half_height
 /// along y swollen by `radius`) or a saw (box of `half_extents`).
 struct CutterShape {
+  /// burr, drill, saw
   enum class Kind { sphere, capsule, box };
-  Kind kind = Kind::sphere;
+  Kind kind = Kind::sphere;                  ///< which shape
   double radius = 1.5e-3;                               ///< sphere, capsule [m], > 0
   double half_height = 0.0;                             ///< capsule [m], >= 0
   std::array<double, 3> half_extents{1e-3, 1e-3, 1e-3};  ///< box [m], > 0
@@ -56,14 +57,14 @@ struct CutterShape {
 /// A rigid pose: the frame's origin [m] and its rotation, a unit quaternion
 /// (w, x, y, z), in the level set's frame.
 struct Pose {
-  std::array<double, 3> position{0.0, 0.0, 0.0};
-  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 3> position{0.0, 0.0, 0.0};       ///< the origin [m]
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
 };
 
 /// What one cut changed.
 struct CutReport {
   double removed_volume = 0.0;      ///< [m^3], measured on the grid (see LevelSet::cut)
-  std::uint64_t changed_voxels = 0;
+  std::uint64_t changed_voxels = 0;  ///< voxels whose value changed
   std::uint32_t changed_leaves = 0;  ///< 8^3-voxel blocks of the grid
   /// Byte ranges (offset, size) of the NanoVDB grid that changed: what a
   /// device's copy needs (update_level_set, src/level_set/device_level_set.h).
@@ -73,7 +74,7 @@ struct CutReport {
 /// A signed distance field on a sparse grid, in its own frame (the frame of
 /// the surface or shape it was built from). Copies share the grid (cheap).
 ///
-/// Bounds every factory and cut checks first (issue 39), so that no input
+/// Bounds every factory and cut checks first, so that no input
 /// overflows or runs without end: every length and coordinate within
 /// float32's range (the device samples in float; e.g. a cube of 1e39 m is
 /// bad_parameter); every voxel index, the shape's box grown by the
@@ -99,9 +100,9 @@ class LevelSet {
   static Result<LevelSet> box(const std::array<double, 3>& lo, const std::array<double, 3>& hi,
                               const LevelSetSettings& settings);
 
-  [[nodiscard]] double voxel_size() const;
-  [[nodiscard]] double exterior_band() const;
-  [[nodiscard]] double interior_band() const;
+  [[nodiscard]] double voxel_size() const;     ///< the voxels' edge [m]
+  [[nodiscard]] double exterior_band() const;  ///< how far outside distances are exact [m]
+  [[nodiscard]] double interior_band() const;  ///< how far inside distances are exact [m] (infinity: the whole inside)
   /// The box of the stored voxels [m] (lo then hi).
   [[nodiscard]] std::array<double, 6> bounds() const;
   /// Stored voxels (active and inactive, in allocated leaves).
@@ -158,6 +159,7 @@ class LevelSet {
 
   struct Impl;  ///< opaque outside sinew (src/level_set/level_set_impl.h)
   explicit LevelSet(std::shared_ptr<Impl> impl);
+  /// The library's own view of the grid (opaque outside sinew).
   [[nodiscard]] const Impl& internals() const { return *impl_; }
 
  private:

@@ -33,7 +33,7 @@ struct TetMesh {
 /// outside (normals point outward).
 struct TriMesh {
   std::vector<Vec3d> vertices;                     ///< positions [m]
-  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::array<std::uint32_t, 3>> triangles;  ///< vertex indices, counter-clockwise from outside
 };
 
 /// Reads a binary STL file: the triangles, with vertices at equal positions
@@ -57,8 +57,10 @@ struct SurfaceReport {
   std::uint64_t intersecting_pairs = 0;
   /// Whether the crossing search ran: false when the edge and triangle
   /// counts already show the surface does not bound a solid (the search
-  /// would only cost time: issue 39).
+  /// would only cost time).
   bool crossings_tested = false;
+  /// Whether the surface bounds a solid: no open, non-manifold or misoriented edge, no degenerate triangle and
+  /// no crossing.
   [[nodiscard]] bool closed() const {
     return open_edges == 0 && nonmanifold_edges == 0 && misoriented_edges == 0 && degenerate_triangles == 0 &&
            crossings_tested && intersecting_pairs == 0;
@@ -87,10 +89,12 @@ enum class TetsPerCell {
 
 /// A box [origin, origin + (nx, ny, nz) * cell_size] of nx*ny*nz cells.
 struct TetGridDesc {
-  int nx = 1, ny = 1, nz = 1;     ///< cells per axis, >= 1
+  int nx = 1;                     ///< cells along x, >= 1
+  int ny = 1;                     ///< cells along y, >= 1
+  int nz = 1;                     ///< cells along z, >= 1
   Vec3d origin{0.0, 0.0, 0.0};    ///< lowest corner [m]
   Vec3d cell_size{1.0, 1.0, 1.0}; ///< cell edge lengths [m], > 0
-  TetsPerCell split = TetsPerCell::six;
+  TetsPerCell split = TetsPerCell::six;  ///< 5 or 6 tets per cell
 };
 
 /// [in] desc: grid size; errors name the bad parameter.
@@ -153,7 +157,7 @@ TriMesh extract_boundary_surface(const TetMesh& mesh);
 
 /// A per-vertex field written to VTU: 1 (scalar) or 3 (vector) components.
 struct VertexField {
-  std::string name;
+  std::string name;               ///< the field's name in the file
   int components = 1;             ///< 1 or 3
   std::span<const float> values;  ///< vertex_count * components values
 };

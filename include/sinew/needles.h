@@ -42,7 +42,8 @@ struct NeedleState {
   /// tie to the thread, and their torque about its origin [N m] (world
   /// frame). Kinematic needles report it too: it is the force to render
   /// on a haptic device.
-  std::array<double, 3> reaction_force{}, reaction_torque{};
+  std::array<double, 3> reaction_force{};
+  std::array<double, 3> reaction_torque{};  ///< see reaction_force
   std::vector<Puncture> punctures;             ///< in the order they were made
   bool pushing = false;    ///< the tip pushes a surface it has not punctured
   double tip_force = 0.0;  ///< that push, along the tip, averaged over the frame [N]
@@ -50,7 +51,9 @@ struct NeedleState {
   /// puncture because they were degenerate (no area) or inverted (their
   /// tet turned inside out), and frames in which the push passed
   /// puncture_force at more than max_puncture_angle.
-  std::uint32_t refused_degenerate = 0, refused_inverted = 0, refused_angle = 0;
+  std::uint32_t refused_degenerate = 0;
+  std::uint32_t refused_inverted = 0;  ///< see refused_degenerate
+  std::uint32_t refused_angle = 0;     ///< see refused_degenerate
 };
 
 /// A handle on a Simulation's needles; a view of the Simulation, valid
@@ -60,7 +63,7 @@ class Needles {
  public:
   /// The id of needle `index` (SceneDesc::needles). Errors: an index past them.
   [[nodiscard]] Result<NeedleId> needle(std::size_t index) const;
-  [[nodiscard]] std::size_t count() const;
+  [[nodiscard]] std::size_t count() const;  ///< the scene's needles
   /// Moves kinematic `needle` to this pose [m, unit quaternion (w, x, y,
   /// z)] by the end of the next frame (NeedleDesc); its substeps
   /// interpolate each of its points linearly. Errors: a force-driven needle.
@@ -70,8 +73,10 @@ class Needles {
   /// frame (then reset to zero); calls before one step add up. Errors: a
   /// kinematic needle.
   Status apply_force(NeedleId needle, const std::array<double, 3>& force, const std::array<double, 3>& torque);
+  /// `needle`'s pose, velocity, reaction, punctures and refusals (NeedleState).
   [[nodiscard]] Result<NeedleState> state(NeedleId needle) const;
 
+  /// A view of `sim` (Simulation::needles() makes one).
   explicit Needles(Simulation* sim) : sim_(sim) {}
 
  private:

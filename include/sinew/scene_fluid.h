@@ -37,11 +37,14 @@ class SceneFluid {
   Status read(std::vector<FluidParticle>& particles) const;
   /// The counts after the last frame (Fluid::stats).
   [[nodiscard]] Result<FluidStats> stats() const;
+  /// What the scene's fluid holds (SceneFluidInfo).
   [[nodiscard]] Result<SceneFluidInfo> info() const;
   /// As Fluid::set_emitter and set_sink; an emitter's check against the
   /// boundary (a source inside a collider) sees the boundary as it was made.
+  ///@{
   Status set_emitter(std::size_t index, const FluidEmitter& emitter);
   Status set_sink(std::size_t index, const FluidSink& sink);
+  ///@}
   /// The last frame's impulses, summed (reads 16 bytes per boundary particle).
   [[nodiscard]] Result<FluidImpulses> last_impulses() const;
 

@@ -32,22 +32,23 @@ namespace sinew {
 
 /// What a compiled scene holds; fixed for the life of a Simulation.
 struct SceneInfo {
-  std::uint32_t particles = 0;
-  std::uint32_t distance_constraints = 0;
-  std::uint32_t volume_constraints = 0;
+  std::uint32_t particles = 0;             ///< particles of every body (tet, tri and line bodies' vertices)
+  std::uint32_t distance_constraints = 0;  ///< edge (and thread segment) distance constraints
+  std::uint32_t volume_constraints = 0;    ///< tet volume constraints
   std::uint32_t distance_colors = 0;  ///< colours of the distance constraints
   std::uint32_t volume_colors = 0;    ///< colours of the volume constraints
   std::uint32_t other_constraints = 0;  ///< every other kind (FEM tets, thin bodies, contacts, attachments)
   std::uint32_t colors = 0;           ///< dependent sweeps per iteration (sum of the above)
-  std::uint32_t dispatches_per_frame = 0;
-  std::uint32_t barriers_per_frame = 0;
+  std::uint32_t dispatches_per_frame = 0;  ///< kernel dispatches in one frame's program
+  std::uint32_t barriers_per_frame = 0;    ///< barriers between dependent dispatches in one frame's program
   std::vector<std::uint32_t> tet_body_first_particle;   ///< body i's vertex 0 is this particle
-  std::vector<std::uint32_t> tri_body_first_particle;
-  std::vector<std::uint32_t> line_body_first_particle;
+  std::vector<std::uint32_t> tri_body_first_particle;   ///< as tet_body_first_particle, for tri bodies
+  std::vector<std::uint32_t> line_body_first_particle;  ///< as tet_body_first_particle, for line bodies
   /// Mesh self-collision: pairs of a body's triangles closer than the
   /// thickness in the starting shape, which never make contacts with each
   /// other (MeshCollisionDesc::self_collision).
   std::uint32_t rest_close_triangle_pairs = 0;
+  /// All constraints of the bodies: distance + volume + other.
   [[nodiscard]] std::uint32_t constraints() const {
     return distance_constraints + volume_constraints + other_constraints;
   }
@@ -70,7 +71,7 @@ enum class SolveStop {
 /// "mesh collision", "continuous collision", "sutures", "solve",
 /// "statistics", "tearing", ...; only those the scene uses).
 struct StageProfile {
-  std::string name;
+  std::string name;  ///< the stage's name, e.g. "mesh collision"
   double ms = 0.0;  ///< wall time of the stage's work in the last step() [ms]
   /// The stage's own figures of the last step(), by name (the units in the
   /// name: "margin_m"); FrameStats::counter reads one. Mesh collision:
@@ -78,14 +79,17 @@ struct StageProfile {
   /// repairs, reverted, carried, forced; sutures: host_ms; fluid:
   /// particles, steps.
   struct Counter {
-    std::string name;
-    double value = 0.0;
+    std::string name;    ///< e.g. "contacts", "margin_m"
+    double value = 0.0;  ///< its value in the last step()
   };
-  std::vector<Counter> counters;
+  std::vector<Counter> counters;  ///< the stage's counters, in the order they were first set
   /// Sets counter `name` (added the first time).
   void set(std::string_view counter, double value);
 };
 
+/// What the last frame did and cost: its time, the solver's errors (residuals,
+/// energy, volume change), contacts, continuous collision, device times and
+/// the profile of each stage (Simulation::last_frame).
 struct FrameStats {
   std::uint64_t frame = 0;  ///< frames done
   double time = 0.0;        ///< simulated time [s]
@@ -98,12 +102,19 @@ struct FrameStats {
   /// collision's reads inside the solve are not among them (read_back_bytes
   /// counts them).
   std::uint32_t position_reads = 0;
-  std::uint64_t read_back_bytes = 0;  ///< bytes the host read from the device in the last step():
-                                      ///< the statistics' few words; with mesh collision, needles or
-                                      ///< tearing, the positions once (16 per particle, position_reads);
-                                      ///< 32 per contact when a tool has face contacts; 96 per suture
-                                      ///< row; with continuous collision, 32 per particle per substep
-                                      ///< and 16 per particle per repair round more
+  /// Bytes the host read from the device in the last step(), as the device
+  /// counted them (every backend alike): the statistics' few words; with
+  /// mesh collision, needles or tearing, the positions once (16 per
+  /// particle, position_reads); 32 per contact when a tool has face
+  /// contacts; 96 per suture row; with continuous collision, 32 per
+  /// particle per substep and 16 per particle per repair round more. Each
+  /// stage's share is its profile's counter "read_bytes".
+  std::uint64_t read_back_bytes = 0;
+  std::uint32_t host_reads = 0;  ///< read-backs (round trips) in the last step()
+  /// Times the last step() blocked on the device: every read-back, and
+  /// every wait for a submitted program (each stage's share: its counter
+  /// "host_waits"). A frame that ran wholly on the device would wait once.
+  std::uint32_t host_waits = 0;
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,
   /// rest volume, ...): 0 when the xPBD system is solved exactly. Contact
@@ -139,8 +150,8 @@ struct FrameStats {
   /// particles back, finding, colouring and uploading them (part of wall_ms).
   std::uint32_t mesh_contacts = 0;
   std::uint32_t mesh_contact_colors = 0;  ///< 0 with ContactSchedule::jacobi
-  double collision_margin = 0.0;
-  double collision_ms = 0.0;
+  double collision_margin = 0.0;  ///< the motion margin the mesh contacts were found within [m]
+  double collision_ms = 0.0;      ///< reading back, finding, colouring and uploading the mesh contacts [ms]
   /// The deepest any of the frame's mesh contacts ended inside the
   /// thickness [m], max(thickness - gap) at the frame's end (0 when none
   /// touches): how well the sweeps converged on the contacts.
@@ -150,9 +161,9 @@ struct FrameStats {
   /// (each round's touches counted), the repair rounds run, the particles
   /// the fail-safe stopped at their substep's start, and the wall time
   /// [ms] of the tests (read-back, broad phase, queries; part of wall_ms).
-  std::uint32_t ccd_hits = 0;
-  std::uint32_t ccd_repairs = 0;
-  std::uint32_t ccd_reverted = 0;
+  std::uint32_t ccd_hits = 0;      ///< touching pairs found in the frame's substeps
+  std::uint32_t ccd_repairs = 0;   ///< repair rounds run
+  std::uint32_t ccd_reverted = 0;  ///< particles the fail-safe stopped at their substep's start
   /// The particles the fail-safe moved with a tool or capsule collider
   /// (rigidly, over their substep) so its axis could not cross them.
   std::uint32_t ccd_carried = 0;
@@ -161,7 +172,7 @@ struct FrameStats {
   /// through other tissue (it is kinematic within the frame). 0 but for such
   /// scenes.
   std::uint32_t ccd_forced = 0;
-  double ccd_ms = 0.0;
+  double ccd_ms = 0.0;  ///< wall time of the continuous collision tests [ms] (part of wall_ms)
   /// Needles (SceneDesc::needles), 0 without: the wall time [ms] of their
   /// host side, before the frame (reading the positions back, testing the
   /// tips' paths against the surfaces, uploading the rows) and after it
@@ -183,14 +194,21 @@ struct FrameStats {
   [[nodiscard]] double counter(std::string_view stage, std::string_view counter) const;
 };
 
+/// A scene compiled onto a device: created from a SceneDesc, stepped frame by
+/// frame, read back, and reached through the feature handles (tools(),
+/// graspers(), needles(), topology(), fluid()). Movable, not copyable; a
+/// handle is valid while its Simulation is neither destroyed nor moved.
 class Simulation {
  public:
   /// Checks and compiles the scene and prepares it on a device. Errors name
   /// the bad parameter, or say why the backend is not available.
   static Result<Simulation> create(const SceneDesc& scene, const DeviceOptions& device = {});
 
+  /// Moves the scene and its device; handles of the moved-from Simulation become invalid.
+  ///@{
   Simulation(Simulation&&) noexcept;
   Simulation& operator=(Simulation&&) noexcept;
+  ///@}
   ~Simulation();
 
   /// Advances one frame (SolverSettings::time_step), then checks it for
@@ -265,15 +283,19 @@ class Simulation {
   /// the scene has none.
   [[nodiscard]] SceneFluid fluid();
 
+  /// What the compiled scene holds (fixed for the Simulation's life).
   [[nodiscard]] const SceneInfo& info() const;
+  /// The last step()'s figures (default values before the first step()).
   [[nodiscard]] const FrameStats& last_frame() const;
   /// The backend running the scene: "cpu", "opencl" or "vulkan".
   [[nodiscard]] std::string backend_name() const;
   /// Its device, e.g. "CPU reference (2 threads, AVX2)" or "Vulkan: NVIDIA H100 (discrete GPU, ...)".
   [[nodiscard]] std::string device_name() const;
 
-  // ---- Deprecated: the calls by raw index, kept for one release. Each
-  // does what its replacement does (the feature headers document them).
+  /// Deprecated: the calls by raw index, kept for one release. Each does
+  /// what its replacement, named in its deprecation message, does (the
+  /// feature headers document them).
+  ///@{
   using TopologyEvent = sinew::TopologyEvent;
   using Blade = sinew::Blade;
   using HeldPoint = sinew::HeldPoint;
@@ -321,6 +343,7 @@ class Simulation {
                                                                    const std::array<double, 3>& force,
                                                                    const std::array<double, 3>& torque);
   [[deprecated("use needles().state(NeedleId)")]] Result<NeedleState> needle_state(std::size_t index) const;
+  ///@}
 
   /// The library's own state behind a Simulation (src/runtime/simulation_impl.h; incomplete here, named so
   /// that the frame's stages, src/runtime/stages/, can refer to it).

@@ -27,8 +27,10 @@ struct ToolState {
   /// A level-set tool's penalty from the colliders and the other tools
   /// (or a capsule tool's from level-set tools), at the start of the last
   /// frame, which it drove (ToolDesc) [N], about its centre [N m].
+  ///@{
   std::array<double, 3> penalty_force{};
   std::array<double, 3> penalty_torque{};
+  ///@}
   std::uint32_t penalty_points = 0;  ///< a level-set tool's surface points inside other shapes then
   double penalty_depth = 0.0;        ///< the deepest one's depth [m]
 };
@@ -40,14 +42,17 @@ class Tools {
  public:
   /// Ids of the scene's tools, colliders and targets by their index in
   /// SceneDesc. Errors: an index past them.
+  ///@{
   [[nodiscard]] Result<ToolId> tool(std::size_t index) const;
   [[nodiscard]] Result<ColliderId> collider(std::size_t index) const;
   [[nodiscard]] Result<TargetId> target(std::size_t index) const;
+  ///@}
 
   /// Force [N] and torque [N m] (world frame, about the tool's centre)
   /// acting on `tool` during the next frame (then reset to zero); calls
   /// before one step add up.
   Status apply_force(ToolId tool, const std::array<double, 3>& force, const std::array<double, 3>& torque);
+  /// `tool`'s pose, velocities and the last frame's contact reaction (ToolState).
   [[nodiscard]] Result<ToolState> state(ToolId tool) const;
   /// Moves `collider` to this pose [m, unit quaternion (w, x, y, z)] by the
   /// end of the next frame; its substeps interpolate the motion.
@@ -62,6 +67,7 @@ class Tools {
   /// Moves kinematic `target` to `position` [m] by the end of the next frame.
   Status set_position(TargetId target, const std::array<double, 3>& position);
 
+  /// A view of `sim` (Simulation::tools() makes one).
   explicit Tools(Simulation* sim) : sim_(sim) {}
 
  private:

@@ -22,8 +22,10 @@
 // Events are returned, for a renderer to update its meshes
 // (current_tets, current_triangles). Elements are never renumbered or
 // reused: naming one that was removed is an error ("was removed
-// already"). Errors in the arguments change nothing; a device error
-// during a change leaves the Simulation unusable.
+// already"). Errors in the arguments change nothing. A device error
+// during a change is returned by name and the Simulation steps on (its
+// program is rebuilt at the next step), but the change may be partly
+// applied on the device.
 #pragma once
 
 #include <array>
@@ -43,8 +45,8 @@ class Simulation;
 /// What one change did to body `body` (a tet body, a tri body, or a line
 /// body whose segments broke: body_kind).
 struct TopologyEvent {
-  BodyKind body_kind = BodyKind::tet;
-  std::size_t body = 0;
+  BodyKind body_kind = BodyKind::tet;  ///< the kind of body changed
+  std::size_t body = 0;                ///< its index among the scene's bodies of that kind
   std::vector<std::uint32_t> tets_removed;      ///< a tet body's: indices into its mesh.tets
   std::vector<std::uint32_t> triangles_removed; ///< a tri body's: indices into its mesh.triangles
   std::vector<std::uint32_t> segments_removed;  ///< a line body's: indices into its segments
@@ -59,7 +61,8 @@ struct TopologyEvent {
 
 /// A blade: the segment from `a` to `b` [m].
 struct Blade {
-  std::array<double, 3> a{}, b{};
+  std::array<double, 3> a{};  ///< one end [m]
+  std::array<double, 3> b{};  ///< the other end [m]
 };
 
 /// A handle on a Simulation's topology changes; a view of the Simulation,
@@ -70,9 +73,11 @@ class Topology {
  public:
   /// The id of tet body `index` (SceneDesc::tet_bodies), tri body, line
   /// body. Errors: an index past the scene's bodies of that kind.
+  ///@{
   [[nodiscard]] Result<TetBodyId> tet_body(std::size_t index) const;
   [[nodiscard]] Result<TriBodyId> tri_body(std::size_t index) const;
   [[nodiscard]] Result<LineBodyId> line_body(std::size_t index) const;
+  ///@}
 
   /// Removes tets of `body` (indices into its mesh.tets, each alive, no
   /// repeats). Errors: a tet that does not exist or was removed (named); on
@@ -100,10 +105,12 @@ class Topology {
   /// mass) once it has been touched for dwell_time [s] (> 0) in all. The
   /// rate: the ball's volume inside a tet body (its disc's area across a
   /// sheet) goes every dwell_time.
+  ///@{
   Result<TopologyEvent> cauterize(TetBodyId body, const std::array<double, 3>& centre, double radius,
                                   double seconds, double dwell_time);
   Result<TopologyEvent> cauterize(TriBodyId body, const std::array<double, 3>& centre, double radius,
                                   double seconds, double dwell_time);
+  ///@}
   /// What tore in the last step() (the bodies' tear_strain), one event per
   /// body that tore (none on a scene without topology changes).
   [[nodiscard]] const std::vector<TopologyEvent>& last_tears() const;
@@ -112,6 +119,7 @@ class Topology {
   /// The live triangles of `body`: its current surface, for a renderer.
   [[nodiscard]] Result<std::vector<std::array<std::uint32_t, 3>>> current_triangles(TriBodyId body) const;
 
+  /// A view of `sim` (Simulation::topology() makes one).
   explicit Topology(Simulation* sim) : sim_(sim) {}
 
  private:

@@ -97,9 +97,6 @@ class SphSolver {
     next_id_ = state.next_id;
   }
   [[nodiscard]] std::vector<FluidEmitter>& emitter_settings() { return emitters_desc_; }
-  /// Bytes step() reads back after its steps: the count, the state's five
-  /// words and the fastest speed.
-  static constexpr std::uint64_t kStepReadBytes = 28;
 
  private:
   explicit SphSolver(Device& device) : device_(device) {}

@@ -185,11 +185,9 @@ SceneFluid::State::~State() {
 
 Status SceneFluid::State::run_frame(bool add_to_host_forces) {
   pending = {};
-  read_back_bytes = 0;
   if (follow_.id != UINT32_MAX)
     if (Status s = device.run_program(follow_); !s) return s;
   Status stepped = solver->step(static_cast<int>(info.steps_per_frame));
-  read_back_bytes = SphSolver::kStepReadBytes;
   // What fits was made: the frame goes on, and the error waits for its end.
   if (!stepped && stepped.error().code() != ErrorCode::capacity_exceeded) return stepped;
   pending = stepped;

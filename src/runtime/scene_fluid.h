@@ -38,7 +38,6 @@ struct SceneFluid::State {
   std::unique_ptr<SphSolver> solver;
   SceneFluidInfo info;
   Status pending;  ///< a capacity error of this frame's steps, returned by step() when the frame is done
-  std::uint64_t read_back_bytes = 0;  ///< in the last frame
 
  private:
   explicit State(Device& d) : device(d) {}

@@ -36,13 +36,27 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 Simulation::~Simulation() = default;
 
 Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOptions& device_options) {
+  // The scene is checked before a device is made: a bad scene costs no driver start.
   auto compiled = compile_scene(scene);
   if (!compiled) return compiled.error();
   auto device = create_device(device_options);
   if (!device) return device.error();
+  return SimulationInternals::assemble(scene, *compiled, std::move(*device));
+}
 
+Result<Simulation> SimulationInternals::create(const SceneDesc& scene, std::unique_ptr<Device> device) {
+  if (!device) return Error(ErrorCode::bad_parameter, "Simulation::create: no device");
+  auto compiled = compile_scene(scene);
+  if (!compiled) return compiled.error();
+  return assemble(scene, *compiled, std::move(device));
+}
+
+Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, CompiledScene& compiled_scene,
+                                                 std::unique_ptr<Device> device) {
+  using Impl = Simulation::Impl;
+  CompiledScene* const compiled = &compiled_scene;  // as the Result it was
   auto impl = std::make_unique<Impl>();
-  impl->device = std::move(*device);
+  impl->device = std::move(device);
   static std::atomic<std::uint32_t> simulations{0};  // ids name their Simulation by this
   impl->serial = ++simulations;
   auto buffers = upload_scene(*impl->device, *compiled);
@@ -193,10 +207,13 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
 Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
   program = build_xpbd_program(compiled, buffers, solver, gravity, sweep_extras());
   append_stats(program, stats_plan, buffers);
-  if (prepared.id != UINT32_MAX)
-    if (Status s = device->destroy_program(prepared); !s) return s;
-  auto made = device->create_program(program);
+  auto made = device->create_program(program);  // made before the old one goes: a failure leaves it whole
   if (!made) return made.error();
+  if (prepared.id != UINT32_MAX)
+    if (Status s = device->destroy_program(prepared); !s) {
+      (void)device->destroy_program(*made);
+      return s;
+    }
   prepared = *made;
   info.dispatches_per_frame = static_cast<std::uint32_t>(program.dispatch_count());
   info.barriers_per_frame = static_cast<std::uint32_t>(program.barrier_count());
@@ -204,6 +221,15 @@ Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
 }
 
 Status Simulation::Impl::rebuild_program() {
+  // Not ready until rebuilt: after a failure (a device error) the next
+  // step() rebuilds before it runs anything.
+  program_ready = false;
+  if (Status s = rebuild_programs(); !s) return s;
+  program_ready = true;
+  return {};
+}
+
+Status Simulation::Impl::rebuild_programs() {
   stats_plan.in_use.clear();  // the residuals' RMS divides by the constraints in use
   for (const ConstraintBlock& block : program_shape.blocks) stats_plan.in_use.push_back(block.in_use());
   if (!stepper) return prepare_program(program_shape);
@@ -224,24 +250,39 @@ void Simulation::Impl::add_stage(std::unique_ptr<FrameStage> stage) {
 Status Simulation::step() {
   Impl& im = *impl_;
   const auto start = std::chrono::steady_clock::now();
+  if (!im.program_ready)  // a rebuild failed (topology change, contacts that grew)
+    if (Status s = im.rebuild_program(); !s) return s;
   FrameContext frame{*im.device, im.stats, {}};
   for (StageProfile& p : im.stats.stages) p.ms = 0.0;
   im.positions_mirror.begin_frame();
+  // The device counts what the host reads and how often it waits; each
+  // stage is given what its own hooks did.
+  const HostTransfers& device = im.device->transfers();
+  const HostTransfers frame_start = device;
+  im.stage_transfers.assign(im.stages.size(), {});
   using Hook = Status (FrameStage::*)(FrameContext&);
   im.stepping = true;
   for (Hook hook : {&FrameStage::before_frame, &FrameStage::solve, &FrameStage::after_solve, &FrameStage::after_frame})
     for (std::size_t i = 0; i < im.stages.size(); ++i) {
       const auto t0 = std::chrono::steady_clock::now();
+      const HostTransfers before = device;
       if (Status s = (im.stages[i].get()->*hook)(frame); !s) {
         im.stepping = false;
         return im.after_failed_frame(s.error());
       }
       im.stats.stages[i].ms += ms_since(t0);
+      im.stage_transfers[i].read_bytes += device.read_bytes - before.read_bytes;
+      im.stage_transfers[i].waits += device.waits - before.waits;
     }
   im.stepping = false;
-  im.stats.read_back_bytes = im.positions_mirror.bytes();
-  for (const auto& stage : im.stages) im.stats.read_back_bytes += stage->read_back_bytes();
-  for (std::size_t i = 0; i < im.stages.size(); ++i) im.stages[i]->report(im.stats.stages[i]);
+  for (std::size_t i = 0; i < im.stages.size(); ++i) {
+    im.stages[i]->report(im.stats.stages[i]);
+    im.stats.stages[i].set("read_bytes", static_cast<double>(im.stage_transfers[i].read_bytes));
+    im.stats.stages[i].set("host_waits", static_cast<double>(im.stage_transfers[i].waits));
+  }
+  im.stats.read_back_bytes = device.read_bytes - frame_start.read_bytes;
+  im.stats.host_reads = static_cast<std::uint32_t>(device.reads - frame_start.reads);
+  im.stats.host_waits = static_cast<std::uint32_t>(device.waits - frame_start.waits);
   im.stats.position_reads = im.positions_mirror.reads();
   const auto end = std::chrono::steady_clock::now();
   im.stats.frame += 1;

@@ -36,6 +36,7 @@ struct Simulation::Impl {
   // registered in Simulation::create); stats.stages holds their profiles
   // in the same order.
   std::vector<std::unique_ptr<FrameStage>> stages;
+  std::vector<HostTransfers> stage_transfers;  // this frame's, per stage (step())
   void add_stage(std::unique_ptr<FrameStage> stage);
   // The positions as read back for the stages that need them on the host
   // (runtime/positions_mirror.h): at most once between two changes.
@@ -104,16 +105,17 @@ struct Simulation::Impl {
   /// Builds the fixed-mode frame program (solve + statistics) and prepares it on the device.
   Status prepare_program(const CompiledScene& compiled);
   /// Builds the frame's program(s) again from program_shape: after the mesh
-  /// contacts outgrew theirs, or a topology change.
+  /// contacts outgrew theirs, or a topology change. On an error the
+  /// programs are not ready, and the next step() tries again.
   Status rebuild_program();
+  Status rebuild_programs();  // rebuild_program's work
+  bool program_ready = true;
 
   // With topology changes and mesh collision: the scene's bodies as the
   // collision sees them (each tet body's live tets), to make the mesh
-  // collision again after a change (null otherwise).
+  // collision again after a change (null otherwise; the mesh collision
+  // stage's topology_changed).
   std::unique_ptr<SceneDesc> collision_scene;
-  /// After a topology change: the mesh collision (and continuous collision)
-  /// made again from the live tets.
-  Status remake_collision();
   // SceneDesc::graspers (null without).
   std::unique_ptr<GrasperHolds> graspers;
   // SceneDesc::topology_changes: the host copy of the constraints that
@@ -132,8 +134,9 @@ struct Simulation::Impl {
   /// are the tet bodies' live boundaries and rest_volume the live tets',
   /// so FrameStats::volume_change measures what is left.
   Status refresh_volume(const TopologyEvent& event);
-  /// After the editor changed something: the mesh collision made again,
-  /// the program rebuilt, the event's times filled in.
+  /// After the editor changed something: every stage's topology_changed
+  /// (the mesh collision made again, ...), the program rebuilt, the event's
+  /// times filled in.
   Result<TopologyEvent> finish_change(Result<TopologyEvent> event, bool changed,
                                                   std::chrono::steady_clock::time_point start);
 

@@ -13,7 +13,14 @@
 
 namespace sinew {
 
+struct CompiledScene;
+
 struct SimulationInternals {
+  /// A Simulation of `scene` on a device the caller made (a test's device
+  /// wrapper that injects faults: tests/faulty_device.h).
+  static Result<Simulation> create(const SceneDesc& scene, std::unique_ptr<Device> device);
+  /// Simulation::create's work once the scene is compiled and the device made.
+  static Result<Simulation> assemble(const SceneDesc& scene, CompiledScene& compiled, std::unique_ptr<Device> device);
   static const Device& device(const Simulation& sim);
   static const FrameProgram& program(const Simulation& sim);
   static double frame_length(const Simulation& sim);  ///< SolverSettings::time_step [s]

@@ -51,13 +51,11 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
   if (changed) ++shape_generation;  // a saved state does not hold the topology (simulation_state.cpp)
-  if (changed) positions_mirror.changed();  // a removal hands mass on: the positions' w
-  if (changed && graspers) graspers->invalidate();
-  if (changed && measure_errors && event->body_kind == BodyKind::tet)
-    if (Status s = refresh_volume(*event); !s) return s.error();
-  if (changed && collision_scene)
-    if (Status s = remake_collision(); !s) return s.error();
   if (changed) {
+    positions_mirror.changed();  // a removal hands mass on: the positions' w
+    TopologyChange change{*event};
+    for (const auto& stage : stages)  // each feature follows (FrameStage::topology_changed)
+      if (Status s = stage->topology_changed(*device, change); !s) return s.error();
     const auto rebuild = std::chrono::steady_clock::now();
     if (Status s = rebuild_program(); !s) return s.error();
     event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
@@ -98,33 +96,6 @@ Status Simulation::Impl::refresh_volume(const TopologyEvent& event) {
                               2 * static_cast<std::uint32_t>(faces.size()), stats_plan.tet_list);
   if (!plan) return plan.error();
   stats_plan = std::move(*plan);
-  return {};
-}
-
-Status Simulation::Impl::remake_collision() {
-  for (std::size_t b = 0; b < topology->sheets(); ++b)  // each tri body's live triangles
-    collision_scene->tri_bodies[b].mesh.triangles = topology->live_triangles(b);
-  for (std::size_t b = 0; b < topology->line_bodies(); ++b) {  // and each line body's whole segments
-    auto& segments = collision_scene->line_bodies[b].segments;
-    segments.clear();
-    for (std::size_t s = 0; s < topology->whole(b).size(); ++s)
-      if (topology->whole(b)[s]) segments.push_back(topology->line(b).segments[s]);
-  }
-  // The collision surface follows in place: each tet body's boundary from
-  // the tets that died, the tri and line bodies that changed replaced (a
-  // whole remake took 20 ms on a 50,400-tet block; MeshCollision::update_topology).
-  std::vector<const std::vector<std::uint8_t>*> alive;
-  for (std::size_t b = 0; b < topology->bodies(); ++b) alive.push_back(&topology->alive(b));
-  bool changed = false;
-  if (Status s = mesh_collision->update_topology(*device, *collision_scene, alive, changed); !s) return s;
-  if (continuous && changed)
-    continuous = std::make_unique<ContinuousCollision>(mesh_collision->segments(), mesh_collision->triangles(),
-                                                       *mesh_collision, buffers, collision_scene->mesh_collision,
-                                                       collision_scene->solver.substeps);
-  if (sutures) {
-    mesh_collision->set_suture_exemption(sutures->exemption());
-    if (continuous) continuous->set_suture_exemption(sutures->exemption());
-  }
   return {};
 }
 

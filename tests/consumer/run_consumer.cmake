@@ -5,7 +5,9 @@
 #  install:      cmake --install BUILD_DIR --prefix PREFIX (a fresh PREFIX)
 #  find_package: configure, build and run this folder's project against PREFIX
 #                (no build type, or Debug: unoptimised, to compile fast, and
-#                a configuration the installed Release library must serve)
+#                a configuration the installed Release library must serve);
+#                with -DPROJECT_DIR=... -DPROGRAM=..., another project built
+#                and run the same way (docs/tutorial: Tutorial.FirstScene)
 #  pkg_config:   compile and run main.cpp with the flags of
 #                `pkg-config --cflags --libs [--static] sinew` (--static
 #                for a static libsinew); skipped
@@ -25,9 +27,13 @@ if(STEP STREQUAL "install")
   run("install" ${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${PREFIX}" --config "${CONFIG}")
 
 elseif(STEP STREQUAL "find_package")
-  set(build "${WORK_DIR}/find_package")
+  if(NOT PROJECT_DIR)
+    set(PROJECT_DIR "${CMAKE_CURRENT_LIST_DIR}")
+    set(PROGRAM consumer)
+  endif()
+  set(build "${WORK_DIR}/find_package_${PROGRAM}")
   file(REMOVE_RECURSE "${build}")
-  run("configure" ${CMAKE_COMMAND} -S "${CMAKE_CURRENT_LIST_DIR}" -B "${build}" -G "${GENERATOR}"
+  run("configure" ${CMAKE_COMMAND} -S "${PROJECT_DIR}" -B "${build}" -G "${GENERATOR}"
       "-DCMAKE_CXX_COMPILER=${CXX}" "-DCMAKE_PREFIX_PATH=${PREFIX}" -DCMAKE_BUILD_TYPE=)
   # The package found must be the one just installed, not another sinew.
   file(STRINGS "${build}/CMakeCache.txt" found REGEX "^sinew_DIR:")
@@ -36,8 +42,8 @@ elseif(STEP STREQUAL "find_package")
     message(FATAL_ERROR "consumer: found ${found}, not the package under ${PREFIX}")
   endif()
   run("build" ${CMAKE_COMMAND} --build "${build}" --config Debug)
-  find_program(consumer consumer PATHS "${build}" "${build}/Debug" NO_DEFAULT_PATH REQUIRED)
-  run("run" "${consumer}")
+  find_program(program ${PROGRAM} PATHS "${build}" "${build}/Debug" NO_DEFAULT_PATH REQUIRED NO_CACHE)
+  run("run" "${program}")
 
 elseif(STEP STREQUAL "pkg_config")
   find_program(pkg_config NAMES pkg-config pkgconf)

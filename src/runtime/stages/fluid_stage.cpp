@@ -21,7 +21,6 @@ class FluidStage final : public FrameStage {
     profile.set("particles", sim_.fluid->solver->stats().particles);
     profile.set("steps", sim_.fluid->info.steps_per_frame);
   }
-  std::uint64_t read_back_bytes() const override { return sim_.fluid->read_back_bytes; }
 
  private:
   Simulation::Impl& sim_;

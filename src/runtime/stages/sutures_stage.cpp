@@ -31,9 +31,14 @@ class SuturesStage final : public FrameStage {
     return {};
   }
 
+  // A thread runs through its punctures: the remade contacts may not push it out there.
+  Status topology_changed(Device&, TopologyChange&) override {
+    if (sim_.mesh_collision && sim_.collision_scene) sim_.mesh_collision->set_suture_exemption(sim_.sutures->exemption());
+    return {};
+  }
+
   void report(StageProfile& profile) const override { profile.set("host_ms", host_ms_); }
 
-  std::uint64_t read_back_bytes() const override { return sim_.sutures->read_back_bytes(); }
 
  private:
   Simulation::Impl& sim_;
