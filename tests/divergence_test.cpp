@@ -5,9 +5,11 @@
 // as the host counts them; a Neo-Hookean block past its Courant limit is
 // found; each policy does what it says: report (and log), stop with
 // ErrorCode::diverged, roll back bitwise to the last good frame (also after
-// a frame that failed half-way, and keeping a topology change made before).
+// a frame that failed half-way, a stage's error or the device's, and keeping
+// a topology change made before).
 #include <limits>
 
+#include "faulty_device.h"
 #include "robustness_scenes.h"
 #include "runtime/simulation_internals.h"
 #include "sinew/log.h"
@@ -202,6 +204,38 @@ TEST_P(DivergenceTest, FailedFrameRollsBackAndTheSceneGoesOn) {
   ASSERT_EQ(warnings_.size(), 1u);
   test::run(*sim, 5, 6);  // usable: the frames the failure interrupted, as if it never happened
   EXPECT_TRUE(same_bits(snapshot(*sim), expected[6])) << "on " << GetParam();
+}
+
+TEST_P(DivergenceTest, InjectedDeviceFaultsRollBackBitwise) {
+  // The device itself fails in the middle of frame 5 (tests/faulty_device.h):
+  // a submission, a wait or a read-back. Each time the scene goes back to
+  // frame 4 and continues as the run that never failed.
+  const SceneDesc scene = test::robustness_block();
+  const std::vector<test::Snapshot> expected = uninterrupted(scene, GetParam(), 6);
+  ASSERT_EQ(expected.size(), 7u);
+  using Call = test::FaultyDevice::Call;
+  for (Call call : {Call::submit, Call::wait, Call::read_buffer}) {
+    SCOPED_TRACE(test::FaultyDevice::name(call));
+    auto real = create_device({.backend = GetParam(), .quiet = true});
+    ASSERT_TRUE(real.ok()) << real.error().message();
+    auto faulty = std::make_unique<test::FaultyDevice>(std::move(*real));
+    test::FaultyDevice& device = *faulty;
+    auto sim = SimulationInternals::create(scene, std::move(faulty));
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
+    SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::roll_back}));
+    capture_log();
+    test::run(*sim, 1, 4);
+    drive(*sim, 5);
+    device.arm(call, 1);
+    const Status failed = sim->step();
+    ASSERT_TRUE(device.fired());
+    ASSERT_FALSE(failed.ok());
+    EXPECT_NE(failed.error().message().find(test::FaultyDevice::tag()), std::string::npos) << failed.error().message();
+    EXPECT_NE(failed.error().message().find("rolled back to frame 4"), std::string::npos) << failed.error().message();
+    EXPECT_TRUE(same_bits(snapshot(*sim), expected[4])) << "on " << GetParam();
+    test::run(*sim, 5, 6);
+    EXPECT_TRUE(same_bits(snapshot(*sim), expected[6])) << "on " << GetParam();
+  }
 }
 
 TEST_P(DivergenceTest, RollBackAfterATopologyChangeKeepsTheChange) {
