@@ -65,6 +65,7 @@
   SINEW_KERNEL(stats_kinetic_energy, 3, StatsParams, 0)                          \
   SINEW_KERNEL(stats_surface_volume, 3, StatsParams, 0)                          \
   SINEW_KERNEL(stats_tool_terms, 2, StatsParams, 0)                              \
+  SINEW_KERNEL(stats_inverted_tets, 3, StatsParams, 0)                           \
   SINEW_KERNEL(reduce_dd_blocks, 3, ReduceDdParams, 256)                         \
   /* the sweeps' accelerators (kernels/shared/accelerator_params.h) */           \
   SINEW_KERNEL(xpbd_chebyshev, 3, ChebyshevParams, 0)                            \

@@ -1,6 +1,7 @@
 // fluid_cup.h — the tissue cup the fluid coupling tests pour fluid into:
 // 8 x 5 x 8 cells of 1 mm with its inside [1, 7] x [1, 5] x [1, 7] mm taken
-// out (walls and floor one cell thick), and blocks of fluid particles.
+// out (walls and floor one cell thick), blocks of fluid particles, and a
+// scene of fluid poured into the cup.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -50,6 +51,27 @@ inline std::vector<std::array<double, 3>> fluid_block(int nx, int ny, int nz, st
       for (int k = 0; k < nz; ++k)
         out.push_back({lo[0] + (i + 0.5) * kCupCell, lo[1] + (j + 0.5) * kCupCell, lo[2] + (k + 0.5) * kCupCell});
   return out;
+}
+
+// The cup (pinned at its base or free) with fluid poured in, coupled
+// through its whole boundary surface.
+inline SceneDesc cup_scene(bool pinned, std::array<double, 3> gravity, std::vector<std::array<double, 3>> fluid,
+                           std::array<double, 3> velocity = {}) {
+  SceneDesc scene;
+  TetBodyDesc body = fluid_cup_body(pinned);
+  scene.tet_bodies.push_back(std::move(body));
+  scene.gravity = gravity;
+  scene.solver.time_step = 1e-3;
+  scene.solver.substeps = 4;
+  scene.solver.iterations = 10;
+  SceneFluidDesc f;
+  f.fluid.settings.spacing = kCupCell;
+  f.fluid.settings.gravity = gravity;
+  f.fluid.velocities.assign(fluid.size(), velocity);
+  f.fluid.particles = std::move(fluid);
+  f.surfaces.push_back({.body_kind = BodyKind::tet, .body = 0, .triangles = {}});
+  scene.fluid = std::move(f);
+  return scene;
 }
 
 }  // namespace sinew::test

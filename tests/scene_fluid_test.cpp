@@ -24,27 +24,6 @@ namespace {
 constexpr double kS = kCupCell;
 
 
-// The cup (pinned at its base or free) with fluid poured in, coupled
-// through its whole boundary surface.
-SceneDesc cup_scene(bool pinned, std::array<double, 3> gravity, std::vector<std::array<double, 3>> fluid,
-                    std::array<double, 3> velocity = {}) {
-  SceneDesc scene;
-  TetBodyDesc body = fluid_cup_body(pinned);
-  scene.tet_bodies.push_back(std::move(body));
-  scene.gravity = gravity;
-  scene.solver.time_step = 1e-3;
-  scene.solver.substeps = 4;
-  scene.solver.iterations = 10;
-  SceneFluidDesc f;
-  f.fluid.settings.spacing = kS;
-  f.fluid.settings.gravity = gravity;
-  f.fluid.velocities.assign(fluid.size(), velocity);
-  f.fluid.particles = std::move(fluid);
-  f.surfaces.push_back({.body_kind = BodyKind::tet, .body = 0, .triangles = {}});
-  scene.fluid = std::move(f);
-  return scene;
-}
-
 TEST(SceneFluid, ACupHoldsTheFluidAndCarriesItsWeight) {
   // 5 x 3 x 5 particles poured into a cup pinned at its base, 0.3 s: none
   // leaves the cavity, and once settled the fluid's push on the tissue over

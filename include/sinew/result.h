@@ -22,6 +22,7 @@ enum class ErrorCode {
   out_of_memory,        ///< host or device memory ran out
   capacity_exceeded,    ///< data-dependent work outgrew a declared capacity (results were kept within it)
   internal,             ///< a bug in sinew, or a device failure with no better description
+  diverged,             ///< a frame diverged and DivergenceSettings::on_divergence is stop (sinew/divergence.h)
 };
 
 /// The code's name, e.g. "capacity_exceeded".
@@ -34,6 +35,7 @@ constexpr const char* error_code_name(ErrorCode code) {
     case ErrorCode::out_of_memory: return "out_of_memory";
     case ErrorCode::capacity_exceeded: return "capacity_exceeded";
     case ErrorCode::internal: return "internal";
+    case ErrorCode::diverged: return "diverged";
   }
   return "unknown";
 }

@@ -17,10 +17,12 @@
 #include <vector>
 
 #include "sinew/device.h"
+#include "sinew/divergence.h"
 #include "sinew/scene.h"
 #include "sinew/graspers.h"
 #include "sinew/ids.h"
 #include "sinew/needles.h"
+#include "sinew/saved_state.h"
 #include "sinew/scene_fluid.h"
 #include "sinew/tools.h"
 #include "sinew/topology.h"
@@ -125,6 +127,10 @@ struct FrameStats {
   /// (remove_tets, cuts, tears, cautery) the live tets' boundaries and rest
   /// volume.
   double volume_change = 0.0;
+  /// Tets whose signed volume is negative at the frame's end (turned inside
+  /// out), over the tet bodies' live tets; reduced on the device with the
+  /// errors (0 with measure_errors off).
+  std::uint32_t inverted_tets = 0;
   /// Gauss-Seidel sweeps (iterations) run in the last frame, over all its substeps.
   std::uint64_t sweeps = 0;
   /// How the sweeps ended; in residual mode the worst substep's reason
@@ -175,6 +181,9 @@ struct FrameStats {
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;
+  /// The divergence checks' verdict on the last frame and what the policy
+  /// did (sinew/divergence.h; Simulation::set_divergence_settings).
+  DivergenceReport divergence;
   /// The frame's stages in the order they run, each with its wall time in
   /// the last step() (their sum is within wall_ms).
   std::vector<StageProfile> stages;
@@ -202,8 +211,37 @@ class Simulation {
   ///@}
   ~Simulation();
 
-  /// Advances one frame (SolverSettings::time_step).
+  /// Advances one frame (SolverSettings::time_step), then checks it for
+  /// divergence (sinew/divergence.h): with OnDivergence::stop a diverged
+  /// frame returns ErrorCode::diverged, with roll_back the scene goes back
+  /// to the last good frame.
   Status step();
+
+  /// [in] settings: the divergence checks' bounds and policy, from the next
+  /// step() on. With OnDivergence::roll_back the current state is saved at
+  /// once (the first frame to roll back to). Errors (bad_parameter, nothing
+  /// changed): energy_growth not > 1, floor_speed < 0, max_volume_change
+  /// not > 0 or checkpoint_every 0 (each named), a scene save_state refuses.
+  Status set_divergence_settings(const DivergenceSettings& settings);
+  [[nodiscard]] const DivergenceSettings& divergence_settings() const;
+
+  /// [out] out: the state after the last frame (sinew/saved_state.h), its
+  /// bytes replaced (their capacity reused: saving every frame allocates
+  /// nothing after the first). Reads the particles' buffers and multipliers
+  /// back from the device (and a fluid's particles and grid). Errors: a scene with what a state
+  /// cannot hold yet (needles, a closed grasper; bad_parameter naming it), a device error.
+  Status save_state(SavedState& out);
+  /// [in] state: from save_state of this scene (this Simulation, or one made
+  /// from the same SceneDesc); the next step() continues from it bitwise as
+  /// the run it was saved from. Errors, leaving the Simulation unchanged:
+  /// bad_input_file for a damaged or foreign state (sinew/saved_state.h),
+  /// bad_parameter for another scene's state (naming what differs) or one
+  /// saved before or after a topology change or level-set cut.
+  Status restore_state(const SavedState& state);
+  /// save_state to a file [in] path (replaced). Errors as save_state's and SavedState::write_file's.
+  Status save_state(const std::string& path);
+  /// restore_state from a file [in] path. Errors as restore_state's and SavedState::read_file's.
+  Status restore_state(const std::string& path);
 
   /// [out] xyzw per particle: position [m] and inverse mass [1/kg] in w.
   Status read_positions(std::vector<float>& xyzw) const;

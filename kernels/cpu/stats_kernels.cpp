@@ -29,6 +29,19 @@ dd difference(float b, float a) { return two_sum(b, -a); }
 
 dd dd_sub(dd a, dd b) { return dd_add(a, dd_neg(b)); }
 
+// dot(a - r, cross(b - r, c - r)), six times the signed volume of the tet
+// (r, a, b, c), from exact differences (the difference of two floats is
+// exact as a pair).
+dd six_volume(float4 a, float4 b, float4 c, float4 r) {
+  const dd e1[3] = {difference(a.x, r.x), difference(a.y, r.y), difference(a.z, r.z)};
+  const dd e2[3] = {difference(b.x, r.x), difference(b.y, r.y), difference(b.z, r.z)};
+  const dd e3[3] = {difference(c.x, r.x), difference(c.y, r.y), difference(c.z, r.z)};
+  const dd n[3] = {dd_sub(dd_mul(e2[1], e3[2]), dd_mul(e2[2], e3[1])),
+                   dd_sub(dd_mul(e2[2], e3[0]), dd_mul(e2[0], e3[2])),
+                   dd_sub(dd_mul(e2[0], e3[1]), dd_mul(e2[1], e3[0]))};
+  return dd_add(dd_add(dd_mul(e1[0], n[0]), dd_mul(e1[1], n[1])), dd_mul(e1[2], n[2]));
+}
+
 }  // namespace
 
 void stats_kinetic_energy(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
@@ -54,14 +67,18 @@ void stats_surface_volume(const void* params, std::byte* const* bindings, std::u
   const auto* faces = reinterpret_cast<const uint4*>(bindings[1]);
   auto* terms = reinterpret_cast<float*>(bindings[2]);
   for (std::uint32_t i = begin; i < end && i < p.count; ++i) {
-    const float4 a = x[faces[i].x], b = x[faces[i].y], c = x[faces[i].z], r = x[faces[i].w];
-    const dd e1[3] = {difference(a.x, r.x), difference(a.y, r.y), difference(a.z, r.z)};
-    const dd e2[3] = {difference(b.x, r.x), difference(b.y, r.y), difference(b.z, r.z)};
-    const dd e3[3] = {difference(c.x, r.x), difference(c.y, r.y), difference(c.z, r.z)};
-    const dd n[3] = {dd_sub(dd_mul(e2[1], e3[2]), dd_mul(e2[2], e3[1])),
-                     dd_sub(dd_mul(e2[2], e3[0]), dd_mul(e2[0], e3[2])),
-                     dd_sub(dd_mul(e2[0], e3[1]), dd_mul(e2[1], e3[0]))};
-    store(terms, i, dd_add(dd_add(dd_mul(e1[0], n[0]), dd_mul(e1[1], n[1])), dd_mul(e1[2], n[2])));
+    store(terms, i, six_volume(x[faces[i].x], x[faces[i].y], x[faces[i].z], x[faces[i].w]));
+  }
+}
+
+void stats_inverted_tets(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const StatsParams*>(params);
+  const auto* x = reinterpret_cast<const float4*>(bindings[0]);
+  const auto* tets = reinterpret_cast<const uint4*>(bindings[1]);
+  auto* flags = reinterpret_cast<std::uint32_t*>(bindings[2]);
+  for (std::uint32_t i = begin; i < end && i < p.count; ++i) {
+    const dd six_v = six_volume(x[tets[i].y], x[tets[i].z], x[tets[i].w], x[tets[i].x]);
+    flags[i] = six_v.hi < 0.0f ? 1u : 0u;
   }
 }
 

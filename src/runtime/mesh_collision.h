@@ -106,6 +106,10 @@ class MeshCollision {
   /// [in] mask: per particle, what sutures exempt (suture_exemption.h);
   /// outlives this, read every frame.
   void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }
+  /// The device's positions and velocities changed outside the frames
+  /// (Simulation::restore_state): the next frame reads them again instead
+  /// of using those the last after_frame read.
+  void positions_changed() { fresh_ = false; }
   /// Reads the positions through the frame's shared mirror (null: on its own).
   void set_positions_mirror(PositionsMirror* mirror) { mirror_ = mirror; }
   /// Particles of the scene (device order).

@@ -27,6 +27,7 @@ void Simulation::Impl::measure(FrameStats& out) const {
   out.max_residual = d.residual_max;
   out.kinetic_energy = d.kinetic_energy;
   out.volume_change = rest_volume > 0.0 ? d.volume / rest_volume - 1.0 : 0.0;
+  out.inverted_tets = d.inverted_tets;
 }
 
 Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -75,15 +76,25 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
   // Every tet body's boundary (wound outward) with one particle of the body
   // as the reference point: its volume on the device (stats_surface_volume).
   std::vector<std::array<std::uint32_t, 4>> faces;
+  // Every tet, wound with a positive rest volume: the inverted tets' count
+  // (stats_inverted_tets; FrameStats::inverted_tets).
+  std::vector<std::array<std::uint32_t, 4>> tets;
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
     const TetMesh& mesh = scene.tet_bodies[b].mesh;
     const std::uint32_t first = compiled->tet_body_first_particle[b];
+    impl->stats_tet_first.push_back(static_cast<std::uint32_t>(tets.size()));
     for (const auto& t : mesh.tets) {
       const auto at = [&](int k) {
         const Vec3d& p = mesh.vertices[t[k]];
         return kernels::double4{p[0], p[1], p[2], 0.0};
       };
-      impl->rest_volume += kernels::tet_volume(at(0), at(1), at(2), at(3));
+      const double volume = kernels::tet_volume(at(0), at(1), at(2), at(3));
+      impl->rest_volume += volume;
+      if (!impl->measure_errors) continue;
+      std::array<std::uint32_t, 4> d;
+      for (int k = 0; k < 4; ++k) d[k] = compiled->order.device_of[first + t[k]];
+      if (volume < 0.0) std::swap(d[2], d[3]);
+      tets.push_back(d);
     }
     if (!impl->measure_errors) continue;
     const TriMesh boundary = extract_boundary_surface(mesh);
@@ -96,7 +107,8 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
   // (refresh_volume writes them without making the plan again).
   auto plan = make_stats_plan(*impl->device, *compiled, faces, impl->measure_errors,
                               static_cast<std::uint32_t>(impl->contacts.tools.size()),
-                              scene.topology_changes ? 2 * static_cast<std::uint32_t>(faces.size()) : 0u);
+                              scene.topology_changes ? 2 * static_cast<std::uint32_t>(faces.size()) : 0u,
+                              std::move(tets));
   if (!plan) return plan.error();
   impl->stats_plan = std::move(*plan);
   impl->solver = scene.solver;
@@ -166,6 +178,8 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
   im.add_stage(make_solve_stage(im));
   im.add_stage(make_statistics_stage(im));
   if (im.topology && im.topology->tears()) im.add_stage(make_tearing_stage(im));
+
+  impl->init_state_buffers(*compiled);
 
   SceneInfo& info = impl->info;
   info.particles = static_cast<std::uint32_t>(compiled->positions.size());
@@ -247,15 +261,20 @@ Status Simulation::step() {
   const HostTransfers frame_start = device;
   im.stage_transfers.assign(im.stages.size(), {});
   using Hook = Status (FrameStage::*)(FrameContext&);
+  im.stepping = true;
   for (Hook hook : {&FrameStage::before_frame, &FrameStage::solve, &FrameStage::after_solve, &FrameStage::after_frame})
     for (std::size_t i = 0; i < im.stages.size(); ++i) {
       const auto t0 = std::chrono::steady_clock::now();
       const HostTransfers before = device;
-      if (Status s = (im.stages[i].get()->*hook)(frame); !s) return s;
+      if (Status s = (im.stages[i].get()->*hook)(frame); !s) {
+        im.stepping = false;
+        return im.after_failed_frame(s.error());
+      }
       im.stats.stages[i].ms += ms_since(t0);
       im.stage_transfers[i].read_bytes += device.read_bytes - before.read_bytes;
       im.stage_transfers[i].waits += device.waits - before.waits;
     }
+  im.stepping = false;
   for (std::size_t i = 0; i < im.stages.size(); ++i) {
     im.stages[i]->report(im.stats.stages[i]);
     im.stats.stages[i].set("read_bytes", static_cast<double>(im.stage_transfers[i].read_bytes));
@@ -269,6 +288,7 @@ Status Simulation::step() {
   im.stats.frame += 1;
   im.stats.time = static_cast<double>(im.stats.frame) * im.time_step;
   im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
+  if (Status s = im.check_divergence(); !s) return s;
   return frame.deferred;
 }
 
@@ -286,7 +306,9 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
                                                " particles, so it needs " + std::to_string(3 * n) +
                                                " (x, y, z per particle)");
   // Checked and staged before anything is uploaded: on an error the forces
-  // set before stay.
+  // set before stay. force_energy: sum |f|^2 / (2 m), the divergence
+  // check's bound on the energy they add (sinew/divergence.h).
+  double force_energy = 0.0;
   for (std::size_t u = 0; u < n; ++u) {
     const float* f = &xyz[3 * u];
     if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2])) {
@@ -312,6 +334,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
       }
     }
     im.force_scratch[slot] = kernels::float4{f[0], f[1], f[2], 0.0f};
+    if (w > 0.0f) force_energy += (double(f[0]) * f[0] + double(f[1]) * f[1] + double(f[2]) * f[2]) * w / 2.0;
   }
   if (n == 0) return {};
   if (Status s = im.device->write_buffer(im.buffers.external_force, 0, im.force_scratch.data(),
@@ -320,6 +343,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
     return s;
   im.forces_for_next_frame = true;
   im.forces_on_device = true;
+  im.history.next_force_speed = im.time_step * std::sqrt(force_energy);
   return {};
 }
 
@@ -331,6 +355,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
 Status Simulation::Impl::begin_frame_forces() {
   const bool stale = forces_on_device && !forces_for_next_frame;
   host_forces_this_frame = forces_for_next_frame;
+  history.force_speed = forces_for_next_frame ? history.next_force_speed : 0.0;
   forces_for_next_frame = false;  // this frame consumes them
   if (!stale) return {};
   std::fill(force_scratch.begin(), force_scratch.end(), kernels::float4{0.0f, 0.0f, 0.0f, 0.0f});
@@ -409,5 +434,6 @@ double SimulationInternals::frame_length(const Simulation& sim) { return sim.imp
 void SimulationInternals::add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage) {
   sim.impl_->add_stage(std::move(stage));
 }
+BufferHandle SimulationInternals::velocity_buffer(const Simulation& sim) { return sim.impl_->buffers.velocity; }
 
 }  // namespace sinew

@@ -363,6 +363,7 @@ Result<CutReport> Simulation::cut_collider(std::size_t index, const CutterShape&
   // grids buffer, before the next frame reads them.
   const std::span<const std::byte> bytes = collider.level_set->nanovdb_bytes();
   const std::uint64_t base = c.level_set_offsets[index];
+  if (!report->changed_bytes.empty()) ++impl_->shape_generation;  // a saved state does not hold the grids
   for (const auto& [offset, size] : report->changed_bytes)
     if (Status s = impl_->device->write_buffer(impl_->buffers.level_set_grids, base + offset, bytes.data() + offset,
                                                size);

@@ -22,6 +22,8 @@
 #include "runtime/sutures.h"
 #include "runtime/topology_editor.h"
 #include "runtime/scene_fluid.h"
+#include "sinew/divergence.h"
+#include "sinew/saved_state.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
@@ -61,6 +63,7 @@ struct Simulation::Impl {
   // The errors and the tools' reaction, reduced on the device at the end of
   // each frame (stats_program.h) and read back as a few words.
   StatsPlan stats_plan;
+  std::vector<std::uint32_t> stats_tet_first;  ///< per tet body, its first tet in stats_plan.tet_list
   DeviceStats device_stats;
 
   void measure(FrameStats& stats) const;
@@ -155,6 +158,48 @@ struct Simulation::Impl {
   /// continuous collision detection (after before_frame).
   [[nodiscard]] std::vector<FrameCapsule> frame_capsules() const;
   Status after_frame();   ///< settles what moved, takes each tool's reaction from device_stats
+
+  // ---- Saved state and divergence (simulation_state.cpp, divergence_check.cpp).
+  /// Changes of the scene's shape a saved state does not hold: topology
+  /// changes (finish_change) and level-set cuts (cut_collider). A state
+  /// restores only at the generation it was saved at.
+  std::uint64_t shape_generation = 0;
+  /// The device buffers whose contents carry from one frame to the next,
+  /// with their sizes (set in create; save_state reads them in this order).
+  struct StateBuffer {
+    BufferHandle buffer;
+    std::size_t bytes = 0;
+    const char* name = "";
+  };
+  std::vector<StateBuffer> state_buffers;
+  /// state_buffers and the fluid's (sph_solver.h), in the order a state holds them.
+  [[nodiscard]] std::vector<StateBuffer> saved_buffers() const;
+  /// Fills state_buffers and the divergence checks' scene figures (history) from the compiled scene.
+  void init_state_buffers(const CompiledScene& compiled);
+  Status save_state(SavedState& out, const char* call);
+  Status restore_state(const SavedState& state, const std::string& what);
+
+  DivergenceSettings divergence;
+  /// What the checks keep between frames: the last frame's kinetic energy,
+  /// the scene's movable mass and starting extent, the force term of the
+  /// energy bound for the coming frame (set_particle_forces) and the frame being run.
+  struct DivergenceHistory {
+    double last_energy = 0.0;       ///< [J]
+    double movable_mass = 0.0;      ///< [kg]
+    double extent = 0.0;            ///< the starting positions' bounding-box diagonal [m]
+    double next_force_speed = 0.0;  ///< sqrt(sum dt^2 |f|^2 / (2 m)) of the forces set for the coming frame [sqrt(J)]
+    double force_speed = 0.0;       ///< the same for the frame being run
+  } history;
+  SavedState last_good;  ///< OnDivergence::roll_back: the last good frame's state
+  bool checkpoint_failed = false;
+  bool stepping = false;  ///< inside step()'s stages (a topology change there is a tear)
+  /// Saves last_good (OnDivergence::roll_back): after a good frame, and after a topology change between frames.
+  void checkpoint();
+  /// After a frame: the checks, the log and the policy (divergence_check.cpp).
+  Status check_divergence();
+  /// A frame a stage failed (a device error): with OnDivergence::roll_back
+  /// the scene goes back to the last good frame; the error is returned either way.
+  Status after_failed_frame(const Error& error);
 };
 
 

@@ -27,6 +27,9 @@ struct SimulationInternals {
   /// Appends a stage to the frame: in every phase it runs after the
   /// scene's own, and FrameStats::stages gains its profile.
   static void add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage);
+  /// The particles' velocity buffer (float4 per particle, device order): a
+  /// test stage breaks a frame through it (the divergence tests).
+  static BufferHandle velocity_buffer(const Simulation& sim);
   /// The colouring checker (scenes with topology_changes): every block's
   /// colours in use, read back from the device, and the particles they
   /// share. conflicts: movable particles (inverse mass > 0 on the device)

@@ -50,6 +50,7 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
+  if (changed) ++shape_generation;  // a saved state does not hold the topology (simulation_state.cpp)
   if (changed) {
     positions_mirror.changed();  // a removal hands mass on: the positions' w
     TopologyChange change{*event};
@@ -59,12 +60,18 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
     if (Status s = rebuild_program(); !s) return s.error();
     event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
   }
+  // Between frames the changed scene is the one to roll back to (a saved
+  // state holds no topology); a tear, inside a frame, waits for the frame's verdict.
+  if (changed && !stepping && divergence.on_divergence == OnDivergence::roll_back) checkpoint();
   event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return event;
 }
 
 Status Simulation::Impl::refresh_volume(const TopologyEvent& event) {
   const TetMesh& mesh = topology->mesh(event.body);
+  std::vector<std::uint32_t> removed;  // in the statistics' tet list: no longer counted as inverted
+  for (std::uint32_t t : event.tets_removed) removed.push_back(stats_tet_first[event.body] + t);
+  if (Status s = clear_stats_tets(*device, stats_plan, removed); !s) return s;
   for (std::uint32_t t : event.tets_removed) {  // as create sums the rest volume
     const auto at = [&](int k) {
       const Vec3d& p = mesh.vertices[mesh.tets[t][k]];
@@ -86,7 +93,7 @@ Status Simulation::Impl::refresh_volume(const TopologyEvent& event) {
   if (Status s = set_stats_faces(*device, stats_plan, faces, fitted); !s || fitted) return s;
   if (Status s = release_stats_plan(*device, stats_plan); !s) return s;
   auto plan = make_stats_plan(*device, program_shape, faces, true, static_cast<std::uint32_t>(contacts.tools.size()),
-                              2 * static_cast<std::uint32_t>(faces.size()));
+                              2 * static_cast<std::uint32_t>(faces.size()), stats_plan.tet_list);
   if (!plan) return plan.error();
   stats_plan = std::move(*plan);
   return {};

@@ -61,6 +61,11 @@ class SolveStepper {
   /// counts and what tests inspect.
   [[nodiscard]] const FrameProgram& frame_program() const { return shortest_frame_; }
 
+  /// Whether the next frame warm-starts (false after a substep the time
+  /// budget stopped); a saved state carries it (Simulation::save_state).
+  [[nodiscard]] bool warm() const { return warm_; }
+  void set_warm(bool warm) { warm_ = warm; }
+
  private:
   Status build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
                const std::array<double, 3>& gravity, const StatsPlan& stats, SweepExtras extras);
