@@ -127,10 +127,7 @@ void read_tet_mesh_source(const Json& v, const std::string& path, const Where& w
   double scale = 1.0;
   read_scale(o, scale);
   if (o.has("file")) {
-    std::string file;
-    o.read("file", file);
-    if (ctx.failed()) return;
-    const std::filesystem::path p = resolve_file(where, file, o.path("file"), ctx);
+    const std::filesystem::path p = read_file_member(o, where, ctx);
     if (ctx.failed()) return;
     auto mesh = read_tet_mesh(p);
     if (!mesh) return mesh_file_error(ctx, o.path("file"), mesh.error());
@@ -164,10 +161,7 @@ void read_tri_mesh_source(const Json& v, const std::string& path, const Where& w
   double scale = 1.0;
   read_scale(o, scale);
   if (o.has("file")) {
-    std::string file;
-    o.read("file", file);
-    if (ctx.failed()) return;
-    const std::filesystem::path p = resolve_file(where, file, o.path("file"), ctx);
+    const std::filesystem::path p = read_file_member(o, where, ctx);
     if (ctx.failed()) return;
     auto mesh = read_stl(p);
     if (!mesh) return mesh_file_error(ctx, o.path("file"), mesh.error());
@@ -238,6 +232,13 @@ std::filesystem::path resolve_file(const Where& where, const std::string& name, 
   if (!std::filesystem::is_regular_file(p, ec))
     ctx.fail(ErrorCode::bad_input_file, path, p.string() + " is not a readable file");
   return p;
+}
+
+std::filesystem::path read_file_member(Object& o, const Where& where, Context& ctx) {
+  std::string file;
+  o.read("file", file);
+  if (ctx.failed()) return {};
+  return resolve_file(where, file, o.path("file"), ctx);
 }
 
 void read_tet_body(const Json& v, const std::string& path, const Where& where, Context& ctx, TetBodyDesc& out,

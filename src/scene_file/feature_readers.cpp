@@ -46,10 +46,7 @@ void read_level_set(const Json& v, const std::string& path, const Where& where, 
   if (!ctx.failed() && !(scale > 0.0)) return ctx.fail(ErrorCode::bad_parameter, o.path("scale"), "must be > 0");
   Result<LevelSet> made = Error(ErrorCode::internal, "no level set");
   if (o.has("file")) {
-    std::string file;
-    o.read("file", file);
-    if (ctx.failed()) return;
-    const std::filesystem::path p = resolve_file(where, file, o.path("file"), ctx);
+    const std::filesystem::path p = read_file_member(o, where, ctx);
     if (ctx.failed()) return;
     auto surface = read_stl(p);
     if (!surface) return ctx.fail(ErrorCode::bad_input_file, o.path("file"), surface.error().message());

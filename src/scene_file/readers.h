@@ -22,6 +22,9 @@ struct Where {
 /// pipe a read would wait on), else an error at `path`.
 std::filesystem::path resolve_file(const Where& where, const std::string& name, const std::string& path,
                                    Context& ctx);
+/// The object's "file" member, read and resolved (resolve_file); empty
+/// when it is missing or wrong (the error is in ctx).
+std::filesystem::path read_file_member(Object& o, const Where& where, Context& ctx);
 
 // body_readers.cpp
 void read_tet_body(const Json& v, const std::string& path, const Where& where, Context& ctx, TetBodyDesc& out,
