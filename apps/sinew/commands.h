@@ -16,6 +16,11 @@ struct RunOptions {
   std::string out;       ///< VTU folder; empty: no VTU output
   int threads = 0;       ///< cpu backend's worker threads; 0: all
   bool quiet = false;    ///< no per-output lines (the summary and profile only)
+  /// After the last frame, every particle's position and inverse mass as
+  /// raw float32 x, y, z, w (little-endian, in read_positions' order) to
+  /// this file; empty: none. For bitwise comparisons with other front ends
+  /// (the C API, Python).
+  std::string positions;
 };
 
 /// Runs the scene; returns the process's exit status (0, or 1 on an error).

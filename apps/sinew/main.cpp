@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--every", run.every, "Statistics line and VTU output every N frames (default: run.every)")
       ->check(CLI::PositiveNumber);
   run_cmd->add_option("--threads", run.threads, "CPU backend worker threads (0: all)")->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--positions", run.positions,
+                      "Write the final positions (raw float32 x y z w per particle) to this file");
   run_cmd->add_flag("--quiet", run.quiet, "Only the summary and the profile, no per-output lines");
 
   std::string check_path;

@@ -178,6 +178,18 @@ void print_frame(int frame, const FrameStats& st) {
   std::fflush(stdout);
 }
 
+// The particles' positions as raw float32 xyzw, for bitwise comparisons.
+Status write_positions(const Simulation& sim, const std::string& path) {
+  std::vector<float> xyzw;
+  if (Status s = sim.read_positions(xyzw); !s) return s;
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) return Error{ErrorCode::bad_input_file, path + ": cannot be written"};
+  const std::size_t written = std::fwrite(xyzw.data(), sizeof(float), xyzw.size(), f);
+  const bool closed = std::fclose(f) == 0;
+  if (written != xyzw.size() || !closed) return Error{ErrorCode::bad_input_file, path + ": write failed"};
+  return {};
+}
+
 }  // namespace
 
 int run_scene(const RunOptions& o) {
@@ -230,6 +242,10 @@ int run_scene(const RunOptions& o) {
   if (vtu) {
     if (Status s = vtu->finish(); !s) return fail(s.error().message());
     std::printf("wrote VTU series (one .pvd per body) to %s\n", o.out.c_str());
+  }
+  if (!o.positions.empty()) {
+    if (Status s = write_positions(*sim, o.positions); !s) return fail(s.error().message());
+    std::printf("wrote %u particles' final positions to %s\n", info.particles, o.positions.c_str());
   }
   profile.print(frames, total_ms);
   std::fflush(stdout);
