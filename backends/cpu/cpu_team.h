@@ -39,6 +39,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -47,9 +48,11 @@ namespace sinew {
 class CpuTeam {
  public:
   /// A team of `members` threads: the caller of run() and members - 1
-  /// workers started here. members >= 1; workers that cannot be started
-  /// (the system refused a thread) leave a smaller team, never an
-  /// exception: members() says how many there are.
+  /// workers started here, on std::thread or, when an engine set
+  /// TaskHooks::start_thread (sinew/hooks.h), on the engine's threads.
+  /// members >= 1; workers that cannot be started (the system or the hook
+  /// refused a thread) leave a smaller team, never an exception: members()
+  /// says how many there are.
   explicit CpuTeam(unsigned members);
   ~CpuTeam();
   CpuTeam(const CpuTeam&) = delete;
@@ -82,6 +85,9 @@ class CpuTeam {
 
   unsigned members_ = 1;
   std::vector<std::thread> workers_;
+  // Workers on an engine's threads (TaskHooks::start_thread) still running;
+  // shared with their loops, so the last one can signal after the team is gone.
+  std::shared_ptr<std::atomic<std::uint32_t>> hooked_running_;
   // The job: published by bumping job_; stop_ ends the workers.
   void (*work_)(void*, unsigned) = nullptr;
   void* context_ = nullptr;
