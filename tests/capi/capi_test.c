@@ -8,9 +8,11 @@
  * --quiet --positions FILE` wrote. With GRASP_AND_CUT_REFERENCE (the cpu
  * run) it also plays scenes/grasp_and_cut.json for 75 frames and compares
  * likewise, reads its events, frame statistics and surface, drives a tool
- * in a scene given as a JSON string, and checks the errors: codes and
- * messages. Exit 77 (ctest's SKIP_RETURN_CODE) when BACKEND has no device
+ * in a scene given as a JSON string, checks the errors (codes and
+ * messages), and runs two simulations on two threads at once, each with
+ * its own last error. Exit 77 (ctest's SKIP_RETURN_CODE) when BACKEND has no device
  * here; 1 on the first failed check. */
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -319,6 +321,59 @@ static void check_tool(void) {
   sinew_destroy(sim);
 }
 
+/* One thread's run: tissue_sag for 5 frames, its positions compared with
+ * the runner's, then a failing call whose message must be this thread's. */
+struct thread_run {
+  const char* scene;
+  const char* reference;
+  const char* bad_path; /* a missing file only this thread names */
+  int equal;            /* [out] the positions equal the reference's */
+  int own_message;      /* [out] the last error names this thread's file */
+};
+
+static void* run_on_thread(void* arg) {
+  struct thread_run* run = (struct thread_run*)arg;
+  sinew_simulation* sim = NULL;
+  sinew_simulation* none = NULL;
+  size_t particles = 0, bytes = 0;
+  unsigned char* expected = read_file(run->reference, &bytes);
+  float* xyzw;
+  int f;
+  if (sinew_create_from_file(run->scene, "cpu", 1, &sim) != SINEW_OK) return NULL;
+  for (f = 0; f < 5; ++f)
+    if (sinew_step(sim) != SINEW_OK) return NULL;
+  xyzw = positions(sim, &particles);
+  run->equal = expected && bytes == 16 * particles && memcmp(expected, xyzw, bytes) == 0;
+  sinew_create_from_file(run->bad_path, "cpu", 0, &none);
+  run->own_message = strstr(sinew_last_error(), run->bad_path) != NULL;
+  free(xyzw);
+  free(expected);
+  sinew_destroy(sim);
+  return NULL;
+}
+
+/* Two simulations stepped at the same time on two threads give the
+ * runner's positions, and each thread reads its own last error. */
+static void check_threads(const char* scenes, const char* reference) {
+  char scene[4096];
+  struct thread_run runs[2];
+  pthread_t threads[2];
+  int t;
+  snprintf(scene, sizeof scene, "%s/tissue_sag.json", scenes);
+  for (t = 0; t < 2; ++t) {
+    runs[t].scene = scene;
+    runs[t].reference = reference;
+    runs[t].bad_path = t == 0 ? "/nonexistent/first.json" : "/nonexistent/second.json";
+    runs[t].equal = runs[t].own_message = 0;
+  }
+  for (t = 0; t < 2; ++t) CHECK(pthread_create(&threads[t], NULL, run_on_thread, &runs[t]) == 0);
+  for (t = 0; t < 2; ++t) pthread_join(threads[t], NULL);
+  for (t = 0; t < 2; ++t) {
+    CHECK(runs[t].equal);
+    CHECK(runs[t].own_message);
+  }
+}
+
 int main(int argc, char** argv) {
   const char* backend;
   sinew_simulation* sim = NULL;
@@ -351,6 +406,7 @@ int main(int argc, char** argv) {
     check_errors(argv[2], sim);
     check_grasp_and_cut(argv[2], argv[4]);
     check_tool();
+    check_threads(argv[2], argv[3]);
   }
   MUST(sinew_destroy(sim));
   if (failures) fprintf(stderr, "%d checks failed\n", failures);
