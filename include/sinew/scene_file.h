@@ -28,6 +28,7 @@
 #include "sinew/level_set.h"
 #include "sinew/result.h"
 #include "sinew/scene.h"
+#include "sinew/topology.h"
 
 namespace sinew {
 
@@ -135,15 +136,27 @@ Result<SceneFile> load_scene_file(const std::filesystem::path& path);
 /// names in it. Messages start with the JSON path.
 Result<SceneFile> parse_scene_json(std::string_view json, const std::filesystem::path& base_dir);
 
+/// What one script action did (ScriptPlayer::before_frame), for callers
+/// that react to it (the C API's events, sinew/sinew.h).
+struct ScriptActionResult {
+  ScriptActionKind kind = ScriptActionKind::close_grasper;  ///< the action's kind
+  std::uint32_t index = 0;              ///< its grasper, body, collider, emitter or sink
+  std::size_t particles = 0;            ///< close_grasper: particles held; open_grasper: released
+  TopologyEvent topology;               ///< cut, cauterize, remove: what the change did
+  double removed_volume = 0.0;          ///< cut_collider: the volume cut away [m^3]
+};
+
 /// Plays a SceneScript on a Simulation made from its scene, frame by frame.
 class ScriptPlayer {
  public:
   explicit ScriptPlayer(SceneScript script);
   /// Sets the poses and forces of frame `frame` (>= 1) and runs its
   /// actions; call it before the step() that makes that frame, for frames
-  /// 1, 2, 3, ... in order. [out] events, when given, gets what the
-  /// actions' topology changes did. Errors: the first failing call's.
-  Status before_frame(Simulation& sim, int frame, std::vector<std::string>* events = nullptr);
+  /// 1, 2, 3, ... in order. [out] events, when given, gets a line for what
+  /// each grasper and topology action did; [out] results, when given, gets
+  /// a record of every action run. Errors: the first failing call's.
+  Status before_frame(Simulation& sim, int frame, std::vector<std::string>* events = nullptr,
+                      std::vector<ScriptActionResult>* results = nullptr);
 
  private:
   SceneScript script_;
