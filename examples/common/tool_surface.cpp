@@ -3,7 +3,6 @@
 
 #include <cmath>
 
-#include "sinew/mesh.h"
 
 namespace sinew::examples {
 
@@ -23,7 +22,7 @@ void place(const Pose& pose, const std::array<double, 3>& local, std::vector<flo
 }
 }  // namespace
 
-Status write_capsule_vtu(const std::filesystem::path& path, double radius, double half_height, const Pose& pose) {
+TriMesh capsule_surface(double radius, double half_height, const Pose& pose) {
   // Rings of latitude: the upper half-sphere's lifted by +half_height, the
   // lower one's by -half_height (two rings at the equator: the cylinder).
   constexpr int kAround = 24, kLatitudes = 12;  // kLatitudes even
@@ -31,30 +30,39 @@ Status write_capsule_vtu(const std::filesystem::path& path, double radius, doubl
   for (int k = 1; k <= kLatitudes / 2; ++k) rings.push_back({M_PI * k / kLatitudes, half_height});
   for (int k = kLatitudes / 2 + (half_height > 0.0 ? 0 : 1); k < kLatitudes; ++k)
     rings.push_back({M_PI * k / kLatitudes, -half_height});
-  std::vector<float> xyz;
-  place(pose, {0.0, radius + half_height, 0.0}, xyz);  // the top pole: vertex 0
+  TriMesh mesh;
+  const auto place = [&](const std::array<double, 3>& local) {
+    const auto p = rotate(pose.rotation, local);
+    mesh.vertices.push_back({pose.position[0] + p[0], pose.position[1] + p[1], pose.position[2] + p[2]});
+  };
+  place({0.0, radius + half_height, 0.0});  // the top pole: vertex 0
   for (const auto& [theta, lift] : rings)
     for (int a = 0; a < kAround; ++a) {
       const double phi = 2.0 * M_PI * a / kAround;
-      place(pose, {radius * std::sin(theta) * std::cos(phi), lift + radius * std::cos(theta),
-                   radius * std::sin(theta) * std::sin(phi)},
-            xyz);
+      place({radius * std::sin(theta) * std::cos(phi), lift + radius * std::cos(theta),
+             radius * std::sin(theta) * std::sin(phi)});
     }
-  const auto bottom = static_cast<std::uint32_t>(xyz.size() / 3);
-  place(pose, {0.0, -radius - half_height, 0.0}, xyz);
-  std::vector<std::array<std::uint32_t, 3>> triangles;
+  const auto bottom = static_cast<std::uint32_t>(mesh.vertices.size());
+  place({0.0, -radius - half_height, 0.0});
   const auto at = [](std::size_t ring, int a) {
     return static_cast<std::uint32_t>(1 + ring * kAround + (a % kAround));
   };
   for (int a = 0; a < kAround; ++a) {
-    triangles.push_back({0, at(0, a + 1), at(0, a)});
+    mesh.triangles.push_back({0, at(0, a + 1), at(0, a)});
     for (std::size_t r = 0; r + 1 < rings.size(); ++r) {
-      triangles.push_back({at(r, a), at(r, a + 1), at(r + 1, a + 1)});
-      triangles.push_back({at(r, a), at(r + 1, a + 1), at(r + 1, a)});
+      mesh.triangles.push_back({at(r, a), at(r, a + 1), at(r + 1, a + 1)});
+      mesh.triangles.push_back({at(r, a), at(r + 1, a + 1), at(r + 1, a)});
     }
-    triangles.push_back({bottom, at(rings.size() - 1, a), at(rings.size() - 1, a + 1)});
+    mesh.triangles.push_back({bottom, at(rings.size() - 1, a), at(rings.size() - 1, a + 1)});
   }
-  return write_vtu_triangles(path, xyz, 3, triangles);
+  return mesh;
+}
+
+Status write_capsule_vtu(const std::filesystem::path& path, double radius, double half_height, const Pose& pose) {
+  const TriMesh mesh = capsule_surface(radius, half_height, pose);
+  std::vector<float> xyz;
+  for (const auto& v : mesh.vertices) xyz.insert(xyz.end(), {float(v[0]), float(v[1]), float(v[2])});
+  return write_vtu_triangles(path, xyz, 3, mesh.triangles);
 }
 
 Status write_box_vtu(const std::filesystem::path& path, const std::array<double, 3>& half_extents, const Pose& pose) {

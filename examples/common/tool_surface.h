@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sinew/level_set.h"
+#include "sinew/mesh.h"
 #include "sinew/result.h"
 
 namespace sinew::examples {
@@ -18,10 +19,13 @@ namespace sinew::examples {
 /// A unit quaternion [in] q (w, x, y, z) applied to [in] v.
 std::array<double, 3> rotate(const std::array<double, 4>& q, const std::array<double, 3>& v);
 
-/// Writes to [in] path a capsule's closed triangle surface: the segment
-/// from (0, -half_height, 0) to (0, +half_height, 0) [m] swollen by
-/// `radius` [m] (half_height 0: a ball), moved to [in] pose. Errors: the
-/// file's (write_vtu_triangles).
+/// A capsule's closed triangle surface (outward, counter-clockwise from
+/// outside): the segment from (0, -half_height, 0) to (0, +half_height, 0)
+/// [m] swollen by `radius` [m] (half_height 0: a ball), moved to [in] pose.
+TriMesh capsule_surface(double radius, double half_height, const Pose& pose);
+
+/// Writes capsule_surface(radius, half_height, pose) to [in] path. Errors:
+/// the file's (write_vtu_triangles).
 Status write_capsule_vtu(const std::filesystem::path& path, double radius, double half_height, const Pose& pose);
 
 /// Writes to [in] path a box's surface: [in] half_extents [m] about its
