@@ -18,8 +18,8 @@ Plots error_vs_time's CSV files (case,substeps,iterations,sweeps,ms_per_frame,er
 named after the CSV's folder: DIR/<folder>.png and DIR/<folder>_pareto.csv (the Pareto front per case).
 
   --out DIR          where the PNG and the Pareto CSV files go (default: ./error_vs_time_plots)
-  --run BUILD_DIR    first run BUILD_DIR/benchmarks/error_vs_time --out DIR/run (with the arguments
-                     after --), then plot DIR/run/error_vs_time.csv
+  --run BUILD_DIR    first run BUILD_DIR/benchmarks/error_vs_time --out DIR/error_vs_time_run (arguments
+                     after -- go to it), then plot its CSV
   CSV ...            the files to plot (default: the committed ones,
                      benchmarks/results/error_vs_time*/error_vs_time.csv)
   -h, --help         this text
@@ -46,8 +46,8 @@ command -v gnuplot >/dev/null || { echo "plot_error_vs_time.sh: gnuplot not foun
 mkdir -p "$out"
 
 if [ -n "$build" ]; then
-  "$build/benchmarks/error_vs_time" --out "$out/run" "${run_args[@]}"
-  csvs+=("$out/run/error_vs_time.csv")
+  "$build/benchmarks/error_vs_time" --out "$out/error_vs_time_run" "${run_args[@]}"
+  csvs+=("$out/error_vs_time_run/error_vs_time.csv")
 fi
 if [ ${#csvs[@]} -eq 0 ]; then
   here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
