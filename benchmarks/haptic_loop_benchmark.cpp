@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", opt.seconds, "Length of the run [s]")->check(at_least(2));
   // The rate is checked with the loop's settings (a clear error for 0, nan, ...).
   app.add_option("--rate", opt.rate, "Haptic loop rate [Hz]");
-  app.add_flag("--no-realtime{false}", opt.realtime, "Do not ask for SCHED_FIFO for the haptic thread");
+  app.add_flag_callback("--no-realtime", [&opt] { opt.realtime = false; }, "Do not ask for SCHED_FIFO for the haptic thread");
   app.add_flag("--zero-cpu-latency", opt.zero_cpu_latency, "Hold /dev/cpu_dma_latency at 0 during the run");
   app.add_option("--priority", opt.priority, "SCHED_FIFO priority, 1..99")->check(CLI::Range(1, 99));
   app.add_option("--cpu", opt.cpu, "Pin the haptic thread to this CPU (-1: not pinned)")->check(at_least(-1));

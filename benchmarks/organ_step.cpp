@@ -46,9 +46,9 @@ int main(int argc, char** argv) {
   cli.app().add_flag("--errors", errors, "Measure the frame's errors (residual, energy, volume)");
   cli.app().add_option("--material", material, "none (distance + volume constraints) or an FEM material")
       ->check(CLI::IsMember({"none", "neo_hookean", "stvk", "corotational"}));
-  cli.app().add_flag("--no-reorder{false}", reorder, "Keep the mesher's particle order on the device");
+  cli.app().add_flag_callback("--no-reorder", [&reorder] { reorder = false; }, "Keep the mesher's particle order on the device");
   // cpu: the scalar reference solves (DeviceOptions::cpu_simd).
-  cli.app().add_flag("--no-simd{false}", simd, "cpu backend: the scalar reference solves, no AVX2");
+  cli.app().add_flag_callback("--no-simd", [&simd] { simd = false; }, "cpu backend: the scalar reference solves, no AVX2");
   cli.app().add_option("--substeps", substeps, "Substeps per frame")->check(sinew::examples::at_least(1));
   cli.app().add_option("--iterations", iterations, "Iterations per substep")->check(sinew::examples::at_least(1));
   cli.app().add_option("--threads", threads, "cpu backend worker threads (0: all)")->check(sinew::examples::at_least(0));

@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
   cli.add_backend(opt.backend);
   // The rate is checked with the loop's settings below (a clear error for 0, nan, ...).
   cli.app().add_option("--rate", opt.rate, "Haptic loop rate [Hz]");
-  cli.app().add_flag("--no-realtime{false}", opt.realtime, "Run the haptic thread without asking for SCHED_FIFO");
+  cli.app().add_flag_callback("--no-realtime", [&opt] { opt.realtime = false; }, "Run the haptic thread without asking for SCHED_FIFO");
   cli.add_out(opt.out);
   if (auto exit = cli.parse(argc, argv)) return *exit;
 
