@@ -12,21 +12,22 @@
 // compressibility error (the densest particle's rho / rho0 - 1) and its
 // Mach number, the wall time per 2 ms frame of the fluid's stage and of the
 // rest of the frame (the tissue's). Writes blood_N.vtu (density, pressure, velocity per
-// particle) and tissue_N.vtu, with blood.pvd and tissue.pvd, for ParaView.
+// particle), tissue_N.vtu and suction_N.vtu (the tip's ball), with blood.pvd,
+// tissue.pvd and suction.pvd, for ParaView.
 //
-//   bleeding [--backend auto|cpu|opencl|vulkan] [--seconds S (3)] [--out DIR]
-//            [--flow ML_PER_S (1)] [--every N (25 frames between outputs)]
+//   bleeding --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "tool_surface.h"
 
 namespace {
 
@@ -59,20 +60,24 @@ sinew::Result<sinew::TetMesh> tissue_block() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string backend = "auto", out = "bleeding_out";
+  sinew::examples::CommandLine cli(
+      "bleeding",
+      "Blood from a cut vessel fills a pit in a block of tissue (SPH coupled both ways with the tissue), and\n"
+      "from 1.5 s a suction tip removes it. Prints every --every frames (of 2 ms) the particles, the blood\n"
+      "made and removed, the mass books, the compressibility error and the wall time per frame; writes\n"
+      "blood.pvd, tissue.pvd and suction.pvd (VTU series) into --out.");
+  using sinew::examples::at_least;
+  std::string backend = "auto", out = cli.default_out();
   double seconds = 3.0, flow_ml = 1.0;
   int every = 25;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i], value = argv[i + 1];
-    if (key == "--backend") backend = value;
-    else if (key == "--seconds") seconds = std::atof(value.c_str());
-    else if (key == "--out") out = value;
-    else if (key == "--flow") flow_ml = std::atof(value.c_str());
-    else if (key == "--every") every = std::atoi(value.c_str());
-    else return fail("unknown option " + key);
-  }
-  if (!(seconds > 0.0) || !(flow_ml >= 0.0) || every < 1) return fail("--seconds > 0, --flow >= 0 and --every >= 1, please");
-  std::filesystem::create_directories(out);
+  cli.add_backend(backend);
+  cli.app().add_option("--seconds", seconds, "Simulated time [s]")->check(sinew::examples::greater_than(0));
+  cli.app().add_option("--flow", flow_ml, "The vessel's mean flow [ml/s] (pulsing +-50% at 72 beats a minute)")
+      ->check(at_least(0));
+  cli.app().add_option("--every", every, "Report and write the VTU files every N frames of 2 ms (and the last)")
+      ->check(at_least(1));
+  cli.add_out(out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
 
   // The tissue: 20 kPa, pinned at its base.
   auto mesh = tissue_block();
@@ -129,7 +134,7 @@ int main(int argc, char** argv) {
 
   const int frames = static_cast<int>(std::lround(seconds / kFrame));
   const double ml = kSpacing * kSpacing * kSpacing * 1e6;
-  std::vector<std::filesystem::path> blood_files, tissue_files;
+  std::vector<std::filesystem::path> blood_files, tissue_files, suction_files;
   std::vector<double> times;
   std::vector<sinew::FluidParticle> q;
   std::vector<float> x, xyz, rho, pressure, velocity;
@@ -182,10 +187,14 @@ int main(int argc, char** argv) {
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
     tissue_files.push_back(out + "/tissue_" + std::to_string(frame) + ".vtu");
     if (auto s = sinew::write_vtu(tissue_files.back(), x, 4, mesh->tets); !s) return fail(s.error().message());
+    suction_files.push_back(out + "/suction_" + std::to_string(frame) + ".vtu");
+    if (auto s = sinew::examples::write_capsule_vtu(suction_files.back(), 3e-3, 0.0, {.position = tip}); !s)
+      return fail(s.error().message());
     times.push_back(t);
   }
   if (auto s = sinew::write_pvd(out + "/blood.pvd", blood_files, times); !s) return fail(s.error().message());
   if (auto s = sinew::write_pvd(out + "/tissue.pvd", tissue_files, times); !s) return fail(s.error().message());
-  std::printf("bleeding: wrote %zu frames of blood.pvd and tissue.pvd to %s\n", times.size(), out.c_str());
+  if (auto s = sinew::write_pvd(out + "/suction.pvd", suction_files, times); !s) return fail(s.error().message());
+  std::printf("bleeding: wrote %zu frames of blood.pvd, tissue.pvd and suction.pvd to %s\n", times.size(), out.c_str());
   return 0;
 }

@@ -17,7 +17,7 @@
 // the punctures (entering or leaving, on the needle or on the thread) and
 // how wide the slit is at the stitches' depth.
 //
-//   suturing [--backend auto|cpu|opencl|vulkan] [--out DIR] [--every N]
+//   suturing --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -26,8 +26,10 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "tool_surface.h"
 
 namespace {
 
@@ -88,15 +90,18 @@ Pose script(int f, double pulled) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string backend = "auto", out = "suturing_out";
+  sinew::examples::CommandLine cli(
+      "suturing",
+      "Two stitches across a cut in a tissue pad, tightened: a curved needle with a 100 mm thread turned\n"
+      "about the cut twice, then pulled until the knot holds. Prints per reported frame the wall time, the\n"
+      "punctures and the slit's width; writes pad.pvd, thread.pvd and needle.pvd (VTU series) into --out.");
+  std::string backend = "auto", out = cli.default_out();
   int every = 10;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    if (flag == "--backend") backend = argv[i + 1];
-    else if (flag == "--out") out = argv[i + 1];
-    else if (flag == "--every") every = std::max(1, std::atoi(argv[i + 1]));
-    else return fail("unknown option " + flag + " (--backend, --out, --every)");
-  }
+  cli.add_backend(backend);
+  cli.app().add_option("--every", every, "Report and write the VTU files every N frames of 1/60 s (and the last)")
+      ->check(sinew::examples::at_least(1));
+  cli.add_out(out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
 
   sinew::SceneDesc scene;
   scene.gravity = {0.0, 0.0, 0.0};  // on a table
@@ -157,9 +162,8 @@ int main(int argc, char** argv) {
 
   std::vector<std::filesystem::path> pad_files, thread_files, needle_files;
   std::vector<double> times;
-  std::vector<std::array<std::uint32_t, 2>> thread_cells, needle_cells;
+  std::vector<std::array<std::uint32_t, 2>> thread_cells;
   for (std::uint32_t i = 0; i < kThreadSegments; ++i) thread_cells.push_back({i, i + 1});
-  for (std::uint32_t i = 0; i + 1 < needle.curve.size(); ++i) needle_cells.push_back({i, i + 1});
   std::vector<float> x, ms;
   double width_before = 0.0, pulled = 0.0;
   int knot_frame = -1, last = -1;  // when the knot first held; the last frame
@@ -205,19 +209,9 @@ int main(int argc, char** argv) {
                                         thread_cells);
         !s)
       return fail(s.error().message());
-    std::vector<float> curve;
-    for (const auto& c : needle.curve) {
-      // The point rotated by the state's quaternion (w, x, y, z), then moved.
-      const auto& r = state->rotation;
-      const double w = r[0], u[3] = {r[1], r[2], r[3]};
-      const double t[3] = {2 * (u[1] * c[2] - u[2] * c[1]), 2 * (u[2] * c[0] - u[0] * c[2]),
-                           2 * (u[0] * c[1] - u[1] * c[0])};
-      for (int k = 0; k < 3; ++k) {
-        const double cross = u[(k + 1) % 3] * t[(k + 2) % 3] - u[(k + 2) % 3] * t[(k + 1) % 3];
-        curve.push_back(static_cast<float>(state->position[k] + c[k] + w * t[k] + cross));
-      }
-    }
-    if (auto s = sinew::write_vtu_lines(needle_files.back(), curve, 3, needle_cells); !s)
+    if (auto s = sinew::examples::write_polyline_vtu(needle_files.back(), needle.curve,
+                                                     {.position = state->position, .rotation = state->rotation});
+        !s)
       return fail(s.error().message());
   }
   for (const auto& [name, files] : {std::pair{"pad.pvd", &pad_files}, std::pair{"thread.pvd", &thread_files},
