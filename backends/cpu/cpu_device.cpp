@@ -184,7 +184,7 @@ class CpuDevice final : public Device {
   CpuDevice(int threads, bool simd, bool adaptive)
       : simd_(simd),
         adaptive_(adaptive),
-        team_(static_cast<unsigned>(threads)),
+        team_(static_cast<unsigned>(threads), hooks::tasks()->start_thread),
         shares_(team_.members()),
         busy_(team_.members()) {}
 

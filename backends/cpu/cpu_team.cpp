@@ -2,8 +2,6 @@
 // waiting policy (see cpu_team.h for why).
 #include "backends/cpu/cpu_team.h"
 
-#include "hooks/hooks_internal.h"
-
 #include <algorithm>
 #include <chrono>
 #include <climits>
@@ -105,19 +103,18 @@ Count await_change(const std::atomic<std::uint32_t>& word, std::uint32_t old, st
 
 }  // namespace
 
-CpuTeam::CpuTeam(unsigned members) {
+CpuTeam::CpuTeam(unsigned members, const StartThread& start_thread) {
   const unsigned asked = members < 1 ? 1 : members;
-  const std::shared_ptr<const TaskHooks> hooks = hooks::tasks();
   hooked_running_ = std::make_shared<std::atomic<std::uint32_t>>(0);
   // A thread the system (or the engine's hook) refuses ends the team where
   // it is: a smaller team computes the same results (a dispatch's split
   // does not change them).
   for (unsigned m = 1; m < asked; ++m) {
-    if (hooks->start_thread) {
+    if (start_thread) {
       hooked_running_->fetch_add(1);
       bool started = false;
       try {
-        started = hooks->start_thread([this, m, running = hooked_running_] {
+        started = start_thread([this, m, running = hooked_running_] {
           worker(m);
           // The team may be destroyed from here on: only `running` is touched.
           running->fetch_sub(1);

@@ -39,6 +39,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -47,13 +48,15 @@ namespace sinew {
 
 class CpuTeam {
  public:
+  /// Starts a worker's loop on a thread of its own at once, or returns
+  /// false (an engine's TaskHooks::start_thread, sinew/hooks.h).
+  using StartThread = std::function<bool(std::function<void()> loop)>;
   /// A team of `members` threads: the caller of run() and members - 1
-  /// workers started here, on std::thread or, when an engine set
-  /// TaskHooks::start_thread (sinew/hooks.h), on the engine's threads.
-  /// members >= 1; workers that cannot be started (the system or the hook
-  /// refused a thread) leave a smaller team, never an exception: members()
-  /// says how many there are.
-  explicit CpuTeam(unsigned members);
+  /// workers started here, on std::thread or, given [in] start_thread, on
+  /// the threads it starts. members >= 1; workers that cannot be started
+  /// (the system or start_thread refused a thread) leave a smaller team,
+  /// never an exception: members() says how many there are.
+  explicit CpuTeam(unsigned members, const StartThread& start_thread = {});
   ~CpuTeam();
   CpuTeam(const CpuTeam&) = delete;
   CpuTeam& operator=(const CpuTeam&) = delete;

@@ -299,11 +299,7 @@ Status Simulation::apply_tool_force(std::size_t index, const std::array<double, 
   if (Status s = check_finite(call, "force", force); !s) return s;
   if (Status s = check_finite(call, "torque", torque); !s) return s;
   ToolBody& b = tools[index];
-  for (int k = 0; k < 3; ++k) {  // calls before one frame add up
-    b.force[k] += force[k];
-    b.torque[k] += torque[k];
-  }
-  return {};
+  return add_frame_force(b, force, torque, impl_->time_step, std::string(call) + ": tool " + std::to_string(index));
 }
 
 Result<ToolState> Simulation::tool_state(std::size_t index) const {
@@ -339,7 +335,7 @@ Status Simulation::apply_needle_force(std::size_t index, const std::array<double
   if (Status s = check_index(call, "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s) return s;
   if (Status s = check_finite(call, "force", force); !s) return s;
   if (Status s = check_finite(call, "torque", torque); !s) return s;
-  return impl_->sutures->apply_force(index, force, torque);
+  return impl_->sutures->apply_force(index, force, torque, impl_->time_step);
 }
 
 Result<NeedleState> Simulation::needle_state(std::size_t index) const {
