@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""What a Python loop costs over a C++ loop: the same scene, in the same
-process and module, stepped N frames by sim.run(N) (the loop in C++) and by
-`for _ in range(N): sim.step()` (the loop in Python: a call, the GIL
+"""What a Python loop costs over a C++ loop: one Simulation stepped in
+alternating blocks of frames, by sim.run(B) (the loop in C++) and by
+`for _ in range(B): sim.step()` (the loop in Python: a call, the GIL
 released and taken back, a FrameStats copied to Python per frame), each
-timed by time.perf_counter around the whole loop, alternating which goes
-first, several runs; the overhead is the ratio of the medians. With
+block timed by time.perf_counter; the overhead is the median over the
+pairs of blocks of Python's time over C++'s (a pair sees the same load on
+a shared machine), over several runs. With
 --runner it also runs `sinew run` and reports its own mean frame time (the
 mean of FrameStats.wall_ms, the time inside Simulation::step only), for
 reference.
@@ -35,17 +36,27 @@ def runner_mean_ms(runner, scene, backend, threads, frames):
     return float(match.group(1))
 
 
-def loop_ms(scene, backend, threads, frames, in_python):
-    """Wall time per frame [ms] of `frames` frames stepped in a C++ or a Python loop."""
+def paired_blocks(scene, backend, threads, frames, block):
+    """One Simulation stepped `frames` frames in blocks of `block`, each pair
+    of blocks one by run(block) (the loop in C++) and one by a Python loop of
+    step(), in alternating order: the two see the same scene state and the
+    same load on the machine within a pair. Returns (C++ ms/frame, Python
+    ms/frame) of every pair."""
     sim = sinew.Simulation(scene, backend=backend, threads=threads)
     sim.step()  # the first frame (the CPU team's first timings) is not the loop's
-    start = time.perf_counter()
-    if in_python:
-        for _ in range(frames):
-            sim.step()
-    else:
-        sim.run(frames)
-    return (time.perf_counter() - start) * 1e3 / frames
+    pairs = []
+    for b in range(max(1, frames // (2 * block))):
+        timed = {}
+        for in_python in ((False, True) if b % 2 == 0 else (True, False)):
+            start = time.perf_counter()
+            if in_python:
+                for _ in range(block):
+                    sim.step()
+            else:
+                sim.run(block)
+            timed[in_python] = (time.perf_counter() - start) * 1e3 / block
+        pairs.append((timed[False], timed[True]))
+    return pairs
 
 
 def main():
@@ -53,7 +64,8 @@ def main():
     parser.add_argument("--scene", default="scenes/tissue_sag.json")
     parser.add_argument("--backend", default="cpu")
     parser.add_argument("--frames", type=int, default=10000)
-    parser.add_argument("--runs", type=int, default=5, help="runs of each loop, alternating")
+    parser.add_argument("--runs", type=int, default=5, help="runs (each a fresh Simulation)")
+    parser.add_argument("--block", type=int, default=50, help="frames per block (C++ and Python blocks alternate)")
     parser.add_argument("--threads", type=int, default=0, help="CPU worker threads (0: all)")
     parser.add_argument("--cells", type=int, nargs=3, metavar=("X", "Y", "Z"),
                         help="the first tet body's grid cells instead of the file's (a smaller block: the "
@@ -72,20 +84,25 @@ def main():
         scene = sinew.scene_from_dict(d)
     else:
         scene = sinew.load_scene_file(args.scene)
-    cpp, py, runner = [], [], []
+    cpp, py, ratios, runner = [], [], [], []
     for r in range(args.runs):
-        # Alternate which goes first, so a drift in the machine's load hits both alike.
-        for in_python in ((False, True) if r % 2 == 0 else (True, False)):
-            (py if in_python else cpp).append(loop_ms(scene, args.backend, args.threads, args.frames, in_python))
+        pairs = paired_blocks(scene, args.backend, args.threads, args.frames, args.block)
+        cpp.extend(c for c, _ in pairs)
+        py.extend(p for _, p in pairs)
+        ratios.extend(p / c for c, p in pairs)
         if args.runner:
             runner.append(runner_mean_ms(args.runner, args.scene, args.backend, args.threads, args.frames))
-        print(f"run {r + 1}: C++ loop {cpp[-1]:.4f} ms/frame, Python loop {py[-1]:.4f} ms/frame "
-              f"({100 * (py[-1] / cpp[-1] - 1):+.2f}%)" + (f", runner {runner[-1]:.4f}" if runner else ""), flush=True)
+        print(f"run {r + 1}: {len(pairs)} pairs of {args.block}-frame blocks: C++ loop "
+              f"{statistics.median(c for c, _ in pairs):.4f} ms/frame, Python loop "
+              f"{statistics.median(p for _, p in pairs):.4f} ms/frame, Python/C++ per pair "
+              f"{100 * (statistics.median(p / c for c, p in pairs) - 1):+.2f}%"
+              + (f", runner {runner[-1]:.4f}" if runner else ""), flush=True)
     c, p = statistics.median(cpp), statistics.median(py)
-    print(f"median of {args.runs} runs of {args.frames} frames of {args.scene}"
-          + (f" with {args.cells} cells" if args.cells else "") + f" on {args.backend}: "
-          f"C++ loop {c:.4f} ms/frame, Python loop {p:.4f} ms/frame ({100 * (p / c - 1):+.2f}%, "
-          f"{1e3 * (p - c):+.1f} us/frame)" + (f"; runner mean {statistics.median(runner):.4f} ms/frame" if runner else ""))
+    print(f"median over {args.runs} runs of {args.frames} frames of {args.scene}"
+          + (f" with {args.cells} cells" if args.cells else "") + f" on {args.backend} ({len(ratios)} block pairs): "
+          f"C++ loop {c:.4f} ms/frame, Python loop {p:.4f} ms/frame ({1e3 * (p - c):+.1f} us/frame); "
+          f"Python/C++ per pair {100 * (statistics.median(ratios) - 1):+.2f}%"
+          + (f"; runner mean {statistics.median(runner):.4f} ms/frame" if runner else ""))
     return 0
 
 
