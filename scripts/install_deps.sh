@@ -13,6 +13,7 @@ packages=(
   libembree-dev                       # CPU broad phase
   nlohmann-json3-dev libcli11-dev      # scene files, the sinew runner
   python3-jsonschema                  # the scene files checked against their schema (tests)
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib  # the Python module, its tests, its plot example
   gnuplot-nox                         # plots in the reports
   doxygen                             # API reference (cmake --build build --target docs; optional)
 )

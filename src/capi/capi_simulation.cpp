@@ -141,7 +141,7 @@ void step_events(sinew_simulation& h, std::uint64_t frame, std::vector<sinew_eve
   }
 }
 
-sinew_event action_event(const ScriptActionResult& r, std::uint64_t frame) {
+sinew_event action_event(const ScriptEvent& r, std::uint64_t frame) {
   switch (r.kind) {
     case ScriptActionKind::cut: return topology_event(SINEW_EVENT_CUT, r.topology, frame);
     case ScriptActionKind::cauterize: return topology_event(SINEW_EVENT_CAUTERY, r.topology, frame);
@@ -152,10 +152,10 @@ sinew_event action_event(const ScriptActionResult& r, std::uint64_t frame) {
   e.object = r.index, e.frame = frame;
   if (r.kind == ScriptActionKind::close_grasper || r.kind == ScriptActionKind::open_grasper) {
     e.kind = r.kind == ScriptActionKind::close_grasper ? SINEW_EVENT_GRASP : SINEW_EVENT_RELEASE;
-    e.count = static_cast<std::uint32_t>(r.particles);
+    e.count = static_cast<std::uint32_t>(r.particles.size());
   } else if (r.kind == ScriptActionKind::cut_collider) {
     e.kind = SINEW_EVENT_COLLIDER_CUT;
-    e.volume_removed = r.removed_volume;
+    e.volume_removed = r.collider_cut.removed_volume;
   }
   return e;
 }
@@ -255,9 +255,11 @@ sinew_status sinew_step(sinew_simulation* sim) {
   return with_sim("sinew_step", sim, [&]() -> sinew_status {
     const std::uint64_t frame = std::uint64_t(sim->frames_done) + 1;
     if (sim->play_script) {
-      std::vector<sinew::ScriptActionResult> done;
-      const sinew::Status played = sim->player->before_frame(*sim->sim, sim->frames_done + 1, nullptr, &done);
-      for (const sinew::ScriptActionResult& r : done) sim->pending_events.push_back(action_event(r, frame));
+      std::vector<sinew::ScriptEvent> done;
+      const sinew::Status played = sim->player->before_frame(*sim->sim, sim->frames_done + 1, done);
+      // Emitters and sinks changed make no event (kind 0): the C API has none for them.
+      for (const sinew::ScriptEvent& r : done)
+        if (const sinew_event e = action_event(r, frame); e.kind != 0) sim->pending_events.push_back(e);
       if (!played) return fail(played.error());
     }
     ++sim->frames_done;
