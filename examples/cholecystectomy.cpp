@@ -21,11 +21,11 @@
 //     along the gallbladder edge, cutting the membrane free of it.
 //
 // Prints each topology event (what it removed and what it took) and the wall
-// time per frame; writes gallbladder_N.vtu (its tets) and membrane_N.vtu
-// (the live triangles) with gallbladder.pvd and membrane.pvd, the tools
-// while they act (grasper.pvd: the jaws' box; cautery.pvd: the tip's ball;
-// blade.pvd: the blade's edge as a line), and events.csv, the event log,
-// to --out.
+// time per frame; writes cholecystectomy.pvd (sinew/vtk_output.h, from
+// frame 0): the gallbladder's tets and the membrane's triangles (removed
+// ones empty, with an alive flag) and the tools
+// while they act (grasper: the jaws' box; cautery: the tip's ball; blade:
+// the blade's edge as a line), and events.csv, the event log, to --out.
 //
 //   cholecystectomy --help   (the options, their defaults and units)
 #include <algorithm>
@@ -41,8 +41,9 @@
 
 #include "command_line.h"
 #include "sinew/mesh.h"
+#include "sinew/display_surfaces.h"
 #include "sinew/simulation.h"
-#include "tool_surface.h"
+#include "sinew/vtk_output.h"
 
 namespace {
 
@@ -69,8 +70,8 @@ int main(int argc, char** argv) {
       "cholecystectomy",
       "A cholecystectomy-like sequence on the gallbladder: a grasper lifts the membrane joining it to the\n"
       "liver bed, a cautery tip burns a strand, a blade cuts the membrane free (topology changes while the\n"
-      "scene runs), 150 frames of 1/60 s. Prints each topology event; writes gallbladder.pvd, membrane.pvd,\n"
-      "grasper.pvd, cautery.pvd, blade.pvd (VTU series) and events.csv into --out.");
+      "scene runs), 150 frames of 1/60 s. Prints each topology event; writes cholecystectomy.pvd (the\n"
+      "gallbladder, the membrane and the tools while they act) and events.csv into --out.");
   std::string backend = "auto", out = cli.default_out();
   int every = 5;
   cli.add_backend(backend);
@@ -195,15 +196,15 @@ int main(int argc, char** argv) {
 
   const int frames = 150;
   std::vector<float> x;
-  std::vector<std::filesystem::path> organ_files, sheet_files;
-  std::vector<double> times, frame_ms;
+  std::vector<double> frame_ms;
   sinew::Pose jaws;
   std::size_t held = 0;
-  // The tools, written while they act: each its own series.
-  struct ToolSeries {
-    std::vector<std::filesystem::path> files;
-    std::vector<double> times;
-  } grasper_series, cautery_series, blade_series;
+  auto output = sinew::SceneOutput::create(
+      scene, out,
+      {.bodies = {{.kind = sinew::BodyKind::tet, .name = "gallbladder"}, {.kind = sinew::BodyKind::tri, .name = "membrane"}},
+       .name = "cholecystectomy"});
+  if (!output) return fail(output.error().message());
+  if (auto s = output->write(*sim, 0); !s) return fail(s.error().message());
   const std::array<double, 3> jaws_half_extents{1.5e-3, 2e-3, 1.5e-3};  // 3 x 3 vertices
   for (int frame = 1; frame <= frames; ++frame) {
     const double t = frame * kFrame;
@@ -271,44 +272,13 @@ int main(int argc, char** argv) {
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
     for (float c : x)
       if (!std::isfinite(c)) return fail("a position is not finite at " + std::to_string(t) + " s");
-    const auto organ_tets = topology.current_tets(*gallbladder_id);
-    const auto sheet_triangles = topology.current_triangles(*membrane_id);
-    if (!organ_tets || !sheet_triangles) return fail("current_tets, current_triangles");
-    const std::span<const float> organ_x(x.data() + 4 * std::size_t{organ_first}, 4 * organ.mesh.vertices.size());
-    const std::span<const float> sheet_x(x.data() + 4 * std::size_t{sheet_first}, 4 * sheet.mesh.vertices.size());
-    organ_files.push_back(out + "/gallbladder_" + std::to_string(frame) + ".vtu");
-    sheet_files.push_back(out + "/membrane_" + std::to_string(frame) + ".vtu");
-    if (auto s = sinew::write_vtu(organ_files.back(), organ_x, 4, *organ_tets); !s) return fail(s.error().message());
-    if (auto s = sinew::write_vtu_triangles(sheet_files.back(), sheet_x, 4, *sheet_triangles); !s)
-      return fail(s.error().message());
-    times.push_back(t);
-    const std::string stem = std::to_string(frame) + ".vtu";
-    if (frame >= 30) {
-      grasper_series.files.push_back(out + "/grasper_" + stem);
-      grasper_series.times.push_back(t);
-      if (auto s = sinew::examples::write_box_vtu(grasper_series.files.back(), jaws_half_extents, jaws); !s)
-        return fail(s.error().message());
-    }
-    if (cautery_tip) {
-      cautery_series.files.push_back(out + "/cautery_" + stem);
-      cautery_series.times.push_back(t);
-      if (auto s = sinew::examples::write_capsule_vtu(cautery_series.files.back(), 3e-3, 0.0, {.position = *cautery_tip});
-          !s)
-        return fail(s.error().message());
-    }
-    if (blade) {
-      blade_series.files.push_back(out + "/blade_" + stem);
-      blade_series.times.push_back(t);
-      if (auto s = sinew::examples::write_polyline_vtu(blade_series.files.back(), {blade->a, blade->b}, {}); !s)
-        return fail(s.error().message());
-    }
+    // The tools while they act.
+    if (frame >= 30) output->add_surface("grasper", sinew::box_surface(jaws_half_extents, jaws));
+    if (cautery_tip) output->add_surface("cautery", sinew::capsule_surface(3e-3, 0.0, {.position = *cautery_tip}));
+    if (blade) output->add_polyline("blade", std::array{blade->a, blade->b});
+    if (auto s = output->write(*sim, frame); !s) return fail(s.error().message());
   }
   std::fclose(log);
-  if (auto s = sinew::write_pvd(out + "/gallbladder.pvd", organ_files, times); !s) return fail(s.error().message());
-  if (auto s = sinew::write_pvd(out + "/membrane.pvd", sheet_files, times); !s) return fail(s.error().message());
-  for (const auto& [name, series] : {std::pair{"/grasper.pvd", &grasper_series}, std::pair{"/cautery.pvd", &cautery_series},
-                                     std::pair{"/blade.pvd", &blade_series}})
-    if (auto s = sinew::write_pvd(out + name, series->files, series->times); !s) return fail(s.error().message());
   // The cut freed the membrane: the gap between the live vertices on the
   // gallbladder's side of the blade's line (rest z > near_z - 2 mm) and
   // those on the liver's side (rest z < near_z - 3 mm), at the end.
@@ -350,9 +320,9 @@ int main(int argc, char** argv) {
   std::sort(frame_ms.begin(), frame_ms.end());
   std::printf("cholecystectomy: membrane %zu of %zu triangles left; the gallbladder's edge is %s the liver's; across the "
               "cut the nearest live vertices are %.1f mm apart (1 mm at rest); frame median %.1f ms, slowest %.1f ms; "
-              "wrote %zu frames and events.csv to %s\n",
+              "wrote %d frames and events.csv to %s\n",
               live->size(), sheet.mesh.triangles.size(), joined ? "still joined to" : "cut free of", 1e3 * gap,
-              frame_ms[frame_ms.size() / 2], frame_ms.back(), times.size(), out.c_str());
+              frame_ms[frame_ms.size() / 2], frame_ms.back(), 1 + frames / every, out.c_str());
   if (joined) return fail("the blade left the membrane joined to the gallbladder");
   return 0;
 }

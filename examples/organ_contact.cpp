@@ -5,8 +5,8 @@
 // they touch through their boundary surfaces (SceneDesc::mesh_collision:
 // vertex-triangle and edge-edge contacts found each frame, solved colour by
 // colour in every sweep). The liver is pinned along its lowest fifth.
-// Writes three VTU series (open kidney.pvd, liver.pvd and probe.pvd in
-// ParaView) and prints per frame the wall time, the collision's share, the
+// Writes organ_contact.pvd (the liver, the kidney and the probe as
+// collider0, from frame 0) and prints per frame the wall time, the collision's share, the
 // contacts and their colours, and the deepest contact violation: while it
 // stays below the thickness the surfaces have not passed through each other.
 //
@@ -22,7 +22,7 @@
 #include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
-#include "tool_surface.h"
+#include "sinew/vtk_output.h"
 
 namespace {
 
@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
       "Tissue against tissue on the real organ meshes: a probe (a kinematic capsule) presses the kidney\n"
       "down onto the liver and slides it along the liver's surface (mesh collision between the two tet\n"
       "bodies). Prints per reported frame the wall time, the collision's share, the contacts and the deepest\n"
-      "contact violation; writes kidney.pvd, liver.pvd and probe.pvd (VTU series) into --out.");
+      "contact violation; writes organ_contact.pvd (liver, kidney, probe) into --out.");
   using sinew::examples::at_least;
   using sinew::examples::greater_than;
   std::string backend = "auto", out = cli.default_out();
@@ -143,11 +143,11 @@ int main(int argc, char** argv) {
   if (!probe_id) return fail(probe_id.error());
   std::printf("%s on %s: liver %zu tets, kidney %zu tets, %u particles\n", backend.c_str(),
               sim->device_name().c_str(), liver->tets.size(), kidney->tets.size(), sim->info().particles);
-  std::vector<std::filesystem::path> kidney_files, liver_files, probe_files;
-  std::vector<double> times;
-  std::vector<float> x;
+  auto output = sinew::SceneOutput::create(
+      scene, out, {.bodies = {{.index = 0, .name = "liver"}, {.index = 1, .name = "kidney"}}, .name = "organ_contact"});
+  if (!output) return fail(output.error());
+  if (auto w = output->write(*sim, 0); !w) return fail(w.error());
   double worst = 0.0, total_ms = 0.0, collision_ms = 0.0, ccd_ms = 0.0;
-  const std::uint32_t kidney_first = sim->info().tet_body_first_particle[1];
   for (int f = 0; f < frames; ++f) {
     // Down by 2 cm over the first quarter (the probe starts 5 mm above the
     // kidney, the kidney 3 mm above the liver: it is pressed about 1.2 cm
@@ -165,30 +165,16 @@ int main(int argc, char** argv) {
     worst = std::max(worst, st.contact_violation);
 
     if ((f + 1) % every != 0 && f + 1 != frames) continue;
-    if (auto r = sim->read_positions(x); !r) return fail(r.error());
-    const std::span<const float> all(x);
-    kidney_files.push_back(out + "/kidney_" + std::to_string(f + 1) + ".vtu");
-    liver_files.push_back(out + "/liver_" + std::to_string(f + 1) + ".vtu");
-    times.push_back(st.time);
-    if (auto w = sinew::write_vtu(liver_files.back(), all.subspan(0, std::size_t{kidney_first} * 4), 4, liver->tets); !w)
-      return fail(w.error());
-    if (auto w = sinew::write_vtu(kidney_files.back(), all.subspan(std::size_t{kidney_first} * 4), 4, kidney->tets); !w)
-      return fail(w.error());
-    probe_files.push_back(out + "/probe_" + std::to_string(f + 1) + ".vtu");
-    if (auto w = sinew::examples::write_capsule_vtu(probe_files.back(), probe.radius, probe.half_height, probe_pose); !w)
-      return fail(w.error());
+    if (auto w = output->write(*sim, f + 1); !w) return fail(w.error());
     std::printf("frame %4d  %.1f ms (collision %.1f, CCD %.1f)  %u contacts in %u colours  contact violation %.3f mm "
                 "(thickness %g mm)\n",
                 f + 1, st.wall_ms, st.collision_ms, st.ccd_ms, st.mesh_contacts, st.mesh_contact_colors,
                 1e3 * st.contact_violation, thickness_mm);
   }
-  if (auto w = sinew::write_pvd(out + "/kidney.pvd", kidney_files, times); !w) return fail(w.error());
-  if (auto w = sinew::write_pvd(out + "/liver.pvd", liver_files, times); !w) return fail(w.error());
-  if (auto w = sinew::write_pvd(out + "/probe.pvd", probe_files, times); !w) return fail(w.error());
   std::printf("mean %.1f ms/frame, of which collision %.1f and CCD %.1f; deepest contact violation %.3f mm: %s\n",
               total_ms / frames, collision_ms / frames, ccd_ms / frames, 1e3 * worst,
               worst < scene.mesh_collision.thickness ? "the organs never passed through each other"
                                                       : "the organs came closer than the thickness allows");
-  std::printf("open %s/kidney.pvd, liver.pvd and probe.pvd in ParaView\n", out.c_str());
+  std::printf("open %s/organ_contact.pvd in ParaView\n", out.c_str());
   return 0;
 }

@@ -12,8 +12,8 @@
 // the first puncture, then 4 mm more (kTighten frames), and held there: the
 // stitches close the slit.
 //
-// Writes three VTU series (pad.pvd, thread.pvd and needle.pvd; the thread
-// and needle as line cells) and prints, per reported frame, the wall time,
+// Writes suturing.pvd (the pad, the thread and the needle as lines, from
+// frame 0: sinew/vtk_output.h) and prints, per reported frame, the wall time,
 // the punctures (entering or leaving, on the needle or on the thread) and
 // how wide the slit is at the stitches' depth.
 //
@@ -29,7 +29,7 @@
 #include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
-#include "tool_surface.h"
+#include "sinew/vtk_output.h"
 
 namespace {
 
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
       "suturing",
       "Two stitches across a cut in a tissue pad, tightened: a curved needle with a 100 mm thread turned\n"
       "about the cut twice, then pulled until the knot holds. Prints per reported frame the wall time, the\n"
-      "punctures and the slit's width; writes pad.pvd, thread.pvd and needle.pvd (VTU series) into --out.");
+      "punctures and the slit's width; writes suturing.pvd (pad, thread, needle) into --out.");
   std::string backend = "auto", out = cli.default_out();
   int every = 10;
   cli.add_backend(backend);
@@ -143,7 +143,6 @@ int main(int argc, char** argv) {
               sim->device_name().c_str(), pad.mesh.tets.size(), kThreadSegments, kStitched);
 
   const std::uint32_t pad_first = sim->info().tet_body_first_particle[0];
-  const std::uint32_t thread_first = sim->info().line_body_first_particle[0];
   const std::size_t pad_vertices = pad.mesh.vertices.size();
   // The slit's width at the stitches' depth (y = -6 mm): its two faces'
   // vertices at each stitch's z (mean of the two nearest grid planes).
@@ -160,10 +159,14 @@ int main(int argc, char** argv) {
     return n > 0 ? sum / n : 0.0;
   };
 
-  std::vector<std::filesystem::path> pad_files, thread_files, needle_files;
-  std::vector<double> times;
-  std::vector<std::array<std::uint32_t, 2>> thread_cells;
-  for (std::uint32_t i = 0; i < kThreadSegments; ++i) thread_cells.push_back({i, i + 1});
+  // Bodies named as in scenes/suturing.json; frame numbers counted as the
+  // runner does (its frame 1 is this loop's f = 0), so its output is the same.
+  auto output = sinew::SceneOutput::create(
+      scene, out,
+      {.bodies = {{.kind = sinew::BodyKind::tet, .name = "pad"}, {.kind = sinew::BodyKind::line, .name = "thread"}},
+       .name = "suturing"});
+  if (!output) return fail(output.error().message());
+  if (auto s = output->write(*sim, 0); !s) return fail(s.error().message());
   std::vector<float> x, ms;
   double width_before = 0.0, pulled = 0.0;
   int knot_frame = -1, last = -1;  // when the knot first held; the last frame
@@ -193,34 +196,11 @@ int main(int argc, char** argv) {
     for (const auto& h : state->punctures) holes += std::string(h.exit ? "out" : "in") + (h.on_thread ? "/thread " : "/needle ");
     std::printf("frame %3d  %6.2f ms  slit %.2f mm  %zu punctures: %s\n", f, ms.back(), slit_width(x) * 1e3,
                 state->punctures.size(), holes.c_str());
-    // The VTU series: the pad, the thread, the needle at its pose.
-    const std::string stem = std::to_string(f);
-    pad_files.push_back(std::filesystem::path(out) / ("pad_" + stem + ".vtu"));
-    thread_files.push_back(std::filesystem::path(out) / ("thread_" + stem + ".vtu"));
-    needle_files.push_back(std::filesystem::path(out) / ("needle_" + stem + ".vtu"));
-    times.push_back(sim->last_frame().time);
-    const std::span<const float> all(x);
-    if (auto s = sinew::write_vtu(pad_files.back(), all.subspan(std::size_t{pad_first} * 4, pad_vertices * 4), 4,
-                                  pad.mesh.tets);
-        !s)
-      return fail(s.error().message());
-    if (auto s = sinew::write_vtu_lines(thread_files.back(),
-                                        all.subspan(std::size_t{thread_first} * 4, (kThreadSegments + 1) * 4), 4,
-                                        thread_cells);
-        !s)
-      return fail(s.error().message());
-    if (auto s = sinew::examples::write_polyline_vtu(needle_files.back(), needle.curve,
-                                                     {.position = state->position, .rotation = state->rotation});
-        !s)
-      return fail(s.error().message());
+    if (auto s = output->write(*sim, f + 1); !s) return fail(s.error().message());
   }
-  for (const auto& [name, files] : {std::pair{"pad.pvd", &pad_files}, std::pair{"thread.pvd", &thread_files},
-                                    std::pair{"needle.pvd", &needle_files}})
-    if (auto s = sinew::write_pvd(std::filesystem::path(out) / name, *files, times); !s)
-      return fail(s.error().message());
   std::sort(ms.begin(), ms.end());
   std::printf("median %.2f ms per frame; the slit at the stitches %.2f -> %.2f mm\n", ms[ms.size() / 2],
               width_before * 1e3, slit_width(x) * 1e3);
-  std::printf("open %s/pad.pvd, thread.pvd and needle.pvd in ParaView\n", out.c_str());
+  std::printf("open %s/suturing.pvd in ParaView\n", out.c_str());
   return 0;
 }

@@ -1,7 +1,7 @@
-// tool_surface_test.cpp — the examples' tool surfaces (examples/common/
-// tool_surface.h): a capsule's surface bounds a solid, faces outward, and
-// lies on the capsule at its pose.
-#include "tool_surface.h"
+// tool_surface_test.cpp — the display surfaces of tools and colliders
+// (sinew/display_surfaces.h): a capsule's surface bounds a solid, faces
+// outward, and lies on the capsule at its pose; boxes and cylinders close.
+#include "sinew/display_surfaces.h"
 
 #include <gtest/gtest.h>
 
@@ -10,11 +10,11 @@
 
 namespace {
 
-using sinew::examples::capsule_surface;
+using sinew::capsule_surface;
 
 // Distance from p to the posed capsule's axis segment.
 double axis_distance(const sinew::Vec3d& p, double half_height, const sinew::Pose& pose) {
-  const auto axis = sinew::examples::rotate(pose.rotation, {0.0, 1.0, 0.0});
+  const auto axis = sinew::rotate(pose.rotation, {0.0, 1.0, 0.0});
   double along = 0.0;
   for (int k = 0; k < 3; ++k) along += (p[k] - pose.position[k]) * axis[k];
   along = std::clamp(along, -half_height, half_height);
@@ -24,6 +24,41 @@ double axis_distance(const sinew::Vec3d& p, double half_height, const sinew::Pos
     d2 += d * d;
   }
   return std::sqrt(d2);
+}
+
+// The signed volume of a closed surface (positive when wound outward).
+double signed_volume(const sinew::TriMesh& mesh, const sinew::Pose& pose) {
+  double volume = 0.0;
+  for (const auto& t : mesh.triangles) {
+    std::array<std::array<double, 3>, 3> p{};
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) p[i][k] = mesh.vertices[t[i]][k] - pose.position[k];
+    volume += (p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) - p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
+               p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0])) /
+              6.0;
+  }
+  return volume;
+}
+
+::testing::AssertionResult closed(const sinew::TriMesh& mesh) {
+  auto report = sinew::check_closed_surface(mesh);
+  if (!report) return ::testing::AssertionFailure() << report.error().message();
+  if (report->open_edges || report->nonmanifold_edges || report->misoriented_edges || report->degenerate_triangles)
+    return ::testing::AssertionFailure() << "open, non-manifold, misoriented or degenerate";
+  return ::testing::AssertionSuccess();
+}
+
+TEST(ToolSurface, BoxAndCylinderAreClosedOutwardWithTheirVolume) {
+  const double s = std::sqrt(0.5);
+  const sinew::Pose pose{.position = {0.1, -0.2, 0.3}, .rotation = {s, s, 0.0, 0.0}};
+  const sinew::TriMesh box = sinew::box_surface({0.01, 0.02, 0.03}, pose);
+  EXPECT_TRUE(closed(box));
+  EXPECT_NEAR(signed_volume(box, pose), 8 * 0.01 * 0.02 * 0.03, 1e-12);
+  const sinew::TriMesh cylinder = sinew::cylinder_surface(0.01, 0.02, pose);
+  EXPECT_TRUE(closed(cylinder));
+  const double exact = M_PI * 0.01 * 0.01 * 0.04;
+  EXPECT_GT(signed_volume(cylinder, pose), 0.95 * exact);
+  EXPECT_LT(signed_volume(cylinder, pose), exact);  // inscribed
 }
 
 TEST(ToolSurface, CapsuleAndBallAreClosedOutwardAndOnTheShape) {
@@ -40,17 +75,7 @@ TEST(ToolSurface, CapsuleAndBallAreClosedOutwardAndOnTheShape) {
     for (const auto& v : mesh.vertices) EXPECT_NEAR(axis_distance(v, half_height, pose), 0.008, 1e-12);
     // Outward: the signed volume (divergence theorem) is positive and
     // close to the capsule's.
-    double volume = 0.0;
-    for (const auto& t : mesh.triangles) {
-      const auto &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
-      volume += ((a[0] - pose.position[0]) * ((b[1] - pose.position[1]) * (c[2] - pose.position[2]) -
-                                             (b[2] - pose.position[2]) * (c[1] - pose.position[1])) -
-                 (a[1] - pose.position[1]) * ((b[0] - pose.position[0]) * (c[2] - pose.position[2]) -
-                                             (b[2] - pose.position[2]) * (c[0] - pose.position[0])) +
-                 (a[2] - pose.position[2]) * ((b[0] - pose.position[0]) * (c[1] - pose.position[1]) -
-                                             (b[1] - pose.position[1]) * (c[0] - pose.position[0]))) /
-                6.0;
-    }
+    const double volume = signed_volume(mesh, pose);
     const double exact = M_PI * 0.008 * 0.008 * (2.0 * half_height + 4.0 / 3.0 * 0.008);
     EXPECT_GT(volume, 0.9 * exact);
     EXPECT_LT(volume, exact);  // inscribed

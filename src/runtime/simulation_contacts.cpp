@@ -37,6 +37,7 @@
 #include "math/vec3.h"
 #include "runtime/call_checks.h"
 #include "runtime/simulation_impl.h"
+#include "runtime/simulation_internals.h"
 #include "runtime/tool_contacts.h"
 #include "runtime/tool_penalty.h"
 
@@ -275,6 +276,11 @@ Status Simulation::set_collider_pose(std::size_t index, const std::array<double,
   store_words(c, entry_at(index), e);
   impl_->contacts.colliders_dirty = true;
   return {};
+}
+
+Pose SimulationInternals::collider_pose(const Simulation& sim, std::size_t index) {
+  const auto e = load_words<ColliderEntry>(sim.impl_->colliders, entry_at(index));
+  return Pose{.position = {e.end_px, e.end_py, e.end_pz}, .rotation = {e.end_qw, e.end_qx, e.end_qy, e.end_qz}};
 }
 
 Status Simulation::set_target(std::size_t index, const std::array<double, 3>& position) {
