@@ -29,10 +29,13 @@ struct ViewOptions {
   std::string scene;    ///< the scene file
   std::string backend;  ///< as RunOptions::backend
   std::string device;   ///< as RunOptions::device
-  int threads = 0;      ///< as RunOptions::threads
+  int threads = 0;      ///< cpu backend's worker threads; 0: all but one (left to the renderer)
   bool probe = true;    ///< a scene without a tool gets a probe for the mouse to drive
   int width = 1280, height = 720;  ///< the window [pixels]
   bool vsync = true;    ///< wait for the display's refresh between frames
+  /// Multisample antialiasing samples (0: none; a software renderer such as
+  /// Mesa's llvmpipe pays for each sample in every pixel).
+  int msaa = 0;
   bool no_panel = false;  ///< start with the ImGui panel hidden
   int frames = 0;       ///< close after this many rendered frames (0: when the window is closed)
   std::string screenshot;  ///< with frames: the last frame as a PPM image to this file

@@ -40,13 +40,14 @@ int main(int argc, char** argv) {
   view_cmd->add_option("--backend", view.backend, "Backend (default: the file's run.backend, else auto)")
       ->check(CLI::IsMember({"auto", "cpu", "opencl", "vulkan"}));
   view_cmd->add_option("--device", view.device, "Device index or name substring (opencl, vulkan)");
-  view_cmd->add_option("--threads", view.threads, "CPU backend worker threads (0: all)")->check(CLI::NonNegativeNumber);
+  view_cmd->add_option("--threads", view.threads, "CPU backend worker threads (0: all but one, left to the renderer)")->check(CLI::NonNegativeNumber);
   view_cmd->add_flag_callback("--no-probe", [&view] { view.probe = false; },
                               "Add no probe to a scene without tools (nothing for the mouse to drive)");
   view_cmd->add_option("--width", view.width, "Window width [pixels]")->check(CLI::Range(64, 16384));
   view_cmd->add_option("--height", view.height, "Window height [pixels]")->check(CLI::Range(64, 16384));
   view_cmd->add_flag_callback("--no-vsync", [&view] { view.vsync = false; },
                               "Draw as fast as possible instead of at the display's refresh");
+  view_cmd->add_option("--msaa", view.msaa, "Antialiasing samples per pixel (0: none)")->check(CLI::Range(0, 16));
   view_cmd->add_flag("--no-panel", view.no_panel, "Start with the panel hidden (h shows it)");
   view_cmd->add_option("--frames", view.frames, "Close after this many rendered frames")->check(CLI::PositiveNumber);
   view_cmd->add_option("--screenshot", view.screenshot, "With --frames: save the last frame to this PPM file")

@@ -8,6 +8,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "commands.h"
@@ -59,7 +61,7 @@ ToolDesc make_probe(const SceneDesc& scene) {
   probe.mass = 0.5;  // [kg]
   const double r2 = probe.radius * probe.radius, l2 = 4 * probe.half_height * probe.half_height;
   probe.inertia = {probe.mass * (3 * r2 + l2) / 12, probe.mass * r2 / 2, probe.mass * (3 * r2 + l2) / 12};
-  probe.position = {0.5 * (lo.x + hi.x), hi.y + 0.05 * size + probe.radius + probe.half_height, 0.5 * (lo.z + hi.z)};
+  probe.position = {0.5 * (lo.x + hi.x), hi.y + 0.25 * size + probe.radius + probe.half_height, 0.5 * (lo.z + hi.z)};
   probe.gravity = false;  // the hand carries the instrument
   return probe;
 }
@@ -129,7 +131,7 @@ int view_scene(const ViewOptions& o) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_SAMPLES, 4);
+  glfwWindowHint(GLFW_SAMPLES, o.msaa);
   GLFWwindow* window = glfwCreateWindow(o.width, o.height, title.c_str(), nullptr, nullptr);
   if (!window) {
     glfwTerminate();
@@ -153,8 +155,12 @@ int view_scene(const ViewOptions& o) {
     Renderer renderer;
     if (Status s = renderer.init(); !s) status = fail(s.error().message());
     MouseDevice device;
+    // The CPU backend leaves one hardware thread to this one: a software
+    // OpenGL (Mesa's llvmpipe) draws on the CPU too, and a thread team
+    // sharing its cores with the renderer waits at every barrier.
+    const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
     PhysicsThread physics(*file, DeviceOptions{.backend = o.backend.empty() ? file->run.backend : o.backend,
-                                               .device = o.device, .threads = o.threads, .quiet = true},
+                                               .device = o.device, .threads = threads, .quiet = true},
                           device);
     if (status == 0)
       if (Status s = physics.start(); !s) status = fail(s.error().message());

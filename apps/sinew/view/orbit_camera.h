@@ -23,7 +23,7 @@ class OrbitCamera {
   /// Frames a box [in] lo, hi [m]: the target at its centre, the distance to see it whole.
   void frame_box(V3 lo, V3 hi) {
     target = (lo + hi) * 0.5f;
-    distance = std::max(1.3f * length(hi - lo) / (2 * std::tan(fov_y / 2)), 1e-3f);
+    distance = std::max(1.8f * length(hi - lo) / (2 * std::tan(fov_y / 2)), 1e-3f);
   }
   [[nodiscard]] V3 eye() const {
     return target + V3{std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw)} * distance;

@@ -33,7 +33,7 @@ class ScriptedRun {
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
 
  private:
-  static constexpr std::uint64_t kSettle = 90, kStill = 30, kFollow = 60;  // physics frames
+  static constexpr std::uint64_t kSettle = 150, kStill = 30, kFollow = 60;  // physics frames
   std::filesystem::path dir_;
   V3 move_;
   int stage_ = 0;

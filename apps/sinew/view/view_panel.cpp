@@ -12,12 +12,12 @@ namespace sinew::view {
 PanelActions draw_panel(const ViewSnapshot& snap, const PanelInfo& info, DrawOptions& options) {
   PanelActions act;
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(460, 0), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("sinew view");
   ImGui::TextWrapped("%s", info.scene.c_str());
   ImGui::TextWrapped("%s", info.device.c_str());
-  ImGui::Text("rendering %.1f fps; physics %.1f Hz (the scene's rate %.1f Hz)", info.render_fps, snap.physics_hz,
+  ImGui::TextWrapped("rendering %.1f fps; physics %.1f Hz (the scene's rate %.1f Hz)", info.render_fps, snap.physics_hz,
               info.frame_time > 0 ? 1.0 / info.frame_time : 0.0);
   if (!snap.error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "stopped: %s", snap.error.c_str());
 
@@ -61,9 +61,9 @@ PanelActions draw_panel(const ViewSnapshot& snap, const PanelInfo& info, DrawOpt
   ImGui::Text("mesh contacts %u  ccd hits %u  sweeps %llu", st.mesh_contacts, st.ccd_hits,
               static_cast<unsigned long long>(st.sweeps));
   if (ImGui::BeginTable("stages", 3, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
-    ImGui::TableSetupColumn("stage");
-    ImGui::TableSetupColumn("ms");
-    ImGui::TableSetupColumn("counters");
+    ImGui::TableSetupColumn("stage", ImGuiTableColumnFlags_WidthFixed, 150.0f);
+    ImGui::TableSetupColumn("ms", ImGuiTableColumnFlags_WidthFixed, 60.0f);
+    ImGui::TableSetupColumn("counters", ImGuiTableColumnFlags_WidthStretch);
     ImGui::TableHeadersRow();
     for (const StageProfile& s : st.stages) {
       ImGui::TableNextRow();
