@@ -15,6 +15,8 @@ packages=(
   python3-jsonschema                  # the scene files checked against their schema (tests)
   gnuplot-nox                         # plots in the reports
   doxygen                             # API reference (cmake --build build --target docs; optional)
+  libglfw3-dev libgl-dev libimgui-dev libgl1-mesa-dri  # sinew view (docs/viewer.md)
+  xvfb xauth                          # sinew view's headless test (xvfb-run)
 )
 
 missing=()

@@ -207,7 +207,9 @@ void Renderer::draw(const GpuMesh& mesh, const M4& model, const DrawStyle& style
   glUniform1i(u_vertex_colours_, style.vertex_colours ? 1 : 0);
   glUniform1f(u_point_size_, style.point_size);
   glDepthMask(style.alpha < 1.0f ? GL_FALSE : GL_TRUE);
+  if (style.on_top) glDisable(GL_DEPTH_TEST);
   mesh.draw();
+  if (style.on_top) glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
 }
 

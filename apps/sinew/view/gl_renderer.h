@@ -54,6 +54,7 @@ struct DrawStyle {
   bool vertex_colours = false; ///< the vertices' colours instead of `colour`
   float alpha = 1.0f;          ///< < 1: blended (drawn after the opaque ones)
   float point_size = 4.0f;     ///< [pixels], points only
+  bool on_top = false;         ///< drawn over everything (no depth test): the handle inside its tool
 };
 
 /// The shader program and the frame's camera.

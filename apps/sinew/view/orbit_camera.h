@@ -16,8 +16,8 @@ class OrbitCamera {
  public:
   V3 target{0, 0, 0};     ///< the point orbited [m]
   float distance = 0.3f;  ///< from the target [m], > 0
-  float yaw = 0.6f;       ///< [rad]
-  float pitch = 0.45f;    ///< [rad], within +-1.5
+  float yaw = 0.35f;       ///< [rad]
+  float pitch = 0.35f;    ///< [rad], within +-1.5
   float fov_y = 0.8f;     ///< vertical field of view [rad]
 
   /// Frames a box [in] lo, hi [m]: the target at its centre, the distance to see it whole.

@@ -187,14 +187,14 @@ void SceneDrawer::draw(Renderer& r, const ViewSnapshot& snap, const DrawOptions&
     const V3 tool = V3(snap.tools[static_cast<std::size_t>(handle.tool)].position);
     const float knob = 0.012f * extent_;
     r.draw(sphere_, pose_matrix(handle.position.to_double(), {1, 0, 0, 0}, {knob, knob, knob}),
-           {.colour = kHandleColour, .alpha = 0.8f});
+           {.colour = kHandleColour, .alpha = 0.8f, .on_top = true});
     MeshData spring;
     spring.add(handle.position, {0, 1, 0});
     spring.add(tool, {0, 1, 0});
     spring.indices = {0, 1};
     spring_.set_vertices(spring.vertices);
     spring_.set_indices(spring.indices);
-    r.draw(spring_, identity, {.colour = kHandleColour, .lit = false});
+    r.draw(spring_, identity, {.colour = kHandleColour, .lit = false, .on_top = true});
     draw_arrow(r, handle.position, handle.force * arrow_scale_, kForceColour);
   }
 }
