@@ -3,6 +3,8 @@
 // (view/physics_thread.h); this thread draws the newest snapshot, runs the
 // ImGui panel, and turns the mouse into a virtual haptic device whose
 // handle the haptic loop couples to the picked tool (view/mouse_device.h).
+#include <sys/resource.h>
+
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
@@ -332,9 +334,16 @@ int view_scene(const ViewOptions& o) {
       }
       const double seconds = std::chrono::duration<double>(clock::now() - start).count();
       const std::uint64_t physics_frames = snapshots.front().frame - physics_start;
-      std::printf("rendered %d frames in %.2f s: %.1f frames per second; physics %llu frames: %.1f Hz (the scene's rate %.1f Hz)\n",
+      // The process's CPU time (physics, haptic loop, this thread and a
+      // software OpenGL's threads): how many cores the view needs.
+      rusage usage{};
+      getrusage(RUSAGE_SELF, &usage);
+      const double cpu = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+      std::printf("rendered %d frames in %.2f s: %.1f frames per second; physics %llu frames: %.1f Hz (the scene's rate %.1f Hz); "
+                  "CPU time %.2f s (%.2f cores)\n",
                   rendered, seconds, rendered / seconds, static_cast<unsigned long long>(physics_frames),
-                  physics_frames / seconds, 1.0 / physics.file().scene.solver.time_step);
+                  physics_frames / seconds, 1.0 / physics.file().scene.solver.time_step, cpu, cpu / seconds);
       if (script && status == 0) std::printf("%s", script->report().c_str());
       std::fflush(stdout);
       physics.stop();

@@ -73,7 +73,6 @@ Status PhysicsThread::make_simulation() {
   auto sim = Simulation::create(file_.scene, device_options_);
   if (!sim) return sim.error();
   sim_.emplace(std::move(*sim));
-  device_name_ = sim_->device_name();
   player_.emplace(file_.script);
   bridged_tool_ = -1;
   ++generation_;
@@ -214,6 +213,7 @@ Status PhysicsThread::fill_snapshot(ViewSnapshot& out) {
 
 void PhysicsThread::run(std::promise<Status> ready) {
   Status made = make_simulation();
+  if (made) device_name_ = sim_->device_name();  // before start() returns: the viewer reads it from then on
   if (made)
     if (Status s = fill_snapshot(snapshots_.back()); !s) made = s;
   const bool ok = static_cast<bool>(made);
