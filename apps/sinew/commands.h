@@ -37,6 +37,7 @@ struct ViewOptions {
   /// Mesa's llvmpipe pays for each sample in every pixel).
   int msaa = 0;
   bool no_panel = false;  ///< start with the ImGui panel hidden
+  bool paused = false;    ///< start with the physics paused (space runs it)
   int frames = 0;       ///< close after this many rendered frames (0: when the window is closed)
   std::string screenshot;  ///< with frames: the last frame as a PPM image to this file
   /// A headless test: screenshots into this folder before and after moving

@@ -48,13 +48,15 @@ int main(int argc, char** argv) {
   view_cmd->add_flag_callback("--no-vsync", [&view] { view.vsync = false; },
                               "Draw as fast as possible instead of at the display's refresh");
   view_cmd->add_option("--msaa", view.msaa, "Antialiasing samples per pixel (0: none)")->check(CLI::Range(0, 16));
+  CLI::Option* paused = view_cmd->add_flag("--paused", view.paused, "Start with the physics paused (space runs it)");
   view_cmd->add_flag("--no-panel", view.no_panel, "Start with the panel hidden (h shows it)");
   view_cmd->add_option("--frames", view.frames, "Close after this many rendered frames")->check(CLI::PositiveNumber);
   view_cmd->add_option("--screenshot", view.screenshot, "With --frames: save the last frame to this PPM file")
       ->needs("--frames");
   view_cmd->add_option("--script-test", view.script_test,
                        "Headless test: settle, screenshot, move the handle by --move-tool, screenshot, close; "
-                       "images into this folder");
+                       "images into this folder")
+      ->excludes(paused);
   view_cmd->add_option("--move-tool", view.move_tool, "With --script-test: the handle's move dx,dy,dz [m]")
       ->needs("--script-test");
 #endif

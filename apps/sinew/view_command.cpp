@@ -164,6 +164,7 @@ int view_scene(const ViewOptions& o) {
     PhysicsThread physics(*file, DeviceOptions{.backend = o.backend.empty() ? file->run.backend : o.backend,
                                                .device = o.device, .threads = threads, .quiet = true},
                           device);
+    physics.set_paused(o.paused);
     if (status == 0)
       if (Status s = physics.start(); !s) status = fail(s.error().message());
     if (status == 0) {
