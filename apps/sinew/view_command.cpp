@@ -192,12 +192,15 @@ int view_scene(const ViewOptions& o) {
       auto fps_start = start;
       int fps_frames = 0, rendered = 0;
       double fps = 0.0;
-      const std::uint64_t physics_start = snapshots.front().frame;
+      // Physics frames seen, over resets (each new Simulation counts from 0).
+      std::uint64_t physics_frames = 0, counted_frame = snapshots.front().frame;
       while (!glfwWindowShouldClose(window)) {
         glfwPollEvents();
         snapshots.update();
         const ViewSnapshot& snap = snapshots.front();
-        // A new Simulation (reset) or another tool: the handle goes to the tool.
+        physics_frames += snap.generation == generation_seen ? snap.frame - counted_frame : snap.frame;
+        counted_frame = snap.frame;
+        // A new Simulation (reset): the handle goes to the driven tool.
         if (snap.generation != generation_seen) {
           generation_seen = snap.generation;
           const int t = physics.driven_tool();
@@ -334,7 +337,6 @@ int view_scene(const ViewOptions& o) {
         if (last) break;
       }
       const double seconds = std::chrono::duration<double>(clock::now() - start).count();
-      const std::uint64_t physics_frames = snapshots.front().frame - physics_start;
       // The process's CPU time (physics, haptic loop, this thread and a
       // software OpenGL's threads): how many cores the view needs.
       rusage usage{};
