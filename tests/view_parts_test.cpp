@@ -174,6 +174,28 @@ TEST(ViewShapeMeshes, CapsuleSurfaceIsAtItsRadius) {
   for (std::uint32_t i : m.indices) EXPECT_LT(i, m.vertices.size() / 9);
 }
 
+// A needle's tube: every vertex at the radius from its segment, normals out.
+TEST(ViewShapeMeshes, TubeAroundAPolyline) {
+  const std::vector<Vec3d> curve = {{0, 0, 0}, {0.01, 0, 0}, {0.01, 0.01, 0.005}};
+  const double radius = 2e-4;
+  const MeshData m = tube(curve, radius);
+  ASSERT_EQ(m.indices.size() % 3, 0u);
+  ASSERT_GT(m.indices.size(), 0u);
+  for (std::size_t v = 0; v < m.vertices.size(); v += 9) {
+    const V3 p{m.vertices[v], m.vertices[v + 1], m.vertices[v + 2]};
+    const V3 n{m.vertices[v + 3], m.vertices[v + 4], m.vertices[v + 5]};
+    // The nearest of the two segments.
+    float best = 1e30f;
+    for (std::size_t k = 1; k < curve.size(); ++k) {
+      const V3 a(curve[k - 1]), b(curve[k]);
+      const float t = std::fmax(0.0f, std::fmin(1.0f, dot(p - a, b - a) / dot(b - a, b - a)));
+      best = std::fmin(best, length(p - (a + (b - a) * t)));
+    }
+    EXPECT_NEAR(best, radius, 1e-7);
+    EXPECT_NEAR(length(n), 1.0f, 1e-5);
+  }
+}
+
 // A body's vertex normals: the mean of its faces', outward for a closed box.
 TEST(ViewShapeMeshes, BodyNormalsPointOut) {
   // The unit box's corners as one body (8 particles, 12 outward triangles).

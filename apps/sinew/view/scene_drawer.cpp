@@ -51,12 +51,10 @@ SceneDrawer::SceneDrawer(const SceneDesc& scene)
   }
   for (const ColliderDesc& c : scene.colliders) collider_meshes_.push_back(collider_mesh(c, nullptr));
   for (const NeedleDesc& n : scene.needles) {
-    MeshData curve;
-    for (std::size_t k = 0; k < n.curve.size(); ++k) {
-      curve.add(V3(n.curve[k]), {0, 1, 0});
-      if (k) curve.indices.insert(curve.indices.end(), {static_cast<std::uint32_t>(k - 1), static_cast<std::uint32_t>(k)});
-    }
-    needle_meshes_.emplace_back(curve, Primitive::lines);
+    // A tube a fiftieth of the curve's length thick (a needle's size is not in its description).
+    double curve_length = 0.0;
+    for (std::size_t k = 1; k < n.curve.size(); ++k) curve_length += length(V3(n.curve[k]) - V3(n.curve[k - 1]));
+    needle_meshes_.emplace_back(tube(n.curve, std::max(0.01 * curve_length, 1e-5)));
   }
   fluid_.set_primitive(Primitive::points);
   spring_.set_primitive(Primitive::lines);
@@ -179,7 +177,7 @@ void SceneDrawer::draw(Renderer& r, const ViewSnapshot& snap, const DrawOptions&
     }
   for (std::size_t n = 0; n < snap.needles.size() && n < needle_meshes_.size(); ++n) {
     const NeedleState& s = snap.needles[n];
-    r.draw(needle_meshes_[n], pose_matrix(s.position, s.rotation), {.colour = kNeedleColour, .lit = false});
+    r.draw(needle_meshes_[n], pose_matrix(s.position, s.rotation), {.colour = kNeedleColour});
     if (options.contacts) draw_arrow(r, V3(s.position), V3(s.reaction_force) * arrow_scale_, kContactColour);
   }
   if (options.fluid && !snap.fluid.empty()) r.draw(fluid_, identity, {.colour = kFluidColour, .lit = false, .point_size = 3.0f});

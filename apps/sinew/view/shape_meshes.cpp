@@ -104,6 +104,29 @@ MeshData unit_arrow(int slices) {
   return out;
 }
 
+MeshData tube(std::span<const Vec3d> polyline, double radius, int slices) {
+  MeshData out;
+  const auto r = static_cast<float>(radius);
+  for (std::size_t k = 1; k < polyline.size(); ++k) {
+    const V3 a(polyline[k - 1]), b(polyline[k]);
+    const V3 d = normalize(b - a);
+    const V3 helper = std::fabs(d.x) < 0.9f ? V3{1, 0, 0} : V3{0, 0, 1};
+    const V3 x = normalize(cross(helper, d)), z = cross(d, x);
+    const auto base = static_cast<std::uint32_t>(out.vertices.size() / 9);
+    for (int s = 0; s <= slices; ++s) {
+      const float angle = 2 * kPi * s / slices;
+      const V3 n = x * std::cos(angle) + z * std::sin(angle);
+      out.add(a + n * r, n);
+      out.add(b + n * r, n);
+    }
+    for (std::uint32_t s = 0; s < static_cast<std::uint32_t>(slices); ++s) {
+      const std::uint32_t i = base + 2 * s;
+      out.indices.insert(out.indices.end(), {i, i + 1, i + 2, i + 2, i + 1, i + 3});
+    }
+  }
+  return out;
+}
+
 MeshData surface_mesh(const TriMesh& surface) {
   std::vector<float> xyzw;
   xyzw.reserve(surface.vertices.size() * 4);

@@ -33,6 +33,8 @@ MeshData unit_box();
 MeshData unit_square();
 /// An arrow from the origin to (0, 1, 0), its shaft 0.04 and its head 0.12 wide (scale it).
 MeshData unit_arrow(int slices = 12);
+/// A tube of `radius` [m] along a polyline [m] (a needle's curve), one open cylinder per segment.
+MeshData tube(std::span<const Vec3d> polyline, double radius, int slices = 8);
 /// A surface given in the shape's frame (a level set's, LevelSet::surface), with smooth normals.
 MeshData surface_mesh(const TriMesh& surface);
 
