@@ -174,25 +174,26 @@ TEST(ViewShapeMeshes, CapsuleSurfaceIsAtItsRadius) {
   for (std::uint32_t i : m.indices) EXPECT_LT(i, m.vertices.size() / 9);
 }
 
-// A needle's tube: every vertex at the radius from its segment, normals out.
+// A needle's tube: every vertex at the radius from its own segment, normals out.
 TEST(ViewShapeMeshes, TubeAroundAPolyline) {
   const std::vector<Vec3d> curve = {{0, 0, 0}, {0.01, 0, 0}, {0.01, 0.01, 0.005}};
   const double radius = 2e-4;
-  const MeshData m = tube(curve, radius);
-  ASSERT_EQ(m.indices.size() % 3, 0u);
-  ASSERT_GT(m.indices.size(), 0u);
-  for (std::size_t v = 0; v < m.vertices.size(); v += 9) {
-    const V3 p{m.vertices[v], m.vertices[v + 1], m.vertices[v + 2]};
-    const V3 n{m.vertices[v + 3], m.vertices[v + 4], m.vertices[v + 5]};
-    // The nearest of the two segments.
-    float best = 1e30f;
-    for (std::size_t k = 1; k < curve.size(); ++k) {
-      const V3 a(curve[k - 1]), b(curve[k]);
-      const float t = std::fmax(0.0f, std::fmin(1.0f, dot(p - a, b - a) / dot(b - a, b - a)));
-      best = std::fmin(best, length(p - (a + (b - a) * t)));
-    }
-    EXPECT_NEAR(best, radius, 1e-7);
+  const int slices = 8;
+  const MeshData m = tube(curve, radius, slices);
+  const std::size_t per_segment = 2 * (slices + 1);  // a ring at each end
+  ASSERT_EQ(m.vertices.size(), 9 * per_segment * (curve.size() - 1));
+  ASSERT_EQ(m.indices.size(), 6u * slices * (curve.size() - 1));
+  for (std::size_t v = 0; v < m.vertices.size() / 9; ++v) {
+    const V3 p{m.vertices[9 * v], m.vertices[9 * v + 1], m.vertices[9 * v + 2]};
+    const V3 n{m.vertices[9 * v + 3], m.vertices[9 * v + 4], m.vertices[9 * v + 5]};
+    const std::size_t k = v / per_segment + 1;
+    const V3 a(curve[k - 1]), b(curve[k]);
+    const float t = dot(p - a, b - a) / dot(b - a, b - a);
+    EXPECT_TRUE(std::fabs(t) < 1e-4f || std::fabs(t - 1) < 1e-4f) << "vertex " << v << " not at an end";
+    EXPECT_NEAR(length(p - (a + (b - a) * t)), radius, 1e-7);
     EXPECT_NEAR(length(n), 1.0f, 1e-5);
+    EXPECT_NEAR(dot(n, b - a), 0.0f, 1e-7);
+    EXPECT_GT(dot(n, p - (a + (b - a) * t)), 0.0f);
   }
 }
 
