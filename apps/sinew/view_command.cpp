@@ -149,13 +149,13 @@ int view_scene(const ViewOptions& o) {
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the working folder
   ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init("#version 330 core");
-
   int status = 0;
+  if (!ImGui_ImplGlfw_InitForOpenGL(window, true) || !ImGui_ImplOpenGL3_Init("#version 330 core"))
+    status = fail("Dear ImGui's GLFW or OpenGL 3 backend could not start");
   {
     Renderer renderer;
-    if (Status s = renderer.init(); !s) status = fail(s.error().message());
+    if (status == 0)
+      if (Status s = renderer.init(); !s) status = fail(s.error().message());
     MouseDevice device;
     // The CPU backend leaves one hardware thread to this one: a software
     // OpenGL (Mesa's llvmpipe) draws on the CPU too, and a thread team
