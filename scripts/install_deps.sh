@@ -18,6 +18,8 @@ packages=(
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib  # the Python module, its tests, its plot example
   gnuplot-nox                         # plots in the reports
   doxygen                             # API reference (cmake --build build --target docs; optional)
+  libglfw3-dev libgl-dev libimgui-dev libgl1-mesa-dri  # sinew view (docs/viewer.md)
+  xvfb xauth                          # sinew view's headless test (xvfb-run)
 )
 
 missing=()
