@@ -136,8 +136,8 @@ Status PhysicsThread::step_frame() {
     if (Status s = bridge_->apply_feedback(*sim_); !s) return s;
   results_.clear();
   const int frame = static_cast<int>(frame_ + 1);
-  if (Status s = player_->before_frame(*sim_, frame, nullptr, &results_); !s) return s;
-  for (const ScriptActionResult& r : results_) {
+  if (Status s = player_->before_frame(*sim_, frame, results_); !s) return s;
+  for (const ScriptEvent& r : results_) {
     if (r.kind == ScriptActionKind::cut || r.kind == ScriptActionKind::cauterize ||
         r.kind == ScriptActionKind::remove)
       note_change(r.topology);

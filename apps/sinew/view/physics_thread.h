@@ -93,7 +93,7 @@ class PhysicsThread {
   std::shared_ptr<const std::vector<TriMesh>> collider_surfaces_;
   std::vector<float> velocities_;
   std::vector<FluidParticle> fluid_;
-  std::vector<ScriptActionResult> results_;
+  std::vector<ScriptEvent> results_;
   double physics_hz_ = 0.0;
   std::string error_;
 
