@@ -21,6 +21,7 @@ import struct
 import sys
 
 import scene_json
+from motion import ramp
 
 RADIUS, CUT_DEPTH, VOXEL = 2e-3, 1e-4, 2.5e-4
 TICK = 1e-3
@@ -37,14 +38,6 @@ def read_stl(path):
     count = struct.unpack_from("<I", data, 80)[0]
     return [[[c * 1e-3 for c in struct.unpack_from("<3f", data, 84 + 50 * t + 12 + 12 * k)] for k in range(3)]
             for t in range(count)]
-
-
-def ramp(t, a, b):
-    if t <= a:
-        return 0.0
-    if t >= b:
-        return 1.0
-    return 0.5 - 0.5 * math.cos(math.pi * (t - a) / (b - a))
 
 
 data = sys.argv[1] if len(sys.argv) > 1 else "data"

@@ -13,6 +13,7 @@ import math
 import sys
 
 import scene_json
+from motion import ramp
 
 CELL = 0.004
 TOP = 5 * CELL
@@ -21,14 +22,6 @@ START_Y = TOP + 0.005 + RADIUS + HALF_HEIGHT
 PRESS, DRAG, DURATION, DT = 0.012, 0.02, 5.0, 1.0 / 250.0
 # The ramps' spans [s]: press, drag, lift.
 RAMPS = [(0.5, 1.5), (2.0, 3.5), (4.0, 4.6)]
-
-
-def ramp(t, a, b):
-    if t <= a:
-        return 0.0
-    if t >= b:
-        return 1.0
-    return 0.5 - 0.5 * math.cos(math.pi * (t - a) / (b - a))
 
 
 def hand(t):
