@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>  // getpid
+
 #include "fluid_cup.h"
 #include "mesh_contact_support.h"
 #include "robustness_scenes.h"
@@ -22,9 +24,11 @@ using test::Snapshot;
 
 class SavedStateTest : public test::BackendTest {};
 
+// ctest runs each test in a process of its own, two at a time: a name
+// shared by two tests (bad.state) needs the process's id to stay theirs.
 std::string tmp_path(const std::string& name) {
   std::filesystem::create_directories(SINEW_TEST_TMP_DIR);
-  return std::string(SINEW_TEST_TMP_DIR) + "/" + name;
+  return std::string(SINEW_TEST_TMP_DIR) + "/" + std::to_string(::getpid()) + "_" + name;
 }
 
 TEST_P(SavedStateTest, RestoreThenStepIsBitwiseTheUninterruptedRun) {
