@@ -105,6 +105,16 @@ struct FrameStats {
   /// measure as residual_rms, also when measure_errors is off). 0 in fixed mode.
   double checked_residual = 0.0;
   std::uint32_t residual_checks = 0;  ///< residual mode: checks (round trips) in the last frame
+  /// Residual mode with SolverSettings::warm_start: substeps of the last
+  /// frame whose lambdas were not carried into the next substep (or
+  /// frame), because the substep ended at max_iterations with a residual no
+  /// lower than at its first check (not converging: carried on, such
+  /// lambdas diverged) — the time budget's stops are not counted.
+  std::uint32_t dropped_warm_starts = 0;
+  /// Whether the last frame's solve converged: every substep's residual
+  /// reached SolverSettings::residual_tolerance. Always false in fixed mode
+  /// (no residual is checked there; residual_rms says how far it was).
+  [[nodiscard]] bool converged() const { return stop == SolveStop::converged; }
   /// Mesh collision (SceneDesc::mesh_collision), 0 without: the frame's
   /// contacts, their colours (dispatches per sweep), the motion margin they
   /// were found within [m], and the wall time [ms] of reading the
