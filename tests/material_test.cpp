@@ -45,17 +45,23 @@ TEST(LinearElasticOracle, BarUnderEndTractionIsExact) {
   StaticLoads loads;
   loads.density = 0.0;
   loads.point_forces.assign(mesh.vertices.size(), Vec3d{0, 0, 0});
-  // Consistent loads of a uniform traction on the x = L face: each boundary
-  // triangle gives a third of its area's share to each corner.
+  // Consistent loads of a uniform traction on the x = L face: each tet
+  // face there gives a third of its force to each of its corners.
   const double traction = force / (width * depth);
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j) {
-      const std::uint32_t corner[4] = {std::uint32_t(nx + (nx + 1) * (j + (ny + 1) * k)),
-                                       std::uint32_t(nx + (nx + 1) * (j + 1 + (ny + 1) * k)),
-                                       std::uint32_t(nx + (nx + 1) * (j + (ny + 1) * (k + 1))),
-                                       std::uint32_t(nx + (nx + 1) * (j + 1 + (ny + 1) * (k + 1)))};
-      // Bilinear shape functions integrate to a quarter of the face each.
-      for (std::uint32_t v : corner) loads.point_forces[v][0] += traction * kCell * kCell / 4.0;
+  for (const auto& tet : mesh.tets)
+    for (int skip = 0; skip < 4; ++skip) {
+      std::uint32_t f[3];
+      int n = 0;
+      for (int i = 0; i < 4; ++i)
+        if (i != skip) f[n++] = tet[std::size_t(i)];
+      bool on_end = true;
+      for (std::uint32_t v : f) on_end = on_end && std::abs(mesh.vertices[v][0] - length) < 1e-9;
+      if (!on_end) continue;
+      const Vec3d& a = mesh.vertices[f[0]];
+      const Vec3d& b = mesh.vertices[f[1]];
+      const Vec3d& c = mesh.vertices[f[2]];
+      const double area = 0.5 * std::abs((b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]));
+      for (std::uint32_t v : f) loads.point_forces[v][0] += traction * area / 3.0;
     }
   // Rollers on x = 0 (u_x = 0), one corner held in y and z, one in z.
   for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
@@ -75,31 +81,39 @@ TEST(LinearElasticOracle, BarUnderEndTractionIsExact) {
   EXPECT_NEAR(through, -nu * strain * depth, 1e-6 * nu * strain * depth);
 }
 
-// The oracle: a clamped cantilever under its own weight against Euler-
-// Bernoulli (q L^4 / (8 E I)) plus Timoshenko's shear term (q L^2 /
-// (2 kappa G A), kappa = 5/6), on a mesh fine enough for linear tets.
-TEST(LinearElasticOracle, CantileverMatchesBeamTheoryOnAFineMesh) {
-  const int nx = 60, n = 6;
-  const double h = 0.02, cell = h / n, length = nx * cell, nu = 0.0, rho = 1000.0, g = 1.0;
-  const TetMesh mesh = test::graded_box(nx, n, n, cell, 1.0, 0.0);
-  StaticLoads loads;
-  loads.density = rho;
-  loads.gravity = {0.0, -g, 0.0};
-  for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
-    if (mesh.vertices[v][0] < 1e-9) loads.pinned.push_back(v);
-  std::string error;
-  const auto u = test::solve_linear_elastic(mesh, kE, nu, loads, &error);
-  ASSERT_FALSE(u.empty()) << error;
+// The oracle: a clamped cantilever (L/h = 10, nu = 0) under its own weight
+// against Euler-Bernoulli (q L^4 / (8 E I)) plus Timoshenko's shear term
+// (q L^2 / (2 kappa G A), kappa = 5/6). Linear tets are too stiff in
+// bending by O(h^2), so the check is on two meshes (3 and 6 cells through
+// the thickness): the error must shrink at least 2.5x (3.1x measured: not
+// yet quite the asymptotic 4x), and the Richardson extrapolation
+// (4 r_6 - r_3) / 3 must be within 3% of the theory (measured 0.974: the
+// fully pinned end also stops the section warping that Timoshenko's
+// shear term assumes free, which stiffens it a little).
+TEST(LinearElasticOracle, CantileverConvergesToBeamTheory) {
+  const double h = 0.02, length = 10 * h, nu = 0.0, rho = 1000.0, g = 1.0;
   const double area = h * h, inertia = h * h * h * h / 12.0, q = rho * g * area;
-  const double shear_modulus = kE / (2.0 * (1.0 + nu));
-  const double theory = q * std::pow(length, 4) / (8.0 * kE * inertia) + q * length * length / (2.0 * 5.0 / 6.0 * shear_modulus * area);
-  const double tip = -test::mean_displacement(mesh, u, 1, 0, length);
-  std::printf("[ oracle ] cantilever L/h = %.0f: tip %.5e m, beam theory %.5e m (ratio %.4f)\n", length / h, tip,
-              theory, tip / theory);
-  // Linear tets are a little stiff in bending (about 3% at 6 through the
-  // thickness); the clamp's constraint of the cross-section's own
-  // deformation stiffens it a little more.
-  EXPECT_NEAR(tip / theory, 1.0, 0.05);
+  const double theory = q * std::pow(length, 4) / (8.0 * kE * inertia) +
+                        q * length * length / (2.0 * 5.0 / 6.0 * kE / (2.0 * (1.0 + nu)) * area);
+  double ratio[2];
+  for (int k = 0; k < 2; ++k) {
+    const int n = 3 * (k + 1);
+    const TetMesh mesh = test::graded_box(10 * n, n, n, h / n, 1.0, 0.0);
+    StaticLoads loads;
+    loads.density = rho;
+    loads.gravity = {0.0, -g, 0.0};
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
+      if (mesh.vertices[v][0] < 1e-9) loads.pinned.push_back(v);
+    std::string error;
+    const auto u = test::solve_linear_elastic(mesh, kE, nu, loads, &error);
+    ASSERT_FALSE(u.empty()) << error;
+    ratio[k] = -test::mean_displacement(mesh, u, 1, 0, length) / theory;
+    std::printf("[ oracle ] cantilever, %d cells through the thickness: tip / beam theory %.4f\n", n, ratio[k]);
+  }
+  EXPECT_LT(ratio[0], ratio[1]);  // stiff, less so when finer
+  EXPECT_GT(ratio[1], 0.85);
+  EXPECT_LT(1.0 - ratio[1], (1.0 - ratio[0]) / 2.5);
+  EXPECT_NEAR((4.0 * ratio[1] - ratio[0]) / 3.0, 1.0, 0.03);
 }
 
 // The singular case is an error, not a silent answer.
