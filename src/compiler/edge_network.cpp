@@ -263,15 +263,17 @@ BodyNetworkFit fit_body_network(const TetMesh& mesh, double young, double poisso
   }
   const auto fit_one = [&](const TetFit& f, const P4& p, const Mat6& wtw) {
     const auto k = fit_nonnegative(f, wtw);
-    // Floors, so that every compliance is finite and no mode is free: a
-    // spring part of at least 1e-3 of E V / (6 L^2) (the hand-set rule's
-    // part for c_d = 1/E), a volume term of at least 1e-6 K / V.
+    // Floors, so that every compliance is finite and no spring is left
+    // slack for large deformations to fold: a spring part of at least 0.3
+    // of E V / (6 L^2) (the hand-set rule's part for c_d = 1/E; with
+    // 1e-3, a slab of flat cells squeezed to a quarter of its thickness
+    // folded), a volume term of at least 1e-6 K / V.
     TetNetworkFit out;
     const double vol = tet_volume(p);
     for (int e = 0; e < 6; ++e) {
       double l2 = 0.0;
       (void)edge_vector(p, e, l2);
-      out.edge[std::size_t(e)] = std::max(k[std::size_t(e)], 1e-3 * young * vol / (6.0 * l2));
+      out.edge[std::size_t(e)] = std::max(k[std::size_t(e)], 0.3 * young * vol / (6.0 * l2));
     }
     out.volume = std::max(k[6], 1e-6 * bulk / vol);
     return out;

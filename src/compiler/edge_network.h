@@ -66,7 +66,7 @@ struct BodyNetworkFit {
 /// Fits the springs and volume terms of a body of Young's modulus E [Pa]
 /// and Poisson's ratio nu on `mesh` (every tet positively oriented), as
 /// described at the top. The target is chosen on at most 2000 tets (every
-/// n-th). Deterministic. Each spring part is at least 1e-3 E V / (6 L^2)
+/// n-th). Deterministic. Each spring part is at least 0.3 E V / (6 L^2)
 /// and each volume term at least 1e-6 K / V, so every compliance is finite.
 BodyNetworkFit fit_body_network(const TetMesh& mesh, double young, double poisson);
 
