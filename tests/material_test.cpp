@@ -130,13 +130,13 @@ TEST(LinearElasticOracle, TooFewSupportsIsAnError) {
 // 0.45, on the regular and on the graded, jittered mesh. The bounds are
 // what the fit reaches (docs/materials.md): along the axes the mean
 // stiffness is exact, so the regular bar is within 2%; the graded mesh's
-// nodes relax non-uniformly and it is up to 30% softer in tension; bending
+// nodes relax non-uniformly and it is up to 28% softer in tension; bending
 // on two cells through the thickness is up to 17% softer (1-2% on a mesh
 // twice as fine, where the oracle's own locking is less); the wide block
 // in shear is ~30% stiffer: with its normal strains held by the supports,
 // the network's normal-shear coupling adds stiffness the mean compliance
-// does not show. The network before calibration (c_d = 1/E) was 3.4x too
-// soft in bending and 4x in shear.
+// does not show. Compliances set by hand (c_d = 1/E) are 3.4x too soft in
+// bending and 9x in shear on these meshes.
 TEST(Material, SetElasticAgainstTheOracleOnTheSameMesh) {
   for (bool graded : {false, true})
     for (double nu : {0.2, 0.3, 0.45})
