@@ -456,8 +456,11 @@ struct SolverSettings {
   /// sweeps per frame); sweeping to a tolerance keeps each substep implicit.
   /// For the same reason a substep that stops at the time budget passes
   /// nothing on: the next substep starts from lambda = 0 (cold). One that
-  /// stops at max_iterations does pass its lambdas on (a cap far below what
-  /// converges carries the fixed mode's risk). Only for
+  /// stops at max_iterations passes its lambdas on only if its sweeps
+  /// lowered the residual and it ended within 10x residual_tolerance; else
+  /// it starts its successor cold too, so a cap far below what converges
+  /// stays finite at the fixed mode's softness (FrameStats::
+  /// dropped_warm_starts counts those substeps). Only for
   /// scenes of distance and volume constraints (tet bodies without an FEM
   /// material, line bodies without bending; no colliders, no mesh
   /// collision): others are an error naming this setting.
