@@ -180,6 +180,21 @@ struct ProgramHandle {
   std::uint32_t id = UINT32_MAX;
 };
 
+/// What the host exchanged with a device, counted by the Device itself
+/// (every backend alike), from its creation on.
+struct HostTransfers {
+  std::uint64_t read_bytes = 0;   ///< bytes copied device -> host (read_buffer)
+  std::uint64_t reads = 0;        ///< read_buffer calls
+  std::uint64_t write_bytes = 0;  ///< bytes copied host -> device (write_buffer)
+  std::uint64_t submits = 0;      ///< programs submitted
+  /// Times the host blocked on the device: every read_buffer (a round trip),
+  /// and every wait(), write_buffer or submit that found a submission in
+  /// flight. (Creating, resizing or destroying a buffer while one is in
+  /// flight also waits and is not counted; the runtime does that only on
+  /// topology changes, between frames' programs.)
+  std::uint64_t waits = 0;
+};
+
 /// What a device holds now (tests check that destroying gives it back).
 struct DeviceObjects {
   std::uint32_t buffers = 0;       ///< live buffers
@@ -212,9 +227,20 @@ class Device {
   /// prepared again at their next submission (Vulkan records them again).
   virtual Status resize_buffer(BufferHandle buffer, std::size_t bytes) = 0;
   /// Copies host memory into a buffer. Errors: unknown buffer, range past its end.
-  virtual Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) = 0;
-  /// Copies a buffer into host memory.
-  virtual Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) = 0;
+  Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) {
+    settle();
+    transfers_.write_bytes += bytes;
+    return write_buffer_impl(buffer, offset, data, bytes);
+  }
+  /// Copies a buffer into host memory: a round trip, the host waits for
+  /// the device (HostTransfers::waits).
+  Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) {
+    in_flight_ = false;
+    ++transfers_.waits;
+    ++transfers_.reads;
+    transfers_.read_bytes += bytes;
+    return read_buffer_impl(buffer, offset, data, bytes);
+  }
 
   // ---------------------------------------------------------------- programs
 
@@ -227,11 +253,20 @@ class Device {
   /// Starts a program and returns without waiting (on the CPU backend it
   /// has finished when this returns). One submission is in flight at a
   /// time: submitting again first waits for the previous one.
-  virtual Status submit(ProgramHandle program) = 0;
+  Status submit(ProgramHandle program) {
+    settle();
+    ++transfers_.submits;
+    Status s = submit_impl(program);
+    in_flight_ = static_cast<bool>(s);
+    return s;
+  }
   /// Waits for the submission in flight (none: returns at once), then
   /// checks its counters: a counter above its capacity is a
   /// capacity_exceeded error naming it (the frame's other results stand).
-  virtual Status wait() = 0;
+  Status wait() {
+    settle();
+    return wait_impl();
+  }
   /// submit() then wait().
   Status run_program(ProgramHandle program) {
     if (Status s = submit(program); !s) return s;
@@ -249,6 +284,27 @@ class Device {
   }
   /// What the device holds now.
   [[nodiscard]] virtual DeviceObjects objects() const = 0;
+  /// What the host has exchanged with the device since it was made (the
+  /// runtime takes per-frame differences: FrameStats::host_waits, ...).
+  [[nodiscard]] const HostTransfers& transfers() const { return transfers_; }
+
+ protected:
+  // What each backend implements; the public calls above count them.
+  virtual Status write_buffer_impl(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) = 0;
+  virtual Status read_buffer_impl(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) = 0;
+  virtual Status submit_impl(ProgramHandle program) = 0;
+  virtual Status wait_impl() = 0;
+
+ private:
+  // A call that waits for the submission in flight (wait(), a write, the
+  // next submit) counts one wait if there is one; a backend's own calls
+  // inside an _impl then find none in flight and count nothing more.
+  void settle() {
+    if (in_flight_) ++transfers_.waits;
+    in_flight_ = false;
+  }
+  HostTransfers transfers_;
+  bool in_flight_ = false;
 };
 
 /// Makes a device. Asking for a backend that is not built, or that has no

@@ -16,9 +16,11 @@
 #include "backends/vulkan/vulkan_device.h"
 #endif
 #include "backends/kernel_table.h"
+#include "sinew/log.h"
 #include "accelerator_params.h"
 #include "bvh_params.h"
 #include "ccd_params.h"
+#include "fluid_coupling_params.h"
 #include "level_set_params.h"
 #include "narrow_phase_params.h"
 #include "mesh_contact_params.h"
@@ -243,7 +245,7 @@ Result<std::unique_ptr<Device>> create_auto_device(const DeviceOptions& options)
   why = (SINEW_HAS_OPENCL ? why + "; " : std::string()) + vulkan_why;
 #endif
   static std::once_flag said;  // "saying so once"
-  if (!options.quiet) std::call_once(said, [&] { std::fprintf(stderr, "sinew: backend auto -> cpu (%s)\n", why.c_str()); });
+  if (!options.quiet) std::call_once(said, [&] { log_message(LogLevel::warning, "backend auto -> cpu (" + why + ")"); });
   return make_cpu_device(options);
 }
 

@@ -49,7 +49,7 @@ void BM_MeshContacts(benchmark::State& state) {
     for (int f = 0; f < frames; ++f) {
       if (fold)
         for (int k = 0; k <= test::FoldedStrip::nz; ++k)
-          (void)sim->set_target(k, test::FoldedStrip::target(f, k));
+          if (auto id = sim->tools().target(k)) (void)sim->tools().set_position(*id, test::FoldedStrip::target(f, k));
       if (Status s = sim->step(); !s) {
         state.SkipWithError(s.error().message().c_str());
         return;

@@ -92,7 +92,8 @@ void BM_Suture(benchmark::State& state) {
       rest.push_back(st.wall_ms - st.suture_ms - st.collision_ms - st.ccd_ms);
       if (st.device.timed) kernel.push_back(st.device.kernel_ms[sutures_kernel]);
     }
-    auto stitched = sim->needle_state(0);
+    const auto needle_id = sim->needles().needle(0);
+    const auto stitched = needle_id ? sim->needles().state(*needle_id) : Result<NeedleState>(needle_id.error());
     if (needle && (!stitched || stitched->punctures.size() != 4)) {
       state.SkipWithError("the stitch did not make its four punctures");
       return;
@@ -154,7 +155,7 @@ void BM_SutureLiver(benchmark::State& state) {
     wall.clear(), suture.clear();
     for (int f = 0; f < 40; ++f) {
       const auto& p = needle.position;
-      if (Status s = sim->set_needle_pose(0, {p[0], p[1] - 4e-4 * (f + 1), p[2]}, {1.0, 0.0, 0.0, 0.0}); !s) {
+      if (Status s = sim->needles().set_pose(*sim->needles().needle(0), {p[0], p[1] - 4e-4 * (f + 1), p[2]}, {1.0, 0.0, 0.0, 0.0}); !s) {
         state.SkipWithError(s.error().message().c_str());
         return;
       }
@@ -165,7 +166,7 @@ void BM_SutureLiver(benchmark::State& state) {
       wall.push_back(sim->last_frame().wall_ms);
       suture.push_back(sim->last_frame().suture_ms);
     }
-    punctures = sim->needle_state(0)->punctures.size();
+    punctures = sim->needles().state(*sim->needles().needle(0))->punctures.size();
   }
   state.counters["frame_ms"] = median(wall);
   state.counters["suture_host_ms"] = median(suture);

@@ -129,9 +129,9 @@ void BM_Cut(benchmark::State& state) {
       const double z = organ ? top[2] - 0.02 + 0.004 * c : 0.0051 + 0.0095 * c;
       const double bottom = organ ? top[1] - kOrganDepth : kNy * kCell - 2e-2, width = organ ? kOrganWidth : 1e-2;
       const double above = (organ ? top[1] : kNy * kCell) + 1e-2;
-      const Simulation::Blade from{{x, above, z}, {x, bottom, z + width}};
-      const Simulation::Blade to{{x + 5e-3, above, z}, {x + 5e-3, bottom, z + width}};
-      auto e = sim->cut_body(0, from, to);
+      const Blade from{{x, above, z}, {x, bottom, z + width}};
+      const Blade to{{x + 5e-3, above, z}, {x + 5e-3, bottom, z + width}};
+      auto e = sim->topology().cut(*sim->topology().tet_body(0), from, to);
       if (!e) {
         state.SkipWithError(e.error().message().c_str());
         return;

@@ -29,10 +29,8 @@ if(SINEW_OPENVDB)
   # so look for the headers and libraries directly.
   find_path(SINEW_OPENVDB_INCLUDE_DIR openvdb/openvdb.h)
   find_path(SINEW_NANOVDB_INCLUDE_DIR nanovdb/NanoVDB.h)
-  find_library(SINEW_OPENVDB_LIBRARY openvdb)
-  # OpenVDB's headers convert halves inline through Imath (libimath-dev, a
-  # dependency of libopenvdb-dev), so the program links it too.
-  find_library(SINEW_IMATH_LIBRARY NAMES Imath Imath-3_1)
+  # The libraries (OpenVDB's and Imath's, libimath-dev) as sinew::openvdb.
+  include(${CMAKE_CURRENT_LIST_DIR}/SinewOpenVDBLibraries.cmake)
   set(_sinew_openvdb_ok FALSE)
   if(SINEW_OPENVDB_INCLUDE_DIR AND SINEW_NANOVDB_INCLUDE_DIR AND SINEW_OPENVDB_LIBRARY AND SINEW_IMATH_LIBRARY)
     set(_sinew_openvdb_ok TRUE)
@@ -56,3 +54,20 @@ function(sinew_set_warnings target)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
 endfunction()
+
+# libFuzzer: clang's -fsanitize=fuzzer must compile and link a target.
+if(SINEW_FUZZ)
+  set(_sinew_fuzz_ok FALSE)
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    include(CheckCXXSourceCompiles)
+    set(CMAKE_REQUIRED_FLAGS "-fsanitize=fuzzer,address,undefined")
+    set(CMAKE_REQUIRED_LINK_OPTIONS "-fsanitize=fuzzer,address,undefined")
+    check_cxx_source_compiles(
+      "#include <cstddef>\n#include <cstdint>\nextern \"C\" int LLVMFuzzerTestOneInput(const std::uint8_t*, std::size_t) { return 0; }"
+      SINEW_HAVE_LIBFUZZER)
+    unset(CMAKE_REQUIRED_FLAGS)
+    unset(CMAKE_REQUIRED_LINK_OPTIONS)
+    set(_sinew_fuzz_ok ${SINEW_HAVE_LIBFUZZER})
+  endif()
+  sinew_optional(SINEW_FUZZ _sinew_fuzz_ok "clang with libFuzzer (-DCMAKE_CXX_COMPILER=clang++)")
+endif()

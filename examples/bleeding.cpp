@@ -2,23 +2,22 @@
 // suction tip removes it (issue 15's example). The tissue is a 32 x 12 x
 // 32 mm block pinned at its base with a 20 x 8 x 20 mm pit carved in its
 // top (a tet grid of 2 mm cells); its surface carries the fluid's boundary
-// particles and is pushed by the blood (sinew/fluid_coupling.h: two-way,
-// momentum-conserving). A source on the pit's wall bleeds a pulsing 1 ml/s
+// particles and is pushed by the blood (SceneDesc::fluid: two-way,
+// momentum-conserving, run on the scene's device as a stage of its frame). A source on the pit's wall bleeds a pulsing 1 ml/s
 // (the heart's 72 beats a minute, +-50%); at 1.5 s a suction tip (a sink
 // of 3 mm radius) comes down into the pool and sweeps it.
 //
 // Prints every 0.1 s: the particles, the blood made and removed [ml], the
 // mass books (particles - made + removed - initial: always 0), the blood's
 // compressibility error (the densest particle's rho / rho0 - 1) and its
-// Mach number, the wall time per 2 ms frame of the fluid's steps and the
-// tissue's frame. Writes blood_N.vtu (density, pressure, velocity per
+// Mach number, the wall time per 2 ms frame of the fluid's stage and of the
+// rest of the frame (the tissue's). Writes blood_N.vtu (density, pressure, velocity per
 // particle) and tissue_N.vtu, with blood.pvd and tissue.pvd, for ParaView.
 //
 //   bleeding [--backend auto|cpu|opencl|vulkan] [--seconds S (3)] [--out DIR]
 //            [--flow ML_PER_S (1)] [--every N (25 frames between outputs)]
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -26,7 +25,6 @@
 #include <string>
 #include <vector>
 
-#include "sinew/fluid_coupling.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
 
@@ -98,36 +96,35 @@ int main(int argc, char** argv) {
     return !pit && c[1] < 11.9e-3;
   });
   scene.tet_bodies.push_back(body);
-  scene.external_forces = true;
   scene.solver.time_step = kFrame;
   scene.solver.substeps = 4;
   scene.solver.iterations = 8;
-  auto sim = sinew::Simulation::create(scene, {.backend = backend});
-  if (!sim) return fail(sim.error().message());
 
   // The blood: c0 = 5 m/s for flows up to about 0.5 m/s (density within
   // about 1%), 16 steps of 1.25e-4 s per frame (the CFL bound at rest is 1.6e-4).
-  sinew::FluidDesc blood;
-  blood.settings.spacing = kSpacing;
-  blood.settings.rest_density = 1060.0;
-  blood.settings.speed_of_sound = 5.0;
-  blood.settings.time_step = 1.25e-4;
-  blood.settings.viscosity = 0.2;
-  blood.capacity = 8000;  // 1.5 ml/s at the pulse's peak for 3 s is 4,500 particles
-  blood.device = {.backend = backend, .quiet = true};
+  sinew::SceneFluidDesc blood;
+  blood.fluid.settings.spacing = kSpacing;
+  blood.fluid.settings.rest_density = 1060.0;
+  blood.fluid.settings.speed_of_sound = 5.0;
+  blood.fluid.settings.time_step = 1.25e-4;
+  blood.fluid.settings.viscosity = 0.2;
+  blood.fluid.capacity = 8000;  // 1.5 ml/s at the pulse's peak for 3 s is 4,500 particles
   // The cut vessel: a 1.5 mm disc 1.5 mm off the pit's wall at x = 6 mm, bleeding into the pit.
   sinew::FluidEmitter vessel{.centre = {7.5e-3, 9e-3, 16e-3}, .direction = {1, -0.3, 0},
                              .radius = 1.5e-3, .flow_rate = flow_ml * 1e-6};
-  blood.emitters.push_back(vessel);
+  blood.fluid.emitters.push_back(vessel);
   const std::array<double, 3> parked{0.0, 1.0, 0.0};  // the suction tip's place before it comes in
-  blood.sinks.push_back({.centre = parked, .radius = 3e-3});
-  const sinew::CoupledSurface coupled_surface{surface, sim->info().tet_body_first_particle[0]};
-  auto coupled = sinew::FluidCoupling::create(*sim, blood, std::span(&coupled_surface, 1));
-  if (!coupled) return fail(coupled.error().message());
-  sinew::Fluid& fluid = coupled->fluid();
+  blood.fluid.sinks.push_back({.centre = parked, .radius = 3e-3});
+  blood.surfaces.push_back({.body_kind = sinew::BodyKind::tet, .body = 0, .triangles = surface.triangles});
+  scene.fluid = blood;
+  auto sim = sinew::Simulation::create(scene, {.backend = backend});
+  if (!sim) return fail(sim.error().message());
+  sinew::SceneFluid fluid = sim->fluid();
+  const auto fluid_info = fluid.info();
+  if (!fluid_info) return fail(fluid_info.error().message());
   std::printf("bleeding: %s; tissue %zu tets, %u particles; %u boundary particles on its surface; blood up to %u particles\n",
-              fluid.device_name().c_str(), mesh->tets.size(), sim->info().particles, coupled->coupled_count(),
-              fluid.capacity());
+              sim->device_name().c_str(), mesh->tets.size(), sim->info().particles, fluid_info->coupled_boundary,
+              fluid_info->capacity);
   std::printf("   t [s]  particles  made [ml]  removed [ml]  books  rho err  Mach   fluid ms  tissue ms\n");
 
   const int frames = static_cast<int>(std::lround(seconds / kFrame));
@@ -150,15 +147,16 @@ int main(int argc, char** argv) {
       tip = {20e-3, 16e-3 - 8e-3 * down, 16e-3 + 6e-3 * std::sin(2.0 * kPi * 0.5 * sweep)};
     }
     if (auto s = fluid.set_sink(0, {.centre = tip, .radius = 3e-3}); !s) return fail(s.error().message());
-    const auto t0 = std::chrono::steady_clock::now();
-    if (auto s = coupled->step(); !s) return fail(s.error().message());
-    const double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    tissue_ms.push_back(sim->last_frame().wall_ms);
-    fluid_ms.push_back(total - sim->last_frame().wall_ms);
+    if (auto s = sim->step(); !s) return fail(s.error().message());
+    const double fluid_stage_ms = sim->last_frame().stage_ms("fluid");
+    fluid_ms.push_back(fluid_stage_ms);
+    tissue_ms.push_back(sim->last_frame().wall_ms - fluid_stage_ms);
     if (frame % every != 0 && frame != frames) continue;
 
     if (auto s = fluid.read(q); !s) return fail(s.error().message());
-    const sinew::FluidStats& st = fluid.stats();
+    const auto stats = fluid.stats();
+    if (!stats) return fail(stats.error().message());
+    const sinew::FluidStats& st = *stats;
     double densest = 0.0;
     xyz.clear(), rho.clear(), pressure.clear(), velocity.clear();
     for (const auto& p : q) {

@@ -192,6 +192,10 @@ int main(int argc, char** argv) {
   scene.tools.push_back(burr);
   auto sim = sinew::Simulation::create(scene, {.backend = opt.backend, .quiet = true});
   if (!sim) return fail(sim.error().message());
+  sinew::Tools tools = sim->tools();
+  const auto burr_id = tools.tool(0);
+  const auto bone_id = tools.collider(0);
+  if (!burr_id || !bone_id) return fail("the scene lacks its burr or bone");
 
   // ------------------------------------------------------------ the haptic side
   VirtualClock clock{0};
@@ -235,12 +239,12 @@ int main(int argc, char** argv) {
     if (auto s = bridge.apply_feedback(*sim); !s) return fail(s.error().message());
     if (auto s = sim->step(); !s) return fail(s.error().message());
     const double step = ms_since(t0);
-    auto state = sim->tool_state(0);
+    auto state = tools.state(*burr_id);
     if (!state) return fail(state.error().message());
     // The bone the burr's motion in this tick swept deeper than cut_depth.
     const auto t1 = Wall::now();
     const sinew::Pose to{.position = state->position, .rotation = state->rotation};
-    auto cut = sim->cut_collider(0, cutter, from, to);
+    auto cut = tools.cut(*bone_id, cutter, from, to);
     if (!cut) return fail(cut.error().message());
     from = to;
     removed += cut->removed_volume;

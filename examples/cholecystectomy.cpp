@@ -144,6 +144,19 @@ int main(int argc, char** argv) {
   if (!sim) return fail(sim.error().message());
   const std::uint32_t organ_first = sim->info().tet_body_first_particle[0];
   const std::uint32_t sheet_first = sim->info().tri_body_first_particle[0];
+  // The features' handles and the ids of what the script drives.
+  sinew::Tools tools = sim->tools();
+  sinew::Topology topology = sim->topology();
+  const auto grasper = sim->graspers().grasper(0);
+  const auto gallbladder_id = topology.tet_body(0);
+  const auto membrane_id = topology.tri_body(0);
+  if (!grasper || !gallbladder_id || !membrane_id) return fail("the scene lacks its grasper or bodies");
+  std::vector<sinew::TargetId> edge_targets;
+  for (std::size_t i = 0; i < fastened.size(); ++i) {
+    auto id = tools.target(i);
+    if (!id) return fail(id.error().message());
+    edge_targets.push_back(*id);
+  }
   std::printf("cholecystectomy: %s; gallbladder %zu tets, membrane %zu triangles (%zu vertices fastened to the "
               "gallbladder)\n",
               sim->device_name().c_str(), organ.mesh.tets.size(), sheet.mesh.triangles.size(), fastened.size());
@@ -154,7 +167,7 @@ int main(int argc, char** argv) {
   if (!log) return fail("cannot write " + out + "/events.csv");
   std::fprintf(log, "time_s,event,body_kind,body,triangles_removed,vertices_removed,constraints_removed,"
                     "edges_softened,mass_moved_kg,mass_removed_kg,wall_ms,rebuild_ms\n");
-  auto record = [&](double t, const char* what, const sinew::Simulation::TopologyEvent& e) {
+  auto record = [&](double t, const char* what, const sinew::TopologyEvent& e) {
     if (e.triangles_removed.empty()) return;
     std::fprintf(log, "%.4f,%s,tri,%zu,%zu,%zu,%u,%u,%.4g,%.4g,%.3f,%.3f\n", t, what, e.body,
                  e.triangles_removed.size(), e.vertices_removed.size(), e.constraints_removed, e.edges_softened,
@@ -186,7 +199,7 @@ int main(int argc, char** argv) {
     // The near edge's targets: where their gallbladder vertices are now.
     for (std::size_t i = 0; i < fastened.size(); ++i) {
       const float* q = &x[4 * (std::size_t{organ_first} + fastened[i].second)];
-      if (auto s = sim->set_target(i, {q[0] + offset[i][0], q[1] + offset[i][1], q[2] + offset[i][2]}); !s)
+      if (auto s = tools.set_position(edge_targets[i], {q[0] + offset[i][0], q[1] + offset[i][1], q[2] + offset[i][2]}); !s)
         return fail(s.error().message());
     }
     // The grasper: closes on the membrane's middle at 0.5 s, lifts 15 mm by 1.5 s.
@@ -203,20 +216,20 @@ int main(int argc, char** argv) {
       }
       for (double& c : middle) c /= n;
       jaws.position = middle;
-      auto h = sim->close_grasper(0, jaws, {1.5e-3, 2e-3, 1.5e-3});  // 3 x 3 vertices
+      auto h = sim->graspers().close(*grasper, jaws, {1.5e-3, 2e-3, 1.5e-3});  // 3 x 3 vertices
       if (!h) return fail(h.error().message());
       held = h->size();
       std::printf("  %5.3f s  grasp    %zu particles held\n", t, held);
     } else if (frame > 30 && frame <= 90) {
       jaws.position[1] += 0.015 / 60.0;
-      if (auto s = sim->move_grasper(0, jaws); !s) return fail(s.error().message());
+      if (auto s = sim->graspers().move(*grasper, jaws); !s) return fail(s.error().message());
     }
     // Cautery: a 3 mm tip held on a strand near the liver edge, 0.8 to
     // 1.2 s: it touches the membrane where that strand is now (the
     // membrane sags and swings under the grasper).
     if (t >= 0.8 && t < 1.2) {
       const float* tip = &x[4 * (std::size_t{sheet_first} + strand)];
-      auto e = sim->cauterize(sinew::BodyKind::tri, 0, {tip[0], tip[1], tip[2]}, 3e-3, kFrame, 0.1);
+      auto e = topology.cauterize(*membrane_id, {tip[0], tip[1], tip[2]}, 3e-3, kFrame, 0.1);
       if (!e) return fail(e.error().message());
       record(t, "cautery", *e);
     }
@@ -228,9 +241,9 @@ int main(int argc, char** argv) {
     if (t >= 1.5 && t < 2.3) {
       const int k = frame - 90;
       const double bx = centre[0] - 0.021 + 2e-3 * k, bz = near_z - 2e-3;
-      const sinew::Simulation::Blade from{{bx - 2e-3, centre[1] + 5e-3, bz}, {bx - 2e-3, centre[1] - 1e-2, bz}};
-      const sinew::Simulation::Blade to{{bx + 2e-3, centre[1] + 5e-3, bz}, {bx + 2e-3, centre[1] - 1e-2, bz}};
-      auto e = sim->cut_body(sinew::BodyKind::tri, 0, from, to);
+      const sinew::Blade from{{bx - 2e-3, centre[1] + 5e-3, bz}, {bx - 2e-3, centre[1] - 1e-2, bz}};
+      const sinew::Blade to{{bx + 2e-3, centre[1] + 5e-3, bz}, {bx + 2e-3, centre[1] - 1e-2, bz}};
+      auto e = topology.cut(*membrane_id, from, to);
       if (!e) return fail(e.error().message());
       record(t, "cut", *e);
     }
@@ -241,8 +254,8 @@ int main(int argc, char** argv) {
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
     for (float c : x)
       if (!std::isfinite(c)) return fail("a position is not finite at " + std::to_string(t) + " s");
-    const auto organ_tets = sim->current_tets(0);
-    const auto sheet_triangles = sim->current_triangles(0);
+    const auto organ_tets = topology.current_tets(*gallbladder_id);
+    const auto sheet_triangles = topology.current_triangles(*membrane_id);
     if (!organ_tets || !sheet_triangles) return fail("current_tets, current_triangles");
     const std::span<const float> organ_x(x.data() + 4 * std::size_t{organ_first}, 4 * organ.mesh.vertices.size());
     const std::span<const float> sheet_x(x.data() + 4 * std::size_t{sheet_first}, 4 * sheet.mesh.vertices.size());
@@ -259,7 +272,7 @@ int main(int argc, char** argv) {
   // The cut freed the membrane: the gap between the live vertices on the
   // gallbladder's side of the blade's line (rest z > near_z - 2 mm) and
   // those on the liver's side (rest z < near_z - 3 mm), at the end.
-  auto live = sim->current_triangles(0);
+  auto live = topology.current_triangles(*membrane_id);
   if (!live) return fail(live.error().message());
   std::vector<std::uint8_t> used(sheet.mesh.vertices.size(), 0);
   for (const auto& triangle : *live)

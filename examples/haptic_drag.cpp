@@ -129,6 +129,8 @@ int main(int argc, char** argv) {
 
   auto sim = sinew::Simulation::create(scene, {.backend = opt.backend, .quiet = true});
   if (!sim) return fail(sim.error().message());
+  const auto probe_id = sim->tools().tool(0);
+  if (!probe_id) return fail(probe_id.error().message());
 
   // ------------------------------------------------------------ the haptic side
   MonotonicClock clock;
@@ -173,7 +175,7 @@ int main(int argc, char** argv) {
     if (auto s = bridge.publish(*sim); !s) return fail(s.error().message());
     step_ms_max = std::max(step_ms_max, sim->last_frame().wall_ms);
     step_ms_sum += sim->last_frame().wall_ms;
-    auto tool = sim->tool_state(0);
+    auto tool = sim->tools().state(*probe_id);
     if (!tool) return fail(tool.error().message());
     const Vec3& applied = bridge.last_tool_force();
     std::fprintf(frames_csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.3f\n", f * dt, tool->position[0],

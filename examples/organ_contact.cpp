@@ -147,6 +147,8 @@ int main(int argc, char** argv) {
 
   auto sim = sinew::Simulation::create(scene, {.backend = backend});
   if (!sim) return fail(sim.error());
+  const auto probe_id = sim->tools().collider(0);
+  if (!probe_id) return fail(probe_id.error());
   std::printf("%s on %s: liver %zu tets, kidney %zu tets, %u particles\n", backend.c_str(),
               sim->device_name().c_str(), liver->tets.size(), kidney->tets.size(), sim->info().particles);
   std::filesystem::create_directories(out);
@@ -160,7 +162,7 @@ int main(int argc, char** argv) {
     // kidney, the kidney 3 mm above the liver: it is pressed about 1.2 cm
     // into the liver's surface), then 3 cm along x.
     const double press = std::min(1.0, (f + 1) / (0.25 * frames)), slide = std::max(0.0, (f + 1 - 0.25 * frames) / (0.75 * frames));
-    if (auto st = sim->set_collider_pose(0, {start[0] + 0.03 * slide, start[1] - 0.02 * press, start[2]}, probe.rotation); !st)
+    if (auto st = sim->tools().set_pose(*probe_id, {start[0] + 0.03 * slide, start[1] - 0.02 * press, start[2]}, probe.rotation); !st)
       return fail(st.error());
     if (auto st = sim->step(); !st) return fail(st.error());
     const sinew::FrameStats& st = sim->last_frame();

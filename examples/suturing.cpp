@@ -131,6 +131,9 @@ int main(int argc, char** argv) {
 
   auto sim = sinew::Simulation::create(scene, {.backend = backend});
   if (!sim) return fail(sim.error().message());
+  sinew::Needles needles = sim->needles();
+  const auto needle_id = needles.needle(0);
+  if (!needle_id) return fail(needle_id.error().message());
   std::printf("suturing on %s: %zu tets, a %d-segment thread; %d frames of stitching, then the pull\n",
               sim->device_name().c_str(), pad.mesh.tets.size(), kThreadSegments, kStitched);
 
@@ -163,12 +166,12 @@ int main(int argc, char** argv) {
   for (int f = 0; last < 0 || f <= last; ++f) {
     const Pose p = script(f, pulled);
     const std::array<double, 4> q{std::cos(p.angle / 2), 0.0, 0.0, std::sin(p.angle / 2)};
-    if (auto s = sim->set_needle_pose(0, p.position, q); !s) return fail(s.error().message());
+    if (auto s = needles.set_pose(*needle_id, p.position, q); !s) return fail(s.error().message());
     if (auto s = sim->step(); !s) return fail("frame " + std::to_string(f) + ": " + s.error().message());
     ms.push_back(static_cast<float>(sim->last_frame().wall_ms));
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
     if (f == 0) width_before = slit_width(x);
-    auto state = sim->needle_state(0);
+    auto state = needles.state(*needle_id);
     if (!state) return fail(state.error().message());
     if (f >= kStitched) {  // the pull: until the knot holds at the first puncture, then kTighten frames more
       const bool knotted = !state->punctures.empty() && state->punctures[0].on_thread &&

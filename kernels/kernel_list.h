@@ -65,6 +65,7 @@
   SINEW_KERNEL(stats_kinetic_energy, 3, StatsParams, 0)                          \
   SINEW_KERNEL(stats_surface_volume, 3, StatsParams, 0)                          \
   SINEW_KERNEL(stats_tool_terms, 2, StatsParams, 0)                              \
+  SINEW_KERNEL(stats_inverted_tets, 3, StatsParams, 0)                           \
   SINEW_KERNEL(reduce_dd_blocks, 3, ReduceDdParams, 256)                         \
   /* the sweeps' accelerators (kernels/shared/accelerator_params.h) */           \
   SINEW_KERNEL(xpbd_chebyshev, 3, ChebyshevParams, 0)                            \
@@ -105,6 +106,9 @@
   SINEW_KERNEL(pbf_predict, 4, PbfParams, 0)                                    \
   SINEW_KERNEL(pbf_lambda, 6, PbfParams, 0)                                     \
   SINEW_KERNEL(pbf_delta, 6, PbfParams, 0)                                      \
-  SINEW_KERNEL(pbf_finish, 9, PbfParams, 0)
+  SINEW_KERNEL(pbf_finish, 9, PbfParams, 0)                                     \
+  /* a fluid coupled with its scene's tissue (kernels/shared/fluid_coupling_params.h) */ \
+  SINEW_KERNEL(fluid_boundary_follow, 7, FluidCouplingParams, 0)                \
+  SINEW_KERNEL(fluid_forces_on_tissue, 6, FluidCouplingParams, 0)
 
 #endif /* SINEW_KERNEL_LIST_H */

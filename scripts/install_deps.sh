@@ -11,7 +11,10 @@ packages=(
   libvulkan-dev glslc mesa-vulkan-drivers vulkan-validationlayers  # Vulkan (lavapipe: CPU device)
   libopenvdb-dev libnanovdb-dev libboost-dev                   # level sets
   libembree-dev                       # CPU broad phase
+  nlohmann-json3-dev libcli11-dev      # scene files, the sinew runner
+  python3-jsonschema                  # the scene files checked against their schema (tests)
   gnuplot-nox                         # plots in the reports
+  doxygen                             # API reference (cmake --build build --target docs; optional)
 )
 
 missing=()

@@ -10,38 +10,18 @@
 #include <vector>
 
 #include "sinew/fluid_coupling.h"
+#include "fluid_cup.h"
 #include "test_support.h"
+
+// FluidCoupling is deprecated (SceneDesc::fluid, scene_fluid_test.cpp); its
+// tests stay for the release that keeps it.
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 
 namespace sinew::test {
 namespace {
 
-constexpr double kS = 1e-3;  // the fluid's spacing and the cup's cell [m]
+constexpr double kS = kCupCell;
 
-// A cup of 8 x 5 x 8 cells of 1 mm with its inside [1, 7] x [1, 5] x [1, 7]
-// mm taken out (walls and floor one cell thick), vertices renumbered to
-// those the tets use.
-TetMesh cup() {
-  auto grid = make_tet_grid({.nx = 8, .ny = 5, .nz = 8, .cell_size = {kS, kS, kS}});
-  EXPECT_TRUE(grid.ok());
-  TetMesh carved;
-  carved.vertices = grid->vertices;
-  for (const auto& t : grid->tets) {
-    std::array<double, 3> c{};
-    for (std::uint32_t v : t)
-      for (int a = 0; a < 3; ++a) c[a] += 0.25 * grid->vertices[v][a];
-    if (c[0] > kS && c[0] < 7 * kS && c[2] > kS && c[2] < 7 * kS && c[1] > kS) continue;  // the cavity
-    carved.tets.push_back(t);
-  }
-  return drop_unused_vertices(carved);
-}
-
-std::vector<std::array<double, 3>> block(int nx, int ny, int nz, std::array<double, 3> lo) {
-  std::vector<std::array<double, 3>> out;
-  for (int i = 0; i < nx; ++i)
-    for (int j = 0; j < ny; ++j)
-      for (int k = 0; k < nz; ++k) out.push_back({lo[0] + (i + 0.5) * kS, lo[1] + (j + 0.5) * kS, lo[2] + (k + 0.5) * kS});
-  return out;
-}
 
 struct Scene {
   SceneDesc scene;
@@ -50,12 +30,7 @@ struct Scene {
 
 Scene cup_scene(bool pinned, std::array<double, 3> gravity) {
   Scene s;
-  TetBodyDesc body;
-  body.mesh = cup();
-  EXPECT_TRUE(body.set_elastic(2e5, 0.3).ok());
-  if (pinned)
-    for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
-      if (body.mesh.vertices[v][1] < 1e-9) body.pinned.push_back(v);
+  TetBodyDesc body = fluid_cup_body(pinned);
   s.surface = extract_boundary_surface(body.mesh);
   s.scene.tet_bodies.push_back(std::move(body));
   s.scene.gravity = gravity;
@@ -75,7 +50,7 @@ TEST(FluidCoupling, ACupHoldsTheFluidAndCarriesItsWeight) {
   ASSERT_TRUE(sim.ok()) << sim.error().message();
   FluidDesc fluid;
   fluid.settings.spacing = kS;
-  fluid.particles = block(5, 3, 5, {1.5 * kS, 1.5 * kS, 1.5 * kS});  // a spacing from the walls
+  fluid.particles = fluid_block(5, 3, 5, {1.5 * kS, 1.5 * kS, 1.5 * kS});  // a spacing from the walls
   fluid.device = {.backend = "cpu", .quiet = true};
   const CoupledSurface surface{s.surface, sim->info().tet_body_first_particle[0]};
   auto coupled = FluidCoupling::create(*sim, fluid, std::span(&surface, 1));
@@ -114,7 +89,7 @@ TEST(FluidCoupling, SloshingInAFreeCupConservesMomentum) {
   FluidDesc fluid;
   fluid.settings.spacing = kS;
   fluid.settings.gravity = {0, 0, 0};
-  fluid.particles = block(3, 3, 5, {1.5 * kS, 1.5 * kS, 1.5 * kS});
+  fluid.particles = fluid_block(3, 3, 5, {1.5 * kS, 1.5 * kS, 1.5 * kS});
   fluid.velocities.assign(fluid.particles.size(), {0.2, 0.0, 0.0});
   fluid.device = {.backend = "cpu", .quiet = true};
   const CoupledSurface surface{s.surface, sim->info().tet_body_first_particle[0]};
@@ -147,7 +122,7 @@ TEST(FluidCoupling, BadCouplingsAreNamed) {
   FluidDesc fluid;
   fluid.settings.spacing = kS;
   fluid.settings.time_step = 3e-5;  // 1 ms is 33.3 of them
-  fluid.particles = block(2, 2, 2, {3 * kS, 2 * kS, 3 * kS});
+  fluid.particles = fluid_block(2, 2, 2, {3 * kS, 2 * kS, 3 * kS});
   fluid.device = {.backend = "cpu", .quiet = true};
   const CoupledSurface surface{s.surface, sim->info().tet_body_first_particle[0]};
   auto bad = FluidCoupling::create(*sim, fluid, std::span(&surface, 1));

@@ -1,7 +1,8 @@
 // frame_stage_test.cpp — the frame as stages (src/runtime/frame_stage.h):
 // a stage added to a scene runs in every phase in the order registered,
-// after the scene's own, and is profiled; its error stops the frame; its
-// read-back counts; a scene lists only the stages it uses.
+// after the scene's own, and is profiled; its error stops the frame; the
+// device counts what each stage reads back and how often the host waits,
+// alike on every backend; a scene lists only the stages it uses.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -29,12 +30,20 @@ class LogStage final : public FrameStage {
     return note("solve");
   }
   Status after_solve(FrameContext&) override { return note("after_solve"); }
-  Status after_frame(FrameContext&) override {
+  Status after_frame(FrameContext& frame) override {
     if (sleep_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(sleep_ms));
     if (fail) return Error(ErrorCode::bad_parameter, name_ + " refused the frame");
+    if (bytes > 0) {  // reads `bytes` back from a buffer of its own
+      if (!buffer_.valid()) {
+        auto made = frame.device.create_buffer(bytes, name_);
+        if (!made) return made.error();
+        buffer_ = *made;
+      }
+      std::vector<std::uint8_t> host(bytes);
+      if (Status s = frame.device.read_buffer(buffer_, 0, host.data(), bytes); !s) return s;
+    }
     return note("after_frame");
   }
-  std::uint64_t read_back_bytes() const override { return bytes; }
 
   int sleep_ms = 0;
   bool fail = false;
@@ -48,6 +57,7 @@ class LogStage final : public FrameStage {
   }
   std::string name_;
   std::vector<std::string>& log_;
+  BufferHandle buffer_;
 };
 
 SceneDesc hanging_block() {
@@ -93,7 +103,11 @@ TEST(FrameStage, AnAddedStageRunsEveryPhaseInOrderAndIsProfiled) {
   };
   EXPECT_TRUE(timed_within_the_frame(stats));
   EXPECT_GT(stats.stages[1].ms, 0.0) << "the solve is timed";
-  EXPECT_GE(stats.read_back_bytes, 1000u) << "a stage's read-back counts";
+  // The device counts the stage's read-back, and gives it to the stage.
+  EXPECT_EQ(stats.counter("b", "read_bytes"), 1000.0);
+  EXPECT_EQ(stats.counter("b", "host_waits"), 1.0) << "a read-back is a round trip";
+  EXPECT_EQ(stats.counter("a", "read_bytes"), 0.0);
+  EXPECT_GE(stats.read_back_bytes, 1000u + std::uint64_t(stats.counter("statistics", "read_bytes")));
   // The profile is of the last frame: a sum over two frames would pass the
   // second frame's wall time.
   log.clear();
@@ -154,9 +168,87 @@ TEST(FrameStage, ThePositionsAreReadBackOnceAFrame) {
     // collision after the solve, the needles before and after it); the
     // first frame also reads the starting velocities.
     EXPECT_LT(stats.read_back_bytes, (f == 0 ? 3 : 1) * position_bytes + position_bytes / 2) << "frame " << f;
+    // Each stage's figures are its profile's counters.
+    EXPECT_EQ(stats.counter("mesh collision", "contacts"), double(stats.mesh_contacts)) << "frame " << f;
+    EXPECT_EQ(stats.counter("mesh collision", "violation_m"), stats.contact_violation) << "frame " << f;
+    EXPECT_EQ(stats.counter("sutures", "host_ms"), stats.suture_ms) << "frame " << f;
+    EXPECT_EQ(stats.counter("mesh collision", "no such counter"), 0.0);
   }
   EXPECT_EQ(names(sim->last_frame()),
             (std::vector<std::string>{"colliders and tools", "mesh collision", "sutures", "solve", "statistics"}));
+}
+
+// What the host reads and waits for is counted by the device, the same way
+// on every backend: the frame's totals are the sum of the stages' shares,
+// the positions are read once a frame by the whole runtime, and every
+// backend reads the same bytes in the same number of round trips.
+struct Transfers {
+  std::uint64_t bytes = 0;
+  std::uint32_t reads = 0, waits = 0, position_reads = 0;
+  bool operator==(const Transfers&) const = default;
+};
+
+std::vector<Transfers> suture_frames(const std::string& backend, int frames) {
+  SceneDesc scene = test::SuturePads::scene();
+  scene.mesh_collision.enabled = true;
+  auto sim = Simulation::create(scene, {.backend = backend, .quiet = true});
+  EXPECT_TRUE(sim.ok()) << sim.error().message();
+  std::vector<Transfers> out;
+  if (!sim.ok()) return out;
+  for (int f = 0; f < frames; ++f) {
+    EXPECT_TRUE(test::SuturePads::drive(*sim, f).ok());
+    EXPECT_TRUE(sim->step().ok());
+    const FrameStats& stats = sim->last_frame();
+    double stage_bytes = 0.0, stage_waits = 0.0;
+    for (const StageProfile& p : stats.stages) {
+      stage_bytes += stats.counter(p.name, "read_bytes");
+      stage_waits += stats.counter(p.name, "host_waits");
+    }
+    EXPECT_EQ(stage_bytes, double(stats.read_back_bytes)) << backend << " frame " << f;
+    EXPECT_EQ(stage_waits, double(stats.host_waits)) << backend << " frame " << f;
+    EXPECT_GE(stats.host_waits, stats.host_reads) << "every read-back waits";
+    EXPECT_LE(stats.position_reads, f == 0 ? 2u : 1u) << backend << " frame " << f;
+    out.push_back({stats.read_back_bytes, stats.host_reads, stats.host_waits, stats.position_reads});
+  }
+  return out;
+}
+
+TEST(FrameStage, HostTransfersAreCountedAlikeOnEveryBackend) {
+  constexpr int kFrames = 6;
+  const std::vector<Transfers> cpu = suture_frames("cpu", kFrames);
+  ASSERT_EQ(cpu.size(), std::size_t{kFrames});
+  int ran = 0;
+  for (const std::string& backend : test::backends()) {
+    if (backend == "cpu" || !test::missing_device(backend).empty()) continue;
+    ++ran;
+    const std::vector<Transfers> got = suture_frames(backend, kFrames);
+    ASSERT_EQ(got.size(), cpu.size()) << backend;
+    for (int f = 0; f < kFrames; ++f) {
+      EXPECT_EQ(got[f].bytes, cpu[f].bytes) << backend << " frame " << f;
+      EXPECT_EQ(got[f].reads, cpu[f].reads) << backend << " frame " << f;
+      EXPECT_EQ(got[f].waits, cpu[f].waits) << backend << " frame " << f;
+    }
+    std::printf("[ measured ] %s: frame %d read %llu bytes in %u reads, %u waits\n", backend.c_str(), kFrames - 1,
+                static_cast<unsigned long long>(got.back().bytes), got.back().reads, got.back().waits);
+  }
+  if (ran == 0) GTEST_SKIP() << "no GPU backend with a device here (the CPU's counts were checked)";
+}
+
+// A scene with no host-side stage reads only the statistics' words: one
+// read-back and the wait for the frame's program.
+TEST(FrameStage, APlainFrameReadsOnlyItsStatistics) {
+  for (const std::string& backend : test::backends()) {
+    if (!test::missing_device(backend).empty()) continue;
+    auto sim = Simulation::create(hanging_block(), {.backend = backend, .quiet = true});
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
+    SINEW_ASSERT_OK(sim->step());
+    const FrameStats& stats = sim->last_frame();
+    EXPECT_EQ(stats.host_reads, 1u) << backend;
+    EXPECT_EQ(stats.host_waits, 2u) << backend << ": the program's end, then the read-back";
+    EXPECT_EQ(stats.position_reads, 0u) << backend;
+    EXPECT_EQ(double(stats.read_back_bytes), stats.counter("statistics", "read_bytes")) << backend;
+    EXPECT_LT(stats.read_back_bytes, 16u * sim->info().particles) << backend << ": a few words, not the state";
+  }
 }
 
 }  // namespace

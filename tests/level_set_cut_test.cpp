@@ -149,7 +149,7 @@ TEST(LevelSetCut, TheSurfaceIsTheZeroLevelAndFollowsTheCut) {
   TriMesh before = sphere->surface();
   double worst = 0.0;
   for (const auto& v : before.vertices) worst = std::max(worst, std::abs(std::hypot(v[0], v[1], v[2]) - 3e-3));
-  const SurfaceReport closed = check_closed_surface(before);
+  const SurfaceReport closed = check_closed_surface(before).value();
   std::printf("surface: %zu triangles, vertices at most %.3f voxels off the sphere; %llu open edges\n",
               before.triangles.size(), worst / kVoxel, (unsigned long long)closed.open_edges);
   EXPECT_LT(worst, 0.5 * kVoxel);
@@ -177,7 +177,7 @@ TEST(LevelSetCut, APartOfTheSolidIsAClosedSurfaceCappedByTheBox) {
   ASSERT_TRUE(sphere.ok());
   auto half = sphere->surface_in({0.0, -0.01, -0.01, 0.01, 0.01, 0.01});
   ASSERT_TRUE(half.ok()) << half.error().message();
-  const SurfaceReport closed = check_closed_surface(*half);
+  const SurfaceReport closed = check_closed_surface(*half).value();
   double volume = 0.0, lowest_x = 1.0;
   for (const auto& t : half->triangles) {
     const auto &a = half->vertices[t[0]], &b = half->vertices[t[1]], &c = half->vertices[t[2]];

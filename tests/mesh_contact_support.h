@@ -460,11 +460,14 @@ struct ThinProbe {
   static constexpr double kCoupling = 20.0;
   static constexpr std::array<double, 3> kTarget{0.03, -0.01, 0.03};
   static Status couple(Simulation& sim, double mass, std::array<double, 3>& pull) {
-    auto state = sim.tool_state(0);
+    Tools tools = sim.tools();
+    const auto tool = tools.tool(0);
+    if (!tool) return tool.error();
+    auto state = tools.state(*tool);
     if (!state) return state.error();
     const double damping = 2.0 * std::sqrt(kCoupling * mass);
     for (int k = 0; k < 3; ++k) pull[k] = kCoupling * (kTarget[k] - state->position[k]) - damping * state->velocity[k];
-    return sim.apply_tool_force(0, pull, {0.0, 0.0, 0.0});
+    return tools.apply_force(*tool, pull, {0.0, 0.0, 0.0});
   }
 };
 

@@ -2,6 +2,7 @@
 // error whose message names the parameter; nothing crashes.
 #include <gtest/gtest.h>
 
+#include <climits>
 #include <cmath>
 #include <algorithm>
 #include <functional>
@@ -186,6 +187,85 @@ TEST(DeviceBadInput, BuffersAndPrograms) {
   EXPECT_NE(p2.error().message().find("binding 2"), std::string::npos) << p2.error().message();
 
   EXPECT_FALSE(device.run_program(ProgramHandle{5}).ok());
+}
+
+// Finite in double, not in the float32 the device computes in, and work
+// without bound (issue 39): before, each case below passed the checks and
+// gave NaN after one frame, froze a body (an inverse mass rounding to 0
+// pins it) or ran without end (substeps = INT_MAX); now each is an error
+// naming the field.
+TEST(SceneDeviceRange, TheValidSceneStillStepsFinite) {
+  auto sim = Simulation::create(valid_scene(), {.backend = "cpu"});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SINEW_ASSERT_OK(sim->step());
+  std::vector<float> xyzw;
+  SINEW_ASSERT_OK(sim->read_positions(xyzw));
+  for (float v : xyzw) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(SceneDeviceRange, ATimeStepThatIsNoFloatSubstepIsNamed) {
+  expect_error([](SceneDesc& s) { s.solver.time_step = 1e300; }, "solver.time_step");   // inf in float
+  expect_error([](SceneDesc& s) { s.solver.time_step = 1e-300; }, "solver.time_step");  // 0 in float
+  expect_error([](SceneDesc& s) { s.solver.time_step = 1e-20; }, "solver.time_step");   // 1/h^2 inf in float
+}
+
+TEST(SceneDeviceRange, WorkPerFrameIsBounded) {
+  expect_error([](SceneDesc& s) { s.solver.substeps = INT_MAX; }, "solver.substeps");
+  expect_error([](SceneDesc& s) { s.solver.substeps = 10001; }, "solver.substeps");
+  expect_error([](SceneDesc& s) { s.solver.iterations = 10001; }, "solver.iterations");
+  expect_error([](SceneDesc& s) { s.solver.substeps = 1000, s.solver.iterations = 1001; }, "sweeps per frame");
+  expect_error(
+      [](SceneDesc& s) {
+        s.solver.residual_tolerance = 1e-3;
+        s.solver.max_iterations = 100001;
+      },
+      "solver.max_iterations");
+}
+
+TEST(SceneDeviceRange, GravityInfiniteInFloatIsNamed) {
+  expect_error([](SceneDesc& s) { s.gravity[1] = 1e300; }, "gravity[1]");
+  // Finite in float, but h g is not: 1e38 m/s^2 over a substep of 1000 s.
+  expect_error([](SceneDesc& s) { s.gravity[2] = 1e38, s.solver.time_step = 1000.0; }, "gravity[2]");
+  // h g finite, but a frame would move the bodies 3e28 m (a tet's volume,
+  // cubic in its edges, overflows float beyond ~7e12 m).
+  expect_error([](SceneDesc& s) { s.gravity[0] = 1e32; }, "gravity[0]");
+}
+
+TEST(SceneDeviceRange, CompliancesInfiniteInFloatAreNamed) {
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].distance_compliance = 1e300; }, "tet_bodies[0].distance_compliance");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].volume_compliance = 1e300; }, "tet_bodies[0].volume_compliance");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].compliance = 1e300; }, "line_bodies[0].compliance");
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].stiffness_damping = 1e300; }, "tet_bodies[0].stiffness_damping");
+  // Finite in float as given, but not scaled by the element (c L^2 / V)
+  // over h^2 (alpha~, what the device solves with).
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].distance_compliance = 1e36, s.solver.time_step = 1e-3; },
+              "tet_bodies[0].distance_compliance");
+}
+
+TEST(SceneDeviceRange, AMassWhoseFloatInverseRoundsToZeroIsNamed) {
+  // Before, density 1e300 silently pinned every particle of the body.
+  expect_error([](SceneDesc& s) { s.tet_bodies[0].density = 1e300; }, "tet_bodies[0]");
+  expect_error([](SceneDesc& s) { s.line_bodies[0].masses[1] = 1e300; }, "line_bodies[0].masses[1]");
+}
+
+TEST(SceneDeviceRange, AParticleForceWhoseImpulseIsInfiniteInFloatIsNamed) {
+  SceneDesc scene = valid_scene();
+  scene.external_forces = true;
+  auto sim = Simulation::create(scene, {.backend = "cpu"});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const std::size_t n = sim->info().particles;
+  std::vector<float> f(3 * n, 0.0f);
+  f[3 * 3 + 1] = 3e38f;  // finite in float; h f / m is not
+  const Status s = sim->set_particle_forces(f);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
+  EXPECT_NE(s.error().message().find("particle 3"), std::string::npos) << s.error().message();
+  f[3 * 3 + 1] = 1e3f;  // a large but representable push steps finite
+  SINEW_ASSERT_OK(sim->set_particle_forces(f));
+  SINEW_ASSERT_OK(sim->step());
+  std::vector<float> xyzw;
+  SINEW_ASSERT_OK(sim->read_positions(xyzw));
+  for (float v : xyzw) EXPECT_TRUE(std::isfinite(v));
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 // the Vulkan backend. CTest runs the tests with SINEW_VULKAN_VALIDATION=1, so
 // every Vulkan device runs under VK_LAYER_KHRONOS_validation; at the end of
 // the program this fails the run if the layer reported any warning or error
-// (each message is also printed to stderr where it happened).
+// (each message also goes to the log callback, sinew/log.h, where it happened).
 #include <gtest/gtest.h>
 
 #include "backends/vulkan/vulkan_device.h"
@@ -13,7 +13,7 @@ class VulkanValidationIsClean : public ::testing::Environment {
  public:
   void TearDown() override {
     EXPECT_EQ(sinew::vulkan_validation_messages(), 0u)
-        << "the Vulkan validation layer reported problems (printed above as 'sinew: Vulkan validation ...')";
+        << "the Vulkan validation layer reported problems (logged above as 'sinew: warning: Vulkan validation: ...' by the default log callback)";
   }
 };
 

@@ -195,14 +195,14 @@ class CpuDevice final : public Device {
     return {};
   }
 
-  Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
+  Status write_buffer_impl(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
     auto target = range(buffer, offset, bytes, "write_buffer");
     if (!target) return target.status();
     std::memcpy(*target, data, bytes);
     return {};
   }
 
-  Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
+  Status read_buffer_impl(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
     auto source = range(buffer, offset, bytes, "read_buffer");
     if (!source) return source.status();
     std::memcpy(data, *source, bytes);
@@ -226,7 +226,7 @@ class CpuDevice final : public Device {
   }
 
   // The CPU runs the program here; wait() only checks its counters.
-  Status submit(ProgramHandle program) override {
+  Status submit_impl(ProgramHandle program) override {
     if (program.id >= programs_.size() || !programs_[program.id].live)
       return Error(ErrorCode::internal, "submit: not a live program of this device");
     CpuProgram& p = programs_[program.id];
@@ -258,7 +258,7 @@ class CpuDevice final : public Device {
     return {};
   }
 
-  Status wait() override {
+  Status wait_impl() override {
     if (submitted_ == UINT32_MAX) return {};
     const CpuProgram& p = programs_[submitted_];
     submitted_ = UINT32_MAX;

@@ -175,7 +175,7 @@ class OpenclDevice final : public Device {
     return {};
   }
 
-  Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
+  Status write_buffer_impl(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
     if (Status s = drain(); !s) return s;
     auto b = range(buffer, offset, bytes, "write_buffer");
     if (!b) return b.status();
@@ -185,7 +185,7 @@ class OpenclDevice final : public Device {
     return {};
   }
 
-  Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
+  Status read_buffer_impl(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
     if (Status s = drain(); !s) return s;
     auto b = range(buffer, offset, bytes, "read_buffer");
     if (!b) return b.status();
@@ -212,7 +212,7 @@ class OpenclDevice final : public Device {
     return {};
   }
 
-  Status submit(ProgramHandle program) override {
+  Status submit_impl(ProgramHandle program) override {
     if (!live_program(program)) return Error(ErrorCode::internal, "submit: not a live program of this device");
     if (Status s = drain(); !s) return s;
     pending_ = false;  // one submission at a time: the previous one's counters are not checked
@@ -242,7 +242,7 @@ class OpenclDevice final : public Device {
     return {};
   }
 
-  Status wait() override {
+  Status wait_impl() override {
     if (Status s = drain(); !s) return s;
     if (!pending_) return {};
     pending_ = false;

@@ -109,11 +109,11 @@ class VulkanDeviceImpl final : public Device {
     if (Status s = ready("resize_buffer"); !s) return s;
     return buffers_.resize(buffer, bytes);
   }
-  Status write_buffer(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
+  Status write_buffer_impl(BufferHandle buffer, std::size_t offset, const void* data, std::size_t bytes) override {
     if (Status s = ready("write_buffer"); !s) return s;
     return buffers_.write(buffer, offset, data, bytes);
   }
-  Status read_buffer(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
+  Status read_buffer_impl(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) override {
     if (Status s = ready("read_buffer"); !s) return s;
     return buffers_.read(buffer, offset, data, bytes);
   }
@@ -137,7 +137,7 @@ class VulkanDeviceImpl final : public Device {
     return {};
   }
 
-  Status submit(ProgramHandle program) override {
+  Status submit_impl(ProgramHandle program) override {
     if (!live_program(program)) return Error(ErrorCode::internal, "submit: not a live program of this device");
     if (Status s = ready("submit"); !s) return s;
     pending_ = false;  // one submission at a time: the previous one's counters are not checked
@@ -149,7 +149,7 @@ class VulkanDeviceImpl final : public Device {
     return {};
   }
 
-  Status wait() override {
+  Status wait_impl() override {
     if (Status s = drain(); !s) return s;
     if (!pending_) return {};
     pending_ = false;

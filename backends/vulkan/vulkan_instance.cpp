@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "backends/vulkan/vulkan_common.h"
+#include "sinew/log.h"
 
 namespace sinew::vulkan {
 
@@ -31,9 +32,8 @@ static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageS
     return VK_TRUE;  // the layer then skips the invalid call: the driver never sees it
   }
   g_validation_messages.fetch_add(1, std::memory_order_relaxed);
-  std::fprintf(stderr, "sinew: Vulkan validation %s: %s\n",
-               severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
-               data && data->pMessage ? data->pMessage : "(no message)");
+  log_message(severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? LogLevel::error : LogLevel::warning,
+              std::string("Vulkan validation: ") + (data && data->pMessage ? data->pMessage : "(no message)"));
   return VK_FALSE;
 }
 
@@ -107,8 +107,9 @@ Result<std::unique_ptr<Instance>> make_instance() {
   if (validation_requested() && !inst->validation) {
     static std::once_flag said;
     std::call_once(said, [] {
-      std::fprintf(stderr, "sinew: SINEW_VULKAN_VALIDATION=1 but %s is not installed (apt-get install "
-                           "vulkan-validationlayers); Vulkan runs without validation\n", kValidationLayer);
+      log_message(LogLevel::warning, std::string("SINEW_VULKAN_VALIDATION=1 but ") + kValidationLayer +
+                                         " is not installed (apt-get install vulkan-validationlayers); Vulkan runs "
+                                         "without validation");
     });
   }
   auto app = vk_struct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);

@@ -44,7 +44,7 @@ struct Instance {
 };
 
 /// A Vulkan 1.2 instance, with validation when requested and installed (else
-/// a one-time notice on stderr). Errors: a loader older than 1.2, a failed call.
+/// a one-time warning through the log callback, sinew/log.h). Errors: a loader older than 1.2, a failed call.
 Result<std::unique_ptr<Instance>> make_instance();
 
 }  // namespace sinew::vulkan

@@ -1,5 +1,5 @@
 // sinew/ccd.h — continuous collision detection of two primitives moving
-// linearly within a step (issue 13): a vertex against a triangle, an edge
+// linearly within a step (docs/collision.md): a vertex against a triangle, an edge
 // against an edge. Never a false negative: when the primitives touch (come
 // within the minimum separation) at some time of the step, the query says
 // so, and the time it returns is never later than the first touch.
@@ -54,6 +54,7 @@ namespace sinew::ccd {
 
 using Point = std::array<double, 3>;  ///< [m]
 
+/// How a query decides (vertex_face, edge_edge).
 struct Settings {
   /// Distance the primitives may keep and still count as touching [m], >= 0.
   double min_separation = 0.0;
@@ -69,6 +70,7 @@ struct Settings {
   std::uint32_t max_boxes = 1u << 20;
 };
 
+/// A query's answer.
 struct Hit {
   bool touch = false;  ///< the primitives come within min_separation in [0, 1]
   /// A time no later than the first touch, in [0, 1] (1 when no touch).
@@ -76,7 +78,8 @@ struct Hit {
   /// Parameters on the primitives near the touch (the lower corner of the
   /// earliest box found): vertex-face, the face point a + u (b - a) + v
   /// (c - a); edge-edge, a0 + u (a1 - a0) and b0 + v (b1 - b0).
-  double u = 0.0, v = 0.0;
+  double u = 0.0;  ///< see above
+  double v = 0.0;  ///< see above
   bool gave_up = false;      ///< max_boxes reached: a touch reported without proof
   std::uint32_t boxes = 0;   ///< boxes examined
 };

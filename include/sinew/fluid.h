@@ -31,7 +31,7 @@
 
 namespace sinew {
 
-/// The solver (README, "SPH fluid", has the measured comparison).
+/// The solver (docs/fluids.md, "SPH fluid", has the measured comparison).
 enum class FluidMethod {
   /// Weakly compressible SPH (Becker and Teschner 2007): pressure from
   /// density by Tait's equation, explicit steps bound by the speed of sound.
@@ -43,8 +43,10 @@ enum class FluidMethod {
   pbf,
 };
 
+/// The fluid's material and solver: spacing, rest density, speed of sound,
+/// viscosity, time step and the solver's own settings (docs/fluids.md).
 struct FluidSettings {
-  FluidMethod method = FluidMethod::wcsph;
+  FluidMethod method = FluidMethod::wcsph;  ///< weakly compressible SPH (default) or position-based fluids
   double spacing = 1e-3;        ///< the fluid's particle spacing [m], > 0; a particle's mass is rho0 spacing^3
   double support = 2.0;         ///< the kernels' support radius h in spacings, >= 1
   double rest_density = 1000.0; ///< rho0 [kg/m^3], > 0 (blood: about 1060)
@@ -90,8 +92,10 @@ struct FluidSink {
   double radius = 0.0;             ///< [m], > 0
 };
 
+/// A fluid to create: its settings, particles at the start, boundary,
+/// emitters, sinks, capacity and device (Fluid::create).
 struct FluidDesc {
-  FluidSettings settings;
+  FluidSettings settings;  ///< material and solver settings
   /// Fluid at the start [m], about a spacing from the boundary particles:
   /// closer, a single layer of them adds more than the missing fluid's
   /// density (their volumes assume that gap) and the first steps push the
@@ -123,8 +127,10 @@ struct FluidParticle {
   /// Ids are 31 bits: a step() that could pass 2^31 is refused
   /// (capacity_exceeded) before it runs.
   std::uint32_t id = 0;
-  std::array<float, 3> position{}, velocity{};  ///< [m], [m/s]
-  float density = 0.0f, pressure = 0.0f;        ///< [kg/m^3], [Pa] from the last step's start
+  std::array<float, 3> position{};  ///< [m]
+  std::array<float, 3> velocity{};  ///< [m/s]
+  float density = 0.0f;             ///< [kg/m^3], from the last step's start
+  float pressure = 0.0f;            ///< [Pa], from the last step's start
 };
 
 /// Counts after the last step() (read back with it: 6 words).
@@ -143,6 +149,8 @@ struct FluidStats {
   double mass = 0.0;            ///< particles x rho0 spacing^3 [kg]
 };
 
+/// An SPH fluid on a device, on its own (a scene's fluid is reached by
+/// Simulation::fluid instead): created from a FluidDesc, stepped, read back.
 class Fluid {
  public:
   /// Errors (bad_parameter), each naming the field: a setting out of
@@ -152,8 +160,11 @@ class Fluid {
   /// spacing of a boundary particle (a source inside a collider); more
   /// particles than the capacity. The backend's, when it is not available.
   static Result<Fluid> create(const FluidDesc& desc);
+  /// Moves the fluid and its device.
+  ///@{
   Fluid(Fluid&&) noexcept;
   Fluid& operator=(Fluid&&) noexcept;
+  ///@}
   ~Fluid();
 
   /// Advances `steps` time steps, each one device program: the boundary
@@ -166,11 +177,13 @@ class Fluid {
   Status step(int steps = 1);
   /// [out] the fluid particles, by increasing id.
   Status read(std::vector<FluidParticle>& particles) const;
+  /// The counts and figures of the last step() call.
   [[nodiscard]] const FluidStats& stats() const;
 
   /// Moves emitter `index` (its lattice size stays: the radius and spacing
   /// it was created with; a new radius is an error) or changes its rate.
   Status set_emitter(std::size_t index, const FluidEmitter& emitter);
+  /// Moves sink `index` or changes its radius.
   Status set_sink(std::size_t index, const FluidSink& sink);
   /// The boundary's positions [m] and velocities [m/s] for the next steps
   /// (FluidDesc::moving_boundary), one per boundary particle. The particles'
@@ -184,8 +197,8 @@ class Fluid {
   /// float rounding: momentum is conserved. Resets them to zero.
   Status read_boundary_impulses(std::vector<std::array<float, 3>>& impulses);
 
-  [[nodiscard]] std::string device_name() const;
-  [[nodiscard]] std::uint32_t boundary_count() const;
+  [[nodiscard]] std::string device_name() const;      ///< the device the fluid runs on
+  [[nodiscard]] std::uint32_t boundary_count() const;  ///< boundary particles
   [[nodiscard]] std::uint32_t capacity() const;  ///< fluid particles
   [[nodiscard]] double particle_mass() const;    ///< rho0 spacing^3 [kg]
 

@@ -1,5 +1,5 @@
 // sinew/fluid_coupling.h — two-way coupling of a fluid (sinew/fluid.h) with
-// tissue (sinew/simulation.h), issue 15 part 3: the tissue's surfaces are
+// tissue (sinew/simulation.h): the tissue's surfaces are
 // sampled with boundary particles that follow them (Akinci et al., TOG
 // 31(4), 2012), so tissue holds fluid in a cavity; the fluid pushes back on
 // those particles and that push, spread to the surfaces' vertices by the
@@ -38,13 +38,18 @@ namespace sinew {
 /// vertices (e.g. extract_boundary_surface of its TetMesh, or the part of
 /// it that faces the fluid), with rest positions [m].
 struct CoupledSurface {
-  TriMesh surface;
+  TriMesh surface;  ///< the triangles over the body's vertices, with rest positions [m]
   /// The Simulation particle of the surface's vertex 0 (SceneInfo::
   /// tet_body_first_particle or tri_body_first_particle of the body).
   std::uint32_t first_particle = 0;
 };
 
-class FluidCoupling {
+/// Deprecated: a scene's fluid is SceneDesc::fluid (sinew/scene.h), run on
+/// the Simulation's device as a stage of its frame with the same coupling
+/// (the very floats on the CPU backend) and no read-back of the tissue.
+/// Kept for one release.
+class [[deprecated("describe the fluid in SceneDesc::fluid (sinew/scene.h) and reach it through Simulation::fluid()")]]
+FluidCoupling {
  public:
   /// Samples the surfaces at the fluid's spacing, appends the samples to
   /// desc.boundary (after the fixed boundary it holds, which stays put),
@@ -57,8 +62,11 @@ class FluidCoupling {
   /// SceneDesc::external_forces; sample_surface's and Fluid::create's.
   static Result<FluidCoupling> create(Simulation& simulation, FluidDesc desc,
                                       std::span<const CoupledSurface> surfaces);
+  /// Moves the coupling.
+  ///@{
   FluidCoupling(FluidCoupling&&) noexcept;
   FluidCoupling& operator=(FluidCoupling&&) noexcept;
+  ///@}
   ~FluidCoupling();
 
   /// One coupled frame (above). Errors: the fluid's and the simulation's;
@@ -66,11 +74,16 @@ class FluidCoupling {
   /// and then returns capacity_exceeded.
   Status step();
 
+  /// The coupled fluid.
+  ///@{
   [[nodiscard]] Fluid& fluid();
   [[nodiscard]] const Fluid& fluid() const;
+  ///@}
   /// The boundary particles that follow the tissue: [first, first + count).
+  ///@{
   [[nodiscard]] std::uint32_t first_coupled() const;
   [[nodiscard]] std::uint32_t coupled_count() const;
+  ///@}
   /// The impulse the fluid gave the tissue in the last frame, summed [N s].
   [[nodiscard]] std::array<double, 3> last_impulse() const;
   /// The impulse it gave the fixed boundary in the last frame [N s].

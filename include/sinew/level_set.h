@@ -1,4 +1,4 @@
-// level_set.h — signed distance fields on a sparse grid (issue 14): bone and
+// level_set.h — signed distance fields on a sparse grid (docs/level_sets.md): bone and
 // tools as narrow-band level sets built from closed triangle surfaces or
 // analytic shapes, sampled (value and gradient, trilinear) on the host and
 // inside every backend's kernels.
@@ -35,7 +35,7 @@ namespace sinew {
 
 /// What a level set is built with.
 struct LevelSetSettings {
-  double voxel_size = 5e-4;     ///< edge of a cubic voxel [m], > 0
+  double voxel_size = 5e-4;     ///< edge of a cubic voxel [m], >= 1.5e-5 (OpenVDB's smallest) and within float32
   double exterior_band = 1.5e-3;  ///< exact distances this far outside the surface [m], >= voxel_size
   /// ... and this far inside [m], >= voxel_size; +infinity fills the whole
   /// inside (every voxel inside is stored: a solid that will be cut).
@@ -46,8 +46,9 @@ struct LevelSetSettings {
 /// `radius` about the origin), a drill (capsule: the segment +-half_height
 /// along y swollen by `radius`) or a saw (box of `half_extents`).
 struct CutterShape {
+  /// burr, drill, saw
   enum class Kind { sphere, capsule, box };
-  Kind kind = Kind::sphere;
+  Kind kind = Kind::sphere;                  ///< which shape
   double radius = 1.5e-3;                               ///< sphere, capsule [m], > 0
   double half_height = 0.0;                             ///< capsule [m], >= 0
   std::array<double, 3> half_extents{1e-3, 1e-3, 1e-3};  ///< box [m], > 0
@@ -56,14 +57,14 @@ struct CutterShape {
 /// A rigid pose: the frame's origin [m] and its rotation, a unit quaternion
 /// (w, x, y, z), in the level set's frame.
 struct Pose {
-  std::array<double, 3> position{0.0, 0.0, 0.0};
-  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 3> position{0.0, 0.0, 0.0};       ///< the origin [m]
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
 };
 
 /// What one cut changed.
 struct CutReport {
   double removed_volume = 0.0;      ///< [m^3], measured on the grid (see LevelSet::cut)
-  std::uint64_t changed_voxels = 0;
+  std::uint64_t changed_voxels = 0;  ///< voxels whose value changed
   std::uint32_t changed_leaves = 0;  ///< 8^3-voxel blocks of the grid
   /// Byte ranges (offset, size) of the NanoVDB grid that changed: what a
   /// device's copy needs (update_level_set, src/level_set/device_level_set.h).
@@ -72,11 +73,26 @@ struct CutReport {
 
 /// A signed distance field on a sparse grid, in its own frame (the frame of
 /// the surface or shape it was built from). Copies share the grid (cheap).
+///
+/// Bounds every factory and cut checks first, so that no input
+/// overflows or runs without end: every length and coordinate within
+/// float32's range (the device samples in float; e.g. a cube of 1e39 m is
+/// bad_parameter); every voxel index, the shape's box grown by the
+/// exterior band over voxel_size, within +-2^30 (bad_parameter: move the
+/// shape nearer the origin or use a larger voxel); at most 2^30 voxels
+/// visited by one call (capacity_exceeded): a sphere's or box's whole
+/// grown box, a surface's bands (about its area / h^2 voxels per layer) or
+/// its whole box when the inside is filled, a cut's swept box; a cut
+/// places a capsule or box at most 2^20 times (capacity_exceeded).
+/// Whatever OpenVDB still throws becomes an error (bad_parameter, or
+/// out_of_memory for an allocation): no call throws.
 class LevelSet {
  public:
   /// From a closed triangle surface [m]. Errors (bad_parameter): settings
   /// out of range, a surface that is not closed (check_closed_surface; the
-  /// message gives the counts), an empty surface, a non-finite vertex.
+  /// message gives the counts), an empty surface, a non-finite vertex;
+  /// capacity_exceeded from check_closed_surface's pair bound; and the
+  /// bounds above.
   static Result<LevelSet> from_mesh(const TriMesh& surface, const LevelSetSettings& settings);
   /// A sphere of `radius` [m] > 0 about `centre` [m].
   static Result<LevelSet> sphere(const std::array<double, 3>& centre, double radius, const LevelSetSettings& settings);
@@ -84,9 +100,9 @@ class LevelSet {
   static Result<LevelSet> box(const std::array<double, 3>& lo, const std::array<double, 3>& hi,
                               const LevelSetSettings& settings);
 
-  [[nodiscard]] double voxel_size() const;
-  [[nodiscard]] double exterior_band() const;
-  [[nodiscard]] double interior_band() const;
+  [[nodiscard]] double voxel_size() const;     ///< the voxels' edge [m]
+  [[nodiscard]] double exterior_band() const;  ///< how far outside distances are exact [m]
+  [[nodiscard]] double interior_band() const;  ///< how far inside distances are exact [m] (infinity: the whole inside)
   /// The box of the stored voxels [m] (lo then hi).
   [[nodiscard]] std::array<double, 6> bounds() const;
   /// Stored voxels (active and inactive, in allocated leaves).
@@ -143,6 +159,7 @@ class LevelSet {
 
   struct Impl;  ///< opaque outside sinew (src/level_set/level_set_impl.h)
   explicit LevelSet(std::shared_ptr<Impl> impl);
+  /// The library's own view of the grid (opaque outside sinew).
   [[nodiscard]] const Impl& internals() const { return *impl_; }
 
  private:

@@ -33,6 +33,8 @@
 
 namespace sinew {
 
+/// What a NeighbourSearch is for: the radius, the most points, the lists'
+/// starting slots and the device (NeighbourSearch::create).
 struct NeighbourSettings {
   double radius = 0.0;          ///< [m], finite, > 0
   std::uint32_t capacity = 0;   ///< the most points one search takes, 1 .. 2^28
@@ -51,13 +53,18 @@ struct NeighbourLists {
   std::vector<std::uint32_t> neighbours;  ///< offsets[n]
 };
 
+/// For every point, the other points closer than a radius, on any backend
+/// (docs/fluids.md, "Neighbour search").
 class NeighbourSearch {
  public:
   /// Errors (bad_parameter): settings out of range; the backend's when it
   /// is not available.
   static Result<NeighbourSearch> create(const NeighbourSettings& settings);
+  /// Moves the search and its device.
+  ///@{
   NeighbourSearch(NeighbourSearch&&) noexcept;
   NeighbourSearch& operator=(NeighbourSearch&&) noexcept;
+  ///@}
   ~NeighbourSearch();
 
   /// [in] points: xyz [m]; [out] lists. Uploads the points, runs the
@@ -66,7 +73,7 @@ class NeighbourSearch {
   /// 2^16 cells (about 65,000 radii) or more from the origin, naming the point.
   Status find(std::span<const std::array<float, 3>> points, NeighbourLists& lists);
 
-  [[nodiscard]] std::string device_name() const;
+  [[nodiscard]] std::string device_name() const;  ///< the device the search runs on
   /// Times the lists' slots grew since create().
   [[nodiscard]] std::uint32_t regrown() const;
 

@@ -22,6 +22,7 @@ enum class ErrorCode {
   out_of_memory,        ///< host or device memory ran out
   capacity_exceeded,    ///< data-dependent work outgrew a declared capacity (results were kept within it)
   internal,             ///< a bug in sinew, or a device failure with no better description
+  diverged,             ///< a frame diverged and DivergenceSettings::on_divergence is stop (sinew/divergence.h)
 };
 
 /// The code's name, e.g. "capacity_exceeded".
@@ -34,6 +35,7 @@ constexpr const char* error_code_name(ErrorCode code) {
     case ErrorCode::out_of_memory: return "out_of_memory";
     case ErrorCode::capacity_exceeded: return "capacity_exceeded";
     case ErrorCode::internal: return "internal";
+    case ErrorCode::diverged: return "diverged";
   }
   return "unknown";
 }
@@ -42,8 +44,11 @@ constexpr const char* error_code_name(ErrorCode code) {
 /// name the file and line, or the parameter, that caused the problem.
 class Error {
  public:
+  /// An error of kind `code` described by `message`.
   Error(ErrorCode code, std::string message) : code_(code), message_(std::move(message)) {}
+  /// The kind of failure.
   [[nodiscard]] ErrorCode code() const { return code_; }
+  /// What went wrong, naming the file and line or the parameter.
   [[nodiscard]] const std::string& message() const { return message_; }
 
  private:
@@ -54,10 +59,15 @@ class Error {
 /// Success, or an Error. Check with `if (!status)` and read `status.error()`.
 class [[nodiscard]] Status {
  public:
-  Status() = default;  // success
+  /// Success.
+  Status() = default;
+  /// Failure with `error` (implicit, so a function returning Status can `return Error{...}`).
   Status(Error error) : error_(std::move(error)), ok_(false) {}  // NOLINT: implicit by design
+  /// Whether it succeeded.
+  ///@{
   [[nodiscard]] bool ok() const { return ok_; }
   explicit operator bool() const { return ok_; }
+  ///@}
   /// [pre] !ok()
   [[nodiscard]] const Error& error() const { assert(!ok_); return error_; }
 
@@ -70,11 +80,17 @@ class [[nodiscard]] Status {
 template <class T>
 class [[nodiscard]] Result {
  public:
+  /// A value (implicit, so a function returning Result<T> can `return value;`).
   Result(T value) : v_(std::in_place_index<0>, std::move(value)) {}  // NOLINT: implicit by design
+  /// An error (implicit, so a function returning Result<T> can `return Error{...}`).
   Result(Error error) : v_(std::in_place_index<1>, std::move(error)) {}  // NOLINT
+  /// Whether it holds a value.
+  ///@{
   [[nodiscard]] bool ok() const { return v_.index() == 0; }
   explicit operator bool() const { return ok(); }
-  /// [pre] ok()
+  ///@}
+  /// The value. [pre] ok()
+  ///@{
   [[nodiscard]] T& value() & { assert(ok()); return std::get<0>(v_); }
   [[nodiscard]] const T& value() const& { assert(ok()); return std::get<0>(v_); }
   [[nodiscard]] T&& value() && { assert(ok()); return std::get<0>(std::move(v_)); }
@@ -82,6 +98,7 @@ class [[nodiscard]] Result {
   const T& operator*() const& { return value(); }
   T* operator->() { return &value(); }
   const T* operator->() const { return &value(); }
+  ///@}
   /// [pre] !ok()
   [[nodiscard]] const Error& error() const { assert(!ok()); return std::get<1>(v_); }
   /// The error as a Status (for forwarding); [pre] !ok()

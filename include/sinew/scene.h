@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "sinew/fluid.h"
 #include "sinew/level_set.h"
 #include "sinew/mesh.h"
 #include "sinew/result.h"
@@ -36,7 +37,7 @@ namespace sinew {
 /// stvk and corotational need nu > 0 (lambda > 0; Simulation::create names
 /// poisson_ratio otherwise). neo_hookean needs small steps: its shear acts
 /// explicitly, so keep h sqrt(mu / rho) / (edge length) below ~0.2 (above
-/// ~0.75 it is unstable); see README, "FEM materials".
+/// ~0.75 it is unstable); see docs/tissue.md, "FEM materials".
 enum class TetMaterial { none, neo_hookean, stvk, corotational };
 
 /// A volumetric body simulated on a tet mesh with xPBD constraints.
@@ -182,9 +183,9 @@ struct TriBodyDesc {
   std::vector<Vec3d> initial_vertices;    ///< start positions [m] if not the rest shape (empty: rest)
   double thickness = 1e-3;                ///< [m], > 0
   double density = 1000.0;                ///< [kg/m^3], > 0
-  bool distance_constraints = true;
+  bool distance_constraints = true;       ///< stretch: one distance constraint per edge
   double distance_compliance = 1e-5;      ///< c_d [1/Pa], >= 0
-  bool area_constraints = true;
+  bool area_constraints = true;           ///< one area constraint per triangle
   double area_compliance = 1e-5;          ///< c_a [1/Pa], >= 0
   double bending_compliance = -1.0;       ///< [1/(N m)], >= 0; < 0: no bending constraints
   std::vector<std::uint32_t> pinned;      ///< vertices held fixed
@@ -232,8 +233,10 @@ enum class ColliderShape { plane, sphere, capsule, box, cylinder, implicit, leve
 /// normal is the gradient of the primitive that decides the value).
 /// At most 64 nodes, at most 8 values on the stack at once.
 enum class ImplicitOp { half_space, sphere, capsule, box, cylinder, torus, unite, intersect, subtract };
+/// One node of an implicit collider's postfix expression: a primitive with
+/// its pose and size, or an operation on the two values before it.
 struct ImplicitNode {
-  ImplicitOp op = ImplicitOp::sphere;
+  ImplicitOp op = ImplicitOp::sphere;  ///< the primitive, or the operation
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< primitive's origin in the collider's frame [m]
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
   double radius = 0.0;                                  ///< sphere, capsule, cylinder, torus (major) [m], > 0
@@ -249,7 +252,7 @@ struct ImplicitNode {
 /// between frames with Simulation::set_collider_pose; it is interpolated
 /// across the frame's substeps.
 struct ColliderDesc {
-  ColliderShape shape = ColliderShape::plane;
+  ColliderShape shape = ColliderShape::plane;  ///< which shape; the fields below it uses
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< [m]
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
   double radius = 0.0;                                  ///< sphere, capsule, cylinder [m], > 0
@@ -269,8 +272,9 @@ struct ColliderDesc {
 
 /// Which body a vertex belongs to.
 enum class BodyKind { tet, tri, line };
+/// One vertex of one body of the scene.
 struct VertexRef {
-  BodyKind body_kind = BodyKind::tet;
+  BodyKind body_kind = BodyKind::tet;  ///< the kind of body
   std::uint32_t body = 0;    ///< index into the scene's bodies of that kind
   std::uint32_t vertex = 0;  ///< vertex of that body
 };
@@ -280,7 +284,7 @@ struct VertexRef {
 /// points moved between frames with Simulation::set_target and interpolated
 /// across the substeps; several attachments may share one target.
 struct AttachmentDesc {
-  VertexRef vertex;
+  VertexRef vertex;           ///< the vertex held
   std::uint32_t target = 0;   ///< index into SceneDesc::targets
   double compliance = 0.0;    ///< [m/N], >= 0
 };
@@ -312,14 +316,14 @@ enum class ToolShape {
 /// penalty_stiffness pi R delta^2. The penalty at the start of a frame
 /// drives the frame (explicit): stable while sqrt(k / M) time_step < 2 for
 /// the contact's stiffness k = dF/d delta (2 penalty_stiffness pi R delta
-/// for that sphere) and the tool's mass M; README, "Level sets", sizes it.
+/// for that sphere) and the tool's mass M; docs/level_sets.md sizes it.
 /// Particles deeper in the tool than its level set's interior band (zero
 /// gradient) are not pushed out: build a tool's level set with the inside
 /// filled. Continuous collision (MeshCollisionDesc::continuous) sweeps
 /// capsule tools only: a level-set tool meets particles and faces at the
 /// substeps' poses.
 struct ToolDesc {
-  ToolShape shape = ToolShape::capsule;
+  ToolShape shape = ToolShape::capsule;  ///< a capsule, or a level set's shape
   double radius = 0.005;                                ///< capsule [m], > 0
   double half_height = 0.05;                            ///< capsule [m], >= 0
   /// ToolShape::level_set: the signed distance field in the tool's frame
@@ -332,8 +336,8 @@ struct ToolDesc {
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< initial [m]
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< initial unit quaternion (w, x, y, z)
   bool gravity = true;                                  ///< whether gravity acts on the tool
-  double static_friction = 0.3;
-  double dynamic_friction = 0.2;
+  double static_friction = 0.3;                         ///< of its contacts, >= 0
+  double dynamic_friction = 0.2;                        ///< of its contacts, >= 0, <= static_friction
   double compliance = 0.0;                              ///< of its contacts [m/N]
 };
 
@@ -348,11 +352,11 @@ enum class NeedleDrive {
   /// reaction of one frame acts on it in the next. Drive it through a
   /// virtual coupling that also holds its orientation (a needle pushed
   /// along its axis balances on its tip like a pencil); the gains' bounds
-  /// are in the README, "Needles and sutures".
+  /// are in docs/needles.md.
   force,
 };
 
-/// A suture needle (issue 13, part 4): a rigid curve, a polyline in its own
+/// A suture needle (docs/needles.md): a rigid curve, a polyline in its own
 /// frame from its tail (curve.front()) to its tip (curve.back()), moved
 /// kinematically (Simulation::set_needle_pose) or by force
 /// (Simulation::apply_needle_force; `drive`), its substeps interpolating
@@ -372,8 +376,7 @@ enum class NeedleDrive {
 /// thread instead, which slides through it with friction; the thread's last
 /// vertex is a knot that stops at the puncture. Punctures of a triangle
 /// that is degenerate or inverted (its tet turned inside out) are refused
-/// (NeedleState::refused). Details and limits: README, "Needles and
-/// sutures".
+/// (NeedleState::refused). Details and limits: docs/needles.md.
 struct NeedleDesc {
   std::vector<std::array<double, 3>> curve;             ///< [m] in the needle's frame, tail to tip, >= 2 points, no zero-length segment
   std::array<double, 3> position{0.0, 0.0, 0.0};       ///< initial [m]
@@ -386,7 +389,7 @@ struct NeedleDesc {
   int thread = -1;
   double thread_static_friction = 0.3;   ///< of the thread sliding through a puncture, >= 0
   double thread_dynamic_friction = 0.2;  ///< >= 0, <= thread_static_friction
-  NeedleDrive drive = NeedleDrive::kinematic;
+  NeedleDrive drive = NeedleDrive::kinematic;  ///< posed by the caller, or moved by force
   // ---- A force-driven needle's body (drive = force; ignored otherwise).
   // The needle's frame has its origin at the centre of mass and its axes
   // along the principal axes of inertia; the defaults are those of a needle
@@ -401,9 +404,17 @@ struct NeedleDesc {
 /// runs `iterations` Gauss-Seidel sweeps over all constraints (colour by
 /// colour) and updates velocities (Macklin et al., "Small Steps", 2019).
 struct SolverSettings {
-  double time_step = 1.0 / 60.0;  ///< frame length [s], > 0
-  int substeps = 1;               ///< >= 1
-  int iterations = 5;             ///< >= 1
+  /// Frame length [s], > 0. The device computes in float32: h =
+  /// time_step / substeps, 1/h and 1/h^2 must be finite, non-zero floats
+  /// (e.g. 1e300 or 1e-300 is an error naming solver.time_step), and so
+  /// must every compliance alpha the device stores (after scaling by its
+  /// element, e.g. c L^2 / V) and alpha / h^2, each stiffness_damping over
+  /// h, gravity and h g (and a frame's move dt^2 g at most 1e12 m), and
+  /// every particle's inverse mass (a density so large that it rounds to
+  /// 0, which would pin the particle, is an error naming the body).
+  double time_step = 1.0 / 60.0;
+  int substeps = 1;               ///< >= 1, <= 10,000 (a bound on a frame's work)
+  int iterations = 5;             ///< >= 1, <= 10,000; substeps x iterations <= 1,000,000 sweeps a frame
   /// Measure the frame's errors (FrameStats): costs one store per
   /// constraint in the last sweep and a read-back of the residuals,
   /// velocities and positions after each frame.
@@ -427,10 +438,11 @@ struct SolverSettings {
   /// measures the residuals and reduces them on the device, and the host
   /// reads back 3 words per constraint block. For statics within ~5% the
   /// tolerance must be ~1/20 of the body's strain under its load (about
-  /// rho g L / E): see the README's stiffness table. 0: fixed mode.
+  /// rho g L / E): see docs/tissue.md's stiffness table. 0: fixed mode.
   double residual_tolerance = 0.0;
-  /// Residual mode: the most sweeps per substep, >= iterations; rounded up
-  /// to iterations plus a whole number of check_interval.
+  /// Residual mode: the most sweeps per substep, >= iterations, <= 100,000
+  /// (and substeps x max_iterations <= 1,000,000); rounded up to
+  /// iterations plus a whole number of check_interval.
   int max_iterations = 200;
   /// Residual mode: sweeps between two residual checks, >= 1. Each check
   /// costs about one sweep's reads plus a round trip to the device.
@@ -472,7 +484,7 @@ struct SolverSettings {
   /// first chebyshev_delay of a substep, positions AND lambdas are
   /// extrapolated (Wang, SIGGRAPH Asia 2015, eq. 12) with omega_k from rho.
   /// Too large a rho oscillates or diverges, too small gains little (see
-  /// the README's stiffness section for measured values). Works in fixed
+  /// docs/tissue.md's stiffness section for measured values). Works in fixed
   /// and residual mode; costs one pass over positions and lambdas per sweep.
   /// Not with warm_start (an error): together they diverged on the tests'
   /// stiff cantilever.
@@ -496,20 +508,20 @@ struct SolverSettings {
 /// Contacts are found once per frame, at its start, and stay valid for the
 /// whole frame: every pair of primitives closer than thickness + margin is
 /// a contact, the margin covering how far the surfaces can move within the
-/// frame (README, "Mesh collision"). Each contact keeps the first
+/// frame (docs/collision.md, "Mesh collision"). Each contact keeps the first
 /// primitive on its side of the separating plane through the second's
 /// closest point, `thickness` away from it, so surfaces that start a frame
 /// apart cannot pass through each other as long as no particle moves more
 /// than half the margin within it. Redundant contacts are pruned: a
 /// vertex keeps its nearest against another body, a triangle its 3
-/// nearest immovable vertices, an edge its 4 nearest edges (README, "Mesh
+/// nearest immovable vertices, an edge its 4 nearest edges (docs/collision.md, "Mesh
 /// collision"). Contacts are solved after the bodies'
 /// constraints in every sweep, scheduled by `schedule`.
 ///
 /// Not yet: with the Chebyshev accelerator (an error names the setting),
 /// and on the device (the host finds the contacts; GPU backends read the
 /// positions back once per frame).
-/// How the contacts between meshes are scheduled within a sweep (README,
+/// How the contacts between meshes are scheduled within a sweep (docs/collision.md,
 /// "Mesh collision", compares them):
 ///  - colored: coloured on the host every frame so that no two contacts of
 ///    a colour share a movable particle, one dispatch per colour
@@ -520,9 +532,10 @@ struct SolverSettings {
 ///    per sweep however many colours the contacts would need.
 enum class ContactSchedule { colored, jacobi };
 
+/// Contacts between the bodies' meshes and within them (SceneDesc::mesh_collision; docs/collision.md).
 struct MeshCollisionDesc {
-  bool enabled = false;
-  ContactSchedule schedule = ContactSchedule::colored;
+  bool enabled = false;                                 ///< off: no mesh contacts at all
+  ContactSchedule schedule = ContactSchedule::colored;  ///< how the contacts are solved within a sweep
   /// The distance the surfaces keep from each other [m], > 0. Also the
   /// tissue's collision thickness in self-contact.
   double thickness = 1e-3;
@@ -542,13 +555,13 @@ struct MeshCollisionDesc {
   /// every triangle normal at the frame's start within 30 degrees of one
   /// axis (normal cones, Volino and Magnenat-Thalmann 1994). It assumes no
   /// patch winds over itself like a helical ramp; turn it off for scenes
-  /// that may form one (README, mesh collision).
+  /// that may form one (docs/collision.md, mesh collision).
   bool self_culling = true;
   /// The meshes' triangles and thread segments meet the rigid tools
   /// (ToolDesc) too, as they meet the colliders, and their reaction joins
   /// the vertices' on the tool: a thin tool pressed between a coarse
   /// mesh's vertices is held. Off: only vertices meet tools, as without
-  /// mesh collision. Measured (README, "Mesh collision"): a 20 g tool on a
+  /// mesh collision. Measured (docs/collision.md, "Mesh collision"): a 20 g tool on a
   /// virtual coupling in a 2 cm membrane cell is held with faces and passes
   /// through without; a heavy tool (10^4 times a particle) dropped onto a
   /// soft 5 mm block at 20 substeps rests without faces but bounces and
@@ -558,7 +571,7 @@ struct MeshCollisionDesc {
   double static_friction = 0.3;   ///< >= 0
   double dynamic_friction = 0.2;  ///< >= 0, <= static_friction
 
-  /// Continuous collision detection (issue 13, part 3): after every
+  /// Continuous collision detection (docs/collision.md): after every
   /// substep's sweeps the host tests the motion the primitives made in it,
   /// from the substep's start to its end, linearly, with the CCD queries of
   /// sinew/ccd.h (no false negatives):
@@ -579,7 +592,7 @@ struct MeshCollisionDesc {
   /// thread, however fast they move, provided the scene starts with none
   /// through another; the one exception, counted in FrameStats::ccd_forced,
   /// is a tool forcing tissue it carries or pinned tissue through other
-  /// tissue (README, "Continuous collision detection"). Costs a read-back
+  /// tissue (docs/collision.md, "Continuous collision detection"). Costs a read-back
   /// of the positions per substep. Needs ContactSchedule::colored, and
   /// a line body, or a tool or capsule collider and a surface. Surfaces
   /// against surfaces are not tested continuously (the frame's contacts
@@ -608,18 +621,57 @@ struct GrasperDesc {
   double compliance = 0.0;      ///< of each hold [m/N], >= 0 (0: rigid)
 };
 
+/// A tissue surface that holds the scene's fluid and is pushed by it
+/// (SceneDesc::fluid): sampled at the fluid's spacing with boundary
+/// particles that follow the surface's vertices (Akinci et al., TOG 31(4),
+/// 2012; sample_surface), whose push from the fluid goes back to those
+/// vertices as forces.
+struct FluidSurfaceDesc {
+  BodyKind body_kind = BodyKind::tet;  ///< tet or tri
+  std::size_t body = 0;                ///< index among the scene's bodies of that kind
+  /// Triangles over the body's mesh vertices (e.g. the part of its boundary
+  /// that faces the fluid); empty: a tet body's whole boundary surface
+  /// (extract_boundary_surface), a tri body's triangles. Sampled once, at
+  /// Simulation::create, on the rest mesh: cuts do not resample them.
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+/// A fluid that runs with the scene, on the Simulation's device, as one
+/// stage of its frame (Simulation::fluid()). Each frame, on the device and
+/// without the host: the surfaces' boundary particles move to the tissue's
+/// positions and velocities at the frame's start, the fluid takes the
+/// frame's steps (SolverSettings::time_step / FluidSettings::time_step of
+/// them, a whole number), and the impulse J the fluid gave each boundary
+/// particle over them becomes a constant force J / frame on its triangle's
+/// vertices (by its barycentric weights) for the tissue's frame. So the
+/// tissue gains in its frame the momentum the fluid lost to it (up to float
+/// rounding; what lands on pinned or kinematic vertices goes to the fixed
+/// world). The coupling is explicit, one frame apart: stable while the
+/// fluid's push moves the surface by much less than a spacing per frame.
+/// Host reads per frame: the fluid's counts and fastest speed (28 bytes).
+struct SceneFluidDesc {
+  /// The fluid (FluidDesc): its particles, fixed boundary, emitters and
+  /// sinks. Its `device` is not used (the scene's runs it); its
+  /// moving_boundary and boundary_forces are set when there are surfaces.
+  FluidDesc fluid;
+  std::vector<FluidSurfaceDesc> surfaces;  ///< may be empty: a fluid held by its fixed boundary only
+};
+
+/// A whole scene: its bodies, colliders, tools, interactions and solver
+/// settings, in SI units. Simulation::create checks it (errors name the
+/// field, e.g. "tet_bodies[0].density") and compiles it onto a device.
 struct SceneDesc {
   std::array<double, 3> gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
-  SolverSettings solver;
-  std::vector<TetBodyDesc> tet_bodies;
-  std::vector<TriBodyDesc> tri_bodies;
-  std::vector<LineBodyDesc> line_bodies;
-  std::vector<ColliderDesc> colliders;
+  SolverSettings solver;                   ///< time step, substeps, iterations, residual mode
+  std::vector<TetBodyDesc> tet_bodies;     ///< volumetric tissue (tet meshes)
+  std::vector<TriBodyDesc> tri_bodies;     ///< thin tissue: membranes, vessel walls (triangle meshes)
+  std::vector<LineBodyDesc> line_bodies;   ///< threads (polylines)
+  std::vector<ColliderDesc> colliders;     ///< kinematic shapes (Tools::collider reaches them by index)
   std::vector<std::array<double, 3>> targets;       ///< initial kinematic target positions [m]
-  std::vector<AttachmentDesc> attachments;
-  std::vector<ToolDesc> tools;
-  std::vector<NeedleDesc> needles;
-  std::vector<GrasperDesc> graspers;
+  std::vector<AttachmentDesc> attachments; ///< vertices held to targets
+  std::vector<ToolDesc> tools;             ///< rigid tools driven by force
+  std::vector<NeedleDesc> needles;         ///< suture needles and their threads
+  std::vector<GrasperDesc> graspers;       ///< graspers (Graspers closes them)
   MeshCollisionDesc mesh_collision;  ///< contacts between the bodies' meshes (off by default)
   /// Forces on single particles, set by the host before each frame
   /// (Simulation::set_particle_forces; e.g. a fluid's pressure on tissue,
@@ -634,6 +686,10 @@ struct SceneDesc {
   /// host copy of every constraint block (what a removal patches) and the
   /// tet and tri bodies' adjacency; without it those calls are errors.
   bool topology_changes = false;
+  /// A fluid coupled with the tissue (SceneFluidDesc); none by default. A
+  /// fluid with surfaces gives the scene its force buffer (as
+  /// external_forces = true does).
+  std::optional<SceneFluidDesc> fluid;
 };
 
 /// Checks every parameter of a scene; the first problem found is returned,

@@ -13,32 +13,42 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "sinew/device.h"
+#include "sinew/divergence.h"
 #include "sinew/scene.h"
+#include "sinew/graspers.h"
+#include "sinew/ids.h"
+#include "sinew/needles.h"
+#include "sinew/saved_state.h"
+#include "sinew/scene_fluid.h"
+#include "sinew/tools.h"
+#include "sinew/topology.h"
 
 namespace sinew {
 
 
 /// What a compiled scene holds; fixed for the life of a Simulation.
 struct SceneInfo {
-  std::uint32_t particles = 0;
-  std::uint32_t distance_constraints = 0;
-  std::uint32_t volume_constraints = 0;
+  std::uint32_t particles = 0;             ///< particles of every body (tet, tri and line bodies' vertices)
+  std::uint32_t distance_constraints = 0;  ///< edge (and thread segment) distance constraints
+  std::uint32_t volume_constraints = 0;    ///< tet volume constraints
   std::uint32_t distance_colors = 0;  ///< colours of the distance constraints
   std::uint32_t volume_colors = 0;    ///< colours of the volume constraints
   std::uint32_t other_constraints = 0;  ///< every other kind (FEM tets, thin bodies, contacts, attachments)
   std::uint32_t colors = 0;           ///< dependent sweeps per iteration (sum of the above)
-  std::uint32_t dispatches_per_frame = 0;
-  std::uint32_t barriers_per_frame = 0;
+  std::uint32_t dispatches_per_frame = 0;  ///< kernel dispatches in one frame's program
+  std::uint32_t barriers_per_frame = 0;    ///< barriers between dependent dispatches in one frame's program
   std::vector<std::uint32_t> tet_body_first_particle;   ///< body i's vertex 0 is this particle
-  std::vector<std::uint32_t> tri_body_first_particle;
-  std::vector<std::uint32_t> line_body_first_particle;
+  std::vector<std::uint32_t> tri_body_first_particle;   ///< as tet_body_first_particle, for tri bodies
+  std::vector<std::uint32_t> line_body_first_particle;  ///< as tet_body_first_particle, for line bodies
   /// Mesh self-collision: pairs of a body's triangles closer than the
   /// thickness in the starting shape, which never make contacts with each
   /// other (MeshCollisionDesc::self_collision).
   std::uint32_t rest_close_triangle_pairs = 0;
+  /// All constraints of the bodies: distance + volume + other.
   [[nodiscard]] std::uint32_t constraints() const {
     return distance_constraints + volume_constraints + other_constraints;
   }
@@ -61,10 +71,25 @@ enum class SolveStop {
 /// "mesh collision", "continuous collision", "sutures", "solve",
 /// "statistics", "tearing", ...; only those the scene uses).
 struct StageProfile {
-  std::string name;
+  std::string name;  ///< the stage's name, e.g. "mesh collision"
   double ms = 0.0;  ///< wall time of the stage's work in the last step() [ms]
+  /// The stage's own figures of the last step(), by name (the units in the
+  /// name: "margin_m"); FrameStats::counter reads one. Mesh collision:
+  /// contacts, colors, margin_m, violation_m; continuous collision: hits,
+  /// repairs, reverted, carried, forced; sutures: host_ms; fluid:
+  /// particles, steps.
+  struct Counter {
+    std::string name;    ///< e.g. "contacts", "margin_m"
+    double value = 0.0;  ///< its value in the last step()
+  };
+  std::vector<Counter> counters;  ///< the stage's counters, in the order they were first set
+  /// Sets counter `name` (added the first time).
+  void set(std::string_view counter, double value);
 };
 
+/// What the last frame did and cost: its time, the solver's errors (residuals,
+/// energy, volume change), contacts, continuous collision, device times and
+/// the profile of each stage (Simulation::last_frame).
 struct FrameStats {
   std::uint64_t frame = 0;  ///< frames done
   double time = 0.0;        ///< simulated time [s]
@@ -77,12 +102,19 @@ struct FrameStats {
   /// collision's reads inside the solve are not among them (read_back_bytes
   /// counts them).
   std::uint32_t position_reads = 0;
-  std::uint64_t read_back_bytes = 0;  ///< bytes the host read from the device in the last step():
-                                      ///< the statistics' few words; with mesh collision, needles or
-                                      ///< tearing, the positions once (16 per particle, position_reads);
-                                      ///< 32 per contact when a tool has face contacts; 96 per suture
-                                      ///< row; with continuous collision, 32 per particle per substep
-                                      ///< and 16 per particle per repair round more
+  /// Bytes the host read from the device in the last step(), as the device
+  /// counted them (every backend alike): the statistics' few words; with
+  /// mesh collision, needles or tearing, the positions once (16 per
+  /// particle, position_reads); 32 per contact when a tool has face
+  /// contacts; 96 per suture row; with continuous collision, 32 per
+  /// particle per substep and 16 per particle per repair round more. Each
+  /// stage's share is its profile's counter "read_bytes".
+  std::uint64_t read_back_bytes = 0;
+  std::uint32_t host_reads = 0;  ///< read-backs (round trips) in the last step()
+  /// Times the last step() blocked on the device: every read-back, and
+  /// every wait for a submitted program (each stage's share: its counter
+  /// "host_waits"). A frame that ran wholly on the device would wait once.
+  std::uint32_t host_waits = 0;
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,
   /// rest volume, ...): 0 when the xPBD system is solved exactly. Contact
@@ -95,6 +127,10 @@ struct FrameStats {
   /// (remove_tets, cuts, tears, cautery) the live tets' boundaries and rest
   /// volume.
   double volume_change = 0.0;
+  /// Tets whose signed volume is negative at the frame's end (turned inside
+  /// out), over the tet bodies' live tets; reduced on the device with the
+  /// errors (0 with measure_errors off).
+  std::uint32_t inverted_tets = 0;
   /// Gauss-Seidel sweeps (iterations) run in the last frame, over all its substeps.
   std::uint64_t sweeps = 0;
   /// How the sweeps ended; in residual mode the worst substep's reason
@@ -115,14 +151,18 @@ struct FrameStats {
   /// reached SolverSettings::residual_tolerance. Always false in fixed mode
   /// (no residual is checked there; residual_rms says how far it was).
   [[nodiscard]] bool converged() const { return stop == SolveStop::converged; }
+
+  // ---- Per-feature figures, kept for one release: each is also a counter
+  // of its stage (StageProfile::counters, FrameStats::counter), where new
+  // figures go.
   /// Mesh collision (SceneDesc::mesh_collision), 0 without: the frame's
   /// contacts, their colours (dispatches per sweep), the motion margin they
   /// were found within [m], and the wall time [ms] of reading the
   /// particles back, finding, colouring and uploading them (part of wall_ms).
   std::uint32_t mesh_contacts = 0;
   std::uint32_t mesh_contact_colors = 0;  ///< 0 with ContactSchedule::jacobi
-  double collision_margin = 0.0;
-  double collision_ms = 0.0;
+  double collision_margin = 0.0;  ///< the motion margin the mesh contacts were found within [m]
+  double collision_ms = 0.0;      ///< reading back, finding, colouring and uploading the mesh contacts [ms]
   /// The deepest any of the frame's mesh contacts ended inside the
   /// thickness [m], max(thickness - gap) at the frame's end (0 when none
   /// touches): how well the sweeps converged on the contacts.
@@ -132,9 +172,9 @@ struct FrameStats {
   /// (each round's touches counted), the repair rounds run, the particles
   /// the fail-safe stopped at their substep's start, and the wall time
   /// [ms] of the tests (read-back, broad phase, queries; part of wall_ms).
-  std::uint32_t ccd_hits = 0;
-  std::uint32_t ccd_repairs = 0;
-  std::uint32_t ccd_reverted = 0;
+  std::uint32_t ccd_hits = 0;      ///< touching pairs found in the frame's substeps
+  std::uint32_t ccd_repairs = 0;   ///< repair rounds run
+  std::uint32_t ccd_reverted = 0;  ///< particles the fail-safe stopped at their substep's start
   /// The particles the fail-safe moved with a tool or capsule collider
   /// (rigidly, over their substep) so its axis could not cross them.
   std::uint32_t ccd_carried = 0;
@@ -143,7 +183,7 @@ struct FrameStats {
   /// through other tissue (it is kinematic within the frame). 0 but for such
   /// scenes.
   std::uint32_t ccd_forced = 0;
-  double ccd_ms = 0.0;
+  double ccd_ms = 0.0;  ///< wall time of the continuous collision tests [ms] (part of wall_ms)
   /// Needles (SceneDesc::needles), 0 without: the wall time [ms] of their
   /// host side, before the frame (reading the positions back, testing the
   /// tips' paths against the surfaces, uploading the rows) and after it
@@ -152,39 +192,72 @@ struct FrameStats {
   /// Device time of the frame's program per kernel (stage) and in all, from
   /// GPU timestamps; timed = false on backends that record none (see DeviceTimes).
   DeviceTimes device;
+  /// The divergence checks' verdict on the last frame and what the policy
+  /// did (sinew/divergence.h; Simulation::set_divergence_settings).
+  DivergenceReport divergence;
   /// The frame's stages in the order they run, each with its wall time in
   /// the last step() (their sum is within wall_ms).
   std::vector<StageProfile> stages;
+  /// The wall time [ms] of stage `name` in the last step() (0 when the scene has no such stage).
+  [[nodiscard]] double stage_ms(std::string_view name) const;
+  /// Counter `counter` of stage `stage` in the last step() (StageProfile::
+  /// counters; 0 when there is no such stage or counter).
+  [[nodiscard]] double counter(std::string_view stage, std::string_view counter) const;
 };
 
+/// A scene compiled onto a device: created from a SceneDesc, stepped frame by
+/// frame, read back, and reached through the feature handles (tools(),
+/// graspers(), needles(), topology(), fluid()). Movable, not copyable; a
+/// handle is valid while its Simulation is neither destroyed nor moved.
 class Simulation {
  public:
   /// Checks and compiles the scene and prepares it on a device. Errors name
   /// the bad parameter, or say why the backend is not available.
   static Result<Simulation> create(const SceneDesc& scene, const DeviceOptions& device = {});
 
+  /// Moves the scene and its device; handles of the moved-from Simulation become invalid.
+  ///@{
   Simulation(Simulation&&) noexcept;
   Simulation& operator=(Simulation&&) noexcept;
+  ///@}
   ~Simulation();
 
-  /// Advances one frame (SolverSettings::time_step).
+  /// Advances one frame (SolverSettings::time_step), then checks it for
+  /// divergence (sinew/divergence.h): with OnDivergence::stop a diverged
+  /// frame returns ErrorCode::diverged, with roll_back the scene goes back
+  /// to the last good frame.
   Status step();
+
+  /// [in] settings: the divergence checks' bounds and policy, from the next
+  /// step() on. With OnDivergence::roll_back the current state is saved at
+  /// once (the first frame to roll back to). Errors (bad_parameter, nothing
+  /// changed): energy_growth not > 1, floor_speed < 0, max_volume_change
+  /// not > 0 or checkpoint_every 0 (each named), a scene save_state refuses.
+  Status set_divergence_settings(const DivergenceSettings& settings);
+  [[nodiscard]] const DivergenceSettings& divergence_settings() const;
+
+  /// [out] out: the state after the last frame (sinew/saved_state.h), its
+  /// bytes replaced (their capacity reused: saving every frame allocates
+  /// nothing after the first). Reads the particles' buffers and multipliers
+  /// back from the device (and a fluid's particles and grid). Errors: a scene with what a state
+  /// cannot hold yet (needles, a closed grasper; bad_parameter naming it), a device error.
+  Status save_state(SavedState& out);
+  /// [in] state: from save_state of this scene (this Simulation, or one made
+  /// from the same SceneDesc); the next step() continues from it bitwise as
+  /// the run it was saved from. Errors, leaving the Simulation unchanged:
+  /// bad_input_file for a damaged or foreign state (sinew/saved_state.h),
+  /// bad_parameter for another scene's state (naming what differs) or one
+  /// saved before or after a topology change or level-set cut.
+  Status restore_state(const SavedState& state);
+  /// save_state to a file [in] path (replaced). Errors as save_state's and SavedState::write_file's.
+  Status save_state(const std::string& path);
+  /// restore_state from a file [in] path. Errors as restore_state's and SavedState::read_file's.
+  Status restore_state(const std::string& path);
 
   /// [out] xyzw per particle: position [m] and inverse mass [1/kg] in w.
   Status read_positions(std::vector<float>& xyzw) const;
   /// [out] xyz0 per particle: velocity [m/s], w unused.
   Status read_velocities(std::vector<float>& xyzw) const;
-
-  /// Moves collider `index` to this pose [m, unit quaternion (w, x, y, z)]
-  /// by the end of the next frame; its substeps interpolate the motion.
-  Status set_collider_pose(std::size_t index, const std::array<double, 3>& position,
-                           const std::array<double, 4>& rotation);
-  /// Moves kinematic target `index` to `position` [m] by the end of the next frame.
-  Status set_target(std::size_t index, const std::array<double, 3>& position);
-  /// Force [N] and torque [N m] (world frame, about the tool's centre)
-  /// acting on tool `index` during the next frame (then reset to zero);
-  /// calls before one step add up.
-  Status apply_tool_force(std::size_t index, const std::array<double, 3>& force, const std::array<double, 3>& torque);
 
   /// Forces [N] on the scene's particles (3 floats x, y, z per particle, in
   /// the particle order of read_positions), acting during the next frame
@@ -198,210 +271,90 @@ class Simulation {
   /// first frame without a call after one (resetting them).
   /// Needs SceneDesc::external_forces (else an error naming it). Errors
   /// (bad_parameter): a span whose size is not 3 x particles, a non-finite
-  /// value (naming the particle); the forces set before stay then.
+  /// value, or one whose velocity over a frame (time_step f / m) or move
+  /// (time_step^2 f / m) is not finite in float32, the device's precision
+  /// (naming the particle); the forces set before stay then.
   Status set_particle_forces(std::span<const float> xyz);
 
-  /// Cuts level-set collider `index` (ColliderShape::level_set, built with
-  /// its whole inside stored): LevelSet::cut with the tool's poses in the
-  /// collider's frame. The collider's grid changes (and every LevelSet
-  /// sharing it), and so does the device's copy, by the changed leaves,
-  /// before this returns: the next step collides with the cut shape.
-  /// Errors: not a level-set collider; LevelSet::cut's.
-  Result<CutReport> cut_collider(std::size_t index, const CutterShape& shape, const Pose& from, const Pose& to);
+  // ---- Features, each behind its own handle and header (a view of this
+  // Simulation: valid while it is neither destroyed nor moved), with typed
+  // ids (sinew/ids.h).
 
-  // ---- Topology changes (SceneDesc::topology_changes; runtime/topology_editor.h)
-  //
-  // Elements (a tet body's tets, a tri body's triangles) are removed, never
-  // split: what is left is whole original elements, so no sliver is ever
-  // made (the smallest element keeps its rest volume or area). A removed
-  // element's own constraints go (volume and FEM; area), and so do the
-  // distance constraints of edges no remaining element has and, on a tri
-  // body, the dihedral (bending) constraints of the hinges it was part of;
-  // an edge that keeps some of its elements is made softer by the share it
-  // lost (alpha_e = c_d L^2 / V_e, TetBodyDesc; c_d L^2 / (A_e t),
-  // TriBodyDesc). Each removed constraint's colour gives its last
-  // constraint the slot, so every colour stays valid and only the changed
-  // slots are uploaded; the frame program is rebuilt with the new counts.
-  // A vertex left with no element is fixed (inverse mass 0) and its mass
-  // handed to the movable vertices it shared a removed element with, or
-  // else to the nearest live movable vertex of its body; cuts and tears
-  // conserve the total mass unless nothing movable is left to take it
-  // (then it is mass_removed). Cautery burns its elements' mass away.
-  // Events are returned, for a renderer to update its meshes
-  // (current_tets, current_triangles). Errors in the arguments change
-  // nothing; a device error during a change leaves the Simulation unusable.
+  /// Tools, colliders and kinematic targets (sinew/tools.h).
+  [[nodiscard]] Tools tools();
+  /// Graspers (sinew/graspers.h).
+  [[nodiscard]] Graspers graspers();
+  /// Needles and sutures (sinew/needles.h).
+  [[nodiscard]] Needles needles();
+  /// Topology changes: removals, cuts, cautery, tears (sinew/topology.h).
+  [[nodiscard]] Topology topology();
 
-  /// What one change did to body `body` (a tet body, a tri body, or a line
-  /// body whose segments broke: body_kind).
-  struct TopologyEvent {
-    BodyKind body_kind = BodyKind::tet;
-    std::size_t body = 0;
-    std::vector<std::uint32_t> tets_removed;      ///< a tet body's: indices into its mesh.tets
-    std::vector<std::uint32_t> triangles_removed; ///< a tri body's: indices into its mesh.triangles
-    std::vector<std::uint32_t> segments_removed;  ///< a line body's: indices into its segments
-    std::vector<std::uint32_t> vertices_removed;  ///< movable vertices left with no element (now fixed and massless)
-    std::uint32_t constraints_removed = 0;  ///< volume, FEM, area, distance and bending constraints taken out
-    std::uint32_t edges_softened = 0;       ///< distance constraints whose compliance grew
-    double mass_moved = 0.0;    ///< [kg] handed from removed vertices to their neighbours
-    double mass_removed = 0.0;  ///< [kg] that left the scene (burned, or no neighbour left)
-    double wall_ms = 0.0;       ///< host and device time of the change, the program rebuilt included
-    double rebuild_ms = 0.0;    ///< of which rebuilding the frame program
-  };
-  /// Removes tets of tet body `body` (indices into its mesh.tets, each
-  /// alive, no repeats). Errors: topology changes not enabled, a bad body
-  /// or tet (named); on an error nothing changed.
-  Result<TopologyEvent> remove_tets(std::size_t body, std::span<const std::uint32_t> tets);
-  /// Removes triangles of tri body `body` (indices into its mesh.triangles,
-  /// each alive, no repeats). Errors as remove_tets'.
-  Result<TopologyEvent> remove_triangles(std::size_t body, std::span<const std::uint32_t> triangles);
-  /// A blade: the segment from `a` to `b` [m].
-  struct Blade {
-    std::array<double, 3> a{}, b{};
-  };
-  /// Cuts body `body` of `kind` (tet or tri) with a blade swept from `from`
-  /// to `to` (the quad they span, two triangles): every live tet or
-  /// triangle the swept quad touches at the body's current positions is
-  /// removed (mass as above). A sheet cut in its own plane loses the
-  /// triangles the quad overlaps. The query sees the tissue where it is
-  /// now: tissue moving across the blade's path between strokes can slip
-  /// past uncut, so strokes along a line should overlap
-  /// (examples/cholecystectomy.cpp).
-  Result<TopologyEvent> cut_body(BodyKind kind, std::size_t body, const Blade& from, const Blade& to);
-  /// cut_body(BodyKind::tet, body, from, to).
-  Result<TopologyEvent> cut_body(std::size_t body, const Blade& from, const Blade& to);
-  /// A heated tip (a ball of `radius` [m] at `centre` [m]) touching body
-  /// `body` of `kind` (tet or tri) for `seconds` [s] (> 0): a live element
-  /// whose current centroid lies in the ball accumulates that time, and is
-  /// burned (removed with its mass) once it has been touched for
-  /// dwell_time [s] (> 0) in all. The rate: the ball's volume inside a tet
-  /// body (its disc's area across a sheet) goes every dwell_time.
-  Result<TopologyEvent> cauterize(BodyKind kind, std::size_t body, const std::array<double, 3>& centre, double radius,
-                                  double seconds, double dwell_time);
-  /// cauterize(BodyKind::tet, body, ...).
-  Result<TopologyEvent> cauterize(std::size_t body, const std::array<double, 3>& centre, double radius,
-                                  double seconds, double dwell_time);
-  /// Breaks segments of line body `body` (indices into its segments, each
-  /// whole, no repeats): their distance constraints go, with the bending
-  /// constraints across them (a thread cut with scissors). Errors as
-  /// remove_tets'.
-  Result<TopologyEvent> remove_segments(std::size_t body, std::span<const std::uint32_t> segments);
-  /// What tore in the last step() (TetBodyDesc::tear_strain,
-  /// TriBodyDesc::tear_strain, LineBodyDesc::tear_strain), one event per
-  /// body that tore.
-  [[nodiscard]] const std::vector<TopologyEvent>& last_tears() const;
-  /// The live tets of tet body `body` (indices into its mesh.tets, as
-  /// tets; the vertices are the mesh's): its current topology, for
-  /// extract_boundary_surface. Errors: a bad body.
-  Result<std::vector<std::array<std::uint32_t, 4>>> current_tets(std::size_t body) const;
-  /// The live triangles of tri body `body` (as triangles of its mesh's
-  /// vertices): its current surface, for a renderer. Errors: a bad body.
-  Result<std::vector<std::array<std::uint32_t, 3>>> current_triangles(std::size_t body) const;
+  /// The scene's fluid (SceneDesc::fluid; sinew/scene_fluid.h): its
+  /// particles, counts, emitters and sinks. Calls on it are errors when
+  /// the scene has none.
+  [[nodiscard]] SceneFluid fluid();
 
-  // ---- Graspers (SceneDesc::graspers; runtime/graspers.h)
-
-  /// Closes grasper `index` at `pose` [m, unit quaternion (w, x, y, z)]: every
-  /// movable particle (of any body) inside the jaws, the box of
-  /// `half_extents` [m] (> 0) centred on the pose in its frame, is held
-  /// where it is now, at a point fixed in the grasper's frame. So is every
-  /// surface triangle (a tet body's boundary face, a tri body's triangle)
-  /// that crosses the box with none of its vertices inside it: at its
-  /// point nearest the pose's position, through its barycentric weights
-  /// (a coarse mesh grasped between its vertices; held_points lists them).
-  /// Of such triangles sharing a vertex only the one whose point is
-  /// nearest is held (a point's vertices move with it; two points on one
-  /// vertex would fight over it within one colour). Returns the held
-  /// particles (the user's order, as read_positions). Errors: a bad index,
-  /// pose or box; closed already; more particles than its capacity, or
-  /// points than its point_capacity (capacity_exceeded, nothing held).
-  Result<std::vector<std::uint32_t>> close_grasper(std::size_t index, const Pose& pose,
-                                                   const std::array<double, 3>& half_extents);
-  /// A surface point a grasper holds: sum weights[k] x[particles[k]].
-  struct HeldPoint {
-    std::array<std::uint32_t, 3> particles{};  ///< the triangle's particles (user order)
-    std::array<double, 3> weights{};           ///< barycentric, each in [0, 1], summing to 1
-  };
-  /// The surface points grasper `index` holds (none while open). Errors: a bad index.
-  Result<std::vector<HeldPoint>> held_points(std::size_t index) const;
-  /// Moves grasper `index` to `pose` by the end of the next frame (its held
-  /// particles' targets move across the frame's substeps). Errors: a bad
-  /// index or pose.
-  Status move_grasper(std::size_t index, const Pose& pose);
-  /// Opens grasper `index`: what it held is free from the next frame on.
-  /// Returns the released particles. Errors: a bad index.
-  Result<std::vector<std::uint32_t>> open_grasper(std::size_t index);
-
-  /// A tool's state at the end of the last frame.
-  struct ToolState {
-    std::array<double, 3> position{};          ///< [m]
-    std::array<double, 4> rotation{1, 0, 0, 0};  ///< unit quaternion (w, x, y, z)
-    std::array<double, 3> velocity{};          ///< [m/s]
-    std::array<double, 3> angular_velocity{};  ///< world frame [rad/s]
-    std::array<double, 3> contact_force{};     ///< what the tissue pushed the tool with, frame average [N]
-    std::array<double, 3> contact_torque{};    ///< about the tool's centre [N m]
-    /// A level-set tool's penalty from the colliders and the other tools
-    /// (or a capsule tool's from level-set tools), at the start of the last
-    /// frame, which it drove (ToolDesc) [N], about its centre [N m].
-    std::array<double, 3> penalty_force{};
-    std::array<double, 3> penalty_torque{};
-    std::uint32_t penalty_points = 0;  ///< a level-set tool's surface points inside other shapes then
-    double penalty_depth = 0.0;        ///< the deepest one's depth [m]
-  };
-  Result<ToolState> tool_state(std::size_t index) const;
-
-  /// Moves kinematic needle `index` to this pose [m, unit quaternion (w, x,
-  /// y, z)] by the end of the next frame (NeedleDesc); its substeps
-  /// interpolate each of its points linearly. Errors: a force-driven needle.
-  Status set_needle_pose(std::size_t index, const std::array<double, 3>& position,
-                         const std::array<double, 4>& rotation);
-  /// Force [N] and torque [N m] (world frame, about the needle's origin, its
-  /// centre of mass) acting on force-driven needle `index` during the next
-  /// frame (then reset to zero); calls before one step add up. Errors: a
-  /// kinematic needle.
-  Status apply_needle_force(std::size_t index, const std::array<double, 3>& force,
-                            const std::array<double, 3>& torque);
-
-  /// A tissue point held on a needle or its thread (NeedleDesc).
-  struct Puncture {
-    BodyKind body_kind = BodyKind::tet;  ///< tet (its boundary surface) or tri
-    std::uint32_t body = 0;              ///< index among the scene's bodies of that kind
-    /// The triangle: of extract_boundary_surface(mesh) for a tet body, of
-    /// mesh.triangles for a tri body.
-    std::uint32_t triangle = 0;
-    std::array<double, 3> weights{};  ///< barycentric weights of the point on it
-    bool exit = false;       ///< made leaving a tet body (else entering a surface)
-    bool on_thread = false;  ///< the needle has passed it: it holds the thread
-    std::uint32_t thread_segment = 0;  ///< on_thread: the thread's segment through it
-    double thread_s = 0.0;             ///< on_thread: where along that segment, in [0, 1]
-  };
-  /// A needle at the end of the last frame.
-  struct NeedleState {
-    std::array<double, 3> position{};            ///< [m]
-    std::array<double, 4> rotation{1, 0, 0, 0};  ///< unit quaternion (w, x, y, z)
-    std::array<double, 3> velocity{};            ///< over the last frame [m/s]
-    std::array<double, 3> angular_velocity{};    ///< over the last frame, world frame [rad/s]
-    /// What the tissue and the thread did to the needle, averaged over the
-    /// last frame: the force [N] of its tip's push, its punctures and its
-    /// tie to the thread, and their torque about its origin [N m] (world
-    /// frame). Kinematic needles report it too: it is the force to render
-    /// on a haptic device.
-    std::array<double, 3> reaction_force{}, reaction_torque{};
-    std::vector<Puncture> punctures;             ///< in the order they were made
-    bool pushing = false;    ///< the tip pushes a surface it has not punctured
-    double tip_force = 0.0;  ///< that push, along the tip, averaged over the frame [N]
-    /// Since the start: surface triangles the tip met that it could not
-    /// puncture because they were degenerate (no area) or inverted (their
-    /// tet turned inside out), and frames in which the push passed
-    /// puncture_force at more than max_puncture_angle.
-    std::uint32_t refused_degenerate = 0, refused_inverted = 0, refused_angle = 0;
-  };
-  Result<NeedleState> needle_state(std::size_t index) const;
-
+  /// What the compiled scene holds (fixed for the Simulation's life).
   [[nodiscard]] const SceneInfo& info() const;
+  /// The last step()'s figures (default values before the first step()).
   [[nodiscard]] const FrameStats& last_frame() const;
   /// The backend running the scene: "cpu", "opencl" or "vulkan".
   [[nodiscard]] std::string backend_name() const;
   /// Its device, e.g. "CPU reference (2 threads, AVX2)" or "Vulkan: NVIDIA H100 (discrete GPU, ...)".
   [[nodiscard]] std::string device_name() const;
+
+  /// Deprecated: the calls by raw index, kept for one release. Each does
+  /// what its replacement, named in its deprecation message, does (the
+  /// feature headers document them).
+  ///@{
+  using TopologyEvent = sinew::TopologyEvent;
+  using Blade = sinew::Blade;
+  using HeldPoint = sinew::HeldPoint;
+  using ToolState = sinew::ToolState;
+  using Puncture = sinew::Puncture;
+  using NeedleState = sinew::NeedleState;
+  [[deprecated("use tools().set_pose(ColliderId, ...)")]] Status set_collider_pose(std::size_t index, const std::array<double, 3>& position,
+                                                               const std::array<double, 4>& rotation);
+  [[deprecated("use tools().set_position(TargetId, ...)")]] Status set_target(std::size_t index, const std::array<double, 3>& position);
+  [[deprecated("use tools().apply_force(ToolId, ...)")]] Status apply_tool_force(std::size_t index, const std::array<double, 3>& force,
+                                                             const std::array<double, 3>& torque);
+  [[deprecated("use tools().state(ToolId)")]] Result<ToolState> tool_state(std::size_t index) const;
+  [[deprecated("use tools().cut(ColliderId, ...)")]] Result<CutReport> cut_collider(std::size_t index, const CutterShape& shape,
+                                                                const Pose& from, const Pose& to);
+  [[deprecated("use topology().remove_tets(TetBodyId, ...)")]] Result<TopologyEvent> remove_tets(std::size_t body,
+                                                                              std::span<const std::uint32_t> tets);
+  [[deprecated("use topology().remove_triangles(TriBodyId, ...)")]] Result<TopologyEvent> remove_triangles(
+      std::size_t body, std::span<const std::uint32_t> triangles);
+  [[deprecated("use topology().cut(TetBodyId or TriBodyId, ...)")]] Result<TopologyEvent> cut_body(BodyKind kind, std::size_t body,
+                                                                                 const Blade& from, const Blade& to);
+  [[deprecated("use topology().cut(TetBodyId, ...)")]] Result<TopologyEvent> cut_body(std::size_t body, const Blade& from,
+                                                                    const Blade& to);
+  [[deprecated("use topology().cauterize(TetBodyId or TriBodyId, ...)")]] Result<TopologyEvent> cauterize(
+      BodyKind kind, std::size_t body, const std::array<double, 3>& centre, double radius, double seconds,
+      double dwell_time);
+  [[deprecated("use topology().cauterize(TetBodyId, ...)")]] Result<TopologyEvent> cauterize(std::size_t body,
+                                                                           const std::array<double, 3>& centre,
+                                                                           double radius, double seconds,
+                                                                           double dwell_time);
+  [[deprecated("use topology().remove_segments(LineBodyId, ...)")]] Result<TopologyEvent> remove_segments(
+      std::size_t body, std::span<const std::uint32_t> segments);
+  [[deprecated("use topology().last_tears()")]] [[nodiscard]] const std::vector<TopologyEvent>& last_tears() const;
+  [[deprecated("use topology().current_tets(TetBodyId)")]] Result<std::vector<std::array<std::uint32_t, 4>>> current_tets(
+      std::size_t body) const;
+  [[deprecated("use topology().current_triangles(TriBodyId)")]] Result<std::vector<std::array<std::uint32_t, 3>>> current_triangles(
+      std::size_t body) const;
+  [[deprecated("use graspers().close(GrasperId, ...)")]] Result<std::vector<std::uint32_t>> close_grasper(
+      std::size_t index, const Pose& pose, const std::array<double, 3>& half_extents);
+  [[deprecated("use graspers().held_points(GrasperId)")]] Result<std::vector<HeldPoint>> held_points(std::size_t index) const;
+  [[deprecated("use graspers().move(GrasperId, ...)")]] Status move_grasper(std::size_t index, const Pose& pose);
+  [[deprecated("use graspers().open(GrasperId)")]] Result<std::vector<std::uint32_t>> open_grasper(std::size_t index);
+  [[deprecated("use needles().set_pose(NeedleId, ...)")]] Status set_needle_pose(std::size_t index, const std::array<double, 3>& position,
+                                                             const std::array<double, 4>& rotation);
+  [[deprecated("use needles().apply_force(NeedleId, ...)")]] Status apply_needle_force(std::size_t index,
+                                                                   const std::array<double, 3>& force,
+                                                                   const std::array<double, 3>& torque);
+  [[deprecated("use needles().state(NeedleId)")]] Result<NeedleState> needle_state(std::size_t index) const;
+  ///@}
 
   /// The library's own state behind a Simulation (src/runtime/simulation_impl.h; incomplete here, named so
   /// that the frame's stages, src/runtime/stages/, can refer to it).
@@ -409,6 +362,10 @@ class Simulation {
 
  private:
   friend struct SimulationInternals;  // the library's own access (src/runtime/simulation_internals.h)
+  friend class Tools;
+  friend class Graspers;
+  friend class Needles;
+  friend class Topology;
   explicit Simulation(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

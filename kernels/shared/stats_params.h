@@ -51,7 +51,14 @@ namespace sinew::kernels {
  *   slots of contact_params.h): slot +4 holds (r, m) of a particle touching
  *   the tool; terms[SINEW_TOOL_TERMS i + k] = m, then m (|r|^2 delta_ij - r_i r_j)
  *   for ij = xx, xy, xz, yy, yz, zz (all 0 when m <= 0).
- *   bindings: 0 contact impulses float4 [in], 1 terms float2 [out] */
+ *   bindings: 0 contact impulses float4 [in], 1 terms float2 [out]
+ * stats_inverted_tets: item i < count (the tet bodies' tets, each wound so
+ *   that its rest volume is positive; a removed tet as (a, a, a, a)):
+ *   flags[i] = 1 when dot(x1 - x0, cross(x2 - x0, x3 - x0)), computed as
+ *   stats_surface_volume computes its terms (double-float, so every backend
+ *   finds the same sign), is negative, else 0; summed with reduce_blocks
+ *   (sum_u32) into FrameStats::inverted_tets.
+ *   bindings: 0 position float4 [in], 1 tets uint4 [in], 2 flags uint [out] */
 SINEW_STRUCT_BEGIN(StatsParams)
   uint count;
   uint pad0;

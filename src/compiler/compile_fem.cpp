@@ -122,6 +122,11 @@ Status add_fem_constraints(SceneBuilder& b, const TetBodyDesc& body, std::uint32
                    str(condition) + ", must be < 1e5)");
     const double volume = det / 6.0;
     const double alpha_d = 1.0 / (stiff_d * volume), alpha_h = 1.0 / (stiff_h * volume);
+    if (Status s = check_device_compliance(name, ".youngs_modulus (its deviatoric alpha = 1 / (mu V))", alpha_d, b.step); !s)
+      return s;
+    if (Status s = check_device_compliance(name, ".youngs_modulus (its volume alpha = 1 / (lambda V))", alpha_h, b.step);
+        !s)
+      return s;
     float row[SINEW_FEM_DATA_STRIDE] = {};
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) row[SINEW_FEM_DM_INV + 3 * r + c] = static_cast<float>(inv[r][c]);

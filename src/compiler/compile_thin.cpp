@@ -72,8 +72,10 @@ Status add_tri_body(SceneBuilder& b, const TriBodyDesc& body, const std::string&
     RawConstraints& area = b.constraints(Kernel::xpbd_solve_area, 3, SINEW_AREA_DATA_STRIDE);
     for (std::size_t t = 0; t < tris.size(); ++t) {
       for (std::uint32_t k : tris[t]) area.particles.push_back(first + k);
+      const double alpha = body.area_compliance * rest_area[t] / body.thickness;
+      if (Status s = check_device_compliance(name, ".area_compliance", alpha, b.step); !s) return s;
       area.data.push_back(rest_area[t]);
-      area.data.push_back(static_cast<float>(body.area_compliance * rest_area[t] / body.thickness));
+      area.data.push_back(static_cast<float>(alpha));
     }
   }
 
@@ -102,11 +104,12 @@ Status add_tri_body(SceneBuilder& b, const TriBodyDesc& body, const std::string&
     if (distance) {
       // > 0: a zero-length edge would have made its triangles' areas 0.
       const float len = kernels::edge_length(at(e.lo), at(e.hi));
+      const double alpha = body.distance_compliance * static_cast<double>(len) * len / (share * body.thickness);
+      if (Status s = check_device_compliance(name, ".distance_compliance", alpha, b.step); !s) return s;
       distance->particles.push_back(first + e.lo);
       distance->particles.push_back(first + e.hi);
       distance->data.push_back(len);
-      distance->data.push_back(
-          static_cast<float>(body.distance_compliance * static_cast<double>(len) * len / (share * body.thickness)));
+      distance->data.push_back(static_cast<float>(alpha));
     }
     if (dihedral && j - i == 2 && half[i].opposite != half[i + 1].opposite) {
       // The edge in the winding of the first triangle; the second's wing.

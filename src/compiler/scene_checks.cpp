@@ -5,19 +5,24 @@
 #include <sstream>
 #include <string>
 
+#include "compiler/device_ranges.h"
 #include "compiler/edge_network.h"
 #include "contact_params.h"
 #include "math/vec3.h"
+#include "compiler/scene_compiler.h"
 #include "sinew/scene.h"
 
 namespace sinew {
-namespace {
 
-std::string str(double v) {
+std::string number_text(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
 }
+
+namespace {
+
+std::string str(double v) { return number_text(v); }
 
 Status positive(const std::string& name, double v) {
   if (!std::isfinite(v) || v <= 0.0)
@@ -334,13 +339,6 @@ Status check_attachment(const SceneDesc& scene, const AttachmentDesc& a, const s
   return non_negative(name + ".compliance", a.compliance);
 }
 
-template <class T, class Check>
-Status check_all(const std::vector<T>& items, const std::string& name, Check&& check) {
-  for (std::size_t i = 0; i < items.size(); ++i)
-    if (Status s = check(items[i], name + "[" + std::to_string(i) + "]"); !s) return s;
-  return {};
-}
-
 Status check_mesh_collision(const SceneDesc& scene) {
   const MeshCollisionDesc& c = scene.mesh_collision;
   if (!c.enabled) return {};
@@ -453,6 +451,7 @@ Status check_scene(const SceneDesc& scene) {
   if (Status s = check_all(scene.colliders, "colliders", check_collider); !s) return s;
   if (Status s = check_all(scene.tools, "tools", check_tool); !s) return s;
   if (Status s = check_mesh_collision(scene); !s) return s;
+  if (Status s = check_scene_fluid(scene); !s) return s;
   for (std::size_t i = 0; i < scene.needles.size(); ++i)
     if (Status s = check_needle(scene, scene.needles[i], "needles[" + std::to_string(i) + "]"); !s) return s;
   if (!scene.needles.empty() && scene.solver.chebyshev_rho > 0.0)
@@ -503,7 +502,9 @@ Status check_scene(const SceneDesc& scene) {
   for (std::size_t i = 0; i < scene.attachments.size(); ++i)
     if (Status s = check_attachment(scene, scene.attachments[i], "attachments[" + std::to_string(i) + "]"); !s)
       return s;
-  return {};
+  // Last, on values known finite: what the device makes of them in float,
+  // and the caps on a frame's work (device_ranges.h).
+  return check_device_ranges(scene);
 }
 
 }  // namespace sinew

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "coloring/greedy_coloring.h"
+#include "compiler/device_ranges.h"
 #include "compiler/edge_network.h"
 #include "compiler/particle_order.h"
 #include "compiler/solve_order.h"
@@ -51,9 +52,11 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
     RawConstraints& volume = b.volume_constraints(body.stiffness_damping);
     for (std::size_t t = 0; t < tets.size(); ++t) {
       for (std::uint32_t k : tets[t]) volume.particles.push_back(first + k);
+      const double alpha = fits.empty() ? body.volume_compliance * rest_volume[t] : 1.0 / fits[t].volume;
+      const char* field = fits.empty() ? ".volume_compliance" : ".youngs_modulus (its fitted volume alpha)";
+      if (Status s = check_device_compliance(name, field, alpha, b.step); !s) return s;
       volume.data.push_back(rest_volume[t]);
-      volume.data.push_back(fits.empty() ? static_cast<float>(body.volume_compliance * rest_volume[t])
-                                         : static_cast<float>(1.0 / fits[t].volume));
+      volume.data.push_back(static_cast<float>(alpha));
     }
   }
 
@@ -86,10 +89,13 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
       const float len = kernels::edge_length(b.positions[first + edges[i].first], b.positions[first + edges[i].second]);
       distance.particles.push_back(first + edges[i].first);
       distance.particles.push_back(first + edges[i].second);
+      // Hand-set: c L^2 / V; calibrated: 1 / k.
+      const double alpha =
+          fits.empty() ? body.distance_compliance * static_cast<double>(len) * len / share[i] : 1.0 / share[i];
+      const char* field = fits.empty() ? ".distance_compliance" : ".youngs_modulus (its fitted spring alpha)";
+      if (Status s = check_device_compliance(name, field, alpha, b.step); !s) return s;
       distance.data.push_back(len);
-      distance.data.push_back(fits.empty() ? static_cast<float>(body.distance_compliance * static_cast<double>(len) *
-                                                                len / share[i])
-                                           : static_cast<float>(1.0 / share[i]));
+      distance.data.push_back(static_cast<float>(alpha));
     }
   }
   if (body.material != TetMaterial::none)
@@ -201,8 +207,10 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
 
   SceneBuilder b;
   b.substep = scene.solver.time_step / scene.solver.substeps;
+  b.step = *device_step(scene.solver);  // checked by check_scene
   CompiledScene out;
-  out.external_forces = scene.external_forces;
+  // A fluid on the tissue's surfaces pushes it through the force buffer.
+  out.external_forces = scene.external_forces || (scene.fluid && !scene.fluid->surfaces.empty());
   for (std::size_t i = 0; i < scene.tet_bodies.size(); ++i) {
     out.tet_body_first_particle.push_back(static_cast<std::uint32_t>(b.positions.size()));
     if (Status s = add_tet_body(b, scene.tet_bodies[i], "tet_bodies[" + std::to_string(i) + "]"); !s) return s.error();
@@ -225,12 +233,31 @@ Result<CompiledScene> compile_scene(const SceneDesc& scene) {
       b.positions[first + i] = {static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]), 0.0f};
     }
   std::vector<std::uint8_t> movable(b.positions.size());
+  // The body a particle belongs to, for messages.
+  const auto body_of = [&](std::size_t p) {
+    std::string name;
+    const auto find = [&](const std::vector<std::uint32_t>& firsts, const char* kind) {
+      for (std::size_t i = 0; i < firsts.size(); ++i)
+        if (firsts[i] <= p) name = std::string(kind) + "[" + std::to_string(i) + "]";
+    };
+    find(out.tet_body_first_particle, "tet_bodies");
+    find(out.tri_body_first_particle, "tri_bodies");
+    find(out.line_body_first_particle, "line_bodies");
+    return name;
+  };
   for (std::size_t p = 0; p < b.positions.size(); ++p) {
     const double w = b.mass[p] > 0.0 ? 1.0 / b.mass[p] : 0.0;
     if (!std::isfinite(static_cast<float>(w)))
       return Error(ErrorCode::bad_parameter,
-                   "particle " + std::to_string(p) + " has a mass of " + std::to_string(b.mass[p]) +
+                   body_of(p) + ": particle " + std::to_string(p) + " has a mass of " + std::to_string(b.mass[p]) +
                    " kg, too small for a float32 inverse mass");
+    // An inverse mass that rounds to 0 in float would pin the particle
+    // (w = 0 means immovable): a density or mass too large is an error.
+    if (b.mass[p] > 0.0 && !(static_cast<float>(w) >= std::numeric_limits<float>::min()))
+      return Error(ErrorCode::bad_parameter,
+                   body_of(p) + ": particle " + std::to_string(p) + " has a mass of " + std::to_string(b.mass[p]) +
+                   " kg, too large for a float32 inverse mass (it would round to 0, which pins it): check the "
+                   "body's density or masses");
     b.positions[p].w = static_cast<float>(w);
   }
   // Device order (particle_order.h): each body's particles in reverse

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "backends/kernel.h"
+#include "compiler/device_ranges.h"
 #include "compiler/particle_order.h"
 #include "math/vec4.h"
 #include "sinew/scene.h"
@@ -122,6 +123,7 @@ struct SceneBuilder {
   std::vector<std::pair<std::uint32_t, const std::vector<Vec3d>*>> initial;
 
   double substep = 0.0;  ///< h [s], for the velocity damping factors
+  DeviceStep step;       ///< h and 1/h^2 as the device's floats, for check_device_compliance
   /// Appends vertices as particles of mass 0 and velocity damping `k`
   /// [1/s] (factor exp(-k h) per substep); returns the first one's index.
   std::uint32_t add_vertices(const std::vector<Vec3d>& vertices, double velocity_damping);
@@ -152,6 +154,11 @@ Status add_tri_body(SceneBuilder& b, const TriBodyDesc& body, const std::string&
 Status add_line_bending(SceneBuilder& b, const LineBodyDesc& body, std::uint32_t first, const std::string& name);
 /// compile_contacts.cpp: colliders, tools, attachments (after all bodies).
 Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out);
+
+/// SceneDesc::fluid's parameters beyond FluidDesc's (the surfaces' bodies
+/// and triangles, the frame a whole number of fluid steps); part of
+/// check_scene (fluid_checks.cpp).
+Status check_scene_fluid(const SceneDesc& scene);
 
 /// Checks (check_scene) and compiles a scene. Errors name the parameter.
 Result<CompiledScene> compile_scene(const SceneDesc& scene);

@@ -9,6 +9,9 @@
 
 #include "runtime/simulation_internals.h"
 
+// The class is deprecated for users; its own definitions name it.
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+
 namespace sinew {
 
 struct FluidCoupling::Impl {

@@ -103,6 +103,12 @@ Params grid_fields(const kernels::SphParams& p) {
 
 }  // namespace
 
+void SphSolver::state_buffers(std::vector<std::pair<BufferHandle, std::size_t>>& out) const {
+  for (const auto& b : sized_)
+    if (b.second > 0) out.push_back(b);
+  grid_->state_buffers(out);
+}
+
 SphSolver::~SphSolver() {
   if (have_program_) (void)device_.destroy_program(program_);
   for (BufferHandle h : {velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_, state_, emitters_,
@@ -296,6 +302,7 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
     auto buffer = device.create_buffer(std::max<std::size_t>(b.bytes, 16), b.label);
     if (!buffer) return buffer.error();
     *b.handle = *buffer;
+    m.sized_.emplace_back(*buffer, b.bytes);  // what a saved state holds (state_buffers)
   }
   kernels::SphParams p = sph_params(g, h);
   p.rho0 = float(settings.rest_density);

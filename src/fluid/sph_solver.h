@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "backends/backend.h"
@@ -73,6 +74,29 @@ class SphSolver {
   [[nodiscard]] std::uint32_t capacity() const { return capacity_; }
   [[nodiscard]] double particle_mass() const { return mass_; }
   [[nodiscard]] const kernels::SphParams& params() const { return params_; }
+  /// The boundary's device arrays, float4 per boundary particle (invalid
+  /// handles without moving_boundary, boundary_forces): what a stage
+  /// coupling the fluid with tissue on the same device writes (positions,
+  /// velocities) and reads (impulses) instead of set_boundary and
+  /// read_boundary_impulses.
+  [[nodiscard]] BufferHandle boundary_position_buffer() const { return boundary_position_; }
+  [[nodiscard]] BufferHandle boundary_velocity_buffer() const { return boundary_velocity_; }
+  [[nodiscard]] BufferHandle impulse_buffer() const { return impulse_; }
+  /// A saved state's part of the fluid (Simulation::save_state): [out] out:
+  /// every device buffer a step carries to the next (particles, the grid,
+  /// the emitters' and sinks' records), with its size [bytes], appended.
+  void state_buffers(std::vector<std::pair<BufferHandle, std::size_t>>& out) const;
+  /// ... and the host's: the counts, the next particle id, the emitters' settings.
+  struct HostState {
+    FluidStats stats;
+    std::uint32_t next_id = 0;
+  };
+  [[nodiscard]] HostState host_state() const { return {stats_, next_id_}; }
+  void set_host_state(const HostState& state) {
+    stats_ = state.stats;
+    next_id_ = state.next_id;
+  }
+  [[nodiscard]] std::vector<FluidEmitter>& emitter_settings() { return emitters_desc_; }
 
  private:
   explicit SphSolver(Device& device) : device_(device) {}
@@ -108,6 +132,7 @@ class SphSolver {
   std::size_t sinks_count_ = 0;
   std::uint32_t lattice_points_ = 0, next_id_ = 0;  // the emitters' points; the next fluid id
   FluidStats stats_;
+  std::vector<std::pair<BufferHandle, std::size_t>> sized_;  // the buffers create made, with their sizes
 };
 
 }  // namespace sinew

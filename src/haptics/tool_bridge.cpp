@@ -9,6 +9,10 @@
 
 #include "math/vec3.h"
 
+// The bridge reads a const Simulation's tool state through the index-based
+// calls (deprecated for users; the Tools handle is a mutable view).
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+
 namespace sinew::haptics {
 
 Status HapticToolBridge::set_damping(double linear, double angular) {

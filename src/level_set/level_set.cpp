@@ -12,6 +12,12 @@
 // The grid's index space: voxel (i, j, k) holds the distance at the world
 // point (i, j, k) * voxel_size (OpenVDB's linear transform, voxel centres
 // at integers), so the samplers interpolate between those points.
+//
+// Hostile input (issue 39): every length is checked to fit a float (the
+// device samples in float32), every voxel index to lie within +-2^30 and
+// the voxels a call visits to number at most 2^30 (level_set/voxel_bounds.h)
+// before OpenVDB sees them; what OpenVDB still throws becomes a named error
+// (guarded), since a library call here never throws.
 #include "sinew/level_set.h"
 
 #include <algorithm>
@@ -29,6 +35,7 @@
 
 #include "collision/shape_distance.h"
 #include "level_set/level_set_impl.h"
+#include "level_set/voxel_bounds.h"
 #include "math/vec3.h"
 
 namespace sinew {
@@ -42,16 +49,17 @@ void initialize_openvdb() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
-std::string str(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%g", v);
-  return buffer;
-}
+std::string str(double v) { return level_set::number_text(v); }
 
 Status check_settings(const char* call, const LevelSetSettings& s) {
   if (!(s.voxel_size > 0.0) || !std::isfinite(s.voxel_size))
     return Error(ErrorCode::bad_parameter,
                  std::string(call) + ": voxel_size must be finite and > 0 [m] (got " + str(s.voxel_size) + ")");
+  if (!(s.voxel_size >= level_set::kMinVoxelSize))
+    return Error(ErrorCode::bad_parameter, std::string(call) + ": voxel_size must be at least " +
+                                               str(level_set::kMinVoxelSize) +
+                                               " m (OpenVDB's transform refuses smaller voxels; got " +
+                                               str(s.voxel_size) + ")");
   if (!(s.exterior_band >= s.voxel_size) || !std::isfinite(s.exterior_band))
     return Error(ErrorCode::bad_parameter, std::string(call) + ": exterior_band must be finite and at least one voxel, " +
                                                str(s.voxel_size) + " m (got " + str(s.exterior_band) + ")");
@@ -59,12 +67,32 @@ Status check_settings(const char* call, const LevelSetSettings& s) {
     return Error(ErrorCode::bad_parameter, std::string(call) + ": interior_band must be at least one voxel, " +
                                                str(s.voxel_size) + " m, or +infinity (got " + str(s.interior_band) +
                                                ")");
+  if (Status st = level_set::float_finite(call, "voxel_size", s.voxel_size); !st) return st;
+  if (Status st = level_set::float_finite(call, "exterior_band", s.exterior_band); !st) return st;
+  if (std::isfinite(s.interior_band))
+    if (Status st = level_set::float_finite(call, "interior_band", s.interior_band); !st) return st;
   return {};
 }
 
+// Runs `build` (OpenVDB work), turning what it throws into a named error.
+template <class Build>
+Result<LevelSet> guarded(const char* call, Build build) {
+  try {
+    return build();
+  } catch (const std::bad_alloc&) {
+    return Error(ErrorCode::out_of_memory, std::string(call) + ": out of memory building the grid");
+  } catch (const openvdb::Exception& e) {
+    return Error(ErrorCode::bad_parameter, std::string(call) + ": OpenVDB refused the grid (" + e.what() + ")");
+  } catch (const std::exception& e) {
+    return Error(ErrorCode::internal, std::string(call) + ": " + e.what());
+  }
+}
+
 Status check_point(const char* call, const char* what, const Point& p) {
-  for (double c : p)
+  for (double c : p) {
     if (!std::isfinite(c)) return Error(ErrorCode::bad_parameter, std::string(call) + ": " + what + " is not finite");
+    if (Status s = level_set::float_finite(call, what, c); !s) return s;
+  }
   return {};
 }
 
@@ -88,23 +116,24 @@ LevelSet finish(openvdb::FloatGrid::Ptr grid, const LevelSetSettings& s) {
 // every voxel of [lo, hi] (world, grown by the bands) whose distance lies
 // within the bands.
 template <class Distance>
-LevelSet from_function(const Point& lo, const Point& hi, const LevelSetSettings& s, Distance distance) {
-  auto grid = openvdb::FloatGrid::create(float(s.exterior_band));
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(s.voxel_size));
-  auto access = grid->getAccessor();
-  const double reach = s.exterior_band + s.voxel_size;
-  openvdb::Coord first, last;
-  for (int k = 0; k < 3; ++k) {
-    first[k] = static_cast<int>(std::floor((lo[k] - reach) / s.voxel_size));
-    last[k] = static_cast<int>(std::ceil((hi[k] + reach) / s.voxel_size));
-  }
-  for (int i = first[0]; i <= last[0]; ++i)
-    for (int j = first[1]; j <= last[1]; ++j)
-      for (int k = first[2]; k <= last[2]; ++k) {
-        const double d = distance(Point{i * s.voxel_size, j * s.voxel_size, k * s.voxel_size});
-        if (d < s.exterior_band && d > -s.interior_band) access.setValue(openvdb::Coord(i, j, k), float(d));
-      }
-  return finish(grid, s);
+Result<LevelSet> from_function(const char* call, const char* what, const Point& lo, const Point& hi,
+                               const LevelSetSettings& s, Distance distance) {
+  const Result<level_set::VoxelBox> box =
+      level_set::voxel_box(call, what, lo, hi, s.exterior_band + s.voxel_size, s.voxel_size);
+  if (!box) return box.error();
+  if (Status st = level_set::check_visited(call, what, box->count(), s.voxel_size); !st) return st.error();
+  return guarded(call, [&] {
+    auto grid = openvdb::FloatGrid::create(float(s.exterior_band));
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(s.voxel_size));
+    auto access = grid->getAccessor();
+    for (int i = box->first[0]; i <= box->last[0]; ++i)
+      for (int j = box->first[1]; j <= box->last[1]; ++j)
+        for (int k = box->first[2]; k <= box->last[2]; ++k) {
+          const double d = distance(Point{i * s.voxel_size, j * s.voxel_size, k * s.voxel_size});
+          if (d < s.exterior_band && d > -s.interior_band) access.setValue(openvdb::Coord(i, j, k), float(d));
+        }
+    return finish(grid, s);
+  });
 }
 
 }  // namespace
@@ -115,33 +144,64 @@ Result<LevelSet> LevelSet::from_mesh(const TriMesh& surface, const LevelSetSetti
   constexpr const char* call = "LevelSet::from_mesh";
   if (Status s = check_settings(call, settings); !s) return s.error();
   if (surface.triangles.empty()) return Error(ErrorCode::bad_parameter, std::string(call) + ": the surface is empty");
+  Point lo{}, hi{};
   for (std::size_t v = 0; v < surface.vertices.size(); ++v)
-    for (double c : surface.vertices[v])
+    for (int k = 0; k < 3; ++k) {
+      const double c = surface.vertices[v][k];
       if (!std::isfinite(c))
         return Error(ErrorCode::bad_parameter,
                      std::string(call) + ": vertex " + std::to_string(v) + " is not finite");
-  const SurfaceReport report = check_closed_surface(surface);
+      if (!(std::abs(c) <= std::numeric_limits<float>::max()))  // named only then: this runs per vertex
+        return level_set::float_finite(call, "vertex " + std::to_string(v), c).error();
+      lo[k] = v == 0 ? c : std::min(lo[k], c);
+      hi[k] = v == 0 ? c : std::max(hi[k], c);
+    }
+  // The voxels OpenVDB fills: the bands about the surface (about its area
+  // over h^2 voxels per layer), or the whole box with the inside filled.
+  const double h = settings.voxel_size;
+  const Result<level_set::VoxelBox> box =
+      level_set::voxel_box(call, "the surface", lo, hi, settings.exterior_band + h, h);
+  if (!box) return box.error();
+  double voxels = box->count();
+  if (std::isfinite(settings.interior_band)) {
+    double area = 0.0;
+    for (const auto& t : surface.triangles) {
+      if (t[0] >= surface.vertices.size() || t[1] >= surface.vertices.size() || t[2] >= surface.vertices.size())
+        continue;  // check_closed_surface counts it
+      const math::Vec3 a = surface.vertices[t[0]], b = surface.vertices[t[1]], c = surface.vertices[t[2]];
+      area += 0.5 * math::norm(math::cross(math::sub(b, a), math::sub(c, a)));
+    }
+    voxels = std::min(voxels, (area / (h * h) + 1.0) * ((settings.exterior_band + settings.interior_band) / h + 2.0));
+  }
+  if (Status s = level_set::check_visited(call, "the surface's bands", voxels, h); !s) return s.error();
+  const Result<SurfaceReport> checked = check_closed_surface(surface);
+  if (!checked) return Error(checked.error().code(), std::string(call) + ": " + checked.error().message());
+  const SurfaceReport& report = *checked;
   if (!report.closed())
     return Error(ErrorCode::bad_parameter,
                  std::string(call) + ": the surface does not bound a solid (" + std::to_string(report.open_edges) +
                      " open edges, " + std::to_string(report.nonmanifold_edges) + " edges on more than two triangles, " +
                      std::to_string(report.misoriented_edges) + " edges whose triangles face opposite ways, " +
                      std::to_string(report.degenerate_triangles) + " degenerate triangles, " +
-                     std::to_string(report.intersecting_pairs) + " pairs of triangles crossing each other)");
+                     (report.crossings_tested ? std::to_string(report.intersecting_pairs) +
+                                                    " pairs of triangles crossing each other)"
+                                              : std::string("crossings not searched for)")));
   initialize_openvdb();
-  auto transform = openvdb::math::Transform::createLinearTransform(settings.voxel_size);
-  std::vector<openvdb::Vec3s> points;
-  points.reserve(surface.vertices.size());
-  for (const auto& p : surface.vertices) points.emplace_back(float(p[0]), float(p[1]), float(p[2]));
-  std::vector<openvdb::Vec3I> triangles;
-  triangles.reserve(surface.triangles.size());
-  for (const auto& t : surface.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  const float exterior = float(settings.exterior_band / settings.voxel_size);
-  const float interior = std::isfinite(settings.interior_band) ? float(settings.interior_band / settings.voxel_size)
-                                                               : std::numeric_limits<float>::max();
-  auto grid = openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(*transform, points, triangles, {},
-                                                                             exterior, interior);
-  return finish(grid, settings);
+  return guarded(call, [&] {
+    auto transform = openvdb::math::Transform::createLinearTransform(settings.voxel_size);
+    std::vector<openvdb::Vec3s> points;
+    points.reserve(surface.vertices.size());
+    for (const auto& p : surface.vertices) points.emplace_back(float(p[0]), float(p[1]), float(p[2]));
+    std::vector<openvdb::Vec3I> triangles;
+    triangles.reserve(surface.triangles.size());
+    for (const auto& t : surface.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+    const float exterior = float(settings.exterior_band / settings.voxel_size);
+    const float interior = std::isfinite(settings.interior_band) ? float(settings.interior_band / settings.voxel_size)
+                                                                 : std::numeric_limits<float>::max();
+    auto grid = openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(*transform, points, triangles, {},
+                                                                               exterior, interior);
+    return finish(grid, settings);
+  });
 }
 
 Result<LevelSet> LevelSet::sphere(const Point& centre, double radius, const LevelSetSettings& settings) {
@@ -154,7 +214,8 @@ Result<LevelSet> LevelSet::sphere(const Point& centre, double radius, const Leve
   initialize_openvdb();
   const Point lo{centre[0] - radius, centre[1] - radius, centre[2] - radius};
   const Point hi{centre[0] + radius, centre[1] + radius, centre[2] + radius};
-  return from_function(lo, hi, settings, [&](const Point& p) {
+  if (Status s = level_set::float_finite(call, "radius", radius); !s) return s.error();
+  return from_function(call, "the sphere", lo, hi, settings, [&](const Point& p) {
     return std::sqrt((p[0] - centre[0]) * (p[0] - centre[0]) + (p[1] - centre[1]) * (p[1] - centre[1]) +
                      (p[2] - centre[2]) * (p[2] - centre[2])) -
            radius;
@@ -176,7 +237,7 @@ Result<LevelSet> LevelSet::box(const Point& lo, const Point& hi, const LevelSetS
   box.shape = ColliderShape::box;
   for (int k = 0; k < 3; ++k) box.half_extents[k] = 0.5 * (hi[k] - lo[k]);
   const math::Vec3 centre{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
-  return from_function(lo, hi, settings, [&](const Point& p) {
+  return from_function(call, "the box", lo, hi, settings, [&](const Point& p) {
     return collision::shape_distance(box, centre, {1.0, 0.0, 0.0, 0.0}, p).distance;
   });
 }
@@ -250,6 +311,10 @@ ColliderDesc cutter_collider(const CutterShape& shape) {
   return c;
 }
 
+// The most poses a cut places a capsule or box at (2^20: a motion of
+// 2^19 voxels).
+constexpr double kMaxCutPoses = 1048576.0;
+
 // How far the tool reaches from its origin [m].
 double shape_reach(const CutterShape& shape) {
   switch (shape.kind) {
@@ -306,7 +371,14 @@ Result<CutReport> LevelSet::cut(const CutterShape& shape, const Pose& from, cons
   if (shape.kind != CutterShape::Kind::sphere) {
     const double turn = 2.0 * std::acos(std::min(1.0, std::abs(math::qdot(from.rotation, to.rotation))));
     const double travel = math::norm(math::sub(p1, p0)) + reach * turn;
-    const int n = std::max(1, static_cast<int>(std::ceil(travel / (0.5 * h))));
+    // Counted in double first: a long sweep of a fine grid must not
+    // overflow the int (undefined behaviour) nor allocate without bound.
+    const double steps = std::max(1.0, std::ceil(travel / (0.5 * h)));
+    if (!(steps <= kMaxCutPoses))
+      return Error(ErrorCode::capacity_exceeded, "LevelSet::cut: the motion takes " + str(steps) +
+                                                     " poses half a voxel apart, more than " + str(kMaxCutPoses) +
+                                                     ": cut in shorter steps");
+    const int n = static_cast<int>(steps);
     for (int k = 0; k <= n; ++k) {
       const double u = double(k) / n;
       poses.emplace_back(math::add(p0, math::mul(math::sub(p1, p0), u)), math::nlerp(from.rotation, to.rotation, u));
@@ -329,12 +401,16 @@ Result<CutReport> LevelSet::cut(const CutterShape& shape, const Pose& from, cons
   // along its path: the solid's distances change up to there (a voxel
   // deeper keeps its old depth, larger than its distance to the new face:
   // exact within the bands of every surface, as a narrow band is).
-  openvdb::Coord first, last;
   const double margin = reach + impl_->exterior + h;
+  Point lo{}, hi{};
   for (int k = 0; k < 3; ++k) {
-    first[k] = static_cast<int>(std::floor((std::min(p0[k], p1[k]) - margin) / h));
-    last[k] = static_cast<int>(std::ceil((std::max(p0[k], p1[k]) + margin) / h));
+    lo[k] = std::min(p0[k], p1[k]);
+    hi[k] = std::max(p0[k], p1[k]);
   }
+  const Result<level_set::VoxelBox> box = level_set::voxel_box("LevelSet::cut", "the tool's sweep", lo, hi, margin, h);
+  if (!box) return box.error();
+  if (Status s = level_set::check_visited("LevelSet::cut", "the tool's sweep", box->count(), h); !s) return s.error();
+  const std::array<int, 3> first = box->first, last = box->last;
   auto* nano = impl_->nano.grid<float>();
   auto nano_access = nano->getAccessor();
   auto host_access = impl_->grid->getAccessor();

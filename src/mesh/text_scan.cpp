@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <stdexcept>
+#include <string>
 #include <system_error>
 
 namespace sinew::detail {
@@ -21,7 +23,13 @@ Result<std::string> read_whole_file(const fs::path& path) {
   if (!in) return Error(ErrorCode::bad_input_file, path.string() + ": cannot open file (" + std::strerror(errno) + ")");
   const auto size = fs::file_size(path, ec);
   if (ec) return Error(ErrorCode::bad_input_file, path.string() + ": cannot read file size (" + ec.message() + ")");
-  std::string text(static_cast<std::size_t>(size), '\0');
+  std::string text;
+  try {
+    text.resize(static_cast<std::size_t>(size));
+  } catch (const std::exception&) {  // bad_alloc or length_error: a (sparse?) file larger than memory
+    return Error(ErrorCode::out_of_memory,
+                 path.string() + ": " + std::to_string(size) + " bytes, more than can be allocated to read it");
+  }
   in.read(text.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::uintmax_t>(in.gcount()) != size) {
     return Error(ErrorCode::bad_input_file,

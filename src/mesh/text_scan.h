@@ -17,7 +17,8 @@
 namespace sinew::detail {
 
 /// [out] the file's bytes; errors name the path (missing, not a regular
-/// file, unreadable, short read).
+/// file, unreadable, short read); out_of_memory when its size cannot be
+/// allocated.
 Result<std::string> read_whole_file(const std::filesystem::path& path);
 
 /// Space, tab, CR, LF, VT, FF.

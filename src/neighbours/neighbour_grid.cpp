@@ -29,6 +29,28 @@ std::string str(double v) {
 
 }  // namespace
 
+// Every buffer with its size [bytes] and label, in one list: create makes
+// them, the destructor frees them, state_buffers hands them to a saved state.
+template <class Visit>
+void NeighbourGrid::for_each_buffer(Visit visit) {
+  const std::size_t n = capacity_;
+  const std::uint32_t scratch = std::max(radix_sort_scratch_words(capacity_), scan_scratch_words(capacity_));
+  NeighbourGridBuffers& b = b_;
+  visit(b.counts, 8, "neighbour counts");
+  visit(b.points, 16 * n, "neighbour points");
+  visit(b.keys, 4 * n, "neighbour keys");
+  visit(b.keys_tmp, 4 * n, "neighbour keys (sort)");
+  visit(b.order, 4 * n, "neighbour order");
+  visit(b.order_tmp, 4 * n, "neighbour order (sort)");
+  visit(b.cells, 16 * n, "neighbour cells");
+  visit(b.sorted_points, 16 * n, "neighbour sorted points");
+  visit(b.sorted_cells, 16 * n, "neighbour sorted cells");
+  visit(b.ranges, 12 * std::size_t{buckets_}, "neighbour bucket ranges");
+  visit(b.lists, 4 * n, "neighbour lists");
+  visit(b.neighbours, 4 * std::size_t{pair_capacity_}, "neighbours");
+  visit(b.scratch, 4 * std::size_t{scratch}, "neighbour scratch");
+}
+
 Result<std::unique_ptr<NeighbourGrid>> NeighbourGrid::create(Device& device, std::uint32_t capacity, double radius,
                                                              std::uint32_t pair_capacity) {
   if (capacity == 0 || capacity > (1u << 28))
@@ -48,37 +70,29 @@ Result<std::unique_ptr<NeighbourGrid>> NeighbourGrid::create(Device& device, std
   g->table_bits_ = static_cast<std::uint32_t>(std::countr_zero(g->buckets_));
   g->inv_cell_ = float(1.0 / (radius * kCellMargin));
   g->radius2_ = float(radius) * float(radius);
-  const std::size_t n = capacity;
-  struct Made {
-    BufferHandle* handle;
-    std::size_t bytes;
-    const char* label;
-  };
-  NeighbourGridBuffers& b = g->b_;
-  const std::uint32_t scratch = std::max(radix_sort_scratch_words(capacity), scan_scratch_words(capacity));
-  for (const Made& m : {Made{&b.counts, 8, "neighbour counts"}, Made{&b.points, 16 * n, "neighbour points"},
-                        Made{&b.keys, 4 * n, "neighbour keys"}, Made{&b.keys_tmp, 4 * n, "neighbour keys (sort)"},
-                        Made{&b.order, 4 * n, "neighbour order"}, Made{&b.order_tmp, 4 * n, "neighbour order (sort)"},
-                        Made{&b.cells, 16 * n, "neighbour cells"}, Made{&b.sorted_points, 16 * n, "neighbour sorted points"},
-                        Made{&b.sorted_cells, 16 * n, "neighbour sorted cells"},
-                        Made{&b.ranges, 12 * std::size_t{g->buckets_}, "neighbour bucket ranges"},
-                        Made{&b.lists, 4 * n, "neighbour lists"},
-                        Made{&b.neighbours, 4 * std::size_t{pair_capacity}, "neighbours"},
-                        Made{&b.scratch, 4 * std::size_t{scratch}, "neighbour scratch"}}) {
-    auto made = device.create_buffer(m.bytes, m.label);
-    if (!made) return made.error();
-    *m.handle = *made;
-  }
+  Status made;
+  g->for_each_buffer([&](BufferHandle& handle, std::size_t bytes, const char* label) {
+    if (!made) return;
+    auto buffer = device.create_buffer(bytes, label);
+    if (!buffer) made = buffer.error();
+    else handle = *buffer;
+  });
+  if (!made) return made.error();
   if (Status s = g->build_program(); !s) return s.error();
   return g;
+}
+
+void NeighbourGrid::state_buffers(std::vector<std::pair<BufferHandle, std::size_t>>& out) const {
+  const_cast<NeighbourGrid*>(this)->for_each_buffer(
+      [&](BufferHandle& handle, std::size_t bytes, const char*) { out.emplace_back(handle, bytes); });
 }
 
 NeighbourGrid::~NeighbourGrid() {
   if (have_program_) (void)device_.destroy_program(program_);
   if (have_grid_program_) (void)device_.destroy_program(grid_program_);
-  for (BufferHandle h : {b_.counts, b_.points, b_.keys, b_.keys_tmp, b_.order, b_.order_tmp, b_.cells, b_.sorted_points,
-                         b_.sorted_cells, b_.ranges, b_.lists, b_.neighbours, b_.scratch})
-    if (h.valid()) (void)device_.destroy_buffer(h);
+  for_each_buffer([&](BufferHandle& handle, std::size_t, const char*) {
+    if (handle.valid()) (void)device_.destroy_buffer(handle);
+  });
 }
 
 double NeighbourGrid::max_coordinate() const { return kMaxCells / double(inv_cell_); }

@@ -19,6 +19,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "backends/backend.h"
 #include "neighbour_params.h"
@@ -78,9 +80,13 @@ class NeighbourGrid {
   [[nodiscard]] float radius2() const { return radius2_; }
   /// The largest |coordinate| [m] a point may have: 2^16 cells.
   [[nodiscard]] double max_coordinate() const;
+  /// [out] out: every buffer with its size [bytes] appended (a saved state, Simulation::save_state).
+  void state_buffers(std::vector<std::pair<BufferHandle, std::size_t>>& out) const;
 
  private:
   NeighbourGrid(Device& device) : device_(device) {}
+  template <class Visit>
+  void for_each_buffer(Visit visit);
   Status build_program();
   [[nodiscard]] kernels::NeighbourParams params() const;
 

@@ -5,6 +5,7 @@
 #include "program/stats_program.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "contact_params.h"
 #include "program/primitives.h"
@@ -17,7 +18,7 @@ constexpr std::uint32_t kImpulseFloats = 4 * SINEW_CONTACT_IMPULSE_FLOAT4S;  // 
 constexpr std::uint32_t kToolPairs = 12 + SINEW_TOOL_TERMS;  // impulse sums, then mass and inertia
 
 // Word offsets of the item counts in the constants buffer; block k's count at kFirstBlock + k.
-enum CountWord : std::uint32_t { kParticles = 0, kFaces = 1, kSlots = 2, kFirstBlock = 3 };
+enum CountWord : std::uint32_t { kParticles = 0, kFaces = 1, kSlots = 2, kTets = 3, kFirstBlock = 4 };
 
 Result<BufferHandle> make_words(Device& device, std::size_t words, std::string_view label) {
   return device.create_buffer(std::max<std::size_t>(words, 4) * 4, label);
@@ -34,7 +35,7 @@ struct Layout {
 };
 
 // The reductions of a plan, in the order they run.
-enum class Reduction { residual_squares, residual_max, kinetic_energy, volume, tool, end };
+enum class Reduction { residual_squares, residual_max, kinetic_energy, volume, inverted, tool, end };
 
 // Visits the reductions of a plan in one fixed order, with the scratch and
 // result words each one owns; make_stats_plan sizes with it and
@@ -50,6 +51,8 @@ void for_each_reduction(const StatsPlan& plan, Visit visit) {
     }
     visit(Reduction::kinetic_energy, 0, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
     visit(Reduction::volume, 0, scratch.take(reduce_dd_scratch_words(plan.face_capacity)), results.take(2));
+    const auto tets = static_cast<std::uint32_t>(plan.tet_list.size());
+    if (tets > 0) visit(Reduction::inverted, 0, scratch.take(reduce_scratch_words(tets)), results.take(1));
   }
   for (std::uint32_t k = 0; k < plan.tools * kToolPairs; ++k)
     visit(Reduction::tool, k, scratch.take(reduce_dd_scratch_words(plan.particles)), results.take(2));
@@ -62,8 +65,12 @@ double pair(const std::vector<float>& r, std::uint32_t at) { return double(r[at]
 
 Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
                                   const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
-                                  std::uint32_t tools, std::uint32_t face_capacity) {
+                                  std::uint32_t tools, std::uint32_t face_capacity,
+                                  std::vector<std::array<std::uint32_t, 4>> tets) {
   StatsPlan plan;
+  if (errors) plan.tet_list = std::move(tets);
+  for (const auto& t : plan.tet_list) plan.removed_tets += t[0] == t[1] && t[1] == t[2] && t[2] == t[3];
+  const auto tet_count = static_cast<std::uint32_t>(plan.tet_list.size());
   plan.errors = errors;
   plan.tools = tools;
   plan.particles = static_cast<std::uint32_t>(scene.positions.size());
@@ -75,7 +82,7 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
   }
   if (!errors && tools == 0) return plan;
 
-  std::vector<std::uint32_t> constants{plan.particles, plan.face_count, plan.particles * tools};
+  std::vector<std::uint32_t> constants{plan.particles, plan.face_count, plan.particles * tools, tet_count};
   constants.insert(constants.end(), plan.block_sizes.begin(), plan.block_sizes.end());
   auto made = make_words(device, constants.size(), "statistics counts");
   if (!made) return made.error();
@@ -87,9 +94,15 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
   if (plan.face_count)
     if (Status s = device.write_buffer(plan.faces, 0, faces.data(), faces.size() * sizeof(faces[0])); !s)
       return s.error();
+  made = make_words(device, 4 * std::size_t{tet_count}, "statistics tets");
+  if (!made) return made.error();
+  plan.tets = *made;
+  if (tet_count)
+    if (Status s = device.write_buffer(plan.tets, 0, plan.tet_list.data(), plan.tet_list.size() * 16); !s)
+      return s.error();
   // One terms buffer, reused in turn by each map kernel and its reduction.
-  const std::uint32_t terms =
-      std::max({2 * plan.particles, 2 * plan.face_capacity, 2 * SINEW_TOOL_TERMS * plan.particles * tools});
+  const std::uint32_t terms = std::max(
+      {2 * plan.particles, 2 * plan.face_capacity, 2 * SINEW_TOOL_TERMS * plan.particles * tools, tet_count});
   made = make_words(device, terms, "statistics terms");
   if (!made) return made.error();
   plan.terms = *made;
@@ -107,6 +120,8 @@ Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
       plan.kinetic_energy = result;
     } else if (w == Reduction::volume) {
       plan.volume = result;
+    } else if (w == Reduction::inverted) {
+      plan.inverted = result;
     } else if (w == Reduction::tool && k == 0) {
       plan.tool_first = result;
     }
@@ -133,8 +148,20 @@ Status set_stats_faces(Device& device, StatsPlan& plan, const std::vector<std::a
   return {};
 }
 
+Status clear_stats_tets(Device& device, StatsPlan& plan, std::span<const std::uint32_t> removed) {
+  for (std::uint32_t t : removed) {
+    if (t >= plan.tet_list.size()) continue;  // a plan without errors keeps no tets
+    std::array<std::uint32_t, 4>& tet = plan.tet_list[t];
+    if (tet[0] == tet[1] && tet[1] == tet[2] && tet[2] == tet[3]) continue;  // removed before
+    tet = {tet[1], tet[1], tet[1], tet[1]};
+    ++plan.removed_tets;
+    if (Status s = device.write_buffer(plan.tets, std::size_t{t} * 16, tet.data(), 16); !s) return s;
+  }
+  return {};
+}
+
 Status release_stats_plan(Device& device, StatsPlan& plan) {
-  for (BufferHandle* h : {&plan.constants, &plan.faces, &plan.terms, &plan.scratch, &plan.results})
+  for (BufferHandle* h : {&plan.constants, &plan.faces, &plan.tets, &plan.terms, &plan.scratch, &plan.results})
     if (h->valid()) {
       if (Status s = device.destroy_buffer(*h); !s) return s;
       *h = {};
@@ -169,6 +196,12 @@ void append_stats(FrameProgram& program, const StatsPlan& plan, const XpbdBuffer
       program.dispatch(Kernel::stats_surface_volume, plan.face_count, {buffers.position, plan.faces, plan.terms}, p);
       program.barrier();
       from = append_reduce_dd(program, {plan.constants, kFaces, plan.face_count}, DdItems::pairs, {plan.terms, 0}, 2, at);
+    } else if (w == Reduction::inverted) {
+      p.count = static_cast<std::uint32_t>(plan.tet_list.size());
+      program.dispatch(Kernel::stats_inverted_tets, p.count, {buffers.position, plan.tets, plan.terms}, p);
+      program.barrier();
+      from = append_reduce(program, {plan.constants, kTets, p.count}, ReduceOp::sum_u32, {plan.terms, 0}, 1, at);
+      words = 1;
     } else {  // tool sums: pair k of tool t
       const auto t = static_cast<std::uint32_t>(k / kToolPairs), j = static_cast<std::uint32_t>(k % kToolPairs);
       if (k == 0) {  // the mass and inertia terms of every (particle, tool) slot, once
@@ -207,6 +240,8 @@ Status read_stats(Device& device, StatsPlan& plan, DeviceStats& out) {
     }
     out.kinetic_energy = pair(r, plan.kinetic_energy);
     out.volume = pair(r, plan.volume) / 6.0;  // the terms are 6 x volume
+    out.inverted_tets = 0;
+    if (!plan.tet_list.empty()) std::memcpy(&out.inverted_tets, &r[plan.inverted], 4);  // a uint in a float's place
   }
   out.tools.resize(plan.tools);
   for (std::uint32_t t = 0; t < plan.tools; ++t) {

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "compiler/scene_compiler.h"
@@ -24,6 +25,7 @@ struct DeviceStats {
   std::uint64_t constraints = 0;
   double kinetic_energy = 0.0;  ///< [J]
   double volume = 0.0;          ///< total signed volume of the tet bodies [m^3]
+  std::uint32_t inverted_tets = 0;  ///< tets whose signed volume is negative
   struct Tool {
     double sums[4][3] = {};  ///< frame impulse, its moment, last substep's impulse, its moment (contact_params.h)
     double mass = 0.0;       ///< mass of the particles touching it at the frame's end [kg]
@@ -42,14 +44,20 @@ struct StatsPlan {
   /// residual 0). The Simulation refreshes it when the counts change.
   std::vector<std::uint32_t> in_use;
   std::uint32_t particles = 0, face_count = 0;
+  /// Every tet of the tet bodies as (r, a, b, c) device particles, wound so
+  /// that its rest volume is positive; a removed tet as (a, a, a, a), which
+  /// never counts as inverted (clear_stats_tets). The host copy of `tets`.
+  std::vector<std::array<std::uint32_t, 4>> tet_list;
+  std::uint32_t removed_tets = 0;  ///< entries of tet_list marked removed
   /// Faces the buffers have room for (>= face_count): set_stats_faces
   /// changes the faces within it without making the plan again.
   std::uint32_t face_capacity = 0;
-  BufferHandle constants, faces, terms, scratch, results;
+  BufferHandle constants, faces, tets, terms, scratch, results;
   std::uint32_t result_words = 0;
   // Word offsets in `results`:
   std::vector<std::uint32_t> residual_squares, residual_max;  ///< per block: a (hi, lo) pair, a float
   std::uint32_t kinetic_energy = 0, volume = 0;               ///< pairs
+  std::uint32_t inverted = 0;                                 ///< a uint
   std::uint32_t tool_first = 0;                               ///< per tool 19 pairs: 12 sums, mass, 6 inertia
   std::vector<float> read_back;                               ///< the host copy, sized once
 };
@@ -58,10 +66,16 @@ struct StatsPlan {
 /// triangles, wound outward, with a particle of the same body (the
 /// reference point r of stats_surface_volume), as particle indices;
 /// errors: SolverSettings::measure_errors; tools: rigid tools;
-/// face_capacity: room for that many faces (at least faces.size()).
+/// face_capacity: room for that many faces (at least faces.size());
+/// tets: the tet bodies' tets, as StatsPlan::tet_list (the inverted count).
 Result<StatsPlan> make_stats_plan(Device& device, const CompiledScene& scene,
                                   const std::vector<std::array<std::uint32_t, 4>>& faces, bool errors,
-                                  std::uint32_t tools, std::uint32_t face_capacity = 0);
+                                  std::uint32_t tools, std::uint32_t face_capacity,
+                                  std::vector<std::array<std::uint32_t, 4>> tets);
+
+/// Marks tets [in] removed (indices into tet_list) as removed: they no
+/// longer count as inverted. One write per tet.
+Status clear_stats_tets(Device& device, StatsPlan& plan, std::span<const std::uint32_t> removed);
 
 /// Replaces the faces (as make_stats_plan's) when they fit in
 /// face_capacity: one write of the faces and one of their count; the

@@ -419,7 +419,6 @@ ContinuousCollision::ContinuousCollision(std::vector<std::uint32_t> segments, st
 void ContinuousCollision::begin_frame(std::vector<FrameCapsule> capsules) {
   frame_capsules_ = std::move(capsules);
   hits_ = repair_rounds_ = reverted_ = carried_count_ = forced_ = 0;
-  read_back_bytes_ = 0;
   wall_ms_ = 0.0;
 }
 
@@ -490,11 +489,9 @@ Status ContinuousCollision::after_sweeps(Device& device, int substep, int round,
     carried_.assign(floats / 4, kNotCarried);
     // The substep's start does not change across its rounds.
     if (Status s = device.read_buffer(buffers_.previous, 0, start_.data(), floats * 4); !s) return s;
-    read_back_bytes_ += floats * 4;
     if (substep == 0) search_.set_reference(start_);  // the frame's start
   }
   if (Status s = device.read_buffer(buffers_.position, 0, end_.data(), floats * 4); !s) return s;
-  read_back_bytes_ += floats * 4;
   if (Status s = search_.find(start_, end_, hits_found_, capsules_); !s) return s;
   hits_ += static_cast<std::uint32_t>(hits_found_.size());
   Status done;

@@ -176,7 +176,6 @@ class ContinuousCollision final : public SubstepHook {
   [[nodiscard]] std::uint32_t reverted() const { return reverted_; }
   [[nodiscard]] std::uint32_t carried() const { return carried_count_; }
   [[nodiscard]] std::uint32_t forced() const { return forced_; }
-  [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
   [[nodiscard]] double wall_ms() const { return wall_ms_; }
 
  private:
@@ -195,7 +194,6 @@ class ContinuousCollision final : public SubstepHook {
   std::vector<float> start_, end_;
   std::vector<collision::Contact> hits_found_, contacts_;
   std::uint32_t hits_ = 0, repair_rounds_ = 0, reverted_ = 0, carried_count_ = 0, forced_ = 0;
-  std::uint64_t read_back_bytes_ = 0;
   double wall_ms_ = 0.0;
   void substep_capsules(int substep);
   // The contact of a capsule touch (hit.shape: the capsule's index): the

@@ -15,6 +15,14 @@
 //   solve         the frame's device programs (only the solve stage)
 //   after_solve   read back what the solve produced, then the statistics
 //   after_frame   act on the statistics (tools' reactions, errors), tear
+// and, between frames or when tearing removes elements inside one:
+//   topology_changed  follow a removal (collision surfaces, grasps, the
+//                     measured volume); the core then rebuilds the program
+//
+// The host's exchanges with the device are counted by the Device itself
+// (HostTransfers, backends/backend.h); step() attributes them to the stage
+// whose hook made them (its profile's "read_bytes" and "host_waits") and
+// sums them in FrameStats (read_back_bytes, host_reads, host_waits).
 #pragma once
 
 #include <chrono>
@@ -31,6 +39,18 @@ namespace sinew {
 struct FrameContext {
   Device& device;
   FrameStats& stats;
+  /// An error that leaves the frame whole (a fluid's emitter past its
+  /// capacity made what fit): the other stages run, the frame completes,
+  /// and step() returns it at the end.
+  Status deferred;
+};
+
+/// What a topology change did, handed to every stage in registration order.
+struct TopologyChange {
+  const TopologyEvent& event;  ///< the elements removed and the particles freed
+  /// Set by the mesh collision stage when the collision surface changed
+  /// (continuous collision, registered after it, remakes its primitives).
+  bool collision_surface_changed = false;
 };
 
 class FrameStage {
@@ -42,8 +62,11 @@ class FrameStage {
   virtual Status solve(FrameContext&) { return {}; }
   virtual Status after_solve(FrameContext&) { return {}; }
   virtual Status after_frame(FrameContext&) { return {}; }
-  /// Bytes the stage read back from the device in the last frame.
-  [[nodiscard]] virtual std::uint64_t read_back_bytes() const { return 0; }
+  /// Elements were removed (Topology's calls, or tearing after a frame):
+  /// the stage follows before the core rebuilds the frame's program.
+  virtual Status topology_changed(Device&, TopologyChange&) { return {}; }
+  /// After the frame: the stage's own figures into its profile (StageProfile::set).
+  virtual void report(StageProfile&) const {}
 };
 
 /// Milliseconds since `start` (a stage's own figures in FrameStats).

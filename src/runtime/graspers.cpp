@@ -50,13 +50,13 @@ bool crosses(const std::array<math::Vec3, 3>& t, const std::array<double, 3>& ha
 // A triangle's point nearest the jaws' centre (the origin of the box's frame).
 struct Candidate {
   double distance2;
-  Simulation::HeldPoint point;
+  HeldPoint point;
   math::Vec3 local;  // the point, in the grasper's frame
 };
 
 }  // namespace
 
-Graspers::Graspers(const SceneDesc& scene, const CompiledScene& compiled) {
+GrasperHolds::GrasperHolds(const SceneDesc& scene, const CompiledScene& compiled) {
   for (std::size_t i = 0; i < scene.graspers.size(); ++i) {
     Grasper g;
     g.block = compiled.grasper_block[i];
@@ -78,7 +78,7 @@ Graspers::Graspers(const SceneDesc& scene, const CompiledScene& compiled) {
   }
 }
 
-const std::vector<std::uint32_t>& Graspers::surface(const TopologyEditor* topology) {
+const std::vector<std::uint32_t>& GrasperHolds::surface(const TopologyEditor* topology) {
   if (!surface_stale_) return surface_;
   surface_.clear();
   for (std::size_t b = 0; b < tet_meshes_.size(); ++b) {
@@ -95,7 +95,7 @@ const std::vector<std::uint32_t>& Graspers::surface(const TopologyEditor* topolo
   return surface_;
 }
 
-Result<std::vector<std::uint32_t>> Graspers::close(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+Result<std::vector<std::uint32_t>> GrasperHolds::close(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
                                                    std::vector<float>& targets, const ParticleOrder& order,
                                                    std::size_t index, const Pose& pose,
                                                    const std::array<double, 3>& half_extents,
@@ -145,7 +145,7 @@ Result<std::vector<std::uint32_t>> Graspers::close(Device& device, const XpbdBuf
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
     return a.distance2 != b.distance2 ? a.distance2 < b.distance2 : a.point.particles < b.point.particles;
   });
-  std::vector<Simulation::HeldPoint> points;
+  std::vector<HeldPoint> points;
   std::vector<std::array<double, 3>> point_offsets;
   std::vector<std::uint8_t> taken(in_jaws.size(), 0);
   for (const Candidate& c : candidates) {
@@ -204,7 +204,7 @@ Result<std::vector<std::uint32_t>> Graspers::close(Device& device, const XpbdBuf
   return held;
 }
 
-void Graspers::move(std::vector<float>& targets, std::size_t index, const Pose& pose) {
+void GrasperHolds::move(std::vector<float>& targets, std::size_t index, const Pose& pose) {
   Grasper& g = graspers_[index];
   const auto end_at = [&](std::uint32_t target, const std::array<double, 3>& offset) {
     auto e = load_words<kernels::TargetEntry>(targets, target * kTargetFloats);
@@ -219,7 +219,7 @@ void Graspers::move(std::vector<float>& targets, std::size_t index, const Pose& 
     end_at(g.point_first_target + static_cast<std::uint32_t>(i), g.offsets[g.held.size() + i]);
 }
 
-Result<std::vector<std::uint32_t>> Graspers::open(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+Result<std::vector<std::uint32_t>> GrasperHolds::open(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
                                                   std::size_t index) {
   Grasper& g = graspers_[index];
   for (const auto& [block, count] : {std::pair{g.block, g.held.size()}, std::pair{g.point_block, g.points.size()}}) {

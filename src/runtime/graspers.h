@@ -30,9 +30,9 @@
 
 namespace sinew {
 
-class Graspers {
+class GrasperHolds {
  public:
-  Graspers(const SceneDesc& scene, const CompiledScene& compiled);
+  GrasperHolds(const SceneDesc& scene, const CompiledScene& compiled);
 
   [[nodiscard]] std::size_t count() const { return graspers_.size(); }
   [[nodiscard]] bool closed(std::size_t index) const { return graspers_[index].closed; }
@@ -45,7 +45,7 @@ class Graspers {
   /// The bodies' topology changed: surface() is made again when next asked for.
   void invalidate() { surface_stale_ = true; }
   /// The surface points grasper `index` holds (user-order particles).
-  [[nodiscard]] const std::vector<Simulation::HeldPoint>& points(std::size_t index) const {
+  [[nodiscard]] const std::vector<HeldPoint>& points(std::size_t index) const {
     return graspers_[index].points;
   }
 
@@ -82,7 +82,7 @@ class Graspers {
     double compliance = 0.0;  // GrasperDesc::compliance [m/N]
     bool closed = false;
     std::vector<std::uint32_t> held;                // user particles
-    std::vector<Simulation::HeldPoint> points;      // surface points
+    std::vector<HeldPoint> points;      // surface points
     std::vector<std::array<double, 3>> offsets;     // each held particle's, then each point's, in the grasper's frame [m]
   };
   std::vector<Grasper> graspers_;

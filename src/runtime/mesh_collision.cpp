@@ -156,9 +156,8 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
   velocities_.resize(particles * 4);
   if (mirror_) {
     if (Status s = mirror_->copy_to(device, scene_buffers.position, particles * 4, positions_); !s) return s;
-  } else {
-    if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
-    read_back_bytes_ += positions_.size() * 4;
+  } else if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) {
+    return s;
   }
   if (have_start) {
     const auto inv_dt = static_cast<float>(1.0 / time_step_);
@@ -167,8 +166,6 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
   } else if (Status s = device.read_buffer(scene_buffers.velocity, 0, velocities_.data(), velocities_.size() * 4);
              !s) {
     return s;
-  } else {
-    read_back_bytes_ += velocities_.size() * 4;
   }
   fresh_ = true;
   return {};
@@ -185,7 +182,6 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
     tool_lambda_sum_.resize(slots * 4);
     if (Status s = device.read_buffer(buffers_.lambda, 0, tool_lambda_.data(), bytes); !s) return s;
     if (Status s = device.read_buffer(buffers_.lambda_sum, 0, tool_lambda_sum_.data(), bytes); !s) return s;
-    read_back_bytes_ += 2 * bytes;
   }
   // How far the frame's contacts ended inside their thickness, from the
   // very positions the next frame's detection starts from.

@@ -106,6 +106,10 @@ class MeshCollision {
   /// [in] mask: per particle, what sutures exempt (suture_exemption.h);
   /// outlives this, read every frame.
   void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }
+  /// The device's positions and velocities changed outside the frames
+  /// (Simulation::restore_state): the next frame reads them again instead
+  /// of using those the last after_frame read.
+  void positions_changed() { fresh_ = false; }
   /// Reads the positions through the frame's shared mirror (null: on its own).
   void set_positions_mirror(PositionsMirror* mirror) { mirror_ = mirror; }
   /// Particles of the scene (device order).
@@ -141,11 +145,6 @@ class MeshCollision {
   [[nodiscard]] const MeshContactBuffers& buffers() const { return buffers_; }
   [[nodiscard]] std::uint32_t contacts() const { return contact_count_; }  ///< this frame's
   [[nodiscard]] std::uint32_t colors() const { return color_count_; }      ///< this frame's
-  /// Bytes read from the device for this frame (before_frame and
-  /// after_frame): the positions (the velocities too before the first
-  /// frame) and, with contacts on tools, every contact's multipliers (the
-  /// tools' are spread over the colours' slots; 32 bytes per contact).
-  [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
   /// This frame's largest motion margin [m]: the reach of the fastest pair beyond the thickness.
   [[nodiscard]] double margin() const { return margin_; }
   /// Pairs of triangles closer than the thickness at the scene's start,
@@ -210,7 +209,6 @@ class MeshCollision {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> tool_slots_;
   std::vector<float> tool_lambda_, tool_lambda_sum_;
   std::vector<float> upload_motion_;  // per contact slot (Contact::motion)
-  std::uint64_t read_back_bytes_ = 0;
   // Refits each body's tree (against other bodies) to its primitives'
   // `boxes` (builds it when empty). Rebuilt, when degraded past
   // kMaxDegradation, after the cones' update beside it (before_frame).

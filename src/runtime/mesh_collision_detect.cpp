@@ -44,7 +44,6 @@ Status MeshCollision::before_frame(Device& device, const XpbdBuffers& scene_buff
                                    std::span<const PosedShape> colliders, std::span<const PosedShape> tool_starts,
                                    std::span<const PosedShape> tool_ends, bool& grew) {
   grew = false;
-  read_back_bytes_ = 0;
   // The positions and velocities the last frame ended with (after_frame);
   // read here only before the first frame.
   if (!fresh_)

@@ -78,14 +78,17 @@ Status MeshCollision::make_room(Device& device, std::uint32_t count, bool& grew)
   if (want_slots_) reserve_slots_ *= 2;
   want_colors_ = want_slots_ = false;
   if (count + reserve_slots_ > b.capacity) {
-    b.capacity = std::max(count + reserve_slots_, 2 * b.capacity);
+    // The capacity is recorded once every buffer holds it: after a failed
+    // resize the next frame tries again (a buffer already grown is only larger).
+    const std::uint32_t capacity = std::max(count + reserve_slots_, 2 * b.capacity);
     for (BufferHandle h : {b.particles, b.coefficients, b.normals, b.lambda, b.lambda_sum})
-      if (Status s = device.resize_buffer(h, std::size_t{b.capacity} * 16); !s) return s;
-    if (Status s = device.resize_buffer(b.motion, std::size_t{b.capacity} * 4); !s) return s;
+      if (Status s = device.resize_buffer(h, std::size_t{capacity} * 16); !s) return s;
+    if (Status s = device.resize_buffer(b.motion, std::size_t{capacity} * 4); !s) return s;
     if (b.jacobi) {
-      if (Status s = device.resize_buffer(b.delta, std::size_t{b.capacity} * 64); !s) return s;
-      if (Status s = device.resize_buffer(b.slots, std::size_t{b.capacity} * 16); !s) return s;
+      if (Status s = device.resize_buffer(b.delta, std::size_t{capacity} * 64); !s) return s;
+      if (Status s = device.resize_buffer(b.slots, std::size_t{capacity} * 16); !s) return s;
     }
+    b.capacity = capacity;
     grew = true;
   }
   return {};
@@ -108,8 +111,9 @@ Status MeshCollision::assign_slots(Device& device, std::uint32_t count, std::vec
     const std::uint32_t colors = coloring.color_count();
     color_count_ = colors;
     if (colors + reserve_colors_ > b.colors) {
-      b.colors = std::max(colors + reserve_colors_, 2 * b.colors);
-      if (Status s = device.resize_buffer(b.table, std::size_t{2} * b.colors * 4); !s) return s;
+      const std::uint32_t room = std::max(colors + reserve_colors_, 2 * b.colors);
+      if (Status s = device.resize_buffer(b.table, std::size_t{2} * room * 4); !s) return s;
+      b.colors = room;  // once the table holds it
       grew = true;
     }
     table_.assign(std::size_t{2} * b.colors, 0);
@@ -267,7 +271,6 @@ Result<std::uint32_t> MeshCollision::append_contacts(Device& device, std::span<c
     for (const auto& [buffer, moved] : {std::pair{b.lambda, &lambda}, std::pair{b.lambda_sum, &lambda_sum}}) {
       if (Status s = device.read_buffer(buffer, std::size_t{contact_count_} * 16, old.data(), old.size() * 4); !s)
         return s.error();
-      read_back_bytes_ += old.size() * 4;
       for (std::size_t i = 0; i < appended_.size(); ++i)
         std::copy_n(&old[std::size_t{appended_slots_[i] - contact_count_} * 4], 4,
                     &(*moved)[std::size_t{slot_of[i] - contact_count_} * 4]);

@@ -194,9 +194,10 @@ Status MeshCollision::update_topology(Device& device, const SceneDesc& scene,
   // touched particles hold up to every collidable one.
   MeshContactBuffers& buffers = buffers_;
   if (buffers.jacobi && collidable_.size() > buffers.touched_capacity) {
-    buffers.touched_capacity = static_cast<std::uint32_t>(collidable_.size());
-    if (Status s = device.resize_buffer(buffers.touched, std::size_t{buffers.touched_capacity} * 4); !s) return s;
-    if (Status s = device.resize_buffer(buffers.offsets, std::size_t{buffers.touched_capacity + 1} * 4); !s) return s;
+    const auto capacity = static_cast<std::uint32_t>(collidable_.size());
+    if (Status s = device.resize_buffer(buffers.touched, std::size_t{capacity} * 4); !s) return s;
+    if (Status s = device.resize_buffer(buffers.offsets, std::size_t{capacity + 1} * 4); !s) return s;
+    buffers.touched_capacity = capacity;  // once both hold it
   }
   if (desc_.continuous)
     reserve_slots_ = std::max(reserve_slots_, static_cast<std::uint32_t>(segments_.size()));

@@ -27,7 +27,6 @@ class PositionsMirror {
     if (!valid_ || data_.size() != floats) {
       data_.resize(floats);
       if (Status s = device.read_buffer(position, 0, data_.data(), floats * sizeof(float)); !s) return s;
-      bytes_ += floats * sizeof(float);
       ++reads_;
       valid_ = true;
     }
@@ -37,17 +36,12 @@ class PositionsMirror {
   /// The positions on the device changed (or may have).
   void changed() { valid_ = false; }
   /// Starts a frame's count of reads.
-  void begin_frame() {
-    bytes_ = 0;
-    reads_ = 0;
-  }
-  [[nodiscard]] std::uint64_t bytes() const { return bytes_; }  ///< read since begin_frame
+  void begin_frame() { reads_ = 0; }
   [[nodiscard]] std::uint32_t reads() const { return reads_; }   ///< read-backs since begin_frame
 
  private:
   std::vector<float> data_;
   bool valid_ = false;
-  std::uint64_t bytes_ = 0;
   std::uint32_t reads_ = 0;
 };
 

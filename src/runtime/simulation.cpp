@@ -3,12 +3,14 @@
 #include "sinew/simulation.h"
 #include "runtime/simulation_internals.h"
 
+#include <atomic>
 #include <chrono>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
 
+#include "compiler/device_ranges.h"
 #include "compiler/scene_compiler.h"
 #include "math/xpbd_math.h"
 #include "program/xpbd_program.h"
@@ -25,6 +27,7 @@ void Simulation::Impl::measure(FrameStats& out) const {
   out.max_residual = d.residual_max;
   out.kinetic_energy = d.kinetic_energy;
   out.volume_change = rest_volume > 0.0 ? d.volume / rest_volume - 1.0 : 0.0;
+  out.inverted_tets = d.inverted_tets;
 }
 
 Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -33,17 +36,36 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 Simulation::~Simulation() = default;
 
 Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOptions& device_options) {
+  // The scene is checked before a device is made: a bad scene costs no driver start.
   auto compiled = compile_scene(scene);
   if (!compiled) return compiled.error();
   auto device = create_device(device_options);
   if (!device) return device.error();
+  return SimulationInternals::assemble(scene, *compiled, std::move(*device));
+}
 
+Result<Simulation> SimulationInternals::create(const SceneDesc& scene, std::unique_ptr<Device> device) {
+  if (!device) return Error(ErrorCode::bad_parameter, "Simulation::create: no device");
+  auto compiled = compile_scene(scene);
+  if (!compiled) return compiled.error();
+  return assemble(scene, *compiled, std::move(device));
+}
+
+Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, CompiledScene& compiled_scene,
+                                                 std::unique_ptr<Device> device) {
+  using Impl = Simulation::Impl;
+  CompiledScene* const compiled = &compiled_scene;  // as the Result it was
   auto impl = std::make_unique<Impl>();
-  impl->device = std::move(*device);
+  impl->device = std::move(device);
+  static std::atomic<std::uint32_t> simulations{0};  // ids name their Simulation by this
+  impl->serial = ++simulations;
   auto buffers = upload_scene(*impl->device, *compiled);
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
-  if (compiled->external_forces) impl->force_scratch.resize(compiled->positions.size());
+  if (compiled->external_forces) {
+    impl->force_scratch.resize(compiled->positions.size());
+    for (const kernels::float4& p : compiled->positions) impl->force_inverse_mass.push_back(p.w);
+  }
   if (Status s = impl->init_contacts(scene, *compiled); !s) return s.error();
   impl->order = compiled->order;
   impl->scene_targets = scene.targets.size();
@@ -54,15 +76,25 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   // Every tet body's boundary (wound outward) with one particle of the body
   // as the reference point: its volume on the device (stats_surface_volume).
   std::vector<std::array<std::uint32_t, 4>> faces;
+  // Every tet, wound with a positive rest volume: the inverted tets' count
+  // (stats_inverted_tets; FrameStats::inverted_tets).
+  std::vector<std::array<std::uint32_t, 4>> tets;
   for (std::size_t b = 0; b < scene.tet_bodies.size(); ++b) {
     const TetMesh& mesh = scene.tet_bodies[b].mesh;
     const std::uint32_t first = compiled->tet_body_first_particle[b];
+    impl->stats_tet_first.push_back(static_cast<std::uint32_t>(tets.size()));
     for (const auto& t : mesh.tets) {
       const auto at = [&](int k) {
         const Vec3d& p = mesh.vertices[t[k]];
         return kernels::double4{p[0], p[1], p[2], 0.0};
       };
-      impl->rest_volume += kernels::tet_volume(at(0), at(1), at(2), at(3));
+      const double volume = kernels::tet_volume(at(0), at(1), at(2), at(3));
+      impl->rest_volume += volume;
+      if (!impl->measure_errors) continue;
+      std::array<std::uint32_t, 4> d;
+      for (int k = 0; k < 4; ++k) d[k] = compiled->order.device_of[first + t[k]];
+      if (volume < 0.0) std::swap(d[2], d[3]);
+      tets.push_back(d);
     }
     if (!impl->measure_errors) continue;
     const TriMesh boundary = extract_boundary_surface(mesh);
@@ -75,11 +107,17 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   // (refresh_volume writes them without making the plan again).
   auto plan = make_stats_plan(*impl->device, *compiled, faces, impl->measure_errors,
                               static_cast<std::uint32_t>(impl->contacts.tools.size()),
-                              scene.topology_changes ? 2 * static_cast<std::uint32_t>(faces.size()) : 0u);
+                              scene.topology_changes ? 2 * static_cast<std::uint32_t>(faces.size()) : 0u,
+                              std::move(tets));
   if (!plan) return plan.error();
   impl->stats_plan = std::move(*plan);
   impl->solver = scene.solver;
   impl->gravity = scene.gravity;
+  if (scene.fluid) {
+    auto fluid = SceneFluid::State::create(scene, *compiled, *impl->device, impl->buffers);
+    if (!fluid) return fluid.error();
+    impl->fluid = std::move(*fluid);
+  }
   if (scene.mesh_collision.enabled) {
     auto mesh_collision = MeshCollision::create(scene, *compiled, *impl->device);
     if (!mesh_collision) return mesh_collision.error();
@@ -96,7 +134,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
     impl->collision_scene->attachments.clear();  // what MeshCollision does not read
     impl->collision_scene->targets.clear();
   }
-  if (!scene.graspers.empty()) impl->graspers = std::make_unique<Graspers>(scene, *compiled);
+  if (!scene.graspers.empty()) impl->graspers = std::make_unique<GrasperHolds>(scene, *compiled);
   if (impl->mesh_collision || impl->topology || impl->graspers) {  // programs rebuilt while the scene runs start from this
     impl->program_shape = *compiled;
     for (ConstraintBlock& block : impl->program_shape.blocks) block.data = {};
@@ -132,6 +170,7 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   // The frame's stages, in the order they run: one line per feature.
   Impl& im = *impl;
   if (compiled->external_forces) im.add_stage(make_forces_stage(im));
+  if (im.fluid) im.add_stage(make_fluid_stage(im));
   im.add_stage(make_tools_stage(im));
   if (im.mesh_collision) im.add_stage(make_mesh_collision_stage(im));
   if (im.sutures) im.add_stage(make_sutures_stage(im));
@@ -139,6 +178,8 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   im.add_stage(make_solve_stage(im));
   im.add_stage(make_statistics_stage(im));
   if (im.topology && im.topology->tears()) im.add_stage(make_tearing_stage(im));
+
+  impl->init_state_buffers(*compiled);
 
   SceneInfo& info = impl->info;
   info.particles = static_cast<std::uint32_t>(compiled->positions.size());
@@ -166,10 +207,13 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
 Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
   program = build_xpbd_program(compiled, buffers, solver, gravity, sweep_extras());
   append_stats(program, stats_plan, buffers);
-  if (prepared.id != UINT32_MAX)
-    if (Status s = device->destroy_program(prepared); !s) return s;
-  auto made = device->create_program(program);
+  auto made = device->create_program(program);  // made before the old one goes: a failure leaves it whole
   if (!made) return made.error();
+  if (prepared.id != UINT32_MAX)
+    if (Status s = device->destroy_program(prepared); !s) {
+      (void)device->destroy_program(*made);
+      return s;
+    }
   prepared = *made;
   info.dispatches_per_frame = static_cast<std::uint32_t>(program.dispatch_count());
   info.barriers_per_frame = static_cast<std::uint32_t>(program.barrier_count());
@@ -177,6 +221,15 @@ Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
 }
 
 Status Simulation::Impl::rebuild_program() {
+  // Not ready until rebuilt: after a failure (a device error) the next
+  // step() rebuilds before it runs anything.
+  program_ready = false;
+  if (Status s = rebuild_programs(); !s) return s;
+  program_ready = true;
+  return {};
+}
+
+Status Simulation::Impl::rebuild_programs() {
   stats_plan.in_use.clear();  // the residuals' RMS divides by the constraints in use
   for (const ConstraintBlock& block : program_shape.blocks) stats_plan.in_use.push_back(block.in_use());
   if (!stepper) return prepare_program(program_shape);
@@ -188,7 +241,7 @@ Status Simulation::Impl::rebuild_program() {
 }
 
 void Simulation::Impl::add_stage(std::unique_ptr<FrameStage> stage) {
-  stats.stages.push_back({std::string(stage->name()), 0.0});
+  stats.stages.push_back({std::string(stage->name()), 0.0, {}});
   stages.push_back(std::move(stage));
 }
 
@@ -197,24 +250,46 @@ void Simulation::Impl::add_stage(std::unique_ptr<FrameStage> stage) {
 Status Simulation::step() {
   Impl& im = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  FrameContext frame{*im.device, im.stats};
+  if (!im.program_ready)  // a rebuild failed (topology change, contacts that grew)
+    if (Status s = im.rebuild_program(); !s) return s;
+  FrameContext frame{*im.device, im.stats, {}};
   for (StageProfile& p : im.stats.stages) p.ms = 0.0;
   im.positions_mirror.begin_frame();
+  // The device counts what the host reads and how often it waits; each
+  // stage is given what its own hooks did.
+  const HostTransfers& device = im.device->transfers();
+  const HostTransfers frame_start = device;
+  im.stage_transfers.assign(im.stages.size(), {});
   using Hook = Status (FrameStage::*)(FrameContext&);
+  im.stepping = true;
   for (Hook hook : {&FrameStage::before_frame, &FrameStage::solve, &FrameStage::after_solve, &FrameStage::after_frame})
     for (std::size_t i = 0; i < im.stages.size(); ++i) {
       const auto t0 = std::chrono::steady_clock::now();
-      if (Status s = (im.stages[i].get()->*hook)(frame); !s) return s;
+      const HostTransfers before = device;
+      if (Status s = (im.stages[i].get()->*hook)(frame); !s) {
+        im.stepping = false;
+        return im.after_failed_frame(s.error());
+      }
       im.stats.stages[i].ms += ms_since(t0);
+      im.stage_transfers[i].read_bytes += device.read_bytes - before.read_bytes;
+      im.stage_transfers[i].waits += device.waits - before.waits;
     }
-  im.stats.read_back_bytes = im.positions_mirror.bytes();
-  for (const auto& stage : im.stages) im.stats.read_back_bytes += stage->read_back_bytes();
+  im.stepping = false;
+  for (std::size_t i = 0; i < im.stages.size(); ++i) {
+    im.stages[i]->report(im.stats.stages[i]);
+    im.stats.stages[i].set("read_bytes", static_cast<double>(im.stage_transfers[i].read_bytes));
+    im.stats.stages[i].set("host_waits", static_cast<double>(im.stage_transfers[i].waits));
+  }
+  im.stats.read_back_bytes = device.read_bytes - frame_start.read_bytes;
+  im.stats.host_reads = static_cast<std::uint32_t>(device.reads - frame_start.reads);
+  im.stats.host_waits = static_cast<std::uint32_t>(device.waits - frame_start.waits);
   im.stats.position_reads = im.positions_mirror.reads();
   const auto end = std::chrono::steady_clock::now();
   im.stats.frame += 1;
   im.stats.time = static_cast<double>(im.stats.frame) * im.time_step;
   im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
-  return {};
+  if (Status s = im.check_divergence(); !s) return s;
+  return frame.deferred;
 }
 
 Status Simulation::set_particle_forces(std::span<const float> xyz) {
@@ -231,7 +306,9 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
                                                " particles, so it needs " + std::to_string(3 * n) +
                                                " (x, y, z per particle)");
   // Checked and staged before anything is uploaded: on an error the forces
-  // set before stay.
+  // set before stay. force_energy: sum |f|^2 / (2 m), the divergence
+  // check's bound on the energy they add (sinew/divergence.h).
+  double force_energy = 0.0;
   for (std::size_t u = 0; u < n; ++u) {
     const float* f = &xyz[3 * u];
     if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2])) {
@@ -240,7 +317,24 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
               << f[2] << " N)";
       return Error(ErrorCode::bad_parameter, message.str());
     }
-    im.force_scratch[im.order.device_of[u]] = kernels::float4{f[0], f[1], f[2], 0.0f};
+    // What the device makes of it in float (issue 39): the velocity a
+    // frame's substeps add, dt f / m (h f / m each), and the move it makes,
+    // dt^2 f / m, bounded as gravity's is (compiler/device_ranges.h).
+    const std::uint32_t slot = im.order.device_of[u];
+    const float dt = static_cast<float>(im.time_step), w = im.force_inverse_mass[slot];
+    for (int k = 0; k < 3; ++k) {
+      const float dv = dt * (f[k] * w);
+      if (!std::isfinite(dv) || !(std::abs(dt * dv) <= kMaxFrameMove)) {
+        std::ostringstream message;
+        message << call << ": the force on particle " << u << " (" << f[0] << ", " << f[1] << ", " << f[2]
+                << " N) is too large: the velocity h f / m it adds over a frame (inverse mass " << w
+                << " 1/kg, time_step " << im.time_step << " s) must be finite in float32, the device's precision, "
+                << "and the move time_step^2 f / m at most " << kMaxFrameMove << " m";
+        return Error(ErrorCode::bad_parameter, message.str());
+      }
+    }
+    im.force_scratch[slot] = kernels::float4{f[0], f[1], f[2], 0.0f};
+    if (w > 0.0f) force_energy += (double(f[0]) * f[0] + double(f[1]) * f[1] + double(f[2]) * f[2]) * w / 2.0;
   }
   if (n == 0) return {};
   if (Status s = im.device->write_buffer(im.buffers.external_force, 0, im.force_scratch.data(),
@@ -249,6 +343,7 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
     return s;
   im.forces_for_next_frame = true;
   im.forces_on_device = true;
+  im.history.next_force_speed = im.time_step * std::sqrt(force_energy);
   return {};
 }
 
@@ -259,6 +354,8 @@ Status Simulation::set_particle_forces(std::span<const float> xyz) {
 // frame program would cost every frame of every such scene.)
 Status Simulation::Impl::begin_frame_forces() {
   const bool stale = forces_on_device && !forces_for_next_frame;
+  host_forces_this_frame = forces_for_next_frame;
+  history.force_speed = forces_for_next_frame ? history.next_force_speed : 0.0;
   forces_for_next_frame = false;  // this frame consumes them
   if (!stale) return {};
   std::fill(force_scratch.begin(), force_scratch.end(), kernels::float4{0.0f, 0.0f, 0.0f, 0.0f});
@@ -291,6 +388,31 @@ Status Simulation::Impl::positions_in_user_order(std::vector<float>& xyzw) {
   return {};
 }
 
+void StageProfile::set(std::string_view counter, double value) {
+  for (Counter& c : counters)
+    if (c.name == counter) {
+      c.value = value;
+      return;
+    }
+  counters.push_back({std::string(counter), value});
+}
+
+double FrameStats::counter(std::string_view stage, std::string_view counter) const {
+  for (const StageProfile& p : stages)
+    if (p.name == stage)
+      for (const StageProfile::Counter& c : p.counters)
+        if (c.name == counter) return c.value;
+  return 0.0;
+}
+
+double FrameStats::stage_ms(std::string_view name) const {
+  for (const StageProfile& stage : stages)
+    if (stage.name == name) return stage.ms;
+  return 0.0;
+}
+
+SceneFluid Simulation::fluid() { return SceneFluid(impl_->fluid.get()); }
+
 Status Simulation::read_positions(std::vector<float>& xyzw) const {
   return impl_->read_in_user_order(impl_->buffers.position, xyzw);
 }
@@ -312,5 +434,6 @@ double SimulationInternals::frame_length(const Simulation& sim) { return sim.imp
 void SimulationInternals::add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage) {
   sim.impl_->add_stage(std::move(stage));
 }
+BufferHandle SimulationInternals::velocity_buffer(const Simulation& sim) { return sim.impl_->buffers.velocity; }
 
 }  // namespace sinew

@@ -306,7 +306,7 @@ Status Simulation::apply_tool_force(std::size_t index, const std::array<double, 
   return {};
 }
 
-Result<Simulation::ToolState> Simulation::tool_state(std::size_t index) const {
+Result<ToolState> Simulation::tool_state(std::size_t index) const {
   const std::vector<ToolBody>& tools = impl_->contacts.tools;
   if (Status s = check_index("tool_state", "tool", index, tools.size()); !s) return s.error();
   const ToolBody& b = tools[index];
@@ -342,7 +342,7 @@ Status Simulation::apply_needle_force(std::size_t index, const std::array<double
   return impl_->sutures->apply_force(index, force, torque);
 }
 
-Result<Simulation::NeedleState> Simulation::needle_state(std::size_t index) const {
+Result<NeedleState> Simulation::needle_state(std::size_t index) const {
   if (Status s = check_index("needle_state", "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s)
     return s.error();
   return impl_->sutures->state(index);
@@ -363,6 +363,7 @@ Result<CutReport> Simulation::cut_collider(std::size_t index, const CutterShape&
   // grids buffer, before the next frame reads them.
   const std::span<const std::byte> bytes = collider.level_set->nanovdb_bytes();
   const std::uint64_t base = c.level_set_offsets[index];
+  if (!report->changed_bytes.empty()) ++impl_->shape_generation;  // a saved state does not hold the grids
   for (const auto& [offset, size] : report->changed_bytes)
     if (Status s = impl_->device->write_buffer(impl_->buffers.level_set_grids, base + offset, bytes.data() + offset,
                                                size);

@@ -11,7 +11,7 @@ namespace sinew {
 
 namespace {
 
-Status check_grasper(const Graspers* graspers, const char* call, std::size_t index) {
+Status check_grasper(const GrasperHolds* graspers, const char* call, std::size_t index) {
   return call_checks::check_index(call, "grasper", index, graspers ? graspers->count() : 0);
 }
 
@@ -33,7 +33,7 @@ Result<std::vector<std::uint32_t>> Simulation::close_grasper(std::size_t index, 
                                                  "] must be > 0 [m] (got " + call_checks::str(half_extents[k]) + ")");
   std::vector<float> x;  // the device's copy: positions and inverse masses, user order
   if (Status s = impl_->read_in_user_order(impl_->buffers.position, x); !s) return s.error();
-  Graspers& graspers = *impl_->graspers;
+  GrasperHolds& graspers = *impl_->graspers;
   auto held = graspers.close(*impl_->device, impl_->buffers, impl_->program_shape, impl_->targets, impl_->order,
                              index, pose, half_extents, x, graspers.surface(impl_->topology.get()));
   if (!held) return held.error();
@@ -42,7 +42,7 @@ Result<std::vector<std::uint32_t>> Simulation::close_grasper(std::size_t index, 
   return held;
 }
 
-Result<std::vector<Simulation::HeldPoint>> Simulation::held_points(std::size_t index) const {
+Result<std::vector<HeldPoint>> Simulation::held_points(std::size_t index) const {
   if (Status s = check_grasper(impl_->graspers.get(), "held_points", index); !s) return s.error();
   return impl_->graspers->points(index);
 }

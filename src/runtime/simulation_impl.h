@@ -21,16 +21,22 @@
 #include "runtime/graspers.h"
 #include "runtime/sutures.h"
 #include "runtime/topology_editor.h"
+#include "runtime/scene_fluid.h"
+#include "sinew/divergence.h"
+#include "sinew/saved_state.h"
 #include "sinew/simulation.h"
 
 namespace sinew {
 
 struct Simulation::Impl {
   std::unique_ptr<Device> device;
+  /// This Simulation's number, unique in the process: the `scene` of its ids (sinew/ids.h).
+  std::uint32_t serial = 0;
   // The frame's stages in the order they run (runtime/frame_stage.h,
   // registered in Simulation::create); stats.stages holds their profiles
   // in the same order.
   std::vector<std::unique_ptr<FrameStage>> stages;
+  std::vector<HostTransfers> stage_transfers;  // this frame's, per stage (step())
   void add_stage(std::unique_ptr<FrameStage> stage);
   // The positions as read back for the stages that need them on the host
   // (runtime/positions_mirror.h): at most once between two changes.
@@ -57,6 +63,7 @@ struct Simulation::Impl {
   // The errors and the tools' reaction, reduced on the device at the end of
   // each frame (stats_program.h) and read back as a few words.
   StatsPlan stats_plan;
+  std::vector<std::uint32_t> stats_tet_first;  ///< per tet body, its first tet in stats_plan.tet_list
   DeviceStats device_stats;
 
   void measure(FrameStats& stats) const;
@@ -65,11 +72,18 @@ struct Simulation::Impl {
   // so a call allocates nothing); whether a call set the coming frame's,
   // and whether the device buffer holds a call's (nonzero) forces.
   std::vector<kernels::float4> force_scratch;
+  // ... and each particle's float inverse mass (device order), to check
+  // the impulse h f / m a force makes in float (set_particle_forces).
+  std::vector<float> force_inverse_mass;
   bool forces_for_next_frame = false;
   bool forces_on_device = false;
+  bool host_forces_this_frame = false;  ///< the frame being run has a call's forces (the fluid adds to them)
   /// Before a frame's program: the forces of the last frame's call, if no
   /// call since set the coming frame's, are reset to zero.
   Status begin_frame_forces();
+
+  // SceneDesc::fluid (scene_fluid.h; null without): destroyed before the device.
+  std::unique_ptr<SceneFluid::State> fluid;
 
   // Contacts between meshes (mesh_collision.h; null when the scene has
   // none). The program is rebuilt when they outgrow it (or the topology
@@ -91,37 +105,39 @@ struct Simulation::Impl {
   /// Builds the fixed-mode frame program (solve + statistics) and prepares it on the device.
   Status prepare_program(const CompiledScene& compiled);
   /// Builds the frame's program(s) again from program_shape: after the mesh
-  /// contacts outgrew theirs, or a topology change.
+  /// contacts outgrew theirs, or a topology change. On an error the
+  /// programs are not ready, and the next step() tries again.
   Status rebuild_program();
+  Status rebuild_programs();  // rebuild_program's work
+  bool program_ready = true;
 
   // With topology changes and mesh collision: the scene's bodies as the
   // collision sees them (each tet body's live tets), to make the mesh
-  // collision again after a change (null otherwise).
+  // collision again after a change (null otherwise; the mesh collision
+  // stage's topology_changed).
   std::unique_ptr<SceneDesc> collision_scene;
-  /// After a topology change: the mesh collision (and continuous collision)
-  /// made again from the live tets.
-  Status remake_collision();
   // SceneDesc::graspers (null without).
-  std::unique_ptr<Graspers> graspers;
+  std::unique_ptr<GrasperHolds> graspers;
   // SceneDesc::topology_changes: the host copy of the constraints that
   // removals patch (null without), and the last step's tears.
   std::unique_ptr<TopologyEditor> topology;
-  std::vector<Simulation::TopologyEvent> tears;
+  std::vector<TopologyEvent> tears;
   /// After a frame: removes the tets, triangles and segments stretched
   /// past their body's tear_strain.
   Status tear();
   /// Removes elements of a tet or tri body (topology_editor.h), rebuilds
   /// the program and times the whole change from `start`.
-  Result<Simulation::TopologyEvent> apply_removal(BodyKind kind, std::size_t body,
+  Result<TopologyEvent> apply_removal(BodyKind kind, std::size_t body,
                                                   std::span<const std::uint32_t> elements, bool burn,
                                                   std::chrono::steady_clock::time_point start);
   /// After tets were removed (with measure_errors): the statistics' faces
   /// are the tet bodies' live boundaries and rest_volume the live tets',
   /// so FrameStats::volume_change measures what is left.
-  Status refresh_volume(const Simulation::TopologyEvent& event);
-  /// After the editor changed something: the mesh collision made again,
-  /// the program rebuilt, the event's times filled in.
-  Result<Simulation::TopologyEvent> finish_change(Result<Simulation::TopologyEvent> event, bool changed,
+  Status refresh_volume(const TopologyEvent& event);
+  /// After the editor changed something: every stage's topology_changed
+  /// (the mesh collision made again, ...), the program rebuilt, the event's
+  /// times filled in.
+  Result<TopologyEvent> finish_change(Result<TopologyEvent> event, bool changed,
                                                   std::chrono::steady_clock::time_point start);
 
   // simulation_contacts.cpp: host copies of the collider and target
@@ -142,6 +158,48 @@ struct Simulation::Impl {
   /// continuous collision detection (after before_frame).
   [[nodiscard]] std::vector<FrameCapsule> frame_capsules() const;
   Status after_frame();   ///< settles what moved, takes each tool's reaction from device_stats
+
+  // ---- Saved state and divergence (simulation_state.cpp, divergence_check.cpp).
+  /// Changes of the scene's shape a saved state does not hold: topology
+  /// changes (finish_change) and level-set cuts (cut_collider). A state
+  /// restores only at the generation it was saved at.
+  std::uint64_t shape_generation = 0;
+  /// The device buffers whose contents carry from one frame to the next,
+  /// with their sizes (set in create; save_state reads them in this order).
+  struct StateBuffer {
+    BufferHandle buffer;
+    std::size_t bytes = 0;
+    const char* name = "";
+  };
+  std::vector<StateBuffer> state_buffers;
+  /// state_buffers and the fluid's (sph_solver.h), in the order a state holds them.
+  [[nodiscard]] std::vector<StateBuffer> saved_buffers() const;
+  /// Fills state_buffers and the divergence checks' scene figures (history) from the compiled scene.
+  void init_state_buffers(const CompiledScene& compiled);
+  Status save_state(SavedState& out, const char* call);
+  Status restore_state(const SavedState& state, const std::string& what);
+
+  DivergenceSettings divergence;
+  /// What the checks keep between frames: the last frame's kinetic energy,
+  /// the scene's movable mass and starting extent, the force term of the
+  /// energy bound for the coming frame (set_particle_forces) and the frame being run.
+  struct DivergenceHistory {
+    double last_energy = 0.0;       ///< [J]
+    double movable_mass = 0.0;      ///< [kg]
+    double extent = 0.0;            ///< the starting positions' bounding-box diagonal [m]
+    double next_force_speed = 0.0;  ///< sqrt(sum dt^2 |f|^2 / (2 m)) of the forces set for the coming frame [sqrt(J)]
+    double force_speed = 0.0;       ///< the same for the frame being run
+  } history;
+  SavedState last_good;  ///< OnDivergence::roll_back: the last good frame's state
+  bool checkpoint_failed = false;
+  bool stepping = false;  ///< inside step()'s stages (a topology change there is a tear)
+  /// Saves last_good (OnDivergence::roll_back): after a good frame, and after a topology change between frames.
+  void checkpoint();
+  /// After a frame: the checks, the log and the policy (divergence_check.cpp).
+  Status check_divergence();
+  /// A frame a stage failed (a device error): with OnDivergence::roll_back
+  /// the scene goes back to the last good frame; the error is returned either way.
+  Status after_failed_frame(const Error& error);
 };
 
 

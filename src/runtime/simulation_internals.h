@@ -13,13 +13,23 @@
 
 namespace sinew {
 
+struct CompiledScene;
+
 struct SimulationInternals {
+  /// A Simulation of `scene` on a device the caller made (a test's device
+  /// wrapper that injects faults: tests/faulty_device.h).
+  static Result<Simulation> create(const SceneDesc& scene, std::unique_ptr<Device> device);
+  /// Simulation::create's work once the scene is compiled and the device made.
+  static Result<Simulation> assemble(const SceneDesc& scene, CompiledScene& compiled, std::unique_ptr<Device> device);
   static const Device& device(const Simulation& sim);
   static const FrameProgram& program(const Simulation& sim);
   static double frame_length(const Simulation& sim);  ///< SolverSettings::time_step [s]
   /// Appends a stage to the frame: in every phase it runs after the
   /// scene's own, and FrameStats::stages gains its profile.
   static void add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage);
+  /// The particles' velocity buffer (float4 per particle, device order): a
+  /// test stage breaks a frame through it (the divergence tests).
+  static BufferHandle velocity_buffer(const Simulation& sim);
   /// The colouring checker (scenes with topology_changes): every block's
   /// colours in use, read back from the device, and the particles they
   /// share. conflicts: movable particles (inverse mass > 0 on the device)

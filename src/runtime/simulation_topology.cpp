@@ -13,6 +13,10 @@
 #include "runtime/simulation_internals.h"
 #include "runtime/topology_queries.h"
 
+// cut_body and cauterize by BodyKind are deprecated for users; the tet
+// overloads here forward to them.
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+
 namespace sinew {
 
 namespace {
@@ -35,34 +39,39 @@ Status check_body(const TopologyEditor& editor, BodyKind kind, std::size_t body)
 
 }  // namespace
 
-Result<Simulation::TopologyEvent> Simulation::Impl::apply_removal(BodyKind kind, std::size_t body,
+Result<TopologyEvent> Simulation::Impl::apply_removal(BodyKind kind, std::size_t body,
                                                                  std::span<const std::uint32_t> elements, bool burn,
                                                                  std::chrono::steady_clock::time_point start) {
   return finish_change(topology->remove(*device, buffers, program_shape, kind, body, elements, burn),
                        !elements.empty(), start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::Impl::finish_change(Result<Simulation::TopologyEvent> event,
+Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> event,
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
-  if (changed) positions_mirror.changed();  // a removal hands mass on: the positions' w
-  if (changed && graspers) graspers->invalidate();
-  if (changed && measure_errors && event->body_kind == BodyKind::tet)
-    if (Status s = refresh_volume(*event); !s) return s.error();
-  if (changed && collision_scene)
-    if (Status s = remake_collision(); !s) return s.error();
+  if (changed) ++shape_generation;  // a saved state does not hold the topology (simulation_state.cpp)
   if (changed) {
+    positions_mirror.changed();  // a removal hands mass on: the positions' w
+    TopologyChange change{*event};
+    for (const auto& stage : stages)  // each feature follows (FrameStage::topology_changed)
+      if (Status s = stage->topology_changed(*device, change); !s) return s.error();
     const auto rebuild = std::chrono::steady_clock::now();
     if (Status s = rebuild_program(); !s) return s.error();
     event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
   }
+  // Between frames the changed scene is the one to roll back to (a saved
+  // state holds no topology); a tear, inside a frame, waits for the frame's verdict.
+  if (changed && !stepping && divergence.on_divergence == OnDivergence::roll_back) checkpoint();
   event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return event;
 }
 
-Status Simulation::Impl::refresh_volume(const Simulation::TopologyEvent& event) {
+Status Simulation::Impl::refresh_volume(const TopologyEvent& event) {
   const TetMesh& mesh = topology->mesh(event.body);
+  std::vector<std::uint32_t> removed;  // in the statistics' tet list: no longer counted as inverted
+  for (std::uint32_t t : event.tets_removed) removed.push_back(stats_tet_first[event.body] + t);
+  if (Status s = clear_stats_tets(*device, stats_plan, removed); !s) return s;
   for (std::uint32_t t : event.tets_removed) {  // as create sums the rest volume
     const auto at = [&](int k) {
       const Vec3d& p = mesh.vertices[mesh.tets[t][k]];
@@ -84,53 +93,26 @@ Status Simulation::Impl::refresh_volume(const Simulation::TopologyEvent& event) 
   if (Status s = set_stats_faces(*device, stats_plan, faces, fitted); !s || fitted) return s;
   if (Status s = release_stats_plan(*device, stats_plan); !s) return s;
   auto plan = make_stats_plan(*device, program_shape, faces, true, static_cast<std::uint32_t>(contacts.tools.size()),
-                              2 * static_cast<std::uint32_t>(faces.size()));
+                              2 * static_cast<std::uint32_t>(faces.size()), stats_plan.tet_list);
   if (!plan) return plan.error();
   stats_plan = std::move(*plan);
   return {};
 }
 
-Status Simulation::Impl::remake_collision() {
-  for (std::size_t b = 0; b < topology->sheets(); ++b)  // each tri body's live triangles
-    collision_scene->tri_bodies[b].mesh.triangles = topology->live_triangles(b);
-  for (std::size_t b = 0; b < topology->line_bodies(); ++b) {  // and each line body's whole segments
-    auto& segments = collision_scene->line_bodies[b].segments;
-    segments.clear();
-    for (std::size_t s = 0; s < topology->whole(b).size(); ++s)
-      if (topology->whole(b)[s]) segments.push_back(topology->line(b).segments[s]);
-  }
-  // The collision surface follows in place: each tet body's boundary from
-  // the tets that died, the tri and line bodies that changed replaced (a
-  // whole remake took 20 ms on a 50,400-tet block; MeshCollision::update_topology).
-  std::vector<const std::vector<std::uint8_t>*> alive;
-  for (std::size_t b = 0; b < topology->bodies(); ++b) alive.push_back(&topology->alive(b));
-  bool changed = false;
-  if (Status s = mesh_collision->update_topology(*device, *collision_scene, alive, changed); !s) return s;
-  if (continuous && changed)
-    continuous = std::make_unique<ContinuousCollision>(mesh_collision->segments(), mesh_collision->triangles(),
-                                                       *mesh_collision, buffers, collision_scene->mesh_collision,
-                                                       collision_scene->solver.substeps);
-  if (sutures) {
-    mesh_collision->set_suture_exemption(sutures->exemption());
-    if (continuous) continuous->set_suture_exemption(sutures->exemption());
-  }
-  return {};
-}
-
-Result<Simulation::TopologyEvent> Simulation::remove_tets(std::size_t body, std::span<const std::uint32_t> tets) {
+Result<TopologyEvent> Simulation::remove_tets(std::size_t body, std::span<const std::uint32_t> tets) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_tets"); !s) return s.error();
   return impl_->apply_removal(BodyKind::tet, body, tets, false, start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::remove_triangles(std::size_t body,
+Result<TopologyEvent> Simulation::remove_triangles(std::size_t body,
                                                                std::span<const std::uint32_t> triangles) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_triangles"); !s) return s.error();
   return impl_->apply_removal(BodyKind::tri, body, triangles, false, start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::remove_segments(std::size_t body,
+Result<TopologyEvent> Simulation::remove_segments(std::size_t body,
                                                               std::span<const std::uint32_t> segments) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_segments"); !s) return s.error();
@@ -139,11 +121,11 @@ Result<Simulation::TopologyEvent> Simulation::remove_segments(std::size_t body,
                               !segments.empty(), start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
+Result<TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
   return cut_body(BodyKind::tet, body, from, to);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cut_body(BodyKind kind, std::size_t body, const Blade& from,
+Result<TopologyEvent> Simulation::cut_body(BodyKind kind, std::size_t body, const Blade& from,
                                                        const Blade& to) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "cut_body"); !s) return s.error();
@@ -158,12 +140,12 @@ Result<Simulation::TopologyEvent> Simulation::cut_body(BodyKind kind, std::size_
   return impl_->apply_removal(kind, body, cut, false, start);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cauterize(std::size_t body, const std::array<double, 3>& centre,
+Result<TopologyEvent> Simulation::cauterize(std::size_t body, const std::array<double, 3>& centre,
                                                         double radius, double seconds, double dwell_time) {
   return cauterize(BodyKind::tet, body, centre, radius, seconds, dwell_time);
 }
 
-Result<Simulation::TopologyEvent> Simulation::cauterize(BodyKind kind, std::size_t body,
+Result<TopologyEvent> Simulation::cauterize(BodyKind kind, std::size_t body,
                                                         const std::array<double, 3>& centre, double radius,
                                                         double seconds, double dwell_time) {
   const auto start = std::chrono::steady_clock::now();
@@ -216,7 +198,7 @@ Status Simulation::Impl::tear() {
   return {};
 }
 
-const std::vector<Simulation::TopologyEvent>& Simulation::last_tears() const { return impl_->tears; }
+const std::vector<TopologyEvent>& Simulation::last_tears() const { return impl_->tears; }
 
 Result<std::vector<std::array<std::uint32_t, 4>>> Simulation::current_tets(std::size_t body) const {
   if (Status s = need_topology(impl_->topology, "current_tets"); !s) return s.error();

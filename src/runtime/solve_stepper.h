@@ -60,8 +60,11 @@ class SolveStepper {
   /// (fixed mode with the accelerator: the whole frame): what SceneInfo
   /// counts and what tests inspect.
   [[nodiscard]] const FrameProgram& frame_program() const { return shortest_frame_; }
-  /// Bytes the residual checks of the last frame read back.
-  [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
+
+  /// Whether the next frame warm-starts (false after a substep the time
+  /// budget stopped); a saved state carries it (Simulation::save_state).
+  [[nodiscard]] bool warm() const { return warm_; }
+  void set_warm(bool warm) { warm_ = warm; }
 
  private:
   Status build(Device& device, const CompiledScene& scene, const XpbdBuffers& buffers,
@@ -90,7 +93,6 @@ class SolveStepper {
   bool warm_ = true;
   std::vector<std::vector<ProgramHandle>> chunks_;
   ProgramHandle end_;
-  std::uint64_t read_back_bytes_ = 0;
   double chunk_ms_ = -1.0;  // wall time of the last chunk run (< 0: none yet)
 };
 

@@ -261,12 +261,10 @@ bool Sutures::first_crossing(const Vec3& a, const Vec3& b, bool entering, Needle
 Status Sutures::read_positions(Device& device, const XpbdBuffers& scene_buffers) {
   if (mirror_) return mirror_->copy_to(device, scene_buffers.position, positions_.size(), positions_);
   if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) return s;
-  read_back_bytes_ += positions_.size() * 4;
   return {};
 }
 
 Status Sutures::before_frame(Device& device, const XpbdBuffers& scene_buffers) {
-  read_back_bytes_ = 0;
   if (Status s = read_positions(device, scene_buffers); !s) return s;
   for (std::size_t i = 0; i < needles_.size(); ++i) {
     Needle& n = needles_[i];
@@ -337,7 +335,6 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
     if (Status s = device.read_buffer(buffers_.rows, 0, words.data(), words.size() * 4); !s) return s;
     if (Status s = device.read_buffer(buffers_.weights, 0, weights.data(), weights.size() * 4); !s) return s;
     if (Status s = device.read_buffer(buffers_.lambda, 0, lambda.data(), lambda.size() * 4); !s) return s;
-    read_back_bytes_ += rows * 96;
   }
   if (Status s = read_positions(device, scene_buffers); !s) return s;
   std::size_t at = 0;
@@ -486,9 +483,9 @@ void Sutures::mark_exemption() {
   }
 }
 
-Simulation::NeedleState Sutures::state(std::size_t index) const {
+NeedleState Sutures::state(std::size_t index) const {
   const Needle& n = needles_[index];
-  Simulation::NeedleState out;
+  NeedleState out;
   out.position = n.position_start;
   out.rotation = n.rotation_start;
   out.velocity = n.body.velocity;
@@ -502,7 +499,7 @@ Simulation::NeedleState Sutures::state(std::size_t index) const {
   for (const Row& r : n.rows) {
     if (r.words[0] == SINEW_SUTURE_TIP) out.pushing = true;
     if (r.words[0] != SINEW_SUTURE_PUNCTURE && r.words[0] != SINEW_SUTURE_THREAD) continue;
-    Simulation::Puncture p;
+    Puncture p;
     p.body_kind = surfaces_[r.surface].kind;
     p.body = surfaces_[r.surface].body;
     p.triangle = r.triangle;

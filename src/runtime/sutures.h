@@ -80,13 +80,11 @@ class Sutures {
   /// substep [s]; frame: the frame's length [s].
   Status after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame);
 
-  [[nodiscard]] Simulation::NeedleState state(std::size_t index) const;
+  [[nodiscard]] NeedleState state(std::size_t index) const;
   /// Per particle (device order), what the sutures exempt from mesh
   /// collision and CCD (suture_exemption.h); updated after every frame.
   [[nodiscard]] const std::vector<std::uint8_t>* exemption() const { return &exempt_; }
   [[nodiscard]] std::size_t needles() const { return needles_.size(); }
-  /// Bytes read from the device in the last frame.
-  [[nodiscard]] std::uint64_t read_back_bytes() const { return read_back_bytes_; }
 
  private:
   // A surface a tip can puncture: its triangles (device slots), the
@@ -148,7 +146,6 @@ class Sutures {
   std::uint32_t rows_capacity_ = 0, curve_points_ = 0;
   double frame_ = 0.0;      // the frame's length [s]
   double stiffness_ = 0.0;  // iterations times substeps squared (integrate_tool)
-  std::uint64_t read_back_bytes_ = 0;
 };
 
 }  // namespace sinew

@@ -316,7 +316,7 @@ double TopologyEditor::hand_off(const Body& b, std::uint32_t v, std::span<const 
   return 0.0;
 }
 
-Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const XpbdBuffers& buffers,
+Result<TopologyEvent> TopologyEditor::remove(Device& device, const XpbdBuffers& buffers,
                                                          CompiledScene& shape, BodyKind kind, std::size_t body,
                                                          std::span<const std::uint32_t> elements, bool burn) {
   const bool tri = kind == BodyKind::tri;
@@ -336,7 +336,7 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove(Device& device, const X
     if (seen[t]) return Error(ErrorCode::bad_parameter, name + " is listed twice");
     seen[t] = 1;
   }
-  Simulation::TopologyEvent event;
+  TopologyEvent event;
   event.body_kind = kind;
   event.body = body;
   (tri ? event.triangles_removed : event.tets_removed).assign(elements.begin(), elements.end());
@@ -453,7 +453,7 @@ Status TopologyEditor::commit(Device& device, const XpbdBuffers& buffers, Compil
   return {};
 }
 
-Result<Simulation::TopologyEvent> TopologyEditor::remove_segments(Device& device, const XpbdBuffers& buffers,
+Result<TopologyEvent> TopologyEditor::remove_segments(Device& device, const XpbdBuffers& buffers,
                                                                   CompiledScene& shape, std::size_t body,
                                                                   std::span<const std::uint32_t> segments) {
   if (body >= lines_.size())
@@ -470,7 +470,7 @@ Result<Simulation::TopologyEvent> TopologyEditor::remove_segments(Device& device
     if (seen[s]) return Error(ErrorCode::bad_parameter, name + " is listed twice");
     seen[s] = 1;
   }
-  Simulation::TopologyEvent event;
+  TopologyEvent event;
   event.body_kind = BodyKind::line;
   event.body = body;
   event.segments_removed.assign(segments.begin(), segments.end());

@@ -53,7 +53,7 @@ class TopologyEditor {
   /// conserved). Patches the device's constraint buffers and inverse
   /// masses, and [in/out] shape's colour counts; the caller rebuilds the
   /// program. Fills the event but its wall_ms.
-  Result<Simulation::TopologyEvent> remove(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+  Result<TopologyEvent> remove(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
                                            BodyKind kind, std::size_t body, std::span<const std::uint32_t> elements,
                                            bool burn);
 
@@ -61,7 +61,7 @@ class TopologyEditor {
   /// an error nothing changed): their distance constraints and the bending
   /// constraints across them. Patches the device and shape as remove does;
   /// masses stay (a piece of thread keeps its beads).
-  Result<Simulation::TopologyEvent> remove_segments(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+  Result<TopologyEvent> remove_segments(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
                                                     std::size_t body, std::span<const std::uint32_t> segments);
   [[nodiscard]] std::size_t line_bodies() const { return lines_.size(); }
   /// Line body `body`'s rest vertices and segments, which are whole, its

@@ -45,6 +45,7 @@ class SafetyFilter {
   Vec3 apply(const Vec3& raw, double gain, std::uint32_t& flags) noexcept;
   /// Forgets the previous output (the next call slews from zero).
   void reset() noexcept { last_ = {0.0, 0.0, 0.0}; }
+  /// The last output.
   [[nodiscard]] const Vec3& last() const { return last_; }
 
  private:

@@ -40,6 +40,8 @@ namespace sinew::haptics {
 /// at 1 kHz), 2.5 GiB of TickRecords.
 inline constexpr std::size_t kMaxTelemetryCapacity = std::size_t{1} << 24;
 
+/// How a HapticLoop runs: its rate, scheduling, telemetry, and the
+/// coupling, watchdog and interpolation it renders force with.
 struct HapticLoopSettings {
   /// Tick rate [Hz], 1..1e6. At least 1 Hz: the period is an int64 count
   /// of nanoseconds (and twice it the missed-deadline threshold), which a
@@ -54,15 +56,15 @@ struct HapticLoopSettings {
   /// sleep state first. Off by default: it makes every idle CPU spin
   /// (power, heat), and in a VM whose host caps its CPU time the spinning
   /// vCPUs use up the cap and the host pauses the whole VM (measured here:
-  /// 35 ms pauses every 100 ms; benchmarks/README.md). Turn it on for a
+  /// 35 ms pauses every 100 ms; docs/benchmarks.md). Turn it on for a
   /// dedicated machine. Needs write access to the device (root); what was
   /// obtained is reported in SchedulingReport::cpu_latency.
   bool zero_cpu_latency = false;
   std::size_t telemetry_capacity = 1u << 16;  ///< ticks kept in the telemetry ring (the newest), 1..kMaxTelemetryCapacity
   unsigned snapshot_read_attempts = 4;        ///< bounded seqlock retries per tick, >= 1
-  CouplingParams coupling;
-  WatchdogParams watchdog;
-  InterpolationParams interpolation;
+  CouplingParams coupling;            ///< the virtual coupling and force limits
+  WatchdogParams watchdog;            ///< when stale state fades the force out
+  InterpolationParams interpolation;  ///< how the tool's state is interpolated between snapshots
   /// Called once on the loop thread before its first tick (outside the
   /// tick: it may allocate); e.g. to mark the thread for an allocation counter.
   std::function<void()> on_thread_start;
@@ -78,7 +80,9 @@ struct SchedulingReport {
   int cpu = -1;            ///< pinned CPU obtained (-1: none)
   std::string error;       ///< why the request failed ("" when it did not)
   std::string cpu_latency = "not requested";  ///< the PM QoS request: "0 us held", or why not
+  /// Whether a real-time policy (SCHED_FIFO or SCHED_RR) was obtained.
   [[nodiscard]] bool realtime() const { return policy == "SCHED_FIFO" || policy == "SCHED_RR"; }
+  /// One line saying what was requested and obtained.
   [[nodiscard]] std::string describe() const;
 };
 
@@ -96,24 +100,29 @@ struct TickRecord {
   Vec3 force{};                  ///< commanded to the device [N]
   double gain = 0.0;             ///< watchdog gain
   std::uint32_t flags = 0;       ///< TickFlags
-  std::uint32_t device_buttons = 0;
+  std::uint32_t device_buttons = 0;  ///< the device's buttons, one bit each
 };
 
 /// Counters, readable from any thread while the loop runs.
 struct HapticCounters {
-  std::uint64_t ticks = 0;
+  std::uint64_t ticks = 0;             ///< ticks run
   std::uint64_t missed_deadlines = 0;  ///< tick-to-tick intervals > 2 periods
   std::uint64_t skipped_slots = 0;     ///< periods skipped to catch up after a long stall
   std::uint64_t non_finite = 0;        ///< ticks whose raw force/torque had NaN/Inf
-  std::uint64_t clamped = 0;
-  std::uint64_t slew_limited = 0;
-  std::uint64_t stale_ticks = 0;
+  std::uint64_t clamped = 0;           ///< ticks whose force or torque was clamped
+  std::uint64_t slew_limited = 0;      ///< ticks whose force or torque change was limited
+  std::uint64_t stale_ticks = 0;       ///< ticks with stale tool or device state
   std::uint64_t stalls = 0;            ///< fresh -> stale transitions
   std::uint64_t snapshot_read_failures = 0;  ///< ticks whose bounded seqlock read gave up
   std::uint64_t device_failures = 0;   ///< ticks without a device sample
-  std::uint64_t snapshots_received = 0;
+  std::uint64_t snapshots_received = 0;  ///< new snapshots read from the channel
 };
 
+/// The haptic servo loop: each tick samples the device, interpolates the
+/// tool's published state, renders the coupling force through the safety
+/// filters and commands it, on its own thread (start) or called from a
+/// device SDK's scheduler (tick). A tick allocates nothing, takes no lock
+/// and does no I/O.
 class HapticLoop {
  public:
   /// Checks the settings and preallocates everything a tick uses. The
@@ -133,6 +142,7 @@ class HapticLoop {
   /// Stops the thread and the device (the device is commanded zero force;
   /// a later start() ramps the force up again through the watchdog). Idempotent.
   void stop() noexcept;
+  /// Whether the loop thread runs.
   [[nodiscard]] bool running() const { return running_.load(std::memory_order_acquire); }
   /// What the loop thread obtained; filled by start().
   [[nodiscard]] const SchedulingReport& scheduling() const { return scheduling_; }
@@ -147,6 +157,7 @@ class HapticLoop {
   /// SDK callback should stop calling tick() before the telemetry is copied.
   TickRecord tick() noexcept;
 
+  /// The loop's counters so far (ticks, clamps, stale ticks, ...).
   [[nodiscard]] HapticCounters counters() const;
   /// [out] out: the telemetry ring, oldest first (at most telemetry_capacity
   /// ticks). Only while the loop thread is not running and no tick() is in
@@ -154,6 +165,7 @@ class HapticLoop {
   /// ring is written without locks; a lock-free guard keeps an externally
   /// driven tick() (SDK servo callback) and the copy apart.
   Status copy_telemetry(std::vector<TickRecord>& out) const;
+  /// The settings it was created with.
   [[nodiscard]] const HapticLoopSettings& settings() const { return settings_; }
   /// The newest rendered tool state (loop thread / manual ticker only).
   [[nodiscard]] const RenderedTool& rendered_tool() const { return tool_; }

@@ -30,16 +30,18 @@ struct HapticSnapshot {
   double sim_time = 0.0;       ///< simulated time at the end of the frame [s]
   std::uint64_t frame = 0;     ///< frames done
   Vec3 position{};             ///< tool centre [m]
-  Quat rotation{1.0, 0.0, 0.0, 0.0};
+  Quat rotation{1.0, 0.0, 0.0, 0.0};  ///< tool orientation (w, x, y, z)
   Vec3 velocity{};             ///< [m/s]
   Vec3 angular_velocity{};     ///< world frame [rad/s]
   /// Local contact for force rendering: what the tissue pushed the tool
   /// with over the frame (average) [N], its torque about the tool centre
   /// [N m], and the contact normal (unit, the direction of contact_force,
   /// pointing from the tissue to the tool; zero when not in contact).
+  ///@{
   Vec3 contact_force{};
   Vec3 contact_torque{};
   Vec3 contact_normal{};
+  ///@}
   std::uint64_t in_contact = 0;  ///< 1 when |contact_force| > 0
 };
 
@@ -58,7 +60,7 @@ struct CouplingFeedback {
   Vec3 force{};                 ///< device force of the newest tick [N] (held until the next)
   Vec3 torque{};                ///< device torque of the newest tick [N m]
   Vec3 device_position{};       ///< newest device sample [m]
-  Quat device_rotation{1.0, 0.0, 0.0, 0.0};
+  Quat device_rotation{1.0, 0.0, 0.0, 0.0};  ///< newest device sample's orientation
   double gain = 0.0;            ///< watchdog gain of the newest tick, in [0, 1]
   std::uint64_t flags = 0;      ///< TickFlags of the newest tick
 };

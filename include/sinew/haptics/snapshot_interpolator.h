@@ -21,7 +21,7 @@
 // at once (microseconds apart) would multiply the extrapolated speed by
 // frame time / D. Interpolating costs one physics frame of latency
 // in the loop tool -> device -> tool: the coupled tool is stable when the
-// physics frame is short against the tool's coupled period (README).
+// physics frame is short against the tool's coupled period (docs/haptics.md).
 #pragma once
 
 #include <cstdint>
@@ -31,6 +31,7 @@
 
 namespace sinew::haptics {
 
+/// How the loop interpolates and extrapolates the tool's snapshots.
 struct InterpolationParams {
   /// How far past the newest snapshot the state may be extrapolated [s], >= 0.
   double extrapolation_horizon = 0.010;

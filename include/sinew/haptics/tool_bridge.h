@@ -24,6 +24,10 @@
 
 namespace sinew::haptics {
 
+/// The physics thread's side of the haptic hand-off: publish() puts a
+/// tool's state into the snapshot channel after each step, and
+/// apply_feedback() applies the device's coupling force to the tool before
+/// the next (docs/haptics.md).
 class HapticToolBridge {
  public:
   /// [in] tool: index of the tool in the scene; channels and clock must outlive the bridge.

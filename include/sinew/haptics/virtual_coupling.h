@@ -38,6 +38,8 @@
 
 namespace sinew::haptics {
 
+/// The virtual coupling's spring and damper between the tool and the
+/// device (Colgate et al. 1995), and its safety limits (docs/haptics.md).
 struct CouplingParams {
   double stiffness = 500.0;               ///< K [N/m], >= 0 (0.5 N/mm)
   double damping = 1.0;                   ///< B [N s/m], >= 0

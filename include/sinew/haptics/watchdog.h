@@ -19,6 +19,8 @@
 
 namespace sinew::haptics {
 
+/// When the tool's or the device's state counts as stale, and how the
+/// force fades out and back in.
 struct WatchdogParams {
   double stale_after = 0.050;         ///< snapshot age beyond which the state is stale [s], > 0 (3 frames at 60 Hz)
   double device_stale_after = 0.010;  ///< device sample age beyond which it is stale [s], > 0 (10 ticks at 1 kHz)

@@ -29,7 +29,27 @@ class ContinuousStage final : public FrameStage {
     return {};
   }
 
-  std::uint64_t read_back_bytes() const override { return sim_.continuous->read_back_bytes(); }
+  // Its segments and triangles are the mesh collision's: made again when
+  // that stage (registered before) changed them.
+  Status topology_changed(Device&, TopologyChange& change) override {
+    if (!change.collision_surface_changed) return {};
+    const SceneDesc& scene = *sim_.collision_scene;
+    MeshCollision& collision = *sim_.mesh_collision;
+    sim_.continuous = std::make_unique<ContinuousCollision>(collision.segments(), collision.triangles(), collision,
+                                                            sim_.buffers, scene.mesh_collision, scene.solver.substeps);
+    if (sim_.sutures) sim_.continuous->set_suture_exemption(sim_.sutures->exemption());
+    return {};
+  }
+
+  void report(StageProfile& profile) const override {
+    const ContinuousCollision& c = *sim_.continuous;
+    profile.set("hits", c.hits());
+    profile.set("repairs", c.repairs());
+    profile.set("reverted", c.reverted());
+    profile.set("carried", c.carried());
+    profile.set("forced", c.forced());
+  }
+
 
  private:
   Simulation::Impl& sim_;

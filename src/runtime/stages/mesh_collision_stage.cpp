@@ -37,7 +37,34 @@ class MeshCollisionStage final : public FrameStage {
     return {};
   }
 
-  std::uint64_t read_back_bytes() const override { return sim_.mesh_collision->read_back_bytes(); }
+  // The collision surface follows in place: each tet body's boundary from
+  // the tets that died, the tri and line bodies that changed replaced (a
+  // whole remake took 20 ms on a 50,400-tet block; MeshCollision::update_topology).
+  Status topology_changed(Device& device, TopologyChange& change) override {
+    if (!sim_.collision_scene) return {};  // made without topology changes
+    const TopologyEditor& topology = *sim_.topology;
+    SceneDesc& scene = *sim_.collision_scene;
+    for (std::size_t b = 0; b < topology.sheets(); ++b)  // each tri body's live triangles
+      scene.tri_bodies[b].mesh.triangles = topology.live_triangles(b);
+    for (std::size_t b = 0; b < topology.line_bodies(); ++b) {  // and each line body's whole segments
+      auto& segments = scene.line_bodies[b].segments;
+      segments.clear();
+      for (std::size_t s = 0; s < topology.whole(b).size(); ++s)
+        if (topology.whole(b)[s]) segments.push_back(topology.line(b).segments[s]);
+    }
+    std::vector<const std::vector<std::uint8_t>*> alive;
+    for (std::size_t b = 0; b < topology.bodies(); ++b) alive.push_back(&topology.alive(b));
+    return sim_.mesh_collision->update_topology(device, scene, alive, change.collision_surface_changed);
+  }
+
+  void report(StageProfile& profile) const override {
+    const MeshCollision& collision = *sim_.mesh_collision;
+    profile.set("contacts", collision.contacts());
+    profile.set("colors", collision.colors());
+    profile.set("margin_m", collision.margin());
+    profile.set("violation_m", collision.violation());
+  }
+
 
  private:
   Simulation::Impl& sim_;

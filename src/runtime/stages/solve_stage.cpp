@@ -20,7 +20,6 @@ class SolveStage final : public FrameStage {
     return {};
   }
 
-  std::uint64_t read_back_bytes() const override { return sim_.stepper ? sim_.stepper->read_back_bytes() : 0; }
 
  private:
   Simulation::Impl& sim_;

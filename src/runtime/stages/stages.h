@@ -1,7 +1,7 @@
 // stages.h — the stages of the frame (runtime/frame_stage.h), one file
 // each, registered in Simulation::create in this order:
-//   forces, tools, mesh collision, sutures, continuous collision, solve,
-//   statistics, tearing.
+//   forces, fluid, tools, mesh collision, sutures, continuous collision,
+//   solve, statistics, tearing.
 // A stage a scene does not use is not registered.
 #pragma once
 
@@ -14,6 +14,8 @@ namespace sinew {
 
 /// SceneDesc::external_forces: zeroes a past frame's forces no call renewed.
 std::unique_ptr<FrameStage> make_forces_stage(Simulation::Impl& sim);
+/// SceneDesc::fluid: the fluid's frame on the scene's device, coupled with the tissue.
+std::unique_ptr<FrameStage> make_fluid_stage(Simulation::Impl& sim);
 /// Colliders, targets and rigid tools: integrated and uploaded before the
 /// frame, settled (and the tools' reactions taken) after its statistics.
 std::unique_ptr<FrameStage> make_tools_stage(Simulation::Impl& sim);

@@ -21,6 +21,12 @@ class StatisticsStage final : public FrameStage {
     return {};
   }
 
+  // The measured volume is the live tets' (Simulation::Impl::refresh_volume).
+  Status topology_changed(Device&, TopologyChange& change) override {
+    if (!sim_.measure_errors || change.event.body_kind != BodyKind::tet) return {};
+    return sim_.refresh_volume(change.event);
+  }
+
   Status after_frame(FrameContext& frame) override {
     const auto start = std::chrono::steady_clock::now();
     if (sim_.measure_errors) sim_.measure(frame.stats);
@@ -28,7 +34,6 @@ class StatisticsStage final : public FrameStage {
     return {};
   }
 
-  std::uint64_t read_back_bytes() const override { return std::uint64_t{sim_.stats_plan.result_words} * 4; }
 
  private:
   Simulation::Impl& sim_;

@@ -13,6 +13,11 @@ class ToolsStage final : public FrameStage {
   std::string_view name() const override { return "colliders and tools"; }
   Status before_frame(FrameContext&) override { return sim_.before_frame(); }
   Status after_frame(FrameContext&) override { return sim_.after_frame(); }
+  // A grasper's held points may have died with the removed elements.
+  Status topology_changed(Device&, TopologyChange&) override {
+    if (sim_.graspers) sim_.graspers->invalidate();
+    return {};
+  }
 
  private:
   Simulation::Impl& sim_;

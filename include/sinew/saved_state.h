@@ -1,0 +1,60 @@
+// sinew/saved_state.h — a Simulation's state between two frames, in memory
+// or in a file (Simulation::save_state, Simulation::restore_state).
+//
+// What it holds: the particles' positions, previous positions and
+// velocities, every constraint's multiplier (lambda) and residual, the
+// particle forces set for the next frame, the colliders' and kinematic
+// targets' poses, the rigid tools' motion and reactions, a fluid's
+// particles, grid, counts and emitters, the frame count and the divergence
+// checks' history. Restoring it into the Simulation it
+// came from, or into a new Simulation made from the same SceneDesc on the
+// same backend, and stepping gives bitwise the positions of the run that
+// was never interrupted.
+//
+// The bytes are the file's bytes (the format below), so a state in memory
+// can be written as it is. A state restores only into a scene of the same
+// shape (particles, constraint blocks, colliders, targets, tools) with the
+// same topology: restoring across a topology change (a cut, tear,
+// cautery or removal made after the save, or before it in another
+// Simulation) is an error that says so. Not saved yet, so save_state is an
+// error that names them: needles and sutures, and a closed grasper's hold.
+//
+// File format, version 1 (all integers little-endian as the host writes
+// them, which the byte-order word checks):
+//   8 bytes   magic "sinewst\x1a"
+//   uint32    format version (1)
+//   uint32    byte order 0x01020304
+//   uint64    payload size [bytes]
+//   uint64    FNV-1a 64 hash of the payload
+//   payload   the scene's shape, then the state (src/runtime/state_format.h)
+// A file that is shorter than its header says, has another magic, a newer
+// version, another byte order or a wrong hash is an ErrorCode::bad_input_file
+// error naming the file and the check that failed.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sinew/result.h"
+
+namespace sinew {
+
+/// The format version written now; files of this version or older are read.
+inline constexpr std::uint32_t kSavedStateVersion = 1;
+
+struct SavedState {
+  /// The header and payload, as in the file.
+  std::vector<std::byte> bytes;
+  /// The frame it was saved after (FrameStats::frame then); 0 for an empty or malformed state.
+  [[nodiscard]] std::uint64_t frame() const;
+
+  /// [in] path: the file to write (replaced). Errors: bad_input_file naming the path when it cannot be written.
+  Status write_file(const std::string& path) const;
+  /// [in] path: a file write_file wrote. Errors: bad_input_file naming the path and the failed check
+  /// (missing, truncated, foreign magic, unknown version, byte order, hash).
+  static Result<SavedState> read_file(const std::string& path);
+};
+
+}  // namespace sinew

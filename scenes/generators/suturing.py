@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""Writes scenes/suturing.json: examples/suturing.cpp as a scene file.
+
+The needle's path is the example's script(f): two turns about the cut with
+a shift between them, then a pull up and away at 0.425 mm a frame. The
+example pulls until the thread's knot holds at the first puncture, which it
+reads from the running scene, and then 10 frames more and holds 60; a scene
+file cannot read the scene, so the pull's length is the one the example
+measures (the knot holds at its frame 518 on every backend, which agree
+bitwise). The poses are keyed at every frame, with the values the example
+computes (Python's floats are the same IEEE doubles and its math.cos and
+math.sin the same C library's), so the scene runs bitwise as the example.
+
+    scenes/generators/suturing.py > scenes/suturing.json
+"""
+import json
+import math
+import sys
+
+CELL, RADIUS, ABOVE = 0.002, 0.008, 0.002
+NX, NY, NZ, SLIT = 13, 5, 6, 6
+THREAD_SEGMENTS = 100
+STITCH_Z = [-0.003, 0.003]
+TURN, SHIFT = 110, 40
+PULL_SPEED = 4.25e-4
+TIGHTEN, HOLD = 10, 60
+LAST_ANGLE = 2.0 * math.pi - 0.2
+STITCHED = 2 * TURN + SHIFT
+KNOT_FRAME = 518  # measured: the example's "frame 518  the knot holds at the first puncture"
+
+
+def script(f, pulled):
+    """The needle's position and angle about z in the example's frame f (from 0)."""
+    second = TURN + SHIFT
+    if f < TURN:
+        return [0.0, ABOVE, STITCH_Z[0]], LAST_ANGLE * (f + 1) / TURN
+    if f < second:
+        u = float(f - TURN + 1) / SHIFT
+        return [0.0, ABOVE, STITCH_Z[0] + u * (STITCH_Z[1] - STITCH_Z[0])], LAST_ANGLE
+    if f < STITCHED:
+        return [0.0, ABOVE, STITCH_Z[1]], LAST_ANGLE + LAST_ANGLE * (f - second + 1) / TURN
+    return [0.5 * pulled, ABOVE + pulled, STITCH_Z[1]], 2.0 * LAST_ANGLE
+
+
+last = KNOT_FRAME + TIGHTEN + HOLD
+keys, pulled = [], 0.0
+for f in range(last + 1):
+    position, angle = script(f, pulled)
+    # The example's frame f is the runner's frame f + 1 (it counts from 0).
+    keys.append({"frame": f + 1, "position": position,
+                 "rotation": [math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)]})
+    if f >= STITCHED and f < KNOT_FRAME + TIGHTEN:
+        pulled += PULL_SPEED
+
+half_x = NX * CELL / 2
+slit_lo = -half_x + SLIT * CELL
+scene = {
+    "format": "sinew-scene",
+    "version": 1,
+    "description": "Two stitches across a slit in a pad, tightened: a needle turned about the cut twice, "
+                   "its thread following through the punctures, then pulled until the knot holds "
+                   "(examples/suturing.cpp; written by scenes/generators/suturing.py).",
+    "run": {"frames": last + 1, "every": 10, "backend": "auto"},
+    "gravity": [0.0, 0.0, 0.0],
+    "solver": {"time_step": 1.0 / 60.0, "substeps": 8, "iterations": 10},
+    "tet_bodies": [{
+        "name": "pad",
+        # The slit: the cells of column SLIT above the bottom layer removed.
+        "mesh": {"grid": {"cells": [NX, NY, NZ], "origin": [-half_x, -NY * CELL, -NZ * CELL / 2],
+                          "cell_size": [CELL, CELL, CELL]},
+                 "remove": [{"min": [slit_lo, -(NY - 1) * CELL, -1.0], "max": [slit_lo + CELL, 1.0, 1.0]}]},
+        "elastic": {"youngs_modulus": 3e4, "poisson_ratio": 0.45},
+        "velocity_damping": 5.0,
+        # Its two ends in x and its base.
+        "pinned": [{"min": [-1.0, -1.0, -1.0], "max": [-half_x + 1e-9, 1.0, 1.0]},
+                   {"min": [half_x - 1e-9, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
+                   {"min": [-1.0, -1.0, -1.0], "max": [1.0, -NY * CELL + 1e-9, 1.0]}],
+    }],
+    "line_bodies": [{
+        "name": "thread",
+        "vertices": [[RADIUS, ABOVE + 0.001 * i, STITCH_Z[0]] for i in range(THREAD_SEGMENTS + 1)],
+        "mass": 1e-5,
+        "bending_compliance": 10.0,
+        "velocity_damping": 5.0,
+    }],
+    "needles": [{
+        "curve": [[RADIUS * math.cos(math.pi * i / 16), RADIUS * math.sin(math.pi * i / 16), 0.0] for i in range(17)],
+        "position": [0.0, ABOVE, STITCH_Z[0]],
+        "puncture_force": 0.01,
+        "thread": 0,
+    }],
+    "script": {"poses": [{"needle": 0, "keys": "KEYS"}]},
+}
+one_line = ",\n   ".join(json.dumps(k) for k in keys)
+sys.stdout.write(json.dumps(scene, indent=1).replace('"KEYS"', "[\n   " + one_line + "\n  ]") + "\n")

@@ -1,0 +1,176 @@
+// script_player.cpp — playing a scene file's script on a Simulation
+// (sinew/scene_file.h, ScriptPlayer): each frame's interpolated poses and
+// forces, then its actions, through the feature handles.
+#include <cmath>
+
+#include "sinew/scene_file.h"
+#include "sinew/simulation.h"
+
+namespace sinew {
+
+ScriptKey interpolate_keys(const std::vector<ScriptKey>& keys, int frame) {
+  if (frame <= keys.front().frame) return keys.front();
+  if (frame >= keys.back().frame) return keys.back();
+  std::size_t i = 1;
+  while (keys[i].frame < frame) ++i;
+  const ScriptKey& a = keys[i - 1];
+  const ScriptKey& b = keys[i];
+  if (frame == b.frame) return b;
+  const double s = double(frame - a.frame) / double(b.frame - a.frame);
+  ScriptKey k;
+  k.frame = frame;
+  for (int c = 0; c < 3; ++c) {
+    k.position[c] = a.position[c] + (b.position[c] - a.position[c]) * s;
+    k.torque[c] = a.torque[c] + (b.torque[c] - a.torque[c]) * s;
+  }
+  // Normalised linear interpolation along the shorter arc (q and -q are one rotation).
+  double dot = 0.0;
+  for (int c = 0; c < 4; ++c) dot += a.rotation[c] * b.rotation[c];
+  const double sign = dot < 0.0 ? -1.0 : 1.0;
+  double norm = 0.0;
+  for (int c = 0; c < 4; ++c) {
+    k.rotation[c] = a.rotation[c] + (sign * b.rotation[c] - a.rotation[c]) * s;
+    norm += k.rotation[c] * k.rotation[c];
+  }
+  norm = std::sqrt(norm);
+  if (norm > 0.0)
+    for (double& q : k.rotation) q /= norm;
+  return k;
+}
+
+ScriptPlayer::ScriptPlayer(SceneScript script) : script_(std::move(script)) {}
+
+namespace {
+
+std::string describe(const char* what, const TopologyEvent& e) {
+  const std::size_t elements = e.tets_removed.size() + e.triangles_removed.size() + e.segments_removed.size();
+  return std::string(what) + ": " + std::to_string(elements) + " elements, " +
+         std::to_string(e.vertices_removed.size()) + " vertices, " + std::to_string(e.constraints_removed) +
+         " constraints removed";
+}
+
+Status pose_track(Simulation& sim, const ScriptTrack& track, const ScriptKey& k, const std::vector<bool>& closed) {
+  switch (track.subject) {
+    case ScriptSubject::collider: {
+      auto id = sim.tools().collider(track.index);
+      if (!id) return id.error();
+      return sim.tools().set_pose(*id, k.position, k.rotation);
+    }
+    case ScriptSubject::target: {
+      auto id = sim.tools().target(track.index);
+      if (!id) return id.error();
+      return sim.tools().set_position(*id, k.position);
+    }
+    case ScriptSubject::grasper: {
+      // Moving open jaws moves nothing: only a closed grasper is moved.
+      if (track.index >= closed.size() || !closed[track.index]) return {};
+      auto id = sim.graspers().grasper(track.index);
+      if (!id) return id.error();
+      return sim.graspers().move(*id, {k.position, k.rotation});
+    }
+    case ScriptSubject::needle: {
+      auto id = sim.needles().needle(track.index);
+      if (!id) return id.error();
+      return sim.needles().set_pose(*id, k.position, k.rotation);
+    }
+    case ScriptSubject::tool: break;
+  }
+  return Error(ErrorCode::bad_parameter, "a pose track cannot drive a tool (tools are driven by forces)");
+}
+
+Status force_track(Simulation& sim, const ScriptTrack& track, const ScriptKey& k) {
+  if (track.subject == ScriptSubject::tool) {
+    auto id = sim.tools().tool(track.index);
+    if (!id) return id.error();
+    return sim.tools().apply_force(*id, k.position, k.torque);
+  }
+  auto id = sim.needles().needle(track.index);
+  if (!id) return id.error();
+  return sim.needles().apply_force(*id, k.position, k.torque);
+}
+
+Result<TopologyEvent> topology_action(Simulation& sim, const ScriptAction& a) {
+  Topology topology = sim.topology();
+  if (a.kind == ScriptActionKind::remove) {
+    if (a.body_kind == BodyKind::tet) {
+      auto id = topology.tet_body(a.index);
+      if (!id) return id.error();
+      return topology.remove_tets(*id, a.elements);
+    }
+    if (a.body_kind == BodyKind::tri) {
+      auto id = topology.tri_body(a.index);
+      if (!id) return id.error();
+      return topology.remove_triangles(*id, a.elements);
+    }
+    auto id = topology.line_body(a.index);
+    if (!id) return id.error();
+    return topology.remove_segments(*id, a.elements);
+  }
+  const Blade from{a.a_from, a.b_from}, to{a.a_to, a.b_to};
+  if (a.body_kind == BodyKind::tet) {
+    auto id = topology.tet_body(a.index);
+    if (!id) return id.error();
+    if (a.kind == ScriptActionKind::cut) return topology.cut(*id, from, to);
+    return topology.cauterize(*id, a.centre, a.radius, a.seconds, a.dwell_time);
+  }
+  auto id = topology.tri_body(a.index);
+  if (!id) return id.error();
+  if (a.kind == ScriptActionKind::cut) return topology.cut(*id, from, to);
+  return topology.cauterize(*id, a.centre, a.radius, a.seconds, a.dwell_time);
+}
+
+}  // namespace
+
+Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::string>* events) {
+  if (grasper_closed_.size() < sim.graspers().count()) grasper_closed_.resize(sim.graspers().count(), false);
+  for (const ScriptTrack& t : script_.poses)
+    if (Status s = pose_track(sim, t, interpolate_keys(t.keys, frame), grasper_closed_); !s) return s;
+  for (const ScriptTrack& t : script_.forces)
+    if (Status s = force_track(sim, t, interpolate_keys(t.keys, frame)); !s) return s;
+  while (next_action_ < script_.actions.size() && script_.actions[next_action_].frame <= frame) {
+    const ScriptAction& a = script_.actions[next_action_++];
+    if (a.frame < frame) continue;  // a frame skipped by the caller
+    const std::string at = "frame " + std::to_string(frame) + ": ";
+    switch (a.kind) {
+      case ScriptActionKind::close_grasper:
+      case ScriptActionKind::open_grasper: {
+        auto id = sim.graspers().grasper(a.index);
+        if (!id) return id.error();
+        auto held = a.kind == ScriptActionKind::close_grasper ? sim.graspers().close(*id, a.pose, a.half_extents)
+                                                              : sim.graspers().open(*id);
+        if (!held) return held.error();
+        grasper_closed_[a.index] = a.kind == ScriptActionKind::close_grasper;
+        if (events)
+          events->push_back(at + (a.kind == ScriptActionKind::close_grasper ? "grasper closed on " : "grasper released ") +
+                            std::to_string(held->size()) + " vertices");
+        break;
+      }
+      case ScriptActionKind::cut:
+      case ScriptActionKind::cauterize:
+      case ScriptActionKind::remove: {
+        auto e = topology_action(sim, a);
+        if (!e) return e.error();
+        const char* what = a.kind == ScriptActionKind::cut ? "cut" : a.kind == ScriptActionKind::cauterize ? "cautery" : "removal";
+        if (events) events->push_back(at + describe(what, *e));
+        break;
+      }
+      case ScriptActionKind::cut_collider: {
+        auto id = sim.tools().collider(a.index);
+        if (!id) return id.error();
+        auto r = sim.tools().cut(*id, a.cutter, a.from, a.to);
+        if (!r) return r.error();
+        if (events) events->push_back(at + "collider cut, " + std::to_string(r->removed_volume * 1e9) + " mm^3 removed");
+        break;
+      }
+      case ScriptActionKind::set_emitter:
+        if (Status s = sim.fluid().set_emitter(a.index, a.emitter); !s) return s;
+        break;
+      case ScriptActionKind::set_sink:
+        if (Status s = sim.fluid().set_sink(a.index, a.sink); !s) return s;
+        break;
+    }
+  }
+  return {};
+}
+
+}  // namespace sinew

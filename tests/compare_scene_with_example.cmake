@@ -1,0 +1,56 @@
+# compare_scene_with_example.cmake — runs a C++ example (with EXAMPLE_ARGS)
+# and `sinew run` on its scene file (with RUNNER_ARGS), both on the cpu
+# backend, each writing into a folder of WORK, and compares the files
+# COMPARE names: "example_file=runner_file" byte for byte,
+# "example_file~runner_file" from their <Points> on (positions and cells;
+# the point fields before them may differ). The VTU files hold every
+# float exactly (shortest round-trip), so equal text is bitwise equal positions.
+#   cmake -DEXAMPLE=... "-DEXAMPLE_ARGS=--frames;20" -DRUNNER=... -DSCENE=...
+#         "-DRUNNER_ARGS=--frames;20" -DWORK=dir "-DCOMPARE=a=b;c~d" -P this
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+execute_process(COMMAND ${EXAMPLE} --backend cpu ${EXAMPLE_ARGS} --out ${WORK}/example
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the example failed (${rc}):\n${out}\n${err}")
+endif()
+execute_process(COMMAND ${RUNNER} run ${SCENE} --backend cpu ${RUNNER_ARGS} --out ${WORK}/runner
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "sinew run failed (${rc}):\n${out}\n${err}")
+endif()
+message(STATUS "sinew run:\n${out}")
+set(compared 0)
+foreach(pair IN LISTS COMPARE)
+  if(pair MATCHES "^([^=~]+)([=~])(.+)$")
+    set(a ${CMAKE_MATCH_1})
+    set(how ${CMAKE_MATCH_2})
+    set(b ${CMAKE_MATCH_3})
+  else()
+    message(FATAL_ERROR "bad COMPARE entry ${pair}")
+  endif()
+  foreach(f IN ITEMS ${WORK}/example/${a} ${WORK}/runner/${b})
+    if(NOT EXISTS ${f})
+      message(FATAL_ERROR "${f} was not written")
+    endif()
+  endforeach()
+  file(READ ${WORK}/example/${a} text_a)
+  file(READ ${WORK}/runner/${b} text_b)
+  if(how STREQUAL "~")
+    string(FIND "${text_a}" "<Points>" at_a)
+    string(FIND "${text_b}" "<Points>" at_b)
+    if(at_a EQUAL -1 OR at_b EQUAL -1)
+      message(FATAL_ERROR "${a} or ${b} has no <Points>")
+    endif()
+    string(SUBSTRING "${text_a}" ${at_a} -1 text_a)
+    string(SUBSTRING "${text_b}" ${at_b} -1 text_b)
+  endif()
+  if(NOT text_a STREQUAL text_b)
+    message(FATAL_ERROR "example/${a} and runner/${b} differ: the scene file does not run as the example")
+  endif()
+  math(EXPR compared "${compared} + 1")
+endforeach()
+if(compared EQUAL 0)
+  message(FATAL_ERROR "nothing compared")
+endif()
+message(STATUS "${compared} file pairs bitwise equal")

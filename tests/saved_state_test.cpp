@@ -1,0 +1,241 @@
+// saved_state_test.cpp — Simulation::save_state / restore_state: restoring
+// and stepping gives bitwise the run that was never interrupted, on every
+// backend, from memory, from a file, in a new Simulation, and after a
+// topology change; damaged, foreign and mismatched states are named errors
+// that leave the Simulation as it was.
+#include <filesystem>
+#include <fstream>
+
+#include "fluid_cup.h"
+#include "robustness_scenes.h"
+#include "thread_scenes.h"
+
+namespace sinew {
+namespace {
+
+using test::run;
+using test::same_bits;
+using test::snapshot;
+using test::Snapshot;
+
+class SavedStateTest : public test::BackendTest {};
+
+std::string tmp_path(const std::string& name) {
+  std::filesystem::create_directories(SINEW_TEST_TMP_DIR);
+  return std::string(SINEW_TEST_TMP_DIR) + "/" + name;
+}
+
+TEST_P(SavedStateTest, RestoreThenStepIsBitwiseTheUninterruptedRun) {
+  const SceneDesc scene = test::robustness_block();
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 1, 6);
+  SavedState at6;
+  SINEW_ASSERT_OK(sim->save_state(at6));
+  EXPECT_EQ(at6.frame(), 6u);
+  const std::string file = tmp_path("saved_state_" + GetParam() + ".state");
+  SINEW_ASSERT_OK(sim->save_state(file));
+  const Snapshot frame6 = snapshot(*sim);
+  run(*sim, 7, 15);
+  const Snapshot frame15 = snapshot(*sim);
+  ASSERT_FALSE(same_bits(frame6, frame15));  // the scene moves: the comparison below can fail
+
+  // Back in the same Simulation, from memory.
+  SINEW_ASSERT_OK(sim->restore_state(at6));
+  EXPECT_EQ(sim->last_frame().frame, 6u);
+  EXPECT_TRUE(same_bits(snapshot(*sim), frame6));
+  run(*sim, 7, 15);
+  EXPECT_EQ(sim->last_frame().frame, 15u);
+  EXPECT_TRUE(same_bits(snapshot(*sim), frame15)) << "restored in memory, on " << GetParam();
+
+  // A new Simulation of the same scene, from the file (a restart).
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok()) << fresh.error().message();
+  SINEW_ASSERT_OK(fresh->restore_state(file));
+  run(*fresh, 7, 15);
+  EXPECT_TRUE(same_bits(snapshot(*fresh), frame15)) << "restored from a file in a new Simulation, on " << GetParam();
+}
+
+TEST_P(SavedStateTest, RestoreAfterATopologyChangeIsBitwiseAndAcrossOneIsANamedError) {
+  const SceneDesc scene = test::robustness_block(/*topology=*/true);
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 1, 3);
+  SavedState before;
+  SINEW_ASSERT_OK(sim->save_state(before));
+  auto body = sim->topology().tet_body(0);
+  ASSERT_TRUE(body.ok());
+  const std::vector<std::uint32_t> hole{40, 41, 42, 43, 44, 45};  // the cells at the middle of the block
+  auto removed = sim->topology().remove_tets(*body, hole);
+  ASSERT_TRUE(removed.ok()) << removed.error().message();
+  run(*sim, 4, 6);
+  SavedState after;
+  SINEW_ASSERT_OK(sim->save_state(after));
+  run(*sim, 7, 12);
+  const Snapshot frame12 = snapshot(*sim);
+  SINEW_ASSERT_OK(sim->restore_state(after));
+  run(*sim, 7, 12);
+  EXPECT_TRUE(same_bits(snapshot(*sim), frame12)) << "after remove_tets, on " << GetParam();
+
+  // The state from before the removal: its topology is not the scene's now.
+  const Snapshot now = snapshot(*sim);
+  const Status across = sim->restore_state(before);
+  ASSERT_FALSE(across.ok());
+  EXPECT_EQ(across.error().code(), ErrorCode::bad_parameter);
+  EXPECT_NE(across.error().message().find("topology"), std::string::npos) << across.error().message();
+  EXPECT_TRUE(same_bits(snapshot(*sim), now));  // left as it was
+  EXPECT_EQ(sim->last_frame().frame, 12u);
+  // Nor the state from after it in a Simulation that has not made the change.
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok());
+  const Status fresh_across = fresh->restore_state(after);
+  ASSERT_FALSE(fresh_across.ok());
+  EXPECT_NE(fresh_across.error().message().find("topology"), std::string::npos);
+}
+
+// A scene stepped without inputs: save at frame `save`, run to `end`,
+// restore, run to `end` again; the two ends must be the same bits.
+void expect_restore_bitwise(const SceneDesc& scene, const std::string& backend, int save, int end) {
+  auto sim = test::create_or_skip(scene, backend);
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  for (int f = 1; f <= save; ++f) SINEW_ASSERT_OK(sim->step());
+  SavedState state;
+  SINEW_ASSERT_OK(sim->save_state(state));
+  const Snapshot saved = snapshot(*sim);
+  for (int f = save + 1; f <= end; ++f) SINEW_ASSERT_OK(sim->step());
+  const Snapshot uninterrupted = snapshot(*sim);
+  ASSERT_FALSE(same_bits(saved, uninterrupted));  // the scene moves
+  SINEW_ASSERT_OK(sim->restore_state(state));
+  for (int f = save + 1; f <= end; ++f) SINEW_ASSERT_OK(sim->step());
+  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "on " << backend;
+}
+
+TEST_P(SavedStateTest, RestoreWithMeshCollisionIsBitwise) {
+  // Two blocks dropped onto each other: the contacts of the frames after
+  // the restore are found again from the restored positions.
+  expect_restore_bitwise(test::dropped_blocks_scene(ContactSchedule::colored), GetParam(), 20, 40);
+}
+
+TEST_P(SavedStateTest, RestoreWithContinuousCollisionIsBitwise) {
+  // The linked rings of the thread tests hanging from their two targets,
+  // falling onto each other under gravity.
+  SceneDesc scene = test::LinkedRings::scene(/*continuous=*/true);
+  scene.gravity = {0.0, -9.81, 0.0};
+  expect_restore_bitwise(scene, GetParam(), 10, 25);
+}
+
+TEST_P(SavedStateTest, RestoreWithAFluidIsBitwise) {
+  // Fluid poured into the tissue cup of the fluid tests, coupled both ways:
+  // the fluid's particles, their grid and counts are in the state.
+  const SceneDesc scene = test::cup_scene(true, {0, -9.81, 0},
+                                          test::fluid_block(4, 3, 4, {2 * test::kCupCell, 1.5 * test::kCupCell,
+                                                                      2 * test::kCupCell}));
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  for (int f = 1; f <= 20; ++f) SINEW_ASSERT_OK(sim->step());
+  SavedState state;
+  SINEW_ASSERT_OK(sim->save_state(state));
+  std::vector<FluidParticle> saved_fluid;
+  SINEW_ASSERT_OK(sim->fluid().read(saved_fluid));
+  for (int f = 21; f <= 40; ++f) SINEW_ASSERT_OK(sim->step());
+  std::vector<FluidParticle> fluid40, again;
+  SINEW_ASSERT_OK(sim->fluid().read(fluid40));
+  const Snapshot tissue40 = snapshot(*sim);
+  SINEW_ASSERT_OK(sim->restore_state(state));
+  for (int f = 21; f <= 40; ++f) SINEW_ASSERT_OK(sim->step());
+  SINEW_ASSERT_OK(sim->fluid().read(again));
+  EXPECT_TRUE(same_bits(snapshot(*sim), tissue40)) << "the tissue, on " << GetParam();
+  ASSERT_EQ(again.size(), fluid40.size());
+  ASSERT_EQ(saved_fluid.size(), fluid40.size());
+  EXPECT_NE(std::memcmp(saved_fluid.data(), fluid40.data(), fluid40.size() * sizeof(FluidParticle)), 0);  // it moved
+  EXPECT_EQ(std::memcmp(again.data(), fluid40.data(), fluid40.size() * sizeof(FluidParticle)), 0)
+      << "the fluid, on " << GetParam();
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, SavedStateTest, ::testing::ValuesIn(test::backends()), test::backend_name);
+
+// ---- Damaged and foreign states (the format is the same on every backend: CPU only).
+
+class SavedStateFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto made = Simulation::create(test::robustness_block(), {.backend = "cpu", .quiet = true});
+    ASSERT_TRUE(made.ok()) << made.error().message();
+    sim_.emplace(std::move(*made));
+    run(*sim_, 1, 2);
+    SINEW_ASSERT_OK(sim_->save_state(good_));
+    run(*sim_, 3, 4);
+    at4_ = snapshot(*sim_);
+  }
+  // restore_state of `bytes` written to a file: a named error of `code` whose message holds `says`.
+  void expect_refused(const std::vector<std::byte>& bytes, ErrorCode code, const std::string& says) {
+    const std::string file = tmp_path("bad.state");
+    {
+      std::ofstream out(file, std::ios::binary | std::ios::trunc);
+      out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    }
+    const Status s = sim_->restore_state(file);
+    ASSERT_FALSE(s.ok()) << "accepted a state that should fail with: " << says;
+    EXPECT_EQ(s.error().code(), code) << s.error().message();
+    EXPECT_NE(s.error().message().find(says), std::string::npos) << s.error().message();
+    EXPECT_TRUE(same_bits(snapshot(*sim_), at4_));  // the Simulation is left as it was
+    EXPECT_EQ(sim_->last_frame().frame, 4u);
+  }
+  std::optional<Simulation> sim_;
+  SavedState good_;
+  Snapshot at4_;
+};
+
+TEST_F(SavedStateFile, TruncatedFileIsANamedError) {
+  std::vector<std::byte> bytes = good_.bytes;
+  bytes.resize(bytes.size() - 100);
+  expect_refused(bytes, ErrorCode::bad_input_file, "truncated");
+  bytes.resize(10);
+  expect_refused(bytes, ErrorCode::bad_input_file, "header");
+}
+
+TEST_F(SavedStateFile, ForeignFileIsANamedError) {
+  std::vector<std::byte> bytes = good_.bytes;
+  bytes[0] = std::byte{'X'};
+  expect_refused(bytes, ErrorCode::bad_input_file, "magic");
+  const std::string text = "solid cube\n  facet normal 0 0 1\nendsolid cube\n padding padding padding padding";
+  std::vector<std::byte> stl(text.size());
+  std::memcpy(stl.data(), text.data(), text.size());
+  expect_refused(stl, ErrorCode::bad_input_file, "magic");
+}
+
+TEST_F(SavedStateFile, NewerVersionIsANamedError) {
+  std::vector<std::byte> bytes = good_.bytes;
+  const std::uint32_t version = kSavedStateVersion + 1;
+  std::memcpy(bytes.data() + 8, &version, 4);
+  expect_refused(bytes, ErrorCode::bad_input_file, "version");
+}
+
+TEST_F(SavedStateFile, DamagedPayloadIsANamedError) {
+  std::vector<std::byte> bytes = good_.bytes;
+  bytes[bytes.size() / 2] ^= std::byte{0x40};
+  expect_refused(bytes, ErrorCode::bad_input_file, "hash");
+}
+
+TEST_F(SavedStateFile, AnotherScenesStateIsANamedError) {
+  SceneDesc other = test::robustness_block();
+  other.tet_bodies[0].mesh = test::box_mesh(5, 2, 2, 0.01);
+  other.tet_bodies[0].pinned = {0};
+  other.attachments.clear();
+  other.targets.clear();
+  auto sim = Simulation::create(other, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SavedState foreign;
+  SINEW_ASSERT_OK(sim->save_state(foreign));
+  expect_refused(foreign.bytes, ErrorCode::bad_parameter, "another scene");
+}
+
+TEST_F(SavedStateFile, MissingFileIsANamedError) {
+  const Status s = sim_->restore_state(tmp_path("no_such_file.state"));
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().code(), ErrorCode::bad_input_file);
+  EXPECT_NE(s.error().message().find("no_such_file.state"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sinew

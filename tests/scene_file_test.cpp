@@ -1,0 +1,162 @@
+// scene_file_test.cpp — scene files (sinew/scene_file.h): every scene
+// under scenes/ reads and checks; a file and the SceneDesc written in C++
+// run to bitwise the same positions; bad files get errors naming the JSON
+// path and the rule; the script's keys interpolate and drive the scene.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sinew/mesh.h"
+#include "sinew/scene_file.h"
+#include "sinew/simulation.h"
+
+namespace sinew {
+namespace {
+
+const std::filesystem::path kScenes = std::filesystem::path(SINEW_SOURCE_DIR) / "scenes";
+
+// A small scene as text: a 4 x 1 x 2 block pinned at x = 0, with `extra`
+// keys added to its tet body.
+std::string block_scene(const std::string& extra = "") {
+  return R"({"solver": {"time_step": 0.01, "substeps": 4, "iterations": 2},
+    "tet_bodies": [{"name": "block", "mesh": {"grid": {"cells": [4, 1, 2], "size": [0.04, 0.01, 0.02]}},
+      "density": 1000.0, "elastic": {"youngs_modulus": 20000.0, "poisson_ratio": 0.4},
+      "pinned": [{"min": [-1, -1, -1], "max": [0, 1, 1]}])" + extra + "}]}";
+}
+
+std::string error_of(const std::string& json) {
+  auto file = parse_scene_json(json, kScenes);
+  return file ? std::string("(no error)") : file.error().message();
+}
+
+TEST(SceneFile, EverySceneUnderScenesReadsAndChecks) {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kScenes)) {
+    if (entry.path().extension() != ".json") continue;
+    ++scenes;
+    auto file = load_scene_file(entry.path());
+    ASSERT_TRUE(file.ok()) << file.error().message();
+    EXPECT_TRUE(check_scene(file->scene).ok()) << entry.path();
+    EXPECT_FALSE(file->bodies.empty()) << entry.path();
+  }
+  EXPECT_GE(scenes, 1);
+}
+
+TEST(SceneFile, RunsBitwiseAsTheSceneWrittenInCpp) {
+  auto file = parse_scene_json(block_scene(R"(, "velocity_damping": 2.0)"), kScenes);
+  ASSERT_TRUE(file.ok()) << file.error().message();
+
+  SceneDesc scene;
+  scene.solver = {.time_step = 0.01, .substeps = 4, .iterations = 2};
+  TetBodyDesc body;
+  body.mesh = *make_tet_grid({.nx = 4, .ny = 1, .nz = 2, .cell_size = {0.04 / 4, 0.01 / 1, 0.02 / 2}});
+  ASSERT_TRUE(body.set_elastic(2e4, 0.4).ok());
+  body.velocity_damping = 2.0;
+  for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
+    if (body.mesh.vertices[v][0] == 0.0) body.pinned.push_back(v);
+  scene.tet_bodies.push_back(body);
+  EXPECT_EQ(file->scene.tet_bodies[0].pinned, scene.tet_bodies[0].pinned);
+  EXPECT_EQ(file->bodies.at(0).name, "block");
+
+  auto from_file = Simulation::create(file->scene, {.backend = "cpu", .threads = 1});
+  auto from_cpp = Simulation::create(scene, {.backend = "cpu", .threads = 1});
+  ASSERT_TRUE(from_file.ok() && from_cpp.ok());
+  for (int f = 0; f < 10; ++f) ASSERT_TRUE(from_file->step().ok() && from_cpp->step().ok());
+  std::vector<float> a, b;
+  ASSERT_TRUE(from_file->read_positions(a).ok() && from_cpp->read_positions(b).ok());
+  ASSERT_EQ(a, b);
+  // It moved: the comparison is not of two scenes at rest.
+  EXPECT_GT(from_file->last_frame().kinetic_energy, 0.0);
+}
+
+TEST(SceneFile, ErrorsNameTheJsonPathAndTheRule) {
+  EXPECT_EQ(error_of(block_scene(R"(, "density": -1)")), "/tet_bodies/0/density: must be finite and > 0 (got -1)");
+  EXPECT_EQ(error_of(R"({"tet_bodies": [{"mesh": {"grid": {"cells": [1, 1, 1], "size": [1, 1, 1]}},
+                          "elastic": {"youngs_modulus": -5, "poisson_ratio": 0.3}}]})"),
+            "/tet_bodies/0/elastic/youngs_modulus: must be finite and > 0 (got -5)");
+  EXPECT_EQ(error_of(block_scene(R"(, "densty": 5)")),
+            "/tet_bodies/0/densty: unknown key (docs/scene_files.md lists the keys)");
+  EXPECT_EQ(error_of(block_scene(R"(, "density": "heavy")")), "/tet_bodies/0/density: must be a number (got a string)");
+  EXPECT_EQ(error_of(block_scene(R"(, "pinned": [1000])")),
+            "/tet_bodies/0/pinned/0: vertex 1000 is out of range (the mesh has 30)");
+  EXPECT_EQ(error_of(block_scene(R"(, "material": "jelly")")),
+            "/tet_bodies/0/material: must be one of \"none\", \"neo_hookean\", \"stvk\", \"corotational\" (got \"jelly\")");
+  EXPECT_EQ(error_of(R"({"solver": {"substeps": 2.5}})"), "/solver/substeps: must be a whole number (got 2.5)");
+  EXPECT_EQ(error_of(R"({"tet_bodies": [{"mesh": {"file": "no_such_mesh.node"}}]})"),
+            "/tet_bodies/0/mesh/file: " + (kScenes / "no_such_mesh.node").string() + " is not a readable file");
+  // A folder (or a device, a pipe) is not read: nothing waits on it.
+  EXPECT_EQ(error_of(R"({"tri_bodies": [{"mesh": {"file": "schema"}}]})"),
+            "/tri_bodies/0/mesh/file: " + (kScenes / "schema").string() + " is not a readable file");
+  EXPECT_EQ(error_of(R"({"tet_bodies": [{"mesh": {"vertices": [[0,0,0]], "tets": [[0, 1, 2, 3]]}}]})"),
+            "/tet_bodies/0/mesh/tets/0/1: vertex 1 is out of range (there are 1)");
+  EXPECT_EQ(error_of(R"({"line_bodies": [{"vertices": [[0,0,0],[1,0,0]], "mass": 1}],
+                         "script": {"actions": [{"frame": 3, "do": "open_grasper", "grasper": 0}]}})"),
+            "/script/actions (frame 3): grasper 0 does not exist (the scene has 0)");
+  EXPECT_EQ(error_of(R"({"run": {"frames": 0}})"), "/run/frames: must be >= 1");
+  EXPECT_EQ(error_of("[1, 2]"), "/: must be an object (got an array of 2)");
+  EXPECT_EQ(error_of("{\"tet_bodies\": [").rfind("not valid JSON: ", 0), 0u);
+  // The fluid's keys are in "fluid" itself (SceneFluidDesc::fluid's).
+  EXPECT_EQ(error_of(block_scene().substr(0, block_scene().size() - 1) +
+                     R"(, "fluid": {"settings": {"time_step": 0.003}, "capacity": 10}})"),
+            "/fluid/settings/time_step: the scene's frame (solver.time_step 0.01 s) is not a whole number of fluid "
+            "steps of 0.003 s");
+  // An empty scene is check_scene's error, at the root.
+  EXPECT_EQ(error_of("{}").rfind("/: ", 0), 0u);
+}
+
+TEST(SceneFile, LoadingNamesTheFile) {
+  auto file = load_scene_file(kScenes / "no_such_scene.json");
+  ASSERT_FALSE(file.ok());
+  EXPECT_EQ(file.error().code(), ErrorCode::bad_input_file);
+  EXPECT_NE(file.error().message().find("no_such_scene.json: cannot be read"), std::string::npos);
+}
+
+TEST(SceneFile, KeysInterpolateLinearlyAndHoldBeyondTheEnds) {
+  std::vector<ScriptKey> keys(2);
+  keys[0].frame = 10, keys[0].position = {0.0, 1.0, 0.0};
+  keys[1].frame = 20, keys[1].position = {1.0, 3.0, 0.0};
+  keys[1].rotation = {0.0, 0.0, 1.0, 0.0};  // half a turn about y
+  EXPECT_EQ(interpolate_keys(keys, 0).position, keys[0].position);
+  EXPECT_EQ(interpolate_keys(keys, 99).position, keys[1].position);
+  const ScriptKey mid = interpolate_keys(keys, 15);
+  EXPECT_DOUBLE_EQ(mid.position[0], 0.5);
+  EXPECT_DOUBLE_EQ(mid.position[1], 2.0);
+  EXPECT_NEAR(mid.rotation[0], std::sqrt(0.5), 1e-15);  // a quarter turn, normalised
+  EXPECT_NEAR(mid.rotation[2], std::sqrt(0.5), 1e-15);
+}
+
+TEST(SceneFile, ScriptMovesACollider) {
+  // A sphere collider keyed from far away into the block's middle pushes it.
+  auto file = parse_scene_json(R"({"solver": {"time_step": 0.01, "substeps": 4, "iterations": 2}, "gravity": [0, 0, 0],
+    "tet_bodies": [{"mesh": {"grid": {"cells": [4, 1, 2], "size": [0.04, 0.01, 0.02]}},
+      "elastic": {"youngs_modulus": 20000.0, "poisson_ratio": 0.4}, "pinned": [{"min": [-1, -1, -1], "max": [0, 1, 1]}]}],
+    "colliders": [{"shape": "sphere", "radius": 0.004, "position": [0.03, 0.5, 0.01]}],
+    "script": {"poses": [{"collider": 0, "keys": [{"frame": 0, "position": [0.03, 0.02, 0.01]},
+                                                  {"frame": 5, "position": [0.03, 0.008, 0.01]}]}]}})",
+                               kScenes);
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  auto sim = Simulation::create(file->scene, {.backend = "cpu", .threads = 1});
+  ASSERT_TRUE(sim.ok());
+  ScriptPlayer player(file->script);
+  for (int f = 1; f <= 8; ++f) {
+    ASSERT_TRUE(player.before_frame(*sim, f).ok());
+    ASSERT_TRUE(sim->step().ok());
+  }
+  std::vector<float> x;
+  ASSERT_TRUE(sim->read_positions(x).ok());
+  // The block's top vertex under the sphere (rest (0.03, 0.01, 0.01)) is pushed down.
+  const auto& rest = file->scene.tet_bodies[0].mesh.vertices;
+  const auto top = std::min_element(rest.begin(), rest.end(), [](const Vec3d& a, const Vec3d& b) {
+    const auto d = [](const Vec3d& v) { return std::abs(v[0] - 0.03) + std::abs(v[1] - 0.01) + std::abs(v[2] - 0.01); };
+    return d(a) < d(b);
+  });
+  const float lowest_top = x[4 * static_cast<std::size_t>(top - rest.begin()) + 1];
+  EXPECT_LT(lowest_top, 0.0045f);
+}
+
+}  // namespace
+}  // namespace sinew
