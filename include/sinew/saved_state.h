@@ -19,10 +19,11 @@
 // Simulation) is an error that says so. Not saved yet, so save_state is an
 // error that names them: needles and sutures, and a closed grasper's hold.
 //
-// File format, version 1 (all integers little-endian as the host writes
+// File format, version 2 (all integers little-endian as the host writes
 // them, which the byte-order word checks):
 //   8 bytes   magic "sinewst\x1a"
-//   uint32    format version (1)
+//   uint32    format version (2; version 1 lacks the mesh collision's
+//             velocities, see docs/robustness.md)
 //   uint32    byte order 0x01020304
 //   uint64    payload size [bytes]
 //   uint64    FNV-1a 64 hash of the payload
@@ -42,7 +43,7 @@
 namespace sinew {
 
 /// The format version written now; files of this version or older are read.
-inline constexpr std::uint32_t kSavedStateVersion = 1;
+inline constexpr std::uint32_t kSavedStateVersion = 2;
 
 struct SavedState {
   /// The header and payload, as in the file.

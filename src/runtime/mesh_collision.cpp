@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -150,7 +151,7 @@ Status MeshCollision::release(Device& device) {
 // first frame, with no previous positions, reads the device's velocities.
 Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers) {
   const std::size_t particles = movable_.size();
-  const bool have_start = positions_.size() == particles * 4;
+  const bool have_start = positions_.size() == particles * 4 && !restored_;
   if (have_start) start_positions_.swap(positions_);
   positions_.resize(particles * 4);
   velocities_.resize(particles * 4);
@@ -159,7 +160,9 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
   } else if (Status s = device.read_buffer(scene_buffers.position, 0, positions_.data(), positions_.size() * 4); !s) {
     return s;
   }
-  if (have_start) {
+  if (restored_) {
+    restored_ = false;  // velocities_ are the saved state's
+  } else if (have_start) {
     const auto inv_dt = static_cast<float>(1.0 / time_step_);
     for (std::size_t k = 0; k < positions_.size(); ++k)
       velocities_[k] = inv_dt * (positions_[k] - start_positions_[k]);
@@ -168,6 +171,35 @@ Status MeshCollision::read_back(Device& device, const XpbdBuffers& scene_buffers
     return s;
   }
   fresh_ = true;
+  return {};
+}
+
+void MeshCollision::save_velocities(std::vector<float>& out) const {
+  // After a frame (fresh_) or a restore, velocities_ are what the next
+  // frame measures from; before the first frame there are none.
+  if (fresh_ || restored_)
+    out = velocities_;
+  else
+    out.clear();
+}
+
+// Why saved: the next frame's reach and boxes come from the last frame's
+// mean velocities, which the device does not hold (its velocities are the
+// last substep's); measured from the positions read before the restore, a
+// restored run found other contacts than the run it was saved from.
+Status MeshCollision::restore_velocities(std::vector<float> velocities) {
+  if (!velocities.empty() && velocities.size() != movable_.size() * 4)
+    return Error(ErrorCode::bad_parameter, "mesh collision: " + std::to_string(velocities.size()) +
+                                               " restored velocity floats for " + std::to_string(movable_.size()) +
+                                               " particles (4 each)");
+  fresh_ = false;
+  restored_ = !velocities.empty();
+  if (restored_) {
+    velocities_ = std::move(velocities);
+  } else {
+    positions_.clear();  // as before the first frame: the device's velocities are read
+    velocities_.clear();
+  }
   return {};
 }
 

@@ -106,10 +106,19 @@ class MeshCollision {
   /// [in] mask: per particle, what sutures exempt (suture_exemption.h);
   /// outlives this, read every frame.
   void set_suture_exemption(const std::vector<std::uint8_t>* mask) { exempt_ = mask; }
-  /// The device's positions and velocities changed outside the frames
-  /// (Simulation::restore_state): the next frame reads them again instead
-  /// of using those the last after_frame read.
-  void positions_changed() { fresh_ = false; }
+  /// The host state that carries from one frame to the next (a saved
+  /// state's, sinew/saved_state.h): the velocities the next frame's reach
+  /// and swept boxes are measured from, each particle's mean over the last
+  /// frame (device order, xyzw [m/s]). [out] out: empty before the first
+  /// frame (it reads the device's velocities then).
+  void save_velocities(std::vector<float>& out) const;
+  /// Simulation::restore_state: the device's positions changed outside the
+  /// frames; the next frame reads them again and measures its reach from
+  /// `velocities` (what save_velocities gave; empty: from the device's, as
+  /// the first frame does), not from the motion between the positions the
+  /// last after_frame read and the restored ones. Errors (bad_parameter): a
+  /// size that is not 4 floats per particle.
+  Status restore_velocities(std::vector<float> velocities);
   /// Reads the positions through the frame's shared mirror (null: on its own).
   void set_positions_mirror(PositionsMirror* mirror) { mirror_ = mirror; }
   /// Particles of the scene (device order).
@@ -234,6 +243,7 @@ class MeshCollision {
   double margin_ = 0.0;
   double violation_ = 0.0;
   bool fresh_ = false;  // positions_ and velocities_ hold the device's current state
+  bool restored_ = false;  // velocities_ were restored: the next read_back reads the positions only
   PositionsMirror* mirror_ = nullptr;
   Status read_back(Device& device, const XpbdBuffers& scene_buffers);
   // Per-frame scratch, kept to avoid reallocating.

@@ -7,8 +7,10 @@
 // Why bitwise: a frame's result depends only on the device buffers listed
 // in Impl::saved_buffers, the colliders' and targets' host copies (uploaded
 // before the frame), the rigid tools' state, the particle forces' flags,
-// the residual stepper's warm start and the fluid's counts; all are
-// restored exactly (and the mesh collision reads the positions again), and the
+// the residual stepper's warm start, the mesh collision's velocities (the
+// last frame's mean, which set the next frame's reach) and the fluid's
+// counts; all are restored exactly (and the mesh collision reads the
+// positions again), and the
 // scene's constant data (constraint data, level-set grids) is checked to be
 // unchanged through shape_generation.
 #include <algorithm>
@@ -108,6 +110,11 @@ Status Simulation::Impl::save_state(SavedState& out, const char* call) {
   w.value(dirty);
   w.value(static_cast<std::uint64_t>(contacts.tools.size()));
   for (const ToolBody& t : contacts.tools) tool_fields(t, [&](const auto& v) { w.value(v); });
+  if (mesh_collision) {  // since version 2
+    std::vector<float> velocities;
+    mesh_collision->save_velocities(velocities);
+    w.array(std::span<const float>(velocities));
+  }
   if (fluid) {
     w.value(fluid->solver->host_state());
     w.array(std::span<const FluidEmitter>(fluid->solver->emitter_settings()));
@@ -118,7 +125,8 @@ Status Simulation::Impl::save_state(SavedState& out, const char* call) {
 
 Status Simulation::Impl::restore_state(const SavedState& state, const std::string& what) {
   std::span<const std::byte> payload;
-  if (Status s = state_format::open(state.bytes, what, payload); !s) return s;
+  std::uint32_t version = 0;
+  if (Status s = state_format::open(state.bytes, what, payload, &version); !s) return s;
   if (Status s = check_saveable(*this, what.c_str()); !s) return s;
   state_format::Reader r(payload, what);
   const std::vector<StateBuffer> saved = saved_buffers();
@@ -157,6 +165,15 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
       if (read_tools) read_tools = r.value(v);
     });
   if (!read_tools) return read_tools;
+  // Version 1 did not save the mesh collision's velocities: its next frame
+  // measures them from the device's, as a first frame does.
+  std::vector<float> mesh_velocities;
+  if (mesh_collision && version >= 2) {
+    const std::size_t n = mesh_collision->particles() * 4;
+    if (Status s = r.array(mesh_velocities, n, "mesh collision velocities (floats)"); !s) return s;
+    if (!mesh_velocities.empty() && mesh_velocities.size() != n)
+      return r.mismatch("mesh collision velocities (floats)", mesh_velocities.size(), n);
+  }
   SphSolver::HostState fluid_host;
   std::vector<FluidEmitter> emitters;
   if (fluid) {
@@ -193,7 +210,8 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
   stats.frame = frame;
   stats.time = static_cast<double>(frame) * time_step;
   positions_mirror.changed();
-  if (mesh_collision) mesh_collision->positions_changed();
+  if (mesh_collision)
+    if (Status s = mesh_collision->restore_velocities(std::move(mesh_velocities)); !s) return s;
   tears.clear();
   return {};
 }

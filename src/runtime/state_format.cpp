@@ -67,7 +67,8 @@ Status Reader::mismatch(const char* name, std::uint64_t got, std::uint64_t want)
                                              std::to_string(got) + " (this scene: " + std::to_string(want) + ")");
 }
 
-Status open(std::span<const std::byte> bytes, const std::string& what, std::span<const std::byte>& payload) {
+Status open(std::span<const std::byte> bytes, const std::string& what, std::span<const std::byte>& payload,
+            std::uint32_t* version) {
   if (bytes.size() < kHeaderBytes)
     return bad(what, std::to_string(bytes.size()) + " bytes, shorter than the " + std::to_string(kHeaderBytes) +
                          "-byte header");
@@ -82,6 +83,7 @@ Status open(std::span<const std::byte> bytes, const std::string& what, std::span
                          std::to_string(bytes.size() - kHeaderBytes) + " (truncated or extended)");
   payload = bytes.subspan(kHeaderBytes);
   if (hash(payload) != h.payload_hash) return bad(what, "the payload's hash does not match (the state is damaged)");
+  if (version) *version = h.version;
   return {};
 }
 

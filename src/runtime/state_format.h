@@ -93,8 +93,10 @@ class Reader {
   std::string what_;
 };
 
-/// Checks a state's header; [out] payload: the bytes after it. `what` names
-/// the state in errors ("restore_state", or the file's path).
-Status open(std::span<const std::byte> bytes, const std::string& what, std::span<const std::byte>& payload);
+/// Checks a state's header; [out] payload: the bytes after it; version: the
+/// format version it was written in (when not null). `what` names the state
+/// in errors ("restore_state", or the file's path).
+Status open(std::span<const std::byte> bytes, const std::string& what, std::span<const std::byte>& payload,
+            std::uint32_t* version = nullptr);
 
 }  // namespace sinew::state_format
