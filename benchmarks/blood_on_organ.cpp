@@ -21,7 +21,7 @@
 //   - the wall time per 2 ms frame of the fluid's stage and of the rest of
 //     the frame (the tissue's).
 //
-//   build/benchmarks/blood_on_organ [--backend cpu] [--seconds 0.4] [--flow 2 (ml/s)] [--substeps 4]
+//   build/benchmarks/blood_on_organ --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -31,6 +31,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
 
@@ -104,19 +105,22 @@ class TetContainment {
 }  // namespace
 
 int main(int argc, char** argv) {
+  sinew::examples::CommandLine cli(
+      "blood_on_organ",
+      "Blood poured on the kidney (kidney_57k laid on its back, pinned where it rests), coupled both ways:\n"
+      "a 2 mm source 4 mm above its highest vertex pours straight down. Prints every 0.05 s the fluid leaked\n"
+      "into the tissue (0 when it holds), the mass books, the compressibility error, the tissue's largest\n"
+      "displacement and push, and the wall time per 2 ms frame of the fluid and the tissue.");
   std::string backend = "cpu";
   double seconds = 0.4, flow_ml = 2.0;
   int substeps = 10;
   const sinew::TetMaterial material = sinew::TetMaterial::corotational;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i], value = argv[i + 1];
-    if (key == "--backend") backend = value;
-    else if (key == "--seconds") seconds = std::atof(value.c_str());
-    else if (key == "--flow") flow_ml = std::atof(value.c_str());
-    else if (key == "--substeps") substeps = std::atoi(value.c_str());
-    else return fail("unknown option " + key);
-  }
-  if (!(seconds > 0.0) || !(flow_ml > 0.0) || substeps < 1) return fail("--seconds > 0, --flow > 0 and --substeps >= 1, please");
+  cli.add_backend(backend);
+  cli.app().add_option("--seconds", seconds, "Simulated time [s]")->check(sinew::examples::greater_than(0));
+  cli.app().add_option("--flow", flow_ml, "The source's flow [ml/s]")->check(sinew::examples::greater_than(0));
+  cli.app().add_option("--substeps", substeps, "The tissue's substeps per 2 ms frame")
+      ->check(sinew::examples::at_least(1));
+  if (auto exit = cli.parse(argc, argv)) return *exit;
 
   auto mesh = sinew::read_tetgen(std::string(SINEW_DATA_DIR) + "/meshes/tet/kidney_57k");
   if (!mesh) return fail(mesh.error().message());

@@ -25,6 +25,7 @@
 #include "bench_support.h"
 #include "sinew/simulation.h"
 #include "thread_scenes.h"
+#include "benchmark_main.h"
 
 namespace {
 
@@ -89,4 +90,5 @@ BENCHMARK(BM_ContinuousCollision)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+SINEW_BENCHMARK_MAIN("bench_continuous_collision",
+                     "What continuous collision in the solver costs per frame, by stage, on the continuous collision\ntests' three thread scenes, with CCD on and off.")

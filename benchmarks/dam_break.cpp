@@ -24,8 +24,7 @@
 // pressure and velocity every --vtu-every steps (particles_N.vtu and
 // dam_break.pvd, for ParaView); prints the error and the run time.
 //
-//   build/benchmarks/dam_break [--backend cpu] [--cells 24] [--depth 8] [--viscosity 0.1] [--wall-viscosity 0]
-//                              [--length 16] [--vtu-every 500] [--out DIR]
+//   build/benchmarks/dam_break --help   (the options, their defaults and units)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -37,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "backends/backend.h"
 #include "fluid/sph_solver.h"
 #include "sinew/mesh.h"
@@ -52,7 +52,7 @@ struct Options {
   int depth = 8;   // particles across the slab
   double alpha = 0.1;       // Monaghan's viscosity between fluid particles
   double wall_alpha = 0.0;  // ... against the tank (0: free slip)
-  std::string out = "dam_break_out";
+  std::string out;
   int vtu_every = 500;  // steps between the particles' VTU files (0: none)
   double length = 16.0;  // the tank's length in a (the data's front reaches 14 a)
 };
@@ -130,25 +130,26 @@ constexpr int kSampleEvery = 25;  // steps between the front's samples
 
 int main(int argc, char** argv) {
   Options o;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    if (a == "--backend") o.backend = argv[i + 1];
-    else if (a == "--cells") o.cells = std::atoi(argv[i + 1]);
-    else if (a == "--depth") o.depth = std::atoi(argv[i + 1]);
-    else if (a == "--wall-viscosity") o.wall_alpha = std::atof(argv[i + 1]);
-    else if (a == "--viscosity") o.alpha = std::atof(argv[i + 1]);
-    else if (a == "--out") o.out = argv[i + 1];
-    else if (a == "--length") o.length = std::atof(argv[i + 1]);
-    else if (a == "--vtu-every") o.vtu_every = std::atoi(argv[i + 1]);
-    else {
-      std::fprintf(stderr, "unknown option %s\n", a.c_str());
-      return 2;
-    }
-  }
-  if (o.cells < 4 || o.depth < 1 || !(o.length >= 2.0)) {
-    std::fprintf(stderr, "dam_break: --cells must be >= 4, --depth >= 1 and --length >= 2\n");
-    return 2;
-  }
+  sinew::examples::CommandLine cli(
+      "dam_break",
+      "The weakly compressible SPH solver against Martin and Moyce's dam break (1952): a water column of\n"
+      "width a and height 2 a collapses along x; the surge front's Z = z / a against T = t sqrt(2 g / a).\n"
+      "Prints the error against the data and the run time; writes dam_break.csv, dam_break.png (with\n"
+      "gnuplot) and the particles' VTU series (dam_break.pvd) into --out.");
+  using sinew::examples::at_least;
+  o.out = cli.default_out();
+  cli.add_backend(o.backend);
+  cli.app().add_option("--cells", o.cells, "Particles across the column's width a")->check(at_least(4));
+  cli.app().add_option("--depth", o.depth, "Particles across the slab (its thickness)")->check(at_least(1));
+  cli.app().add_option("--viscosity", o.alpha, "Monaghan's viscosity alpha between fluid particles")
+      ->check(at_least(0));
+  cli.app().add_option("--wall-viscosity", o.wall_alpha, "Monaghan's viscosity against the tank (0: free slip)")
+      ->check(at_least(0));
+  cli.app().add_option("--length", o.length, "The tank's length [in units of a]")->check(at_least(2));
+  cli.app().add_option("--vtu-every", o.vtu_every, "Steps between the particles' VTU files (0: none)")
+      ->check(at_least(0));
+  cli.add_out(o.out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
   const auto data = read_data(std::string(SINEW_DATA_DIR) + "/sph/martin_moyce_1952_n2_2_a2.25in.csv");
   if (data.empty()) {
     std::fprintf(stderr, "dam_break: no data in %s/sph\n", SINEW_DATA_DIR);
@@ -200,7 +201,6 @@ int main(int argc, char** argv) {
               "%.3g s, %d steps\n",
               (*device)->device_name().c_str(), a, nx, ny, nz, fluid.size(), boundary.size(),
               settings.speed_of_sound, settings.time_step, steps);
-  std::filesystem::create_directories(o.out);
   const std::string csv = o.out + "/dam_break.csv";
   std::FILE* f = std::fopen(csv.c_str(), "w");
   if (!f) {

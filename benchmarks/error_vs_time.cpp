@@ -30,8 +30,7 @@
 // 4e-2: past ~16 substeps per 60 Hz frame float rounding, not the time
 // step, sets the error (numbers in benchmarks/README.md).
 //
-//   error_vs_time [--backend NAME] [--out DIR] [--seconds T] [--cases a,b,c]
-//                 [--reference SUBSTEPSxITERATIONS]
+//   error_vs_time --help   (the options, their defaults and units)
 // writes DIR/error_vs_time.csv; benchmarks/plot_error_vs_time.sh draws it.
 #include <algorithm>
 #include <chrono>
@@ -47,6 +46,8 @@
 
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+
+#include "command_line.h"
 
 namespace {
 
@@ -177,25 +178,29 @@ double chain_static_error(const std::vector<float>& x) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string backend = "auto", out = "error_vs_time_out", only;
+  sinew::examples::CommandLine cli(
+      "error_vs_time",
+      "The error of a run against its wall time, sweeping substeps x iterations (every product 1..64 in powers\n"
+      "of two) on the cases chain, nh_bar, nh_cube, kidney, chain_damped and kidney_damped; the error is the\n"
+      "RMS particle distance from a converged reference run, divided by the body's size. Writes\n"
+      "error_vs_time.csv into --out (plot it with benchmarks/plot_error_vs_time.sh).");
+  std::string backend = "auto", out = cli.default_out(), only, reference_text = "16x32";
   double seconds = 1.0;
   int ref_substeps = 16, ref_iterations = 32;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    if (a == "--backend") backend = argv[i + 1];
-    else if (a == "--out") out = argv[i + 1];
-    else if (a == "--seconds") seconds = std::atof(argv[i + 1]);
-    else if (a == "--cases") only = argv[i + 1];
-    else if (a == "--reference") std::sscanf(argv[i + 1], "%dx%d", &ref_substeps, &ref_iterations);
-    else {
-      std::fprintf(stderr, "unknown option %s\n", a.c_str());
-      return 2;
-    }
-  }
-  if (!(seconds > 0.0)) {
-    std::fprintf(stderr, "--seconds must be > 0\n");
-    return 2;
-  }
+  cli.add_backend(backend);
+  cli.app().add_option("--seconds", seconds, "Simulated time of each run [s]")->check(sinew::examples::greater_than(0));
+  cli.app().add_option("--cases", only, "Only these cases, comma-separated (default: all)")->type_name("A,B,...");
+  cli.app().add_option("--reference", reference_text, "The reference run's substeps x iterations per 1/60 s frame")
+      ->type_name("SxI")
+      ->check([](const std::string& v) {
+        int a = 0, b = 0;
+        char end = 0;
+        if (std::sscanf(v.c_str(), "%dx%d%c", &a, &b, &end) == 2 && a >= 1 && b >= 1) return std::string();
+        return "must be SUBSTEPSxITERATIONS, both >= 1 (got " + v + ")";
+      });
+  cli.add_out(out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
+  std::sscanf(reference_text.c_str(), "%dx%d", &ref_substeps, &ref_iterations);
   const std::vector<Case> cases = {
       {"chain", 1.0, chain_scene},
       {"nh_bar", 0.1, [] { return nh_block_scene(3, 15, 3, 0.01 / 1.5, 5e4); }},
@@ -204,13 +209,21 @@ int main(int argc, char** argv) {
       {"chain_damped", 1.0, damped(chain_scene, 2.0, 0.005)},
       {"kidney_damped", 0.1, damped(kidney_scene, 4.0, 0.0)},
   };
+  for (std::size_t at = 0; !only.empty() && at <= only.size();) {  // every name in --cases is a case
+    const std::size_t comma = std::min(only.find(',', at), only.size());
+    const std::string name = only.substr(at, comma - at);
+    if (std::none_of(cases.begin(), cases.end(), [&](const Case& c) { return c.name == name; })) {
+      std::fprintf(stderr, "error_vs_time: --cases: no case named '%s'\n", name.c_str());
+      return 2;
+    }
+    at = comma + 1;
+  }
   // Pairs (substeps, iterations): every product 1..64 in powers of two, so
   // runs of equal total sweeps (substeps x iterations) can be compared.
   std::vector<std::pair<int, int>> configs;
   for (int s = 1; s <= 64; s *= 2)
     for (int n = 1; s * n <= 64; n *= 2) configs.emplace_back(s, n);
 
-  std::filesystem::create_directories(out);
   std::ofstream csv(out + "/error_vs_time.csv");
   csv << "case,substeps,iterations,sweeps,ms_per_frame,error,residual_rms,static_error\n";
   std::printf("%-8s %8s %10s %7s %12s %12s %12s\n", "case", "substeps", "iterations", "sweeps", "ms/frame", "error",

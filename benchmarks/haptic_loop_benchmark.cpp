@@ -12,11 +12,9 @@
 // republishes the tool's state at 250 Hz (the platform's own timing, no solver).
 //
 // Writes <out>/<name>.json and <out>/<name>.csv (one summary row), and with
-// --trace <out>/<name>_ticks.csv (every tick). Default out: benchmarks/results.
+// --trace <out>/<name>_ticks.csv (every tick). Default out: ./bench_haptic_loop_out.
 //
-//   bench_haptic_loop [--seconds S] [--rate HZ] [--no-realtime] [--zero-cpu-latency] [--priority P] [--cpu N]
-//                     [--physics saturate|paced|none] [--cells N] [--out DIR] [--name NAME] [--trace] [--mlock]
-// --mlock locks the process's memory (mlockall) before the run.
+//   bench_haptic_loop --help   (the options, their defaults and units)
 #include <sys/mman.h>
 #include <sys/utsname.h>
 #include <unistd.h>
@@ -35,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/haptics/haptic_loop.h"
 #include "sinew/haptics/scripted_device.h"
 #include "sinew/haptics/tool_bridge.h"
@@ -46,10 +45,6 @@ namespace {
 
 using namespace sinew::haptics;
 
-#ifndef SINEW_BENCH_RESULTS_DIR
-#define SINEW_BENCH_RESULTS_DIR "."
-#endif
-
 struct Options {
   double seconds = 20.0;
   double rate = 1000.0;
@@ -59,39 +54,11 @@ struct Options {
   int cpu = -1;
   std::string physics = "saturate";
   int cells = 16;
-  std::string out = SINEW_BENCH_RESULTS_DIR;
+  std::string out;
   std::string name = "haptic_loop";
   bool trace = false;
   bool mlock = false;
 };
-
-bool parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--no-realtime") { o.realtime = false; continue; }
-    if (a == "--zero-cpu-latency") { o.zero_cpu_latency = true; continue; }
-    if (a == "--trace") { o.trace = true; continue; }
-    if (a == "--mlock") { o.mlock = true; continue; }
-    const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
-    if (!v) { std::fprintf(stderr, "missing value after %s\n", a.c_str()); return false; }
-    if (a == "--seconds") o.seconds = std::atof(v);
-    else if (a == "--rate") o.rate = std::atof(v);  // checked with the loop settings
-    else if (a == "--priority") o.priority = std::atoi(v);
-    else if (a == "--cpu") o.cpu = std::atoi(v);
-    else if (a == "--physics") o.physics = v;
-    else if (a == "--cells") o.cells = std::atoi(v);
-    else if (a == "--out") o.out = v;
-    else if (a == "--name") o.name = v;
-    else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return false; }
-    ++i;
-  }
-  if (!(o.seconds >= 2.0) || !std::isfinite(o.seconds) || o.cells < 2 ||
-      (o.physics != "saturate" && o.physics != "paced" && o.physics != "none")) {
-    std::fprintf(stderr, "--seconds >= 2, --cells >= 2, --physics saturate|paced|none\n");
-    return false;
-  }
-  return true;
-}
 
 struct Stats {
   double p50 = 0, p99 = 0, p999 = 0, max = 0, mean = 0;
@@ -169,8 +136,30 @@ ScriptedPose stroke(double t) {
 
 int main(int argc, char** argv) {
   Options opt;
-  if (!parse(argc, argv, opt)) return 2;
-  std::filesystem::create_directories(opt.out);
+  sinew::examples::CommandLine cli(
+      "bench_haptic_loop",
+      "The 1 kHz haptic loop's timing while the solver runs a tissue scene with a probe on the other thread:\n"
+      "tick rate, period jitter, wake-up latency, missed deadlines, tick compute time, the state's age,\n"
+      "allocations in ticks and the scheduling obtained. Writes <out>/<name>.json and .csv (and with --trace\n"
+      "<name>_ticks.csv, every tick).");
+  using sinew::examples::at_least;
+  auto& app = cli.app();
+  opt.out = cli.default_out();
+  app.add_option("--seconds", opt.seconds, "Length of the run [s]")->check(at_least(2));
+  // The rate is checked with the loop's settings (a clear error for 0, nan, ...).
+  app.add_option("--rate", opt.rate, "Haptic loop rate [Hz]");
+  app.add_flag_callback("--no-realtime", [&opt] { opt.realtime = false; }, "Do not ask for SCHED_FIFO for the haptic thread");
+  app.add_flag("--zero-cpu-latency", opt.zero_cpu_latency, "Hold /dev/cpu_dma_latency at 0 during the run");
+  app.add_option("--priority", opt.priority, "SCHED_FIFO priority, 1..99")->check(CLI::Range(1, 99));
+  app.add_option("--cpu", opt.cpu, "Pin the haptic thread to this CPU (-1: not pinned)")->check(at_least(-1));
+  app.add_option("--physics", opt.physics, "saturate (back to back), paced (250 Hz of wall time) or none")
+      ->check(CLI::IsMember({"saturate", "paced", "none"}));
+  app.add_option("--cells", opt.cells, "The block's cells along x and z (4 mm each)")->check(at_least(2));
+  app.add_option("--name", opt.name, "Base name of the files written");
+  app.add_flag("--trace", opt.trace, "Also write every tick to <name>_ticks.csv");
+  app.add_flag("--mlock", opt.mlock, "Lock the process's memory (mlockall) before the run");
+  cli.add_out(opt.out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
   const std::string load_at_start = load_average();
   std::string mlock_report = "not requested";
   if (opt.mlock)

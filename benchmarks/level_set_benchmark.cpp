@@ -33,6 +33,7 @@
 #include "level_set/level_set_impl.h"
 #include "level_set_params.h"
 #include "sinew/mesh.h"
+#include "benchmark_main.h"
 
 namespace {
 
@@ -287,4 +288,5 @@ BENCHMARK(BM_PenaltyContact)->ArgName("spacing_um")->Arg(200)->Arg(100)->Arg(50)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+SINEW_BENCHMARK_MAIN("bench_level_set",
+                     "Sampling a level set (the tibia at 0.5 mm voxels): samples per second of value + gradient on each\nbackend, against OpenVDB's own BoxSampler on the same 2^20 points.")

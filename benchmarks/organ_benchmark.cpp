@@ -23,6 +23,7 @@
 
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "benchmark_main.h"
 
 namespace {
 
@@ -114,4 +115,5 @@ BENCHMARK(BM_Organ)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+SINEW_BENCHMARK_MAIN("bench_organs",
+                     "Real organ meshes (kidney_57k, liver_382k) against cubes of their size, 10 substeps x 1 iteration per\n60 Hz frame: ms per frame and constraint projections per second, reordered or in the mesher's order.")

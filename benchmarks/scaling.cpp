@@ -25,8 +25,7 @@
 // (the "second core is busy" case; the 1-thread time is then also measured
 // beside it).
 //
-//   bench_scaling [--rounds R] [--frames F] [--warmup W] [--threads N] [--busy] [--quick] [--only NAME]
-//                 [--csv FILE]
+//   bench_scaling --help   (the options, their defaults)
 //   e.g. bench_scaling --csv benchmarks/results/scaling_2026-11-28.csv
 // Prints a table and, with --csv, writes one row per scene and configuration:
 //   scene,constraints,particles,busy,config,threads,median_ms,p90_ms,speedup,speedup_p10,speedup_p90
@@ -44,6 +43,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "command_line.h"
 
 #include "bench_support.h"
 #include "mesh_contact_support.h"
@@ -142,30 +143,25 @@ pid_t start_spinner() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  sinew::examples::CommandLine cli(
+      "bench_scaling",
+      "How the CPU backend scales from one thread to all: each scene stepped on 1 thread, on all threads with\n"
+      "the adaptive choice (the default) and on all threads always as a team, in turns within each round.\n"
+      "Prints the median frame time and the paired speedup over 1 thread; with --csv one row per scene and\n"
+      "configuration (scene,constraints,particles,busy,config,threads,median_ms,p90_ms,speedup,...).");
+  using sinew::examples::at_least;
   int rounds = 15, frames = 4, warmup = 10, threads = 0;
   bool busy = false, quick = false;
   std::string csv, only;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--rounds" && i + 1 < argc) rounds = std::atoi(argv[++i]);
-    else if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else if (a == "--warmup" && i + 1 < argc) warmup = std::atoi(argv[++i]);
-    else if (a == "--threads" && i + 1 < argc) threads = std::atoi(argv[++i]);
-    else if (a == "--busy") busy = true;
-    else if (a == "--quick") quick = true;
-    else if (a == "--only" && i + 1 < argc) only = argv[++i];
-    else if (a == "--csv" && i + 1 < argc) csv = argv[++i];
-    else {
-      std::fprintf(stderr,
-                   "usage: bench_scaling [--rounds R] [--frames F] [--warmup W] [--threads N] [--busy] [--quick] "
-                   "[--only NAME] [--csv FILE]\n");
-      return a == "--help" ? 0 : 2;
-    }
-  }
-  if (rounds < 1 || frames < 1 || warmup < 0) {
-    std::fprintf(stderr, "bench_scaling: --rounds and --frames must be >= 1, --warmup >= 0\n");
-    return 2;
-  }
+  cli.app().add_option("--rounds", rounds, "Rounds (each configuration measured once per round)")->check(at_least(1));
+  cli.app().add_option("--frames", frames, "Measured frames per configuration and round")->check(at_least(1));
+  cli.app().add_option("--warmup", warmup, "Unmeasured frames per configuration first")->check(at_least(0));
+  cli.app().add_option("--threads", threads, "Threads of the multi-thread configurations (0: all)")->check(at_least(0));
+  cli.app().add_flag("--busy", busy, "Another process spins on one core throughout");
+  cli.app().add_flag("--quick", quick, "Fewer scenes (cubes of 8 and 24 cells, Neo-Hookean 16, no liver)");
+  cli.app().add_option("--only", only, "Only the scenes whose name contains this");
+  cli.app().add_option("--csv", csv, "Write the rows to this CSV file")->type_name("FILE");
+  if (auto exit = cli.parse(argc, argv)) return *exit;
   const Config configs[] = {{"1_thread", 1, true}, {"adaptive", threads, true}, {"team", threads, false}};
   std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");
   if (!csv.empty() && !out) {

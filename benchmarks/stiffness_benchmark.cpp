@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
 
@@ -189,37 +190,50 @@ int trace(Options o) {
 
 int main(int argc, char** argv) {
   Options o;
-  int i = 1;
-  if (argc > 1 && argv[1][0] != '-') o.mode = argv[i++];
-  for (; i + 1 < argc; i += 2) {
-    const std::string k = argv[i], v = argv[i + 1];
-    if (k == "--cells") {
-      std::sscanf(v.c_str(), "%d,%d,%d", &o.nx, &o.ny, &o.nz);
-    } else if (k == "--dx") o.dx = std::stod(v);
-    else if (k == "--E") o.young = std::stod(v);
-    else if (k == "--nu") o.poisson = std::stod(v);
-    else if (k == "--substeps") o.substeps = std::stoi(v);
-    else if (k == "--iterations") o.iterations = std::stoi(v);
-    else if (k == "--tol") o.tol = std::stod(v);
-    else if (k == "--max-iterations") o.max_iterations = std::stoi(v);
-    else if (k == "--check") o.check = std::stoi(v);
-    else if (k == "--budget") o.budget = std::stod(v);
-    else if (k == "--damping") o.damping = std::stod(v);
-    else if (k == "--rho") o.rho = std::stod(v);
-    else if (k == "--gamma") o.gamma = std::stod(v);
-    else if (k == "--delay") o.delay = std::stoi(v);
-    else if (k == "--frames") o.frames = std::stoi(v);
-    else if (k == "--backend") o.backend = v;
-    else if (k == "--threads") o.threads = std::stoi(v);
-    else if (k == "--csv") o.csv = v;
-    else if (k == "--out") o.out = v;
-    else if (k == "--sweeps") o.sweeps = std::stoi(v);
-    else if (k == "--material") o.material = v;
-    else if (k == "--warm") o.warm = v == "1";
-    else {
-      std::fprintf(stderr, "unknown option %s\n", k.c_str());
-      return 2;
-    }
+  sinew::examples::CommandLine cli(
+      "bench_stiffness",
+      "How far a stiff hanging block sags against what the solver spends (6 tets per cell, distance + volume\n"
+      "constraints or an FEM material, pinned at its top face). run: one setting; prints (and with --csv\n"
+      "appends) the deflection, the median ms per frame over the last half, sweeps per frame, the stop reason\n"
+      "and the residual. trace: the residual after frames of 1, 2, 4 ... --sweeps sweeps, into --out FILE.");
+  using sinew::examples::at_least;
+  using sinew::examples::greater_than;
+  auto& app = cli.app();
+  std::string cells = "12,12,12";
+  app.add_option("mode", o.mode, "run or trace")->check(CLI::IsMember({"run", "trace"}));
+  app.add_option("--cells", cells, "Cells along x, y, z")->type_name("NX,NY,NZ")->check([](const std::string& v) {
+    int x = 0, y = 0, z = 0;
+    char end = 0;
+    if (std::sscanf(v.c_str(), "%d,%d,%d%c", &x, &y, &z, &end) == 3 && x >= 1 && y >= 1 && z >= 1) return std::string();
+    return "must be three whole numbers >= 1, NX,NY,NZ (got " + v + ")";
+  });
+  app.add_option("--dx", o.dx, "Cell edge [m]")->check(greater_than(0));
+  app.add_option("--E", o.young, "Young's modulus [Pa]")->check(greater_than(0));
+  app.add_option("--nu", o.poisson, "Poisson's ratio")->check(at_least(0));
+  app.add_option("--rho", o.rho, "Chebyshev spectral radius estimate (0: plain sweeps)")->check(at_least(0));
+  app.add_option("--gamma", o.gamma, "Chebyshev under-relaxation")->check(greater_than(0));
+  app.add_option("--delay", o.delay, "Sweeps before the Chebyshev acceleration starts")->check(at_least(0));
+  app.add_option("--substeps", o.substeps, "Substeps per frame of 1/60 s")->check(at_least(1));
+  app.add_option("--iterations", o.iterations, "Iterations per substep")->check(at_least(1));
+  app.add_option("--tol", o.tol, "Residual tolerance (0: fixed iterations)")->check(at_least(0));
+  app.add_option("--max-iterations", o.max_iterations, "Residual mode: most iterations per substep")->check(at_least(1));
+  app.add_option("--check", o.check, "Residual mode: sweeps between residual checks")->check(at_least(1));
+  app.add_option("--budget", o.budget, "Time budget per frame [ms] (0: none)")->check(at_least(0));
+  app.add_option("--damping", o.damping, "Velocity damping [1/s]")->check(at_least(0));
+  app.add_option("--frames", o.frames, "Frames of 1/60 s")->check(at_least(2));
+  app.add_option("--warm", o.warm, "Warm-start the residual mode (0 or 1)");
+  app.add_option("--material", o.material, "elastic (distance + volume) or an FEM material")
+      ->check(CLI::IsMember({"elastic", "neo_hookean", "stvk", "corotational"}));
+  cli.add_backend(o.backend);
+  app.add_option("--threads", o.threads, "cpu backend worker threads (0: all)")->check(at_least(0));
+  app.add_option("--csv", o.csv, "run: append the result row to this file")->type_name("FILE");
+  app.add_option("--out", o.out, "trace: append the rows to this file")->type_name("FILE");
+  app.add_option("--sweeps", o.sweeps, "trace: the most sweeps")->check(at_least(1));
+  if (auto exit = cli.parse(argc, argv)) return *exit;
+  std::sscanf(cells.c_str(), "%d,%d,%d", &o.nx, &o.ny, &o.nz);
+  if (o.mode == "trace" && o.out.empty()) {
+    std::fprintf(stderr, "bench_stiffness: trace needs --out FILE\n");
+    return 2;
   }
   return o.mode == "trace" ? trace(o) : run(o);
 }

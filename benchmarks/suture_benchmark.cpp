@@ -42,6 +42,7 @@
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
 #include "suture_scenes.h"
+#include "benchmark_main.h"
 
 namespace {
 
@@ -189,4 +190,5 @@ BENCHMARK(BM_Suture)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+SINEW_BENCHMARK_MAIN("bench_suture",
+                     "A suturing frame by stage: the suture tests' stitch (a needle through two pads, a 60-segment thread),\nturning and pulling phases, with and without mesh collision.")

@@ -35,6 +35,7 @@
 #include "bench_support.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "benchmark_main.h"
 
 namespace {
 
@@ -162,4 +163,5 @@ BENCHMARK(BM_Cut)
     ->Args({1, 0, 1})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_MAIN();
+SINEW_BENCHMARK_MAIN("bench_topology",
+                     "Topology changes: what a cut, a cautery and the rebuild after them cost in a 50,400-tet block (and\non the kidney).")

@@ -96,6 +96,7 @@ function(sinew_pc_dependency target module)
 endfunction()
 
 sinew_pc_dependency(TBB::tbb tbb)
+sinew_pc_dependency(ZLIB::ZLIB zlib)
 if(SINEW_OPENCL)
   sinew_pc_dependency(OpenCL::OpenCL OpenCL)
 endif()

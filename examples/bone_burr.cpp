@@ -18,8 +18,10 @@
 //   force_trace.png   the force and the removed volume (when gnuplot exists)
 //   bone_*.vtu        the bone's surface around the groove (triangles),
 //   bone_burr.pvd     every --surface-every ticks, as a ParaView series
+//   burr_*.vtu,       the burr's surface at the same ticks
+//   burr.pvd
 //
-//   bone_burr [--out DIR] [--backend cpu|opencl|vulkan] [--voxel M] [--cut-depth M] [--surface-every TICKS]
+//   bone_burr --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -31,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/haptics/clock.h"
 #include "sinew/haptics/haptic_loop.h"
 #include "sinew/haptics/scripted_device.h"
@@ -38,42 +41,20 @@
 #include "sinew/level_set.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "tool_surface.h"
 
 namespace {
 
 using namespace sinew::haptics;
 using Wall = std::chrono::steady_clock;
 
-#ifndef SINEW_EXAMPLES_OUT_DIR
-#define SINEW_EXAMPLES_OUT_DIR "."
-#endif
-#ifndef SINEW_DATA_DIR
-#define SINEW_DATA_DIR "data"
-#endif
-
 struct Options {
-  std::string out = std::string(SINEW_EXAMPLES_OUT_DIR) + "/bone_burr_out";
+  std::string out;
   std::string backend = "cpu";
   double voxel = 2.5e-4;      // the bone's voxel [m]
   double cut_depth = 1e-4;    // the burr removes bone it presses deeper than this [m]
   int surface_every = 500;    // ticks between bone surfaces written
 };
-
-bool parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
-    if (!v) { std::fprintf(stderr, "missing value after %s\n", a.c_str()); return false; }
-    if (a == "--out") o.out = v;
-    else if (a == "--backend") o.backend = v;
-    else if (a == "--voxel") o.voxel = std::atof(v);
-    else if (a == "--cut-depth") o.cut_depth = std::atof(v);
-    else if (a == "--surface-every") o.surface_every = std::atoi(v);
-    else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return false; }
-    ++i;
-  }
-  return true;
-}
 
 // The burr: a 4 mm ball (radius 2 mm) on a handpiece of 30 g, whose inertia
 // (a 10 cm pen) keeps the coupling's rotational gains stable at 1 kHz.
@@ -120,11 +101,26 @@ double ms_since(Wall::time_point t) { return std::chrono::duration<double, std::
 
 int main(int argc, char** argv) {
   Options opt;
-  if (!parse(argc, argv, opt)) return 2;
-  if (!(opt.cut_depth >= 0.0 && opt.cut_depth < kRadius))
-    return fail("--cut-depth must be in [0, " + std::to_string(kRadius) + ") m (got " + std::to_string(opt.cut_depth) + ")");
-  if (opt.surface_every < 1) return fail("--surface-every must be >= 1 tick (got " + std::to_string(opt.surface_every) + ")");
-  std::filesystem::create_directories(opt.out);
+  sinew::examples::CommandLine cli(
+      "bone_burr",
+      "A burr cuts a groove across the tibia's plateau: a scripted haptic device drives the burr (a level-set\n"
+      "tool) through the virtual coupling, physics and haptics in lockstep at 1 kHz on a virtual clock; the\n"
+      "bone it presses deeper than --cut-depth is removed. Writes into --out: force_trace.csv (every tick),\n"
+      "force_trace.png (with gnuplot), bone_burr.pvd (the bone's surface around the groove) and burr.pvd.");
+  opt.out = cli.default_out();
+  cli.add_backend(opt.backend);
+  cli.app().add_option("--voxel", opt.voxel, "The bone's voxel size [m]")->check(sinew::examples::greater_than(0));
+  cli.app().add_option("--cut-depth", opt.cut_depth, "Bone pressed deeper than this is removed [m], below the burr's "
+                                                     "2 mm radius")
+      ->check([](const std::string& v) {
+        double d = 0.0;
+        if (CLI::detail::lexical_cast(v, d) && d >= 0.0 && d < kRadius) return std::string();
+        return "must be in [0, 0.002) m (got " + v + ")";
+      });
+  cli.app().add_option("--surface-every", opt.surface_every, "Ticks (of 1 ms) between the surfaces written")
+      ->check(sinew::examples::at_least(1));
+  cli.add_out(opt.out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
 
   // ------------------------------------------------------------ the bone
   const std::string stl = std::string(SINEW_DATA_DIR) + "/meshes/surface/VHF_Left_Bone_Tibia_smooth.stl";
@@ -229,7 +225,7 @@ int main(int argc, char** argv) {
   // would be about a million triangles): the groove and 8 mm around it.
   const std::array<double, 6> region{surface[0] - 8e-3, surface[1] - 0.5 * kGroove - 8e-3, surface[2] - 8e-3,
                                      surface[0] + 8e-3, surface[1] + 0.5 * kGroove + 8e-3, surface[2] + 4e-3};
-  std::vector<std::filesystem::path> files;
+  std::vector<std::filesystem::path> files, burr_files;
   std::vector<double> times, tick_ms, step_ms, cut_ms, cutting_force;
   double removed = 0.0, peak = 0.0, surface_ms = 0.0;
   std::uint64_t changed_bytes = 0;
@@ -274,12 +270,16 @@ int main(int argc, char** argv) {
       for (const auto& v : part->vertices) xyz.insert(xyz.end(), {float(v[0]), float(v[1]), float(v[2])});
       files.push_back(opt.out + "/bone_" + std::to_string(files.size()) + ".vtu");
       if (auto s = sinew::write_vtu_triangles(files.back(), xyz, 3, part->triangles); !s) return fail(s.error().message());
+      burr_files.push_back(opt.out + "/burr_" + std::to_string(burr_files.size()) + ".vtu");
+      if (auto s = sinew::examples::write_capsule_vtu(burr_files.back(), kRadius, 0.0, to); !s)
+        return fail(s.error().message());
       times.push_back(tick * kTick);
       surface_ms = std::max(surface_ms, ms_since(t3));
     }
   }
   std::fclose(csv);
   if (auto s = sinew::write_pvd(opt.out + "/bone_burr.pvd", files, times); !s) return fail(s.error().message());
+  if (auto s = sinew::write_pvd(opt.out + "/burr.pvd", burr_files, times); !s) return fail(s.error().message());
 
   // ------------------------------------------------------------ the plot
   const std::string plot = opt.out + "/force_trace.png";
@@ -324,7 +324,7 @@ int main(int argc, char** argv) {
   std::printf("per tick: %.3f ms median, %.3f ms p99 (step %.3f, cut %.3f ms median) of the 1 ms a tick has; "
               "surface of the region %.0f ms at most\n",
               median(tick_ms), quantile(tick_ms, 0.99), median(step_ms), median(cut_ms), surface_ms);
-  std::printf("wrote %s and %zu surfaces; open %s/bone_burr.pvd in ParaView\n", trace.c_str(), files.size(),
+  std::printf("wrote %s and %zu surfaces; open %s/bone_burr.pvd and burr.pvd in ParaView\n", trace.c_str(), files.size(),
               opt.out.c_str());
   return 0;
 }

@@ -21,11 +21,13 @@
 //     along the gallbladder edge, cutting the membrane free of it.
 //
 // Prints each topology event (what it removed and what it took) and the wall
-// time per frame; writes gallbladder_N.vtu (its tets) and membrane_N.vtu
-// (the live triangles) with gallbladder.pvd and membrane.pvd, and
-// events.csv, the event log, to --out.
+// time per frame; writes cholecystectomy.pvd (sinew/vtk_output.h, from
+// frame 0): the gallbladder's tets and the membrane's triangles (removed
+// ones empty, with an alive flag) and the tools
+// while they act (grasper: the jaws' box; cautery: the tip's ball; blade:
+// the blade's edge as a line), and events.csv, the event log, to --out.
 //
-//   cholecystectomy [--backend auto|cpu|opencl|vulkan] [--out DIR] [--every N (5 frames between outputs)]
+//   cholecystectomy --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -33,11 +35,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/mesh.h"
+#include "sinew/display_surfaces.h"
 #include "sinew/simulation.h"
+#include "sinew/vtk_output.h"
 
 namespace {
 
@@ -60,17 +66,19 @@ struct Box {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string backend = "auto", out = "cholecystectomy_out";
+  sinew::examples::CommandLine cli(
+      "cholecystectomy",
+      "A cholecystectomy-like sequence on the gallbladder: a grasper lifts the membrane joining it to the\n"
+      "liver bed, a cautery tip burns a strand, a blade cuts the membrane free (topology changes while the\n"
+      "scene runs), 150 frames of 1/60 s. Prints each topology event; writes cholecystectomy.pvd (the\n"
+      "gallbladder, the membrane and the tools while they act) and events.csv into --out.");
+  std::string backend = "auto", out = cli.default_out();
   int every = 5;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i], value = argv[i + 1];
-    if (key == "--backend") backend = value;
-    else if (key == "--out") out = value;
-    else if (key == "--every") every = std::atoi(value.c_str());
-    else return fail("unknown option " + key);
-  }
-  if (every < 1) return fail("--every must be >= 1");
-  std::filesystem::create_directories(out);
+  cli.add_backend(backend);
+  cli.app().add_option("--every", every, "Write the VTU files every N frames of 1/60 s")
+      ->check(sinew::examples::at_least(1));
+  cli.add_out(out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
 
   auto gallbladder = sinew::read_tet_mesh(std::string(SINEW_DATA_DIR) + "/meshes/tet/gallbladder_volumetric.vtk");
   if (!gallbladder) return fail(gallbladder.error().message());
@@ -188,10 +196,16 @@ int main(int argc, char** argv) {
 
   const int frames = 150;
   std::vector<float> x;
-  std::vector<std::filesystem::path> organ_files, sheet_files;
-  std::vector<double> times, frame_ms;
+  std::vector<double> frame_ms;
   sinew::Pose jaws;
   std::size_t held = 0;
+  auto output = sinew::SceneOutput::create(
+      scene, out,
+      {.bodies = {{.kind = sinew::BodyKind::tet, .name = "gallbladder"}, {.kind = sinew::BodyKind::tri, .name = "membrane"}},
+       .name = "cholecystectomy"});
+  if (!output) return fail(output.error().message());
+  if (auto s = output->write(*sim, 0); !s) return fail(s.error().message());
+  const std::array<double, 3> jaws_half_extents{1.5e-3, 2e-3, 1.5e-3};  // 3 x 3 vertices
   for (int frame = 1; frame <= frames; ++frame) {
     const double t = frame * kFrame;
     const auto t0 = std::chrono::steady_clock::now();
@@ -216,7 +230,7 @@ int main(int argc, char** argv) {
       }
       for (double& c : middle) c /= n;
       jaws.position = middle;
-      auto h = sim->graspers().close(*grasper, jaws, {1.5e-3, 2e-3, 1.5e-3});  // 3 x 3 vertices
+      auto h = sim->graspers().close(*grasper, jaws, jaws_half_extents);
       if (!h) return fail(h.error().message());
       held = h->size();
       std::printf("  %5.3f s  grasp    %zu particles held\n", t, held);
@@ -227,8 +241,10 @@ int main(int argc, char** argv) {
     // Cautery: a 3 mm tip held on a strand near the liver edge, 0.8 to
     // 1.2 s: it touches the membrane where that strand is now (the
     // membrane sags and swings under the grasper).
+    std::optional<V3> cautery_tip;  // where the cautery touches this frame
     if (t >= 0.8 && t < 1.2) {
       const float* tip = &x[4 * (std::size_t{sheet_first} + strand)];
+      cautery_tip = V3{tip[0], tip[1], tip[2]};
       auto e = topology.cauterize(*membrane_id, {tip[0], tip[1], tip[2]}, 3e-3, kFrame, 0.1);
       if (!e) return fail(e.error().message());
       record(t, "cautery", *e);
@@ -238,11 +254,13 @@ int main(int argc, char** argv) {
     // 2 mm back: a stroke cuts what it touches where the tissue is now, and
     // the membrane moves between frames (strokes that only met end to end
     // left uncut tissue that had swung back across the line).
+    std::optional<sinew::Blade> blade;  // the blade's edge at the end of this frame's stroke
     if (t >= 1.5 && t < 2.3) {
       const int k = frame - 90;
       const double bx = centre[0] - 0.021 + 2e-3 * k, bz = near_z - 2e-3;
       const sinew::Blade from{{bx - 2e-3, centre[1] + 5e-3, bz}, {bx - 2e-3, centre[1] - 1e-2, bz}};
       const sinew::Blade to{{bx + 2e-3, centre[1] + 5e-3, bz}, {bx + 2e-3, centre[1] - 1e-2, bz}};
+      blade = to;
       auto e = topology.cut(*membrane_id, from, to);
       if (!e) return fail(e.error().message());
       record(t, "cut", *e);
@@ -254,21 +272,13 @@ int main(int argc, char** argv) {
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
     for (float c : x)
       if (!std::isfinite(c)) return fail("a position is not finite at " + std::to_string(t) + " s");
-    const auto organ_tets = topology.current_tets(*gallbladder_id);
-    const auto sheet_triangles = topology.current_triangles(*membrane_id);
-    if (!organ_tets || !sheet_triangles) return fail("current_tets, current_triangles");
-    const std::span<const float> organ_x(x.data() + 4 * std::size_t{organ_first}, 4 * organ.mesh.vertices.size());
-    const std::span<const float> sheet_x(x.data() + 4 * std::size_t{sheet_first}, 4 * sheet.mesh.vertices.size());
-    organ_files.push_back(out + "/gallbladder_" + std::to_string(frame) + ".vtu");
-    sheet_files.push_back(out + "/membrane_" + std::to_string(frame) + ".vtu");
-    if (auto s = sinew::write_vtu(organ_files.back(), organ_x, 4, *organ_tets); !s) return fail(s.error().message());
-    if (auto s = sinew::write_vtu_triangles(sheet_files.back(), sheet_x, 4, *sheet_triangles); !s)
-      return fail(s.error().message());
-    times.push_back(t);
+    // The tools while they act.
+    if (frame >= 30) output->add_surface("grasper", sinew::box_surface(jaws_half_extents, jaws));
+    if (cautery_tip) output->add_surface("cautery", sinew::capsule_surface(3e-3, 0.0, {.position = *cautery_tip}));
+    if (blade) output->add_polyline("blade", std::array{blade->a, blade->b});
+    if (auto s = output->write(*sim, frame); !s) return fail(s.error().message());
   }
   std::fclose(log);
-  if (auto s = sinew::write_pvd(out + "/gallbladder.pvd", organ_files, times); !s) return fail(s.error().message());
-  if (auto s = sinew::write_pvd(out + "/membrane.pvd", sheet_files, times); !s) return fail(s.error().message());
   // The cut freed the membrane: the gap between the live vertices on the
   // gallbladder's side of the blade's line (rest z > near_z - 2 mm) and
   // those on the liver's side (rest z < near_z - 3 mm), at the end.
@@ -310,9 +320,9 @@ int main(int argc, char** argv) {
   std::sort(frame_ms.begin(), frame_ms.end());
   std::printf("cholecystectomy: membrane %zu of %zu triangles left; the gallbladder's edge is %s the liver's; across the "
               "cut the nearest live vertices are %.1f mm apart (1 mm at rest); frame median %.1f ms, slowest %.1f ms; "
-              "wrote %zu frames and events.csv to %s\n",
+              "wrote %d frames and events.csv to %s\n",
               live->size(), sheet.mesh.triangles.size(), joined ? "still joined to" : "cut free of", 1e3 * gap,
-              frame_ms[frame_ms.size() / 2], frame_ms.back(), times.size(), out.c_str());
+              frame_ms[frame_ms.size() / 2], frame_ms.back(), 1 + frames / every, out.c_str());
   if (joined) return fail("the blade left the membrane joined to the gallbladder");
   return 0;
 }

@@ -12,8 +12,9 @@
 //                     the tissue, force applied to the tool
 //   force_trace.png   the force trace and the positions (when gnuplot exists)
 //   haptic_drag.pvd   the VTU series of the tissue (frame_*.vtu), for ParaView
+//   probe.pvd         the probe's surface (probe_*.vtu) at the same times
 //
-//   haptic_drag [--out DIR] [--backend cpu|...] [--rate HZ] [--no-realtime]
+//   haptic_drag --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -23,41 +24,24 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/haptics/haptic_loop.h"
 #include "sinew/haptics/scripted_device.h"
 #include "sinew/haptics/tool_bridge.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "tool_surface.h"
 
 namespace {
 
 using namespace sinew::haptics;
 
-#ifndef SINEW_EXAMPLES_OUT_DIR
-#define SINEW_EXAMPLES_OUT_DIR "."
-#endif
-
 struct Options {
-  std::string out = std::string(SINEW_EXAMPLES_OUT_DIR) + "/haptic_drag_out";
+  std::string out;
   std::string backend = "cpu";
   double rate = 1000.0;
   bool realtime = true;
 };
-
-bool parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--no-realtime") { o.realtime = false; continue; }
-    const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
-    if (!v) { std::fprintf(stderr, "missing value after %s\n", a.c_str()); return false; }
-    if (a == "--out") o.out = v;
-    else if (a == "--backend") o.backend = v;
-    else if (a == "--rate") o.rate = std::atof(v);  // checked with the loop settings
-    else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return false; }
-    ++i;
-  }
-  return true;
-}
 
 // The block: 6.4 x 2 x 6.4 cm, 4 mm cells, its top face at y = 2 cm, centred on x = z = 0.
 constexpr double kCell = 0.004, kTop = 5 * kCell;
@@ -93,8 +77,19 @@ int fail(const std::string& what) {
 
 int main(int argc, char** argv) {
   Options opt;
-  if (!parse(argc, argv, opt)) return 2;
-  std::filesystem::create_directories(opt.out);
+  sinew::examples::CommandLine cli(
+      "haptic_drag",
+      "A rigid probe pressed into a block of soft tissue and dragged across it by a scripted haptic device,\n"
+      "through the real 1 kHz haptic loop (virtual coupling) while the physics steps at 250 Hz, for 5 s.\n"
+      "Writes into --out: force_trace.csv (every haptic tick), frames.csv (every physics frame),\n"
+      "force_trace.png (with gnuplot), haptic_drag.pvd (the tissue) and probe.pvd (the probe).");
+  opt.out = cli.default_out();
+  cli.add_backend(opt.backend);
+  // The rate is checked with the loop's settings below (a clear error for 0, nan, ...).
+  cli.app().add_option("--rate", opt.rate, "Haptic loop rate [Hz]");
+  cli.app().add_flag_callback("--no-realtime", [&opt] { opt.realtime = false; }, "Run the haptic thread without asking for SCHED_FIFO");
+  cli.add_out(opt.out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
 
   // ------------------------------------------------------------ the scene
   auto mesh = sinew::make_tet_grid({.nx = 16, .ny = 5, .nz = 16, .origin = {-8 * kCell, 0.0, -8 * kCell},
@@ -162,6 +157,7 @@ int main(int argc, char** argv) {
   const int frames = static_cast<int>(std::lround(kDuration / dt));
   std::vector<std::vector<float>> shots;  // positions kept for the VTU series, written after the run
   std::vector<double> shot_times;
+  std::vector<sinew::Pose> probe_poses;  // the probe at each shot
   std::FILE* frames_csv = std::fopen((opt.out + "/frames.csv").c_str(), "w");
   if (!frames_csv) return fail("cannot write " + opt.out + "/frames.csv");
   std::fprintf(frames_csv, "time,tool_x,tool_y,tool_z,contact_fx,contact_fy,contact_fz,tool_force_x,tool_force_y,"
@@ -185,6 +181,7 @@ int main(int argc, char** argv) {
       if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
       shots.push_back(x);
       shot_times.push_back(f * dt);
+      probe_poses.push_back({.position = tool->position, .rotation = tool->rotation});
     }
     const std::int64_t next = t0 + seconds_to_ns(f * dt);
     if (clock.now_ns() > next) ++late;
@@ -212,12 +209,16 @@ int main(int argc, char** argv) {
   }
   std::fclose(csv);
 
-  std::vector<std::filesystem::path> files;
+  std::vector<std::filesystem::path> files, probe_files;
   for (std::size_t i = 0; i < shots.size(); ++i) {
     files.push_back(opt.out + "/frame_" + std::to_string(i) + ".vtu");
     if (auto s = sinew::write_vtu(files.back(), shots[i], 4, tets); !s) return fail(s.error().message());
+    probe_files.push_back(opt.out + "/probe_" + std::to_string(i) + ".vtu");
+    if (auto s = sinew::examples::write_capsule_vtu(probe_files.back(), kRadius, kHalfHeight, probe_poses[i]); !s)
+      return fail(s.error().message());
   }
   if (auto s = sinew::write_pvd(opt.out + "/haptic_drag.pvd", files, shot_times); !s) return fail(s.error().message());
+  if (auto s = sinew::write_pvd(opt.out + "/probe.pvd", probe_files, shot_times); !s) return fail(s.error().message());
 
   const std::string plot = opt.out + "/force_trace.png";
   if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
@@ -257,7 +258,7 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(c.slew_limited), peak);
   std::printf("%d physics frames of %.1f ms: step %.2f ms mean, %.2f ms max, %d started late\n", frames, 1e3 * dt,
               step_ms_sum / frames, step_ms_max, late);
-  std::printf("wrote %s, %s/frames.csv and %zu VTU files; open %s/haptic_drag.pvd in ParaView\n", trace.c_str(),
+  std::printf("wrote %s, %s/frames.csv and %zu VTU files; open %s/haptic_drag.pvd and probe.pvd in ParaView\n", trace.c_str(),
               opt.out.c_str(), files.size(), opt.out.c_str());
   return 0;
 }

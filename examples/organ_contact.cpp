@@ -5,27 +5,24 @@
 // they touch through their boundary surfaces (SceneDesc::mesh_collision:
 // vertex-triangle and edge-edge contacts found each frame, solved colour by
 // colour in every sweep). The liver is pinned along its lowest fifth.
-// Writes two VTU series (open kidney.pvd and liver.pvd in ParaView) and
-// prints per frame the wall time, the collision's share, the contacts and
-// their colours, and the deepest contact violation: while it stays below
-// the thickness the surfaces have not passed through each other.
+// Writes organ_contact.pvd (the liver, the kidney and the probe as
+// collider0, from frame 0) and prints per frame the wall time, the collision's share, the
+// contacts and their colours, and the deepest contact violation: while it
+// stays below the thickness the surfaces have not passed through each other.
 //
-//   organ_contact [--backend auto|cpu|opencl|vulkan] [--frames N] [--out DIR]
-//                 [--thickness MM] [--self-collision on|off] [--self-culling on|off]
-//                 [--continuous on|off]   (the probe's axis against the organs' surfaces
-//                                          by CCD after every substep; off)
-//                 [--every N]   (report and write every N frames; 10)
+//   organ_contact --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "sinew/vtk_output.h"
 
 namespace {
 
@@ -54,35 +51,30 @@ int fail(const sinew::Error& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string backend = "auto", out = "organ_contact_out";
+  sinew::examples::CommandLine cli(
+      "organ_contact",
+      "Tissue against tissue on the real organ meshes: a probe (a kinematic capsule) presses the kidney\n"
+      "down onto the liver and slides it along the liver's surface (mesh collision between the two tet\n"
+      "bodies). Prints per reported frame the wall time, the collision's share, the contacts and the deepest\n"
+      "contact violation; writes organ_contact.pvd (liver, kidney, probe) into --out.");
+  using sinew::examples::at_least;
+  using sinew::examples::greater_than;
+  std::string backend = "auto", out = cli.default_out();
   int frames = 60;
   bool self_collision = false, self_culling = true, continuous = false;
   double thickness_mm = 1.0;
   int every = 10;
-  const auto on_off = [](const std::string& option, const std::string& value, bool& flag) {
-    if (value != "on" && value != "off") {
-      std::fprintf(stderr, "%s takes on or off (got %s)\n", option.c_str(), value.c_str());
-      return false;
-    }
-    flag = value == "on";
-    return true;
-  };
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    if (a == "--backend") backend = argv[i + 1];
-    else if (a == "--frames") frames = std::atoi(argv[i + 1]);
-    else if (a == "--out") out = argv[i + 1];
-    else if (a == "--thickness") thickness_mm = std::atof(argv[i + 1]);
-    else if (a == "--every") every = std::atoi(argv[i + 1]);
-    else if (a == "--self-collision") { if (!on_off(a, argv[i + 1], self_collision)) return 1; }
-    else if (a == "--self-culling") { if (!on_off(a, argv[i + 1], self_culling)) return 1; }
-    else if (a == "--continuous") { if (!on_off(a, argv[i + 1], continuous)) return 1; }
-    else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 1; }
-  }
-  if (every < 1 || frames < 1) {
-    std::fprintf(stderr, "--every and --frames take a whole number >= 1\n");
-    return 1;
-  }
+  cli.add_backend(backend);
+  cli.app().add_option("--frames", frames, "Frames of 1/60 s to run")->check(at_least(1));
+  cli.app().add_option("--every", every, "Report and write the VTU files every N frames (and the last)")
+      ->check(at_least(1));
+  cli.app().add_option("--thickness", thickness_mm, "Contact thickness of the surfaces [mm]")->check(greater_than(0));
+  cli.add_switch("--self-collision", self_collision, "Each organ's surface also against itself");
+  cli.add_switch("--self-culling", self_culling, "Normal-cone culling of the self-collision pairs");
+  cli.add_switch("--continuous", continuous,
+                 "The probe's axis against the organs' surfaces by CCD after every substep");
+  cli.add_out(out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
   auto liver = organ("liver_382k");
   if (!liver) return fail(liver.error());
   auto kidney = organ("kidney_57k");
@@ -151,18 +143,19 @@ int main(int argc, char** argv) {
   if (!probe_id) return fail(probe_id.error());
   std::printf("%s on %s: liver %zu tets, kidney %zu tets, %u particles\n", backend.c_str(),
               sim->device_name().c_str(), liver->tets.size(), kidney->tets.size(), sim->info().particles);
-  std::filesystem::create_directories(out);
-  std::vector<std::filesystem::path> kidney_files, liver_files;
-  std::vector<double> times;
-  std::vector<float> x;
+  auto output = sinew::SceneOutput::create(
+      scene, out, {.bodies = {{.index = 0, .name = "liver"}, {.index = 1, .name = "kidney"}}, .name = "organ_contact"});
+  if (!output) return fail(output.error());
+  if (auto w = output->write(*sim, 0); !w) return fail(w.error());
   double worst = 0.0, total_ms = 0.0, collision_ms = 0.0, ccd_ms = 0.0;
-  const std::uint32_t kidney_first = sim->info().tet_body_first_particle[1];
   for (int f = 0; f < frames; ++f) {
     // Down by 2 cm over the first quarter (the probe starts 5 mm above the
     // kidney, the kidney 3 mm above the liver: it is pressed about 1.2 cm
     // into the liver's surface), then 3 cm along x.
     const double press = std::min(1.0, (f + 1) / (0.25 * frames)), slide = std::max(0.0, (f + 1 - 0.25 * frames) / (0.75 * frames));
-    if (auto st = sim->tools().set_pose(*probe_id, {start[0] + 0.03 * slide, start[1] - 0.02 * press, start[2]}, probe.rotation); !st)
+    const sinew::Pose probe_pose{.position = {start[0] + 0.03 * slide, start[1] - 0.02 * press, start[2]},
+                                 .rotation = probe.rotation};
+    if (auto st = sim->tools().set_pose(*probe_id, probe_pose.position, probe_pose.rotation); !st)
       return fail(st.error());
     if (auto st = sim->step(); !st) return fail(st.error());
     const sinew::FrameStats& st = sim->last_frame();
@@ -172,26 +165,16 @@ int main(int argc, char** argv) {
     worst = std::max(worst, st.contact_violation);
 
     if ((f + 1) % every != 0 && f + 1 != frames) continue;
-    if (auto r = sim->read_positions(x); !r) return fail(r.error());
-    const std::span<const float> all(x);
-    kidney_files.push_back(out + "/kidney_" + std::to_string(f + 1) + ".vtu");
-    liver_files.push_back(out + "/liver_" + std::to_string(f + 1) + ".vtu");
-    times.push_back(st.time);
-    if (auto w = sinew::write_vtu(liver_files.back(), all.subspan(0, std::size_t{kidney_first} * 4), 4, liver->tets); !w)
-      return fail(w.error());
-    if (auto w = sinew::write_vtu(kidney_files.back(), all.subspan(std::size_t{kidney_first} * 4), 4, kidney->tets); !w)
-      return fail(w.error());
+    if (auto w = output->write(*sim, f + 1); !w) return fail(w.error());
     std::printf("frame %4d  %.1f ms (collision %.1f, CCD %.1f)  %u contacts in %u colours  contact violation %.3f mm "
                 "(thickness %g mm)\n",
                 f + 1, st.wall_ms, st.collision_ms, st.ccd_ms, st.mesh_contacts, st.mesh_contact_colors,
                 1e3 * st.contact_violation, thickness_mm);
   }
-  if (auto w = sinew::write_pvd(out + "/kidney.pvd", kidney_files, times); !w) return fail(w.error());
-  if (auto w = sinew::write_pvd(out + "/liver.pvd", liver_files, times); !w) return fail(w.error());
   std::printf("mean %.1f ms/frame, of which collision %.1f and CCD %.1f; deepest contact violation %.3f mm: %s\n",
               total_ms / frames, collision_ms / frames, ccd_ms / frames, 1e3 * worst,
               worst < scene.mesh_collision.thickness ? "the organs never passed through each other"
                                                       : "the organs came closer than the thickness allows");
-  std::printf("open %s/kidney.pvd and %s/liver.pvd in ParaView\n", out.c_str(), out.c_str());
+  std::printf("open %s/organ_contact.pvd in ParaView\n", out.c_str());
   return 0;
 }

@@ -12,12 +12,12 @@
 // the first puncture, then 4 mm more (kTighten frames), and held there: the
 // stitches close the slit.
 //
-// Writes three VTU series (pad.pvd, thread.pvd and needle.pvd; the thread
-// and needle as line cells) and prints, per reported frame, the wall time,
+// Writes suturing.pvd (the pad, the thread and the needle as lines, from
+// frame 0: sinew/vtk_output.h) and prints, per reported frame, the wall time,
 // the punctures (entering or leaving, on the needle or on the thread) and
 // how wide the slit is at the stitches' depth.
 //
-//   suturing [--backend auto|cpu|opencl|vulkan] [--out DIR] [--every N]
+//   suturing --help   (the options, their defaults and units)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -26,8 +26,10 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "sinew/vtk_output.h"
 
 namespace {
 
@@ -88,15 +90,18 @@ Pose script(int f, double pulled) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string backend = "auto", out = "suturing_out";
+  sinew::examples::CommandLine cli(
+      "suturing",
+      "Two stitches across a cut in a tissue pad, tightened: a curved needle with a 100 mm thread turned\n"
+      "about the cut twice, then pulled until the knot holds. Prints per reported frame the wall time, the\n"
+      "punctures and the slit's width; writes suturing.pvd (pad, thread, needle) into --out.");
+  std::string backend = "auto", out = cli.default_out();
   int every = 10;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    if (flag == "--backend") backend = argv[i + 1];
-    else if (flag == "--out") out = argv[i + 1];
-    else if (flag == "--every") every = std::max(1, std::atoi(argv[i + 1]));
-    else return fail("unknown option " + flag + " (--backend, --out, --every)");
-  }
+  cli.add_backend(backend);
+  cli.app().add_option("--every", every, "Report and write the VTU files every N frames of 1/60 s (and the last)")
+      ->check(sinew::examples::at_least(1));
+  cli.add_out(out);
+  if (auto exit = cli.parse(argc, argv)) return *exit;
 
   sinew::SceneDesc scene;
   scene.gravity = {0.0, 0.0, 0.0};  // on a table
@@ -138,7 +143,6 @@ int main(int argc, char** argv) {
               sim->device_name().c_str(), pad.mesh.tets.size(), kThreadSegments, kStitched);
 
   const std::uint32_t pad_first = sim->info().tet_body_first_particle[0];
-  const std::uint32_t thread_first = sim->info().line_body_first_particle[0];
   const std::size_t pad_vertices = pad.mesh.vertices.size();
   // The slit's width at the stitches' depth (y = -6 mm): its two faces'
   // vertices at each stitch's z (mean of the two nearest grid planes).
@@ -155,11 +159,14 @@ int main(int argc, char** argv) {
     return n > 0 ? sum / n : 0.0;
   };
 
-  std::vector<std::filesystem::path> pad_files, thread_files, needle_files;
-  std::vector<double> times;
-  std::vector<std::array<std::uint32_t, 2>> thread_cells, needle_cells;
-  for (std::uint32_t i = 0; i < kThreadSegments; ++i) thread_cells.push_back({i, i + 1});
-  for (std::uint32_t i = 0; i + 1 < needle.curve.size(); ++i) needle_cells.push_back({i, i + 1});
+  // Bodies named as in scenes/suturing.json; frame numbers counted as the
+  // runner does (its frame 1 is this loop's f = 0), so its output is the same.
+  auto output = sinew::SceneOutput::create(
+      scene, out,
+      {.bodies = {{.kind = sinew::BodyKind::tet, .name = "pad"}, {.kind = sinew::BodyKind::line, .name = "thread"}},
+       .name = "suturing"});
+  if (!output) return fail(output.error().message());
+  if (auto s = output->write(*sim, 0); !s) return fail(s.error().message());
   std::vector<float> x, ms;
   double width_before = 0.0, pulled = 0.0;
   int knot_frame = -1, last = -1;  // when the knot first held; the last frame
@@ -189,44 +196,11 @@ int main(int argc, char** argv) {
     for (const auto& h : state->punctures) holes += std::string(h.exit ? "out" : "in") + (h.on_thread ? "/thread " : "/needle ");
     std::printf("frame %3d  %6.2f ms  slit %.2f mm  %zu punctures: %s\n", f, ms.back(), slit_width(x) * 1e3,
                 state->punctures.size(), holes.c_str());
-    // The VTU series: the pad, the thread, the needle at its pose.
-    const std::string stem = std::to_string(f);
-    pad_files.push_back(std::filesystem::path(out) / ("pad_" + stem + ".vtu"));
-    thread_files.push_back(std::filesystem::path(out) / ("thread_" + stem + ".vtu"));
-    needle_files.push_back(std::filesystem::path(out) / ("needle_" + stem + ".vtu"));
-    times.push_back(sim->last_frame().time);
-    const std::span<const float> all(x);
-    if (auto s = sinew::write_vtu(pad_files.back(), all.subspan(std::size_t{pad_first} * 4, pad_vertices * 4), 4,
-                                  pad.mesh.tets);
-        !s)
-      return fail(s.error().message());
-    if (auto s = sinew::write_vtu_lines(thread_files.back(),
-                                        all.subspan(std::size_t{thread_first} * 4, (kThreadSegments + 1) * 4), 4,
-                                        thread_cells);
-        !s)
-      return fail(s.error().message());
-    std::vector<float> curve;
-    for (const auto& c : needle.curve) {
-      // The point rotated by the state's quaternion (w, x, y, z), then moved.
-      const auto& r = state->rotation;
-      const double w = r[0], u[3] = {r[1], r[2], r[3]};
-      const double t[3] = {2 * (u[1] * c[2] - u[2] * c[1]), 2 * (u[2] * c[0] - u[0] * c[2]),
-                           2 * (u[0] * c[1] - u[1] * c[0])};
-      for (int k = 0; k < 3; ++k) {
-        const double cross = u[(k + 1) % 3] * t[(k + 2) % 3] - u[(k + 2) % 3] * t[(k + 1) % 3];
-        curve.push_back(static_cast<float>(state->position[k] + c[k] + w * t[k] + cross));
-      }
-    }
-    if (auto s = sinew::write_vtu_lines(needle_files.back(), curve, 3, needle_cells); !s)
-      return fail(s.error().message());
+    if (auto s = output->write(*sim, f + 1); !s) return fail(s.error().message());
   }
-  for (const auto& [name, files] : {std::pair{"pad.pvd", &pad_files}, std::pair{"thread.pvd", &thread_files},
-                                    std::pair{"needle.pvd", &needle_files}})
-    if (auto s = sinew::write_pvd(std::filesystem::path(out) / name, *files, times); !s)
-      return fail(s.error().message());
   std::sort(ms.begin(), ms.end());
   std::printf("median %.2f ms per frame; the slit at the stitches %.2f -> %.2f mm\n", ms[ms.size() / 2],
               width_before * 1e3, slit_width(x) * 1e3);
-  std::printf("open %s/pad.pvd, thread.pvd and needle.pvd in ParaView\n", out.c_str());
+  std::printf("open %s/suturing.pvd in ParaView\n", out.c_str());
   return 0;
 }

@@ -652,6 +652,42 @@ TEST_P(TensionAgreement, TheRoundingCubeMatchesTheCpu) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, TensionAgreement, ::testing::ValuesIn(backends()), backend_name);
 
+// Settings finite in double whose device constants are not, in float32:
+// each named, where before they gave NaN (or a frozen fluid) after a step.
+TEST(Fluid, SettingsTheDeviceCannotHoldInFloatAreNamed) {
+  const auto message = [](const FluidDesc& d) {
+    auto made = Fluid::create(d);
+    return made.ok() ? std::string("created") : made.error().message();
+  };
+  FluidDesc d = tank_desc();
+  d.particles = block(3, 3, 3);
+  ASSERT_EQ(message(d), "created");
+  const auto named = [&](FluidDesc bad, const char* words) {
+    const std::string m = message(bad);
+    EXPECT_NE(m.find(words), std::string::npos) << m;
+    EXPECT_NE(m.find("float32"), std::string::npos) << m;
+  };
+  FluidDesc bad = d;
+  bad.settings.rest_density = 1e300;  // a particle's mass and the stiffness overflow
+  named(bad, "rest_density");
+  bad = d;
+  bad.settings.rest_density = 1e-300;  // rounds to 0: a divisor
+  named(bad, "0 or denormal");
+  bad = d;
+  bad.settings.gravity = {0.0, -1e300, 0.0};
+  named(bad, "gravity [m/s^2] = -1e+300");
+  bad = d;
+  bad.settings.speed_of_sound = 1e30;  // c0^2 / h overflows (and the CFL bound is then 1e-33 s)
+  bad.settings.time_step = 1e-36;
+  named(bad, "rho0 c0^2 / 7");
+  bad = d;
+  bad.settings.surface_tension = 0.01;
+  bad.settings.spacing = 1e-6;  // 32 / (pi h^9) = 2e52
+  bad.settings.time_step = 1e-9;
+  bad.particles.clear();
+  named(bad, "cohesion");
+}
+
 TEST(FluidTension, BadTensionIsNamed) {
   FluidDesc d;
   d.particles = block(2, 2, 2);

@@ -92,6 +92,16 @@ TEST(LevelSetBounds, ACutSweptAcrossTheWorldIsNamed) {
   saw.kind = CutterShape::Kind::box;
   to.position = {1e3, 0, 0};  // 4 million poses half a voxel apart
   expect_error(solid->cut(saw, from, to), ErrorCode::capacity_exceeded, "poses");
+  // Within both bounds alone, not together: 2 m is 8,000 poses, each tested
+  // at the millions of voxels along the way (before: minutes of work).
+  to.position = {2.0, 0, 0};
+  expect_error(solid->cut(saw, from, to), ErrorCode::capacity_exceeded, "distance evaluations");
+  // A stroke of a few voxels is well within them, and cuts.
+  to.position = {0.004, 0.005, 0.005};
+  from.position = {-0.004, 0.005, 0.005};
+  const auto stroke = solid->cut(saw, from, to);
+  ASSERT_TRUE(stroke.ok()) << stroke.error().message();
+  EXPECT_GT(stroke->changed_voxels, 0u);
 }
 
 #else

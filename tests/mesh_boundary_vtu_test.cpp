@@ -1,5 +1,6 @@
 // extract_boundary_surface against a brute-force face count on a real mesh;
-// write_vtu / write_pvd read back as text.
+// write_vtu read back by the tests' own binary VTU reader (vtu_reader.h),
+// write_pvd as text.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 
 #include "mesh_test_helpers.h"
 #include "sinew/mesh.h"
+#include "vtu_reader.h"
 
 namespace {
 
@@ -92,33 +94,6 @@ std::string read_text(const fs::path& p) {
   return s.str();
 }
 
-// The values of the first DataArray whose opening tag contains `marker`, or
-// that follows `marker` when it is an element of its own (e.g. "<Points>").
-std::string_view array_body(std::string_view xml, std::string_view marker) {
-  std::size_t at = xml.find(marker);
-  if (at == std::string_view::npos) return {};
-  if (marker.front() == '<') at = xml.find("<DataArray", at);
-  const std::size_t begin = xml.find('>', at) + 1;
-  return xml.substr(begin, xml.find("</DataArray>", begin) - begin);
-}
-
-template <class T>
-std::vector<T> numbers(std::string_view body) {
-  std::vector<T> out;
-  const char* p = body.data();
-  const char* end = p + body.size();
-  while (p < end) {
-    while (p < end && (*p == ' ' || *p == '\n')) ++p;
-    if (p == end) break;
-    T v{};
-    const auto r = std::from_chars(p, end, v);
-    if (r.ec != std::errc()) break;
-    out.push_back(v);
-    p = r.ptr;
-  }
-  return out;
-}
-
 std::size_t occurrences(std::string_view text, std::string_view what) {
   std::size_t n = 0;
   for (std::size_t at = text.find(what); at != std::string_view::npos; at = text.find(what, at + 1)) ++n;
@@ -155,29 +130,29 @@ TEST(Vtu, WritesPointsCellsAndFieldsThatReadBackExactly) {
   const fs::path p = tmp_dir() / "grid.vtu";
   const sinew::Status s = sinew::write_vtu(p, g.xyz, 3, g.mesh.tets, fields);
   ASSERT_TRUE(s.ok()) << s.error().message();
-  const std::string xml = read_text(p);
+  const auto vtu = sinew::vtu_test::read_vtu(p);
+  const std::string& xml = vtu.xml;
   EXPECT_EQ(xml.rfind("<?xml", 0), 0u);
   EXPECT_NE(xml.find("type=\"UnstructuredGrid\""), std::string::npos);
   EXPECT_NE(xml.find("NumberOfPoints=\"" + std::to_string(g.mesh.vertices.size()) + "\""), std::string::npos);
   EXPECT_NE(xml.find("NumberOfCells=\"" + std::to_string(g.mesh.tets.size()) + "\""), std::string::npos);
-  EXPECT_EQ(occurrences(xml, "<DataArray"), occurrences(xml, "</DataArray>"));
   EXPECT_EQ(occurrences(xml, "<DataArray"), 6u);  // 2 fields, points, 3 cell arrays
 
   // Floats must survive the text round trip bit for bit.
-  EXPECT_EQ(numbers<float>(array_body(xml, "<Points>")), g.xyz);
-  EXPECT_EQ(numbers<float>(array_body(xml, "Name=\"temperature\" NumberOfComponents=\"1\"")), g.temperature);
-  EXPECT_EQ(numbers<float>(array_body(xml, "Name=\"velocity\" NumberOfComponents=\"3\"")), g.velocity);
+  EXPECT_EQ(vtu.positions.as<float>(), g.xyz);
+  EXPECT_EQ(vtu.point_data.at("temperature").as<float>(), g.temperature);
+  EXPECT_EQ(vtu.point_data.at("velocity").as<float>(), g.velocity);
 
-  const auto connectivity = numbers<std::int64_t>(array_body(xml, "Name=\"connectivity\""));
+  const auto connectivity = vtu.connectivity.as<std::int64_t>();
   ASSERT_EQ(connectivity.size(), 4 * g.mesh.tets.size());
   for (std::size_t t = 0; t < g.mesh.tets.size(); ++t) {
     for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(connectivity[4 * t + k], g.mesh.tets[t][k]);
   }
-  const auto offsets = numbers<std::int64_t>(array_body(xml, "Name=\"offsets\""));
+  const auto offsets = vtu.offsets.as<std::int64_t>();
   ASSERT_EQ(offsets.size(), g.mesh.tets.size());
   for (std::size_t t = 0; t < offsets.size(); ++t)
     EXPECT_EQ(offsets[t], static_cast<std::int64_t>(4 * (t + 1)));
-  const auto types = numbers<int>(array_body(xml, "Name=\"types\""));
+  const auto types = vtu.types.as<int>();
   ASSERT_EQ(types.size(), g.mesh.tets.size());
   EXPECT_TRUE(std::all_of(types.begin(), types.end(), [](int t) { return t == 10; }));  // VTK_TETRA
 }
@@ -190,13 +165,14 @@ TEST(Vtu, WritesLineCells) {
   const fs::path p = tmp_dir() / "thread.vtu";
   const sinew::Status s = sinew::write_vtu_lines(p, xyzw, 4, segments);
   ASSERT_TRUE(s.ok()) << s.error().message();
-  const std::string xml = read_text(p);
+  const auto vtu = sinew::vtu_test::read_vtu(p);
+  const std::string& xml = vtu.xml;
   EXPECT_NE(xml.find("NumberOfPoints=\"3\" NumberOfCells=\"2\""), std::string::npos);
-  EXPECT_EQ(numbers<float>(array_body(xml, "<Points>")),
+  EXPECT_EQ(vtu.positions.as<float>(),
             (std::vector<float>{0.0f, 0.0f, 0.0f, 0.001f, 0.0f, 0.0f, 0.002f, 0.5f, 0.0f}));
-  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"connectivity\"")), (std::vector<std::int64_t>{0, 1, 1, 2}));
-  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"offsets\"")), (std::vector<std::int64_t>{2, 4}));
-  EXPECT_EQ(numbers<int>(array_body(xml, "Name=\"types\"")), (std::vector<int>{3, 3}));  // VTK_LINE
+  EXPECT_EQ(vtu.connectivity.as<std::int64_t>(), (std::vector<std::int64_t>{0, 1, 1, 2}));
+  EXPECT_EQ(vtu.offsets.as<std::int64_t>(), (std::vector<std::int64_t>{2, 4}));
+  EXPECT_EQ(vtu.types.as<int>(), (std::vector<int>{3, 3}));  // VTK_LINE
   const std::vector<std::array<std::uint32_t, 2>> past{{0, 1}, {2, 3}};
   const sinew::Status bad = sinew::write_vtu_lines(p, xyzw, 4, past);
   ASSERT_FALSE(bad.ok());
@@ -211,12 +187,13 @@ TEST(Vtu, WritesTriangleCells) {
   const fs::path p = tmp_dir() / "surface.vtu";
   const sinew::Status s = sinew::write_vtu_triangles(p, xyz, 3, triangles);
   ASSERT_TRUE(s.ok()) << s.error().message();
-  const std::string xml = read_text(p);
+  const auto vtu = sinew::vtu_test::read_vtu(p);
+  const std::string& xml = vtu.xml;
   EXPECT_NE(xml.find("NumberOfPoints=\"4\" NumberOfCells=\"2\""), std::string::npos);
-  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"connectivity\"")),
+  EXPECT_EQ(vtu.connectivity.as<std::int64_t>(),
             (std::vector<std::int64_t>{0, 2, 1, 0, 1, 3}));
-  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"offsets\"")), (std::vector<std::int64_t>{3, 6}));
-  EXPECT_EQ(numbers<int>(array_body(xml, "Name=\"types\"")), (std::vector<int>{5, 5}));  // VTK_TRIANGLE
+  EXPECT_EQ(vtu.offsets.as<std::int64_t>(), (std::vector<std::int64_t>{3, 6}));
+  EXPECT_EQ(vtu.types.as<int>(), (std::vector<int>{5, 5}));  // VTK_TRIANGLE
   const std::vector<std::array<std::uint32_t, 3>> past{{0, 1, 2}, {1, 2, 4}};
   const sinew::Status bad = sinew::write_vtu_triangles(p, xyz, 3, past);
   ASSERT_FALSE(bad.ok());
@@ -233,12 +210,13 @@ TEST(Vtu, WritesPointCellsWithFields) {
   const fs::path p = tmp_dir() / "particles.vtu";
   const sinew::Status s = sinew::write_vtu_points(p, xyz, 3, fields);
   ASSERT_TRUE(s.ok()) << s.error().message();
-  const std::string xml = read_text(p);
+  const auto vtu = sinew::vtu_test::read_vtu(p);
+  const std::string& xml = vtu.xml;
   EXPECT_NE(xml.find("NumberOfPoints=\"3\" NumberOfCells=\"3\""), std::string::npos);
-  EXPECT_EQ(numbers<std::int64_t>(array_body(xml, "Name=\"connectivity\"")), (std::vector<std::int64_t>{0, 1, 2}));
-  EXPECT_EQ(numbers<int>(array_body(xml, "Name=\"types\"")), (std::vector<int>{1, 1, 1}));  // VTK_VERTEX
-  EXPECT_EQ(numbers<float>(array_body(xml, "Name=\"density\"")), density);
-  EXPECT_EQ(numbers<float>(array_body(xml, "Name=\"velocity\"")), velocity);
+  EXPECT_EQ(vtu.connectivity.as<std::int64_t>(), (std::vector<std::int64_t>{0, 1, 2}));
+  EXPECT_EQ(vtu.types.as<int>(), (std::vector<int>{1, 1, 1}));  // VTK_VERTEX
+  EXPECT_EQ(vtu.point_data.at("density").as<float>(), density);
+  EXPECT_EQ(vtu.point_data.at("velocity").as<float>(), velocity);
   const std::vector<float> short_density{1000.0f};
   const sinew::VertexField bad[] = {{"density", 1, short_density}};
   const sinew::Status wrong = sinew::write_vtu_points(p, xyz, 3, bad);
@@ -254,9 +232,8 @@ TEST(Vtu, StrideFourSkipsW) {
   }
   const fs::path p = tmp_dir() / "stride4.vtu";
   ASSERT_TRUE(sinew::write_vtu(p, xyzw, 4, g.mesh.tets).ok());
-  const std::string xml = read_text(p);
-  EXPECT_EQ(numbers<float>(array_body(xml, "<Points>")), g.xyz);
-  EXPECT_EQ(xml.find("12345"), std::string::npos);
+  const auto vtu = sinew::vtu_test::read_vtu(p);
+  EXPECT_EQ(vtu.positions.as<float>(), g.xyz);
 }
 
 TEST(Vtu, CreatesParentFoldersAndEscapesNames) {

@@ -268,5 +268,55 @@ TEST(SceneDeviceRange, AParticleForceWhoseImpulseIsInfiniteInFloatIsNamed) {
   for (float v : xyzw) EXPECT_TRUE(std::isfinite(v));
 }
 
+// A tool (and a force-driven needle) is integrated on the host but posed on
+// the device in float32: a mass or moment whose float (or inverse) is 0 or
+// infinite, and a force that would throw it beyond float range in a frame,
+// are named; a large but representable push steps finite.
+ToolDesc light_tool() {
+  ToolDesc tool;
+  tool.radius = 0.01;
+  tool.half_height = 0.02;
+  tool.mass = 1e-3;
+  tool.inertia = {1e-7, 1e-7, 1e-7};
+  tool.gravity = false;
+  tool.position = {0.0, 0.5, 0.0};
+  return tool;
+}
+
+TEST(SceneDeviceRange, ToolMassesTheDeviceCannotHoldAreNamed) {
+  expect_error([](SceneDesc& s) { s.tools.push_back(light_tool()); s.tools[0].mass = 1e300; }, "tools[0].mass = 1e+300");
+  expect_error([](SceneDesc& s) { s.tools.push_back(light_tool()); s.tools[0].mass = 1e-300; }, "tools[0].mass");
+  expect_error([](SceneDesc& s) { s.tools.push_back(light_tool()); s.tools[0].inertia[2] = 1e-45; }, "tools[0].inertia[2]");
+}
+
+TEST(SceneDeviceRange, AToolForceThatWouldThrowItBeyondFloatRangeIsNamed) {
+  SceneDesc scene = valid_scene();
+  scene.tools.push_back(light_tool());
+  auto sim = Simulation::create(scene, {.backend = "cpu"});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  auto tools = sim->tools();
+  const ToolId tool = *tools.tool(0);
+  // 1e20 N on a gram moves it (1/60)^2 1e23 ~ 3e19 m in a frame.
+  Status s = tools.apply_force(tool, {1e20, 0.0, 0.0}, {0.0, 0.0, 0.0});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
+  EXPECT_NE(s.error().message().find("tool 0"), std::string::npos) << s.error().message();
+  EXPECT_NE(s.error().message().find("time_step^2 F / m"), std::string::npos) << s.error().message();
+  s = tools.apply_force(tool, {0.0, 0.0, 0.0}, {0.0, 0.0, 1e20});
+  ASSERT_FALSE(s.ok()) << "a torque that would spin it 3e21 rad in a frame";
+  EXPECT_NE(s.error().message().find("time_step^2 T / I"), std::string::npos) << s.error().message();
+  // Calls before a frame add up, and the sum is checked: at 60 Hz a gram
+  // moves 0.278 m per newton, so three pushes of 1e12 N (8.3e11 m) pass and
+  // a fourth (1.1e12 m) is refused, leaving the three.
+  for (int k = 0; k < 3; ++k) SINEW_ASSERT_OK(tools.apply_force(tool, {1e12, 0.0, 0.0}, {0.0, 0.0, 0.0}));
+  s = tools.apply_force(tool, {1e12, 0.0, 0.0}, {0.0, 0.0, 0.0});
+  EXPECT_FALSE(s.ok()) << "the fourth push makes the frame's total too much";
+  SINEW_ASSERT_OK(sim->step());
+  auto state = tools.state(tool);
+  SINEW_ASSERT_OK(state);
+  for (double x : state->position) EXPECT_TRUE(std::isfinite(x) && std::isfinite(float(x))) << x;
+  EXPECT_GT(state->position[0], 5e11) << "the three pushes that were accepted acted";
+}
+
 }  // namespace
 }  // namespace sinew

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -41,7 +43,8 @@ TEST(SceneFile, EverySceneUnderScenesReadsAndChecks) {
     auto file = load_scene_file(entry.path());
     ASSERT_TRUE(file.ok()) << file.error().message();
     EXPECT_TRUE(check_scene(file->scene).ok()) << entry.path();
-    EXPECT_FALSE(file->bodies.empty()) << entry.path();
+    // A body or a tool (bone_burr's only moving part is its burr).
+    EXPECT_FALSE(file->bodies.empty() && file->scene.tools.empty()) << entry.path();
   }
   EXPECT_GE(scenes, 1);
 }
@@ -106,6 +109,36 @@ TEST(SceneFile, ErrorsNameTheJsonPathAndTheRule) {
             "steps of 0.003 s");
   // An empty scene is check_scene's error, at the root.
   EXPECT_EQ(error_of("{}").rfind("/: ", 0), 0u);
+}
+
+// A "data:" file name is found in SINEW_DATA_DIR when the environment sets
+// it, else in the build's data folder; a missing one names the variable.
+TEST(SceneFile, DataNamesResolveInTheDataFolder) {
+  const std::string scene = R"({"tet_bodies": [{"mesh": {"file": "data:meshes/tet/armadillo_4k.node",
+    "scale": 0.5, "translate": [1.0, -2.0, 0.25]}, "elastic": {"youngs_modulus": 20000.0, "poisson_ratio": 0.4}}]})";
+  auto mesh = read_tet_mesh(std::filesystem::path(SINEW_DATA_DIR) / "meshes/tet/armadillo_4k.node");
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message();
+  const std::array<double, 3> shift{1.0, -2.0, 0.25};
+  const char* saved = std::getenv("SINEW_DATA_DIR");
+  const std::string restore = saved ? saved : "";
+  for (const bool from_environment : {false, true}) {
+    if (from_environment) ::setenv("SINEW_DATA_DIR", SINEW_DATA_DIR, 1);
+    else ::unsetenv("SINEW_DATA_DIR");
+    auto file = parse_scene_json(scene, kScenes);
+    ASSERT_TRUE(file.ok()) << file.error().message();
+    const auto& read = file->scene.tet_bodies[0].mesh;
+    ASSERT_EQ(read.vertices.size(), mesh->vertices.size());
+    EXPECT_EQ(read.tets, mesh->tets);
+    for (std::size_t v = 0; v < read.vertices.size(); ++v)
+      for (int k = 0; k < 3; ++k) ASSERT_EQ(read.vertices[v][k], mesh->vertices[v][k] * 0.5 + shift[k]);
+  }
+  ::setenv("SINEW_DATA_DIR", "/no/such/data", 1);
+  const std::string e = error_of(scene);
+  EXPECT_NE(e.find("/tet_bodies/0/mesh/file: /no/such/data/meshes/tet/armadillo_4k.node is not a readable file"),
+            std::string::npos) << e;
+  EXPECT_NE(e.find("SINEW_DATA_DIR"), std::string::npos) << e;
+  if (saved) ::setenv("SINEW_DATA_DIR", restore.c_str(), 1);
+  else ::unsetenv("SINEW_DATA_DIR");
 }
 
 TEST(SceneFile, LoadingNamesTheFile) {

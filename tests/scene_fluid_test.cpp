@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sinew/fluid_coupling.h"
+#include "sinew/log.h"
 #include "sinew/simulation.h"
 #include "fluid_cup.h"
 #include "test_support.h"
@@ -215,12 +216,22 @@ TEST(SceneFluid, AnEmitterPastTheCapacityEndsAWholeFrameAndIsNamed) {
       {.centre = {4 * kS, 4 * kS, 4 * kS}, .direction = {0, -1, 0}, .radius = 1.5 * kS, .flow_rate = 2e-6});
   auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
   ASSERT_TRUE(sim.ok()) << sim.error().message();
+  // The warning comes first: 90% of the capacity (sinew/warnings.h), once.
+  std::vector<std::pair<std::uint64_t, std::string>> warnings;
+  set_log_callback([&](LogLevel level, std::string_view text) {
+    if (level == LogLevel::warning) warnings.emplace_back(sim->last_frame().frame, std::string(text));
+  });
   Status s;
   int frames = 0;
   while (s.ok() && frames < 50) {
     s = sim->step();
     ++frames;
   }
+  set_log_callback({});
+  EXPECT_EQ(sim->last_frame().counter("fluid", "particles_capacity"), 10.0);
+  ASSERT_EQ(warnings.size(), 1u) << "one warning when the particles reached 9 of 10";
+  EXPECT_NE(warnings[0].second.find("fluid: particles reached"), std::string::npos) << warnings[0].second;
+  EXPECT_NE(warnings[0].second.find("of its capacity 10"), std::string::npos) << warnings[0].second;
   ASSERT_FALSE(s.ok()) << "the source outgrew the capacity within 50 frames";
   EXPECT_EQ(s.error().code(), ErrorCode::capacity_exceeded) << s.error().message();
   EXPECT_NE(s.error().message().find("sph particles"), std::string::npos) << s.error().message();

@@ -1,5 +1,6 @@
 // main.cpp — the `sinew` program (docs/runner.md): `sinew run`, `sinew
-// check`, `sinew info`, each with --help (CLI11).
+// check`, `sinew info` and, when built with GLFW, OpenGL and Dear ImGui,
+// `sinew view` (docs/viewer.md), each with --help (CLI11).
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
@@ -32,9 +33,40 @@ int main(int argc, char** argv) {
 
   CLI::App* info_cmd = app.add_subcommand("info", "List the backends built in and the devices each finds");
 
+#ifdef SINEW_HAVE_VIEWER
+  sinew::cli::ViewOptions view;
+  CLI::App* view_cmd = app.add_subcommand("view", "Open a window onto a scene as it runs; the mouse drives a tool (docs/viewer.md)");
+  view_cmd->add_option("scene", view.scene, "The scene file (JSON)")->required()->check(CLI::ExistingFile);
+  view_cmd->add_option("--backend", view.backend, "Backend (default: the file's run.backend, else auto)")
+      ->check(CLI::IsMember({"auto", "cpu", "opencl", "vulkan"}));
+  view_cmd->add_option("--device", view.device, "Device index or name substring (opencl, vulkan)");
+  view_cmd->add_option("--threads", view.threads, "CPU backend worker threads (0: all but one, left to the renderer)")->check(CLI::NonNegativeNumber);
+  view_cmd->add_flag_callback("--no-probe", [&view] { view.probe = false; },
+                              "Add no probe to a scene without tools (nothing for the mouse to drive)");
+  view_cmd->add_option("--width", view.width, "Window width [pixels]")->check(CLI::Range(64, 16384));
+  view_cmd->add_option("--height", view.height, "Window height [pixels]")->check(CLI::Range(64, 16384));
+  view_cmd->add_flag_callback("--no-vsync", [&view] { view.vsync = false; },
+                              "Draw as fast as possible instead of at the display's refresh");
+  view_cmd->add_option("--msaa", view.msaa, "Antialiasing samples per pixel (0: none)")->check(CLI::Range(0, 16));
+  CLI::Option* paused = view_cmd->add_flag("--paused", view.paused, "Start with the physics paused (space runs it)");
+  view_cmd->add_flag("--no-panel", view.no_panel, "Start with the panel hidden (h shows it)");
+  view_cmd->add_option("--frames", view.frames, "Close after this many rendered frames")->check(CLI::PositiveNumber);
+  view_cmd->add_option("--screenshot", view.screenshot, "With --frames: save the last frame to this PPM file")
+      ->needs("--frames");
+  view_cmd->add_option("--script-test", view.script_test,
+                       "Headless test: settle, screenshot, move the handle by --move-tool, screenshot, close; "
+                       "images into this folder")
+      ->excludes(paused);
+  view_cmd->add_option("--move-tool", view.move_tool, "With --script-test: the handle's move dx,dy,dz [m]")
+      ->needs("--script-test");
+#endif
+
   CLI11_PARSE(app, argc, argv);
   if (*run_cmd) return sinew::cli::run_scene(run);
   if (*check_cmd) return sinew::cli::check_scene_file(check_path);
   if (*info_cmd) return sinew::cli::print_info();
+#ifdef SINEW_HAVE_VIEWER
+  if (*view_cmd) return sinew::cli::view_scene(view);
+#endif
   return 2;
 }

@@ -1,6 +1,7 @@
 // run_command.cpp — `sinew run`: a scene file run frame by frame with its
 // script, a progress bar on a terminal or one flushed line per output
-// frame when piped, VTU series per body, and the per-stage profile at the end.
+// frame when piped, the scene's binary VTK output (every body, tool and
+// the fluid: sinew/vtk_output.h), and the per-stage profile at the end.
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include "sinew/mesh.h"
 #include "sinew/scene_file.h"
 #include "sinew/simulation.h"
+#include "sinew/vtk_output.h"
 
 namespace sinew::cli {
 namespace {
@@ -24,97 +26,6 @@ int fail(const std::string& what) {
   std::fprintf(stderr, "sinew run: %s\n", what.c_str());
   return 1;
 }
-
-// The VTU series of one body or of the fluid: its files and their times.
-struct Series {
-  std::vector<std::filesystem::path> files;
-  std::vector<double> times;
-};
-
-// Writes every body (and the fluid) of the frame: <out>/<name>_<frame>.vtu.
-class VtuOutput {
- public:
-  VtuOutput(const SceneFile& file, std::filesystem::path out) : file_(file), out_(std::move(out)) {}
-
-  Status write(Simulation& sim, int frame) {
-    const double t = sim.last_frame().time;
-    if (Status s = sim.read_positions(x_); !s) return s;
-    if (Status s = sim.read_velocities(v_); !s) return s;
-    const SceneInfo& info = sim.info();
-    for (const SceneBodyName& b : file_.bodies) {
-      const std::filesystem::path path = out_ / (b.name + "_" + std::to_string(frame) + ".vtu");
-      if (Status s = write_body(sim, info, b, path); !s) return s;
-      series_[b.name].files.push_back(path);
-      series_[b.name].times.push_back(t);
-    }
-    if (file_.scene.fluid) {
-      const std::filesystem::path path = out_ / ("fluid_" + std::to_string(frame) + ".vtu");
-      if (Status s = write_fluid(sim, path); !s) return s;
-      series_["fluid"].files.push_back(path);
-      series_["fluid"].times.push_back(t);
-    }
-    return {};
-  }
-
-  Status finish() {
-    for (const auto& [name, s] : series_)
-      if (Status st = write_pvd(out_ / (name + ".pvd"), s.files, s.times); !st) return st;
-    return {};
-  }
-
- private:
-  Status write_body(Simulation& sim, const SceneInfo& info, const SceneBodyName& b, const std::filesystem::path& path) {
-    const SceneDesc& scene = file_.scene;
-    std::size_t first = 0, count = 0;
-    if (b.kind == BodyKind::tet) first = info.tet_body_first_particle[b.index], count = scene.tet_bodies[b.index].mesh.vertices.size();
-    if (b.kind == BodyKind::tri) first = info.tri_body_first_particle[b.index], count = scene.tri_bodies[b.index].mesh.vertices.size();
-    if (b.kind == BodyKind::line) first = info.line_body_first_particle[b.index], count = scene.line_bodies[b.index].vertices.size();
-    const std::span<const float> x = std::span<const float>(x_).subspan(4 * first, 4 * count);
-    if (b.kind == BodyKind::tet) {
-      // Each vertex's speed [m/s], as a point field.
-      speed_.resize(count);
-      for (std::size_t p = 0; p < count; ++p) {
-        const float* v = &v_[4 * (first + p)];
-        speed_[p] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      }
-      const VertexField fields[] = {{"speed", 1, speed_}};
-      if (!scene.topology_changes) return write_vtu(path, x, 4, scene.tet_bodies[b.index].mesh.tets, fields);
-      auto id = sim.topology().tet_body(b.index);
-      if (!id) return id.error();
-      auto tets = sim.topology().current_tets(*id);
-      if (!tets) return tets.error();
-      return write_vtu(path, x, 4, *tets, fields);
-    }
-    if (b.kind == BodyKind::tri) {
-      if (!scene.topology_changes) return write_vtu_triangles(path, x, 4, scene.tri_bodies[b.index].mesh.triangles);
-      auto id = sim.topology().tri_body(b.index);
-      if (!id) return id.error();
-      auto triangles = sim.topology().current_triangles(*id);
-      if (!triangles) return triangles.error();
-      return write_vtu_triangles(path, x, 4, *triangles);
-    }
-    return write_vtu_lines(path, x, 4, scene.line_bodies[b.index].segments);
-  }
-
-  Status write_fluid(Simulation& sim, const std::filesystem::path& path) {
-    if (Status s = sim.fluid().read(particles_); !s) return s;
-    xyz_.clear(), rho_.clear(), pressure_.clear(), velocity_.clear();
-    for (const FluidParticle& p : particles_) {
-      xyz_.insert(xyz_.end(), p.position.begin(), p.position.end());
-      velocity_.insert(velocity_.end(), p.velocity.begin(), p.velocity.end());
-      rho_.push_back(p.density);
-      pressure_.push_back(p.pressure);
-    }
-    const VertexField fields[] = {{"density", 1, rho_}, {"pressure", 1, pressure_}, {"velocity", 3, velocity_}};
-    return write_vtu_points(path, xyz_, 3, fields);
-  }
-
-  const SceneFile& file_;
-  std::filesystem::path out_;
-  std::map<std::string, Series> series_;
-  std::vector<float> x_, v_, speed_, xyz_, rho_, pressure_, velocity_;
-  std::vector<FluidParticle> particles_;
-};
 
 // Progress: a bar redrawn in place on a terminal; nothing when piped
 // (the output lines say how far it is).
@@ -208,12 +119,13 @@ int run_scene(const RunOptions& o) {
               file->scene.solver.iterations);
   std::fflush(stdout);
 
-  std::optional<VtuOutput> vtu;
+  std::optional<SceneOutput> vtk;
   if (!o.out.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.out, ec);
-    if (ec) return fail(o.out + ": cannot be made (" + ec.message() + ")");
-    vtu.emplace(*file, o.out);
+    auto made = SceneOutput::create(file->scene, o.out, {.bodies = file->bodies});
+    if (!made) return fail(made.error().message());
+    vtk.emplace(std::move(*made));
+    // Frame 0: the scene as it starts.
+    if (Status s = vtk->write(*sim, 0); !s) return fail(s.error().message());
   }
   ScriptPlayer player(file->script);
   Progress progress(frames, isatty(fileno(stdout)) != 0);
@@ -234,15 +146,12 @@ int run_scene(const RunOptions& o) {
       if (output) print_frame(f, st);
       std::fflush(stdout);
     }
-    if (output && vtu)
-      if (Status s = vtu->write(*sim, f); !s) return fail(s.error().message());
+    if (output && vtk)
+      if (Status s = vtk->write(*sim, f); !s) return fail(s.error().message());
     progress.update(f, total_ms / f);
   }
   progress.clear();
-  if (vtu) {
-    if (Status s = vtu->finish(); !s) return fail(s.error().message());
-    std::printf("wrote VTU series (one .pvd per body) to %s\n", o.out.c_str());
-  }
+  if (vtk) std::printf("wrote %s/scene.pvd (every body, collider, tool and needle, one .vtm per frame)\n", o.out.c_str());
   if (!o.positions.empty()) {
     if (Status s = write_positions(*sim, o.positions); !s) return fail(s.error().message());
     std::printf("wrote %u particles' final positions to %s\n", info.particles, o.positions.c_str());

@@ -14,10 +14,13 @@
 #include "backends/cpu/cpu_device.h"
 #include "backends/cpu/cpu_sharing.h"
 #include "backends/cpu/cpu_team.h"
+#include "hooks/hooks_internal.h"
 
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <memory>
+#include <new>
 #include <string>
 #include <thread>
 
@@ -96,20 +99,51 @@ std::uint32_t item_cost_ns(Kernel kernel) {
   }
 }
 
-// 64-byte aligned, zero-filled host memory.
+constexpr std::size_t kBufferAlignment = 64;
+
+// 64-byte aligned, zero-filled host memory: from the engine's allocation
+// hooks when it set them (sinew/hooks.h), given back through the same
+// hooks, else from the C++ heap.
+// (The deleter is declared outside HostBuffer: a nested class with member
+// initialisers is not yet default-constructible inside its enclosing class.)
+struct FreeHostMemory {
+  std::shared_ptr<const AllocationHooks> hooks;  // null: the heap
+  std::size_t bytes = 0;                         // as allocated (rounded)
+  void operator()(std::byte* p) const {
+    if (hooks)
+      hooks->deallocate(p, bytes, kBufferAlignment);
+    else
+      ::operator delete[](p, std::align_val_t{kBufferAlignment});
+  }
+};
+
 struct HostBuffer {
-  struct Free {
-    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t{64}); }
-  };
+  using Free = FreeHostMemory;
   std::unique_ptr<std::byte[], Free> data;
   std::size_t bytes = 0;  // 0: destroyed
   std::string label;
 };
 
 // Round up so kernels may read whole float4s at the end of any buffer.
-std::unique_ptr<std::byte[], HostBuffer::Free> allocate(std::size_t bytes) {
-  const std::size_t rounded = (bytes + 63) / 64 * 64;
-  std::unique_ptr<std::byte[], HostBuffer::Free> p(static_cast<std::byte*>(::operator new[](rounded, std::align_val_t{64})));
+// out_of_memory, naming the buffer, when neither the hooks nor the heap has it.
+Result<std::unique_ptr<std::byte[], HostBuffer::Free>> allocate(const std::shared_ptr<const AllocationHooks>& hooks,
+                                                                std::size_t bytes, std::string_view label) {
+  const std::size_t rounded = (bytes + kBufferAlignment - 1) / kBufferAlignment * kBufferAlignment;
+  void* memory = nullptr;
+  if (hooks) {
+    try {
+      memory = hooks->allocate(rounded, kBufferAlignment);
+    } catch (...) {  // an engine's allocator that throws has no memory either
+      memory = nullptr;
+    }
+  } else {
+    memory = ::operator new[](rounded, std::align_val_t{kBufferAlignment}, std::nothrow);
+  }
+  if (!memory)
+    return Error(ErrorCode::out_of_memory, "cpu buffer '" + std::string(label) + "': " + std::to_string(rounded) +
+                                               " bytes could not be allocated" +
+                                               (hooks ? " (the allocation hook returned none)" : ""));
+  std::unique_ptr<std::byte[], HostBuffer::Free> p(static_cast<std::byte*>(memory), HostBuffer::Free{hooks, rounded});
   std::fill_n(p.get(), rounded, std::byte{0});
   return p;
 }
@@ -150,7 +184,7 @@ class CpuDevice final : public Device {
   CpuDevice(int threads, bool simd, bool adaptive)
       : simd_(simd),
         adaptive_(adaptive),
-        team_(static_cast<unsigned>(threads)),
+        team_(static_cast<unsigned>(threads), hooks::tasks()->start_thread),
         shares_(team_.members()),
         busy_(team_.members()) {}
 
@@ -163,8 +197,10 @@ class CpuDevice final : public Device {
 
   Result<BufferHandle> create_buffer(std::size_t bytes, std::string_view label) override {
     if (bytes == 0) return Error(ErrorCode::internal, "create_buffer '" + std::string(label) + "': size must be > 0");
+    auto data = allocate(allocation_hooks_, bytes, label);
+    if (!data) return data.error();
     HostBuffer b;
-    b.data = allocate(bytes);
+    b.data = std::move(*data);
     b.bytes = bytes;
     b.label = label;
     buffers_.push_back(std::move(b));
@@ -186,9 +222,10 @@ class CpuDevice final : public Device {
     auto b = live_buffer(buffer, "resize_buffer");
     if (!b) return b.status();
     if (bytes == 0) return Error(ErrorCode::internal, "resize_buffer '" + (*b)->label + "': size must be > 0");
-    auto data = allocate(bytes);
-    std::memcpy(data.get(), (*b)->data.get(), std::min(bytes, (*b)->bytes));
-    (*b)->data = std::move(data);
+    auto data = allocate(allocation_hooks_, bytes, (*b)->label);
+    if (!data) return data.error();
+    std::memcpy(data->get(), (*b)->data.get(), std::min(bytes, (*b)->bytes));
+    (*b)->data = std::move(*data);
     (*b)->bytes = bytes;
     sizes_[buffer.id] = bytes;
     ++generation_;
@@ -439,6 +476,9 @@ class CpuDevice final : public Device {
 
   bool simd_;
   bool adaptive_;  // DeviceOptions::cpu_adaptive_team
+  // The engine's allocation hooks when the device was made (sinew/hooks.h);
+  // each buffer holds them too, to be freed through them.
+  std::shared_ptr<const AllocationHooks> allocation_hooks_ = hooks::allocation();
   CpuTeam team_;   // runs every program worth sharing
   Shares shares_;  // each member's part of a shared dispatch
   struct alignas(64) Busy {

@@ -103,15 +103,35 @@ Count await_change(const std::atomic<std::uint32_t>& word, std::uint32_t old, st
 
 }  // namespace
 
-CpuTeam::CpuTeam(unsigned members) {
+CpuTeam::CpuTeam(unsigned members, const StartThread& start_thread) {
   const unsigned asked = members < 1 ? 1 : members;
-  // A thread the system refuses ends the team where it is: a smaller team
-  // computes the same results (a dispatch's split does not change them).
+  hooked_running_ = std::make_shared<std::atomic<std::uint32_t>>(0);
+  // A thread the system (or the engine's hook) refuses ends the team where
+  // it is: a smaller team computes the same results (a dispatch's split
+  // does not change them).
   for (unsigned m = 1; m < asked; ++m) {
-    try {
-      workers_.emplace_back([this, m] { worker(m); });
-    } catch (const std::system_error&) {
-      break;
+    if (start_thread) {
+      hooked_running_->fetch_add(1);
+      bool started = false;
+      try {
+        started = start_thread([this, m, running = hooked_running_] {
+          worker(m);
+          // The team may be destroyed from here on: only `running` is touched.
+          running->fetch_sub(1);
+          running->notify_all();
+        });
+      } catch (...) {  // an engine's hook that throws refuses the thread too
+      }
+      if (!started) {
+        hooked_running_->fetch_sub(1);
+        break;
+      }
+    } else {
+      try {
+        workers_.emplace_back([this, m] { worker(m); });
+      } catch (const std::system_error&) {
+        break;
+      }
     }
     members_ = m + 1;
   }
@@ -122,6 +142,8 @@ CpuTeam::~CpuTeam() {
   job_.fetch_add(1, std::memory_order_seq_cst);
   wake(job_);
   for (std::thread& t : workers_) t.join();
+  for (std::uint32_t left = hooked_running_->load(); left != 0; left = hooked_running_->load())
+    hooked_running_->wait(left);
 }
 
 // Wakes the sleepers on `word` after it changed. Dekker's pattern: the

@@ -39,6 +39,8 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -46,11 +48,15 @@ namespace sinew {
 
 class CpuTeam {
  public:
+  /// Starts a worker's loop on a thread of its own at once, or returns
+  /// false (an engine's TaskHooks::start_thread, sinew/hooks.h).
+  using StartThread = std::function<bool(std::function<void()> loop)>;
   /// A team of `members` threads: the caller of run() and members - 1
-  /// workers started here. members >= 1; workers that cannot be started
-  /// (the system refused a thread) leave a smaller team, never an
-  /// exception: members() says how many there are.
-  explicit CpuTeam(unsigned members);
+  /// workers started here, on std::thread or, given [in] start_thread, on
+  /// the threads it starts. members >= 1; workers that cannot be started
+  /// (the system or start_thread refused a thread) leave a smaller team,
+  /// never an exception: members() says how many there are.
+  explicit CpuTeam(unsigned members, const StartThread& start_thread = {});
   ~CpuTeam();
   CpuTeam(const CpuTeam&) = delete;
   CpuTeam& operator=(const CpuTeam&) = delete;
@@ -82,6 +88,9 @@ class CpuTeam {
 
   unsigned members_ = 1;
   std::vector<std::thread> workers_;
+  // Workers on an engine's threads (TaskHooks::start_thread) still running;
+  // shared with their loops, so the last one can signal after the team is gone.
+  std::shared_ptr<std::atomic<std::uint32_t>> hooked_running_;
   // The job: published by bumping job_; stop_ ends the workers.
   void (*work_)(void*, unsigned) = nullptr;
   void* context_ = nullptr;

@@ -1,26 +1,34 @@
-# Tutorial.PageMatchesCode: the C++ block of docs/getting_started.md between
-# its "tutorial code" markers must be docs/tutorial/first_scene.cpp exactly,
-# so the code a reader copies is the code Tutorial.FirstScene builds and runs.
-#   cmake -DSOURCE_DIR=<repository> -P check_page.cmake
+# Tutorial.PageMatchesCode (and CApi.PageMatchesCode): the code block of a
+# page between its "tutorial code" markers must be the program's file
+# exactly, so the code a reader copies is the code a test builds and runs.
+#   cmake -DSOURCE_DIR=<repository> [-DPAGE=docs/c_api.md -DCODE=examples/capi_hello.c -DFENCE=c]
+#         -P check_page.cmake
+# (by default docs/getting_started.md and docs/tutorial/first_scene.cpp, a cpp block)
 cmake_minimum_required(VERSION 3.16)
-file(READ "${SOURCE_DIR}/docs/getting_started.md" page)
-file(READ "${SOURCE_DIR}/docs/tutorial/first_scene.cpp" code)
+if(NOT PAGE)
+  set(PAGE docs/getting_started.md)
+  set(CODE docs/tutorial/first_scene.cpp)
+  set(FENCE cpp)
+endif()
+file(READ "${SOURCE_DIR}/${PAGE}" page)
+file(READ "${SOURCE_DIR}/${CODE}" code)
 string(FIND "${page}" "<!-- tutorial code:" begin)
 string(FIND "${page}" "<!-- end of tutorial code -->" end)
 if(begin LESS 0 OR end LESS begin)
-  message(FATAL_ERROR "docs/getting_started.md: the tutorial code's markers are missing")
+  message(FATAL_ERROR "${PAGE}: the tutorial code's markers are missing")
 endif()
 math(EXPR length "${end} - ${begin}")
 string(SUBSTRING "${page}" ${begin} ${length} block)
-string(FIND "${block}" "```cpp\n" open)
+string(FIND "${block}" "```${FENCE}\n" open)
 string(FIND "${block}" "\n```\n" close REVERSE)
 if(open LESS 0 OR close LESS open)
-  message(FATAL_ERROR "docs/getting_started.md: no ```cpp block between the tutorial code's markers")
+  message(FATAL_ERROR "${PAGE}: no ```${FENCE} block between the tutorial code's markers")
 endif()
-math(EXPR open "${open} + 7")
+string(LENGTH "```${FENCE}\n" fence_length)
+math(EXPR open "${open} + ${fence_length}")
 math(EXPR length "${close} + 1 - ${open}")
 string(SUBSTRING "${block}" ${open} ${length} shown)
 if(NOT shown STREQUAL code)
-  message(FATAL_ERROR "docs/getting_started.md shows other code than docs/tutorial/first_scene.cpp: copy the file into the page")
+  message(FATAL_ERROR "${PAGE} shows other code than ${CODE}: copy the file into the page")
 endif()
-message(STATUS "docs/getting_started.md shows docs/tutorial/first_scene.cpp exactly")
+message(STATUS "${PAGE} shows ${CODE} exactly")

@@ -83,7 +83,9 @@ struct CutReport {
 /// visited by one call (capacity_exceeded): a sphere's or box's whole
 /// grown box, a surface's bands (about its area / h^2 voxels per layer) or
 /// its whole box when the inside is filled, a cut's swept box; a cut
-/// places a capsule or box at most 2^20 times (capacity_exceeded).
+/// places a capsule or box at most 2^20 times and makes at most 2^30
+/// distance evaluations, its swept box's voxels x those poses
+/// (capacity_exceeded).
 /// Whatever OpenVDB still throws becomes an error (bad_parameter, or
 /// out_of_memory for an allocation): no call throws.
 class LevelSet {

@@ -155,14 +155,14 @@ void scale_mesh(TriMesh& mesh, double factor);
 /// kept so indices match). Deterministic order.
 TriMesh extract_boundary_surface(const TetMesh& mesh);
 
-/// A per-vertex field written to VTU: 1 (scalar) or 3 (vector) components.
+/// A per-vertex (or per-cell: VtkGrid) field written to VTU: 1 (scalar) or 3 (vector) components.
 struct VertexField {
   std::string name;               ///< the field's name in the file
   int components = 1;             ///< 1 or 3
   std::span<const float> values;  ///< vertex_count * components values
 };
 
-/// Writes a VTK XML unstructured grid (.vtu, ASCII) of tets with per-vertex
+/// Writes a VTK XML unstructured grid (.vtu, binary, zlib: vtk_output.h) of tets with per-vertex
 /// fields. [in] positions: xyz per vertex [m], as 3 floats per vertex
 /// (stride 3) or 4 (stride 4, the w component is skipped).
 /// Errors name the file or the field whose size is wrong.

@@ -28,6 +28,7 @@
 #include "sinew/level_set.h"
 #include "sinew/result.h"
 #include "sinew/scene.h"
+#include "sinew/topology.h"
 
 namespace sinew {
 
@@ -135,15 +136,34 @@ Result<SceneFile> load_scene_file(const std::filesystem::path& path);
 /// names in it. Messages start with the JSON path.
 Result<SceneFile> parse_scene_json(std::string_view json, const std::filesystem::path& base_dir);
 
+/// What one of the script's actions did (ScriptPlayer::before_frame), for
+/// callers that react to it (a renderer updating its meshes, bindings
+/// handing it on) rather than print it.
+struct ScriptEvent {
+  int frame = 1;  ///< the frame whose step() follows the action
+  ScriptActionKind kind = ScriptActionKind::close_grasper;
+  std::uint32_t index = 0;  ///< the grasper, body, collider, emitter or sink (ScriptAction::index)
+  /// close_grasper: the particles now held; open_grasper: those released
+  /// (read_positions order).
+  std::vector<std::uint32_t> particles;
+  TopologyEvent topology;  ///< cut, cauterize, remove: what the change did
+  CutReport collider_cut;  ///< cut_collider: what the cut removed
+  std::string text;        ///< one line saying what happened, as `sinew run` prints it
+};
+
 /// Plays a SceneScript on a Simulation made from its scene, frame by frame.
 class ScriptPlayer {
  public:
   explicit ScriptPlayer(SceneScript script);
   /// Sets the poses and forces of frame `frame` (>= 1) and runs its
   /// actions; call it before the step() that makes that frame, for frames
-  /// 1, 2, 3, ... in order. [out] events, when given, gets what the
-  /// actions' topology changes did. Errors: the first failing call's.
+  /// 1, 2, 3, ... in order. [out] events, when given, gets a line per
+  /// grasp, topology change and collider cut the actions made (emitters and
+  /// sinks say nothing). Errors: the first failing call's.
   Status before_frame(Simulation& sim, int frame, std::vector<std::string>* events = nullptr);
+  /// As before_frame above; [out] events gets (appended) what each of the
+  /// frame's actions did, set_emitter and set_sink included.
+  Status before_frame(Simulation& sim, int frame, std::vector<ScriptEvent>& events);
 
  private:
   SceneScript script_;

@@ -26,6 +26,7 @@
 #include "sinew/scene_fluid.h"
 #include "sinew/tools.h"
 #include "sinew/topology.h"
+#include "sinew/warnings.h"
 
 namespace sinew {
 
@@ -74,10 +75,12 @@ struct StageProfile {
   std::string name;  ///< the stage's name, e.g. "mesh collision"
   double ms = 0.0;  ///< wall time of the stage's work in the last step() [ms]
   /// The stage's own figures of the last step(), by name (the units in the
-  /// name: "margin_m"); FrameStats::counter reads one. Mesh collision:
-  /// contacts, colors, margin_m, violation_m; continuous collision: hits,
+  /// name: "margin_m"); FrameStats::counter reads one. A counter
+  /// "X_capacity" is the capacity of counter "X" (warned near it:
+  /// sinew/warnings.h). Mesh collision: contacts, colors, pairs,
+  /// pairs_capacity, margin_m, violation_m; continuous collision: hits,
   /// repairs, reverted, carried, forced; sutures: host_ms; fluid:
-  /// particles, steps.
+  /// particles, particles_capacity, steps.
   struct Counter {
     std::string name;    ///< e.g. "contacts", "margin_m"
     double value = 0.0;  ///< its value in the last step()
@@ -235,6 +238,12 @@ class Simulation {
   /// not > 0 or checkpoint_every 0 (each named), a scene save_state refuses.
   Status set_divergence_settings(const DivergenceSettings& settings);
   [[nodiscard]] const DivergenceSettings& divergence_settings() const;
+  /// [in] settings: the per-frame warnings' thresholds (sinew/warnings.h),
+  /// from the next step() on. Errors (bad_parameter, nothing changed):
+  /// frame_budget_ms < 0, repeat_seconds not > 0, capacity_fraction outside
+  /// (0, 1], or a non-finite value, each named.
+  Status set_warning_settings(const WarningSettings& settings);
+  [[nodiscard]] const WarningSettings& warning_settings() const;
 
   /// [out] out: the state after the last frame (sinew/saved_state.h), its
   /// bytes replaced (their capacity reused: saving every frame allocates

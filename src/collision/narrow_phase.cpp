@@ -9,10 +9,10 @@
 #include <string>
 #include <tuple>
 
-#include <tbb/parallel_for.h>
 
 #include "math/proximity_math.h"
 #include "math/triangle_separation.h"
+#include "hooks/hooks_internal.h"
 
 namespace sinew::collision {
 namespace {
@@ -179,18 +179,19 @@ Status in_chunks(std::size_t pairs, std::vector<Contact>& contacts, const Contac
   const std::size_t chunks = (pairs + kChunk - 1) / kChunk;
   std::vector<std::vector<Contact>> found(chunks);
   std::vector<Status> errors(chunks);
-  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-    for (std::size_t k = c * kChunk; k < std::min(pairs, (c + 1) * kChunk); ++k) {
-      const std::size_t before = found[c].size();
-      if (Status s = per_pair(k, found[c]); !s) {
-        errors[c] = s;
-        return;
+  hooks::parallel_for(chunks, 1, [&](std::size_t first_chunk, std::size_t end_chunk) {
+    for (std::size_t c = first_chunk; c < end_chunk; ++c)
+      for (std::size_t k = c * kChunk; k < std::min(pairs, (c + 1) * kChunk); ++k) {
+        const std::size_t before = found[c].size();
+        if (Status s = per_pair(k, found[c]); !s) {
+          errors[c] = s;
+          break;
+        }
+        if (keep)
+          found[c].erase(std::remove_if(found[c].begin() + std::ptrdiff_t(before), found[c].end(),
+                                        [&](const Contact& x) { return !keep(x); }),
+                         found[c].end());
       }
-      if (keep)
-        found[c].erase(std::remove_if(found[c].begin() + std::ptrdiff_t(before), found[c].end(),
-                                      [&](const Contact& x) { return !keep(x); }),
-                       found[c].end());
-    }
   });
   for (const Status& e : errors)
     if (!e) return e;

@@ -1,6 +1,7 @@
 // normal_cones.cpp — normal cones and connectivity of BVH nodes (see
 // normal_cones.h).
 #include "collision/normal_cones.h"
+#include "hooks/hooks_internal.h"
 
 #include <algorithm>
 #include <array>
@@ -8,7 +9,6 @@
 #include <cmath>
 #include <numeric>
 
-#include <tbb/parallel_invoke.h>
 
 namespace sinew::collision {
 namespace {
@@ -189,7 +189,7 @@ void NormalCones::connect(const Bvh& tree, std::span<const std::uint32_t> triang
       for (const auto& p : pairs) boundary_[next[p[0]]++] = p[1];
     }
   };
-  tbb::parallel_invoke(connectivity, open_edges, boundaries);
+  hooks::parallel_invoke({connectivity, open_edges, boundaries});
   leaves_.clear();
   for (std::size_t i = 0; i < n; ++i)
     if (nodes[i].count > 0) leaves_.push_back(static_cast<std::uint32_t>(i));

@@ -1,8 +1,8 @@
 // parallel_pairs.cpp — the task split and the TBB loop of the parallel
 // self-pair query (see parallel_pairs.h).
 #include "collision/parallel_pairs.h"
+#include "hooks/hooks_internal.h"
 
-#include <tbb/parallel_for.h>
 
 namespace sinew::collision::detail {
 
@@ -43,7 +43,9 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_tasks(const Bvh& tree,
 }
 
 void run_tasks(std::size_t count, void (*work)(void*, std::size_t), void* context) {
-  tbb::parallel_for(std::size_t{0}, count, [&](std::size_t k) { work(context, k); });
+  hooks::parallel_for(count, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) work(context, k);
+  });
 }
 
 }  // namespace sinew::collision::detail

@@ -114,6 +114,22 @@ Status check_device_ranges(const SceneDesc& scene) {
   if (Status s = check_all(scene.graspers, "graspers", compliance); !s) return s;
   if (scene.mesh_collision.enabled)
     if (Status s = each("mesh_collision", scene.mesh_collision.compliance); !s) return s;
+  // Rigid tools and needles: their mass and moments divide their forces
+  // into moves of a float32 pose; each, and its inverse, a normal float.
+  const auto rigid = [](const auto& item, const std::string& name) -> Status {
+    const auto normal = [&](const std::string& field, double v, const char* unit) -> Status {
+      if (std::isnormal(static_cast<float>(v)) && std::isnormal(static_cast<float>(1.0 / v))) return {};
+      return Error(ErrorCode::bad_parameter, name + field + " = " + str(v) + " " + unit +
+                                                 ": it and its inverse must be normal float32 numbers (about 1e-38 "
+                                                 "to 3e38), the device's precision");
+    };
+    if (Status s = normal(".mass", item.mass, "kg"); !s) return s;
+    for (int k = 0; k < 3; ++k)
+      if (Status s = normal(".inertia[" + std::to_string(k) + "]", item.inertia[k], "kg m^2"); !s) return s;
+    return {};
+  };
+  if (Status s = check_all(scene.tools, "tools", rigid); !s) return s;
+  if (Status s = check_all(scene.needles, "needles", rigid); !s) return s;
   return {};
 }
 

@@ -35,6 +35,61 @@ Status finite3(const std::string& name, const std::array<double, 3>& v) {
   return {};
 }
 
+// What the device computes from the settings (Fluid::create's parameter
+// blocks, sph_params), each checked in float32, the device's precision: a
+// setting finite in double can give an infinite kernel constant (a spacing
+// of 1e-30 m: 1 / (pi l^3) = 1e90) or one that rounds to 0 (a divisor), and
+// then NaN after a step. `scale` values must be finite; `divisor` ones
+// finite and a normal float (not 0, not denormal).
+Status check_device_floats(const FluidSettings& settings) {
+  const double h = settings.support * settings.spacing, l = 0.5 * h, c = settings.speed_of_sound;
+  const double rho0 = settings.rest_density, dt = settings.time_step;
+  struct Derived {
+    const char* what;  // the quantity and its formula
+    double value;
+    bool divisor;
+  };
+  std::vector<Derived> derived = {
+      {"the kernels' support squared h^2 [m^2]", h * h, true},
+      {"the kernels' 1 / l (l = h / 2) [1/m]", 1.0 / l, false},
+      {"the kernels' 1 / (pi l^3) [1/m^3]", 1.0 / (std::numbers::pi * l * l * l), false},
+      {"the kernels' 1 / (pi l^4) [1/m^4]", 1.0 / (std::numbers::pi * l * l * l * l), false},
+      {"the viscosity's 0.01 h^2 [m^2]", 0.01 * h * h, true},
+      {"a particle's mass rho0 spacing^3 [kg]", rho0 * std::pow(settings.spacing, 3), true},
+      {"rest_density [kg/m^3]", rho0, true},
+      {"the pressure stiffness rho0 c0^2 / 7 [Pa]", rho0 * c * c / 7.0, true},
+      {"the pressure's acceleration scale c0^2 / h [m/s^2]", c * c / h, false},
+      {"its change of velocity per step c0^2 dt / h [m/s]", c * c * dt / h, false},
+      {"the viscosity's alpha c0 h [m^2/s]", settings.viscosity * c * h, false},
+      {"the boundary viscosity's alpha c0 h [m^2/s]", settings.boundary_viscosity * c * h, false},
+      {"time_step [s]", dt, true}};
+  for (int k = 0; k < 3; ++k) {
+    derived.push_back({"gravity [m/s^2]", settings.gravity[k], false});
+    derived.push_back({"gravity's change of velocity per step g dt [m/s]", settings.gravity[k] * dt, false});
+  }
+  if (settings.surface_tension > 0.0) {
+    derived.push_back({"surface tension's cohesion 32 / (pi h^9) [1/m^9]", 32.0 / (std::numbers::pi * std::pow(h, 9)), false});
+    derived.push_back({"surface tension's h^6 / 64 [m^6]", std::pow(h, 6) / 64.0, true});
+    derived.push_back({"surface tension's dt^2 [s^2]", dt * dt, true});
+    derived.push_back({"surface_tension", settings.surface_tension, false});
+  }
+  if (settings.method == FluidMethod::pbf) {
+    derived.push_back({"PBF's 1 / rho0 [m^3/kg]", 1.0 / rho0, true});
+    derived.push_back({"PBF's 1 / dt [1/s]", 1.0 / dt, false});
+  }
+  for (const Derived& d : derived) {
+    const float f = static_cast<float>(d.value);
+    const bool ok = std::isfinite(f) && (!d.divisor || std::isnormal(f));
+    if (ok) continue;
+    return Error(ErrorCode::bad_parameter,
+                 "sph: these settings (spacing " + str(settings.spacing) + " m, support " + str(settings.support) +
+                     ", rest_density " + str(rho0) + ", speed_of_sound " + str(c) + ", time_step " + str(dt) +
+                     ") give " + d.what + " = " + str(d.value) + ", which in float32, the device's precision, is " +
+                     (std::isfinite(f) ? "0 or denormal" : "not finite"));
+  }
+  return {};
+}
+
 Status check_settings(const FluidSettings& settings) {
   for (const auto& [name, value] : {std::pair{"spacing", settings.spacing}, {"rest_density", settings.rest_density},
                                     {"speed_of_sound", settings.speed_of_sound}, {"time_step", settings.time_step}})
@@ -55,6 +110,7 @@ Status check_settings(const FluidSettings& settings) {
       return Error(ErrorCode::bad_parameter, "sph: pbf_iterations must be >= 1 (got " + std::to_string(settings.pbf_iterations) + ")");
     return positive("pbf_relaxation", settings.pbf_relaxation);
   }
+  if (Status s = check_device_floats(settings); !s) return s;
   // The CFL condition for the speed of sound (Monaghan 2005): reported, never clamped.
   const double h = settings.support * settings.spacing;
   const double cfl = 0.4 * h / settings.speed_of_sound;
@@ -351,6 +407,11 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
           stiffness += gradient * gradient / mass;
         }
     q.epsilon = float(settings.pbf_relaxation * stiffness);
+    if (!std::isnormal(q.epsilon))
+      return Error(ErrorCode::bad_parameter, "sph: pbf_relaxation " + str(settings.pbf_relaxation) +
+                                                 " gives PBF's relaxation epsilon = " +
+                                                 str(settings.pbf_relaxation * stiffness) +
+                                                 ", which in float32, the device's precision, is not a normal number");
     m.pbf_params_ = q;
   }
 

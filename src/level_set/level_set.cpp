@@ -314,6 +314,9 @@ ColliderDesc cutter_collider(const CutterShape& shape) {
 // The most poses a cut places a capsule or box at (2^20: a motion of
 // 2^19 voxels).
 constexpr double kMaxCutPoses = 1048576.0;
+// The most tool-distance evaluations one cut may make (voxels x poses),
+// 2^30: tens of seconds on one core, where a burr's stroke makes ~10^5.
+constexpr double kMaxCutEvaluations = 1073741824.0;
 
 // How far the tool reaches from its origin [m].
 double shape_reach(const CutterShape& shape) {
@@ -410,6 +413,14 @@ Result<CutReport> LevelSet::cut(const CutterShape& shape, const Pose& from, cons
   const Result<level_set::VoxelBox> box = level_set::voxel_box("LevelSet::cut", "the tool's sweep", lo, hi, margin, h);
   if (!box) return box.error();
   if (Status s = level_set::check_visited("LevelSet::cut", "the tool's sweep", box->count(), h); !s) return s.error();
+  // Each voxel of the box may be tested against every pose: the total is
+  // bounded too, not only each factor.
+  const double evaluations = double(box->count()) * double(std::max<std::size_t>(1, poses.size()));
+  if (!(evaluations <= kMaxCutEvaluations))
+    return Error(ErrorCode::capacity_exceeded,
+                 "LevelSet::cut: the tool's sweep spans " + str(double(box->count())) + " voxels, each tested against " +
+                     str(double(poses.size())) + " poses: " + str(evaluations) + " distance evaluations, more than " +
+                     str(kMaxCutEvaluations) + ": cut in shorter steps");
   const std::array<int, 3> first = box->first, last = box->last;
   auto* nano = impl_->nano.grid<float>();
   auto nano_access = nano->getAccessor();

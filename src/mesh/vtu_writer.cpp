@@ -1,41 +1,25 @@
-// write_vtu and write_pvd: VTK XML files for ParaView.
+// write_vtu, write_vtu_lines, write_vtu_triangles, write_vtu_points and
+// write_pvd (mesh.h): each checks its cells by kind (errors name the tet,
+// segment or triangle), then writes a binary VTU through write_vtu(VtkGrid)
+// (vtk_output.h: appended raw data, zlib-compressed).
 //
-// Format reference: "VTK File Formats", VTK User's Guide / docs.vtk.org,
-// section "XML File Formats" (UnstructuredGrid: Piece, PointData, Points,
-// Cells with connectivity/offsets/types; cell type 10 = VTK_TETRA) and the
-// ParaView Data (.pvd) Collection format.
-//
-// Floats are written with std::to_chars' shortest round-trip form: at most
-// max_digits10 (9) significant digits and exactly the stored float when read
-// back. The whole file is formatted in memory and written in one go.
-#include <cerrno>
+// Format reference: "VTK File Formats", docs.vtk.org, "XML File Formats"
+// (cell type 10 = VTK_TETRA, 3 = VTK_LINE, 5 = VTK_TRIANGLE, 1 = VTK_VERTEX)
+// and the ParaView Data (.pvd) Collection format.
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
 #include <string>
-#include <string_view>
-#include <system_error>
 #include <vector>
 
+#include "output/vtk_files.h"
 #include "sinew/mesh.h"
+#include "sinew/vtk_output.h"
 
 namespace sinew {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr int kVtkTetra = 10;
-constexpr int kVtkLine = 3;
-constexpr int kVtkTriangle = 5;
-constexpr int kVtkVertex = 1;
-
-void append_float(std::string& out, float v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
-}
 
 void append_double(std::string& out, double v) {
   char buf[32];
@@ -43,207 +27,53 @@ void append_double(std::string& out, double v) {
   out.append(buf, r.ptr);
 }
 
-void append_uint(std::string& out, std::uint64_t v) {
-  char buf[24];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
-}
-
-// Escapes text for an XML attribute value in double quotes.
-std::string xml_attribute(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-// Creates missing parent folders, then writes `text` to `path`.
-Status write_text_file(const fs::path& path, const std::string& text) {
-  std::error_code ec;
-  const fs::path parent = path.parent_path();
-  if (!parent.empty()) {
-    fs::create_directories(parent, ec);
-    if (ec)
-      return Error(ErrorCode::bad_input_file,
-                   path.string() + ": cannot create folder " + parent.string() + " (" + ec.message() + ")");
-  }
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out)
-    return Error(ErrorCode::bad_input_file,
-                 path.string() + ": cannot open file for writing (" + std::strerror(errno) + ")");
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  out.close();
-  if (!out) return Error(ErrorCode::bad_input_file, path.string() + ": write failed (disk full?)");
+// Names the first cell that refers to a missing vertex; the rest (stride,
+// fields) is checked by write_vtu(VtkGrid).
+template <std::size_t N>
+Status check_cells(const fs::path& path, std::span<const float> positions, int stride,
+                   std::span<const std::array<std::uint32_t, N>> cells, const char* cell) {
+  if ((stride != 3 && stride != 4) || positions.size() % static_cast<std::size_t>(stride) != 0) return {};
+  const std::size_t n = positions.size() / static_cast<std::size_t>(stride);
+  for (std::size_t t = 0; t < cells.size(); ++t)
+    for (std::uint32_t v : cells[t])
+      if (v >= n)
+        return Error(ErrorCode::bad_parameter, path.string() + ": " + cell + " " + std::to_string(t) +
+                                                   " refers to vertex " + std::to_string(v) + ", but there are only " +
+                                                   std::to_string(n) + " vertices");
   return {};
 }
 
-template <std::size_t N>
-Status check_vtu_input(const fs::path& path, std::span<const float> positions, int stride,
-                       std::span<const std::array<std::uint32_t, N>> tets,
-                       std::span<const VertexField> fields, const char* cell = "tet") {
-  const std::string where = path.string() + ": ";
-  if (stride != 3 && stride != 4) {
-    return Error(ErrorCode::bad_parameter, where + "stride must be 3 or 4 (got " + std::to_string(stride) + ")");
-  }
-  const auto s = static_cast<std::size_t>(stride);
-  if (positions.size() % s != 0) {
-    return Error(ErrorCode::bad_parameter,
-                 where + "positions holds " + std::to_string(positions.size()) +
-                 " floats, not a multiple of stride " + std::to_string(stride));
-  }
-  const std::size_t n = positions.size() / s;
-  for (std::size_t t = 0; t < tets.size(); ++t) {
-    for (std::uint32_t v : tets[t]) {
-      if (v >= n) {
-        return Error(ErrorCode::bad_parameter,
-                     where + cell + " " + std::to_string(t) + " refers to vertex " + std::to_string(v) +
-                     ", but there are only " + std::to_string(n) + " vertices");
-      }
-    }
-  }
-  for (const VertexField& f : fields) {
-    const std::string name = "field '" + f.name + "'";
-    if (f.name.empty()) return Error(ErrorCode::bad_parameter, where + "a field has an empty name");
-    if (f.components != 1 && f.components != 3) {
-      return Error(ErrorCode::bad_parameter,
-                   where + name + ": components must be 1 or 3 (got " + std::to_string(f.components) + ")");
-    }
-    const std::size_t expected = n * static_cast<std::size_t>(f.components);
-    if (f.values.size() != expected) {
-      return Error(ErrorCode::bad_parameter,
-                   where + name + " has " + std::to_string(f.values.size()) + " values, expected " +
-                   std::to_string(expected) + " (" + std::to_string(n) + " vertices x " +
-                   std::to_string(f.components) + " components)");
-    }
-  }
-  return {};
-}
-
-void append_field(std::string& out, const VertexField& f) {
-  out += "        <DataArray type=\"Float32\" Name=\"" + xml_attribute(f.name) + "\" NumberOfComponents=\"" +
-         std::to_string(f.components) + "\" format=\"ascii\">\n";
-  const auto c = static_cast<std::size_t>(f.components);
-  for (std::size_t i = 0; i < f.values.size(); i += c) {
-    out += "          ";
-    for (std::size_t k = 0; k < c; ++k) {
-      if (k) out += ' ';
-      append_float(out, f.values[i + k]);
-    }
-    out += '\n';
-  }
-  out += "        </DataArray>\n";
-}
-
-void append_points(std::string& out, std::span<const float> positions, std::size_t stride) {
-  out += "      <Points>\n";
-  out += "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (std::size_t i = 0; i < positions.size(); i += stride) {
-    out += "          ";
-    append_float(out, positions[i]);
-    out += ' ';
-    append_float(out, positions[i + 1]);
-    out += ' ';
-    append_float(out, positions[i + 2]);
-    out += '\n';
-  }
-  out += "        </DataArray>\n      </Points>\n";
-}
-
-// Cells of N vertices each, all of VTK type `type`.
-template <std::size_t N>
-void append_cells(std::string& out, std::span<const std::array<std::uint32_t, N>> cells, int type) {
-  out += "      <Cells>\n";
-  out += "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& t : cells) {
-    out += "          ";
-    for (std::size_t k = 0; k < N; ++k) {
-      if (k) out += ' ';
-      append_uint(out, t[k]);
-    }
-    out += '\n';
-  }
-  out += "        </DataArray>\n";
-  out += "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < cells.size(); ++t) {
-    out += "          ";
-    append_uint(out, N * (t + 1));
-    out += '\n';
-  }
-  out += "        </DataArray>\n";
-  out += "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < cells.size(); ++t) out += "          " + std::to_string(type) + "\n";
-  out += "        </DataArray>\n      </Cells>\n";
-}
-
-// The whole file: points, their fields and the cells.
+// Cells of N vertices each, all of type `type`, through write_vtu(VtkGrid).
 template <std::size_t N>
 Status write_cells(const fs::path& path, std::span<const float> positions, int stride,
-                   std::span<const std::array<std::uint32_t, N>> cells, std::span<const VertexField> fields, int type,
-                   const char* cell) {
-  if (Status s = check_vtu_input<N>(path, positions, stride, cells, fields, cell); !s) return s;
-  const auto s = static_cast<std::size_t>(stride);
-  std::string out;
-  // About 12 bytes per number keeps reallocation out of the formatting loop.
-  out.reserve(64 + 12 * (positions.size() + cells.size() * (N + 2)) + 12 * positions.size() / s * fields.size() * 3);
-  out += "<?xml version=\"1.0\"?>\n";
-  out +=
-      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-      "header_type=\"UInt64\">\n";
-  out += "  <UnstructuredGrid>\n";
-  out += "    <Piece NumberOfPoints=\"" + std::to_string(positions.size() / s) + "\" NumberOfCells=\"" +
-         std::to_string(cells.size()) + "\">\n";
-  out += "      <PointData>\n";
-  for (const VertexField& f : fields) append_field(out, f);
-  out += "      </PointData>\n";
-  append_points(out, positions, s);
-  append_cells<N>(out, cells, type);
-  out += "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
-  return write_text_file(path, out);
-}
-
-// The name to write for `file` in a .pvd in `folder`: relative when possible.
-std::string relative_name(const fs::path& file, const fs::path& folder) {
-  std::error_code ec;
-  const fs::path abs_file = fs::absolute(file, ec).lexically_normal();
-  if (ec) return file.generic_string();
-  const fs::path abs_folder = fs::absolute(folder.empty() ? fs::path(".") : folder, ec).lexically_normal();
-  if (ec) return file.generic_string();
-  const fs::path rel = abs_file.lexically_relative(abs_folder);
-  // Empty when the two have no common root (e.g. other drives): keep it absolute.
-  return rel.empty() ? abs_file.generic_string() : rel.generic_string();
+                   std::span<const std::array<std::uint32_t, N>> cells, std::span<const VertexField> fields,
+                   VtkCellType type, const char* cell) {
+  if (Status s = check_cells<N>(path, positions, stride, cells, cell); !s) return s;
+  std::vector<std::uint32_t> connectivity;
+  connectivity.reserve(N * cells.size());
+  for (const auto& c : cells) connectivity.insert(connectivity.end(), c.begin(), c.end());
+  std::vector<std::uint32_t> offsets(cells.size());
+  for (std::size_t c = 0; c < cells.size(); ++c) offsets[c] = static_cast<std::uint32_t>(N * (c + 1));
+  const std::vector<VtkCellType> types(cells.size(), type);
+  return write_vtu(path, VtkGrid{.positions = positions, .stride = stride, .connectivity = connectivity,
+                                 .offsets = offsets, .types = types, .point_fields = fields, .cell_fields = {}});
 }
 
 }  // namespace
 
 Status write_vtu(const std::filesystem::path& path, std::span<const float> positions, int stride,
                  std::span<const std::array<std::uint32_t, 4>> tets, std::span<const VertexField> fields) {
-  return write_cells<4>(path, positions, stride, tets, fields, kVtkTetra, "tet");
+  return write_cells<4>(path, positions, stride, tets, fields, VtkCellType::tetra, "tet");
 }
 
 Status write_vtu_lines(const std::filesystem::path& path, std::span<const float> positions, int stride,
                        std::span<const std::array<std::uint32_t, 2>> segments) {
-  return write_cells<2>(path, positions, stride, segments, {}, kVtkLine, "segment");
+  return write_cells<2>(path, positions, stride, segments, {}, VtkCellType::line, "segment");
 }
 
 Status write_vtu_triangles(const std::filesystem::path& path, std::span<const float> positions, int stride,
                            std::span<const std::array<std::uint32_t, 3>> triangles) {
-  return write_cells<3>(path, positions, stride, triangles, {}, kVtkTriangle, "triangle");
+  return write_cells<3>(path, positions, stride, triangles, {}, VtkCellType::triangle, "triangle");
 }
 
 Status write_vtu_points(const std::filesystem::path& path, std::span<const float> positions, int stride,
@@ -251,7 +81,7 @@ Status write_vtu_points(const std::filesystem::path& path, std::span<const float
   // One vertex cell per point, so ParaView shows and colours every point.
   std::vector<std::array<std::uint32_t, 1>> points(stride > 0 ? positions.size() / std::size_t(stride) : 0);
   for (std::size_t i = 0; i < points.size(); ++i) points[i] = {static_cast<std::uint32_t>(i)};
-  return write_cells<1>(path, positions, stride, points, fields, kVtkVertex, "point");
+  return write_cells<1>(path, positions, stride, points, fields, VtkCellType::vertex, "point");
 }
 
 Status write_pvd(const std::filesystem::path& path, std::span<const std::filesystem::path> vtu_files,
@@ -271,10 +101,10 @@ Status write_pvd(const std::filesystem::path& path, std::span<const std::filesys
   for (std::size_t i = 0; i < vtu_files.size(); ++i) {
     out += "    <DataSet timestep=\"";
     append_double(out, times[i]);
-    out += "\" group=\"\" part=\"0\" file=\"" + xml_attribute(relative_name(vtu_files[i], folder)) + "\"/>\n";
+    out += "\" group=\"\" part=\"0\" file=\"" + vtk_files::xml_attribute(vtk_files::relative_name(vtu_files[i], folder)) + "\"/>\n";
   }
   out += "  </Collection>\n</VTKFile>\n";
-  return write_text_file(path, out);
+  return vtk_files::write_file(path, out);
 }
 
 }  // namespace sinew

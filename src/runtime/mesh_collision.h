@@ -154,6 +154,10 @@ class MeshCollision {
   [[nodiscard]] const MeshContactBuffers& buffers() const { return buffers_; }
   [[nodiscard]] std::uint32_t contacts() const { return contact_count_; }  ///< this frame's
   [[nodiscard]] std::uint32_t colors() const { return color_count_; }      ///< this frame's
+  /// The last detection's candidate pairs of primitives (within the reach), at most pair_capacity().
+  [[nodiscard]] std::size_t candidate_pairs() const { return pairs_.size(); }
+  /// The most candidate pairs a detection may find; past it the frame fails with capacity_exceeded.
+  [[nodiscard]] static std::size_t pair_capacity();
   /// This frame's largest motion margin [m]: the reach of the fastest pair beyond the thickness.
   [[nodiscard]] double margin() const { return margin_; }
   /// Pairs of triangles closer than the thickness at the scene's start,

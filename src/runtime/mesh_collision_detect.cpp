@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include <tbb/parallel_invoke.h>
 
 #include "collision/parallel_pairs.h"
+#include "hooks/hooks_internal.h"
 
 namespace sinew {
 namespace {
@@ -222,6 +222,8 @@ bool MeshCollision::wanted_contact(const Contact& c, double common) const {
 // Boxes swollen by fast motion can pair most of two surfaces, and every
 // pair may make up to 15 contacts: past kMaxPairs the frame stops with an
 // error that says why, rather than exhausting memory.
+std::size_t MeshCollision::pair_capacity() { return kMaxPairs; }
+
 Status MeshCollision::check_pairs(float reach, float fastest) const {
   if (pairs_.size() <= kMaxPairs) return {};
   return Error(ErrorCode::capacity_exceeded,
@@ -352,12 +354,12 @@ Status MeshCollision::refit_triangle_trees(float half) {
   // Only trees built before this frame: a first build happens inside fit,
   // beside the cones (shape[b] == 0 until then; build ids start at 1).
   Status fitted;
-  tbb::parallel_invoke([&] { fitted = fit(triangles_, 3, triangle_body_, triangle_trees_, half); },
-                       [&] {
-                         if (!cull) return;
-                         for (std::size_t b = 0; b < triangle_trees_.size(); ++b)
-                           if (shape[b] != 0) cones_of(triangle_trees_[b]);
-                       });
+  hooks::parallel_invoke({[&] { fitted = fit(triangles_, 3, triangle_body_, triangle_trees_, half); },
+                          [&] {
+                            if (!cull) return;
+                            for (std::size_t b = 0; b < triangle_trees_.size(); ++b)
+                              if (shape[b] != 0) cones_of(triangle_trees_[b]);
+                          }});
   if (!fitted) return fitted;
   rebuild_degraded(triangle_trees_);
   if (cull)

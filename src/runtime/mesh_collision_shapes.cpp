@@ -13,10 +13,9 @@
 #include <cstdint>
 #include <span>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "collision/shape_distance.h"
+#include "hooks/hooks_internal.h"
 
 namespace sinew {
 namespace {
@@ -89,8 +88,8 @@ void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<co
     // triangle order so the contacts do not depend on the threads.
     found_.assign(triangles, Contact{});
     face_hit_.assign(triangles, 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles, 256), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t t = r.begin(); t < r.end(); ++t) {
+    hooks::parallel_for(triangles, 256, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
         const std::uint32_t* v = &triangles_[3 * t];
         if (!movable_[v[0]] && !movable_[v[1]] && !movable_[v[2]]) continue;
         math::Vec3 corner[3];

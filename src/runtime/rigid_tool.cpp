@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "compiler/device_ranges.h"
 #include "math/vec3.h"
 
 namespace sinew {
@@ -112,6 +114,30 @@ void integrate_tool(ToolBody& b, double dt, double stiffness) {
   for (double& c : r) c /= norm;
   b.rotation = r;
   b.force = b.torque = V3{0.0, 0.0, 0.0};
+}
+
+Status add_frame_force(ToolBody& b, const math::Vec3& force, const math::Vec3& torque, double dt, const std::string& who) {
+  math::Vec3 total_force{}, total_torque{};
+  for (int k = 0; k < 3; ++k) {
+    total_force[k] = b.force[k] + force[k];
+    total_torque[k] = b.torque[k] + torque[k];
+  }
+  const double f = std::sqrt(math::dot(total_force, total_force));
+  const double t = std::sqrt(math::dot(total_torque, total_torque));
+  const double move = dt * dt * f / b.mass;
+  const double turn = dt * dt * t / std::min({b.inertia[0], b.inertia[1], b.inertia[2]});
+  if (!(move <= kMaxFrameMove) || !(turn <= kMaxFrameMove)) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  ": this frame's force %.6g N and torque %.6g N m would move it time_step^2 F / m = %.6g m and turn "
+                  "it time_step^2 T / I = %.6g rad in one frame; each must be at most %.6g for the device's float32 "
+                  "pose (the forces set before stay)",
+                  f, t, move, turn, kMaxFrameMove);
+    return Error(ErrorCode::bad_parameter, who + text);
+  }
+  b.force = total_force;
+  b.torque = total_torque;
+  return {};
 }
 
 }  // namespace sinew

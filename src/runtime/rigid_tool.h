@@ -62,9 +62,11 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "math/vec3.h"
+#include "sinew/result.h"
 
 namespace sinew {
 
@@ -104,5 +106,13 @@ struct ToolBody {
 /// inertia (see rigid_tool.cpp). `stiffness` is n_it n_sub^2 (iterations
 /// times substeps squared).
 void integrate_tool(ToolBody& b, double dt, double stiffness);
+
+/// Adds [in] force [N] and torque [N m] to what acts on `b` during the
+/// next frame of [in] dt [s] (calls before one frame add up). Errors
+/// (bad_parameter, "<who>: ...", b unchanged): a total that would move the
+/// body more than kMaxFrameMove in the frame (dt^2 |F| / m) or turn it more
+/// than that many radians (dt^2 |T| / I, the least moment): the device
+/// holds its pose in float32.
+Status add_frame_force(ToolBody& b, const math::Vec3& force, const math::Vec3& torque, double dt, const std::string& who);
 
 }  // namespace sinew

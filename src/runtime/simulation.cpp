@@ -54,6 +54,7 @@ Result<Simulation> SimulationInternals::create(const SceneDesc& scene, std::uniq
 Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, CompiledScene& compiled_scene,
                                                  std::unique_ptr<Device> device) {
   using Impl = Simulation::Impl;
+  warn_about_scene(scene);
   CompiledScene* const compiled = &compiled_scene;  // as the Result it was
   auto impl = std::make_unique<Impl>();
   impl->device = std::move(device);
@@ -288,6 +289,7 @@ Status Simulation::step() {
   im.stats.frame += 1;
   im.stats.time = static_cast<double>(im.stats.frame) * im.time_step;
   im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
+  im.warnings.after_frame(im.stats);
   if (Status s = im.check_divergence(); !s) return s;
   return frame.deferred;
 }

@@ -37,6 +37,7 @@
 #include "math/vec3.h"
 #include "runtime/call_checks.h"
 #include "runtime/simulation_impl.h"
+#include "runtime/simulation_internals.h"
 #include "runtime/tool_contacts.h"
 #include "runtime/tool_penalty.h"
 
@@ -277,6 +278,11 @@ Status Simulation::set_collider_pose(std::size_t index, const std::array<double,
   return {};
 }
 
+Pose SimulationInternals::collider_pose(const Simulation& sim, std::size_t index) {
+  const auto e = load_words<ColliderEntry>(sim.impl_->colliders, entry_at(index));
+  return Pose{.position = {e.end_px, e.end_py, e.end_pz}, .rotation = {e.end_qw, e.end_qx, e.end_qy, e.end_qz}};
+}
+
 Status Simulation::set_target(std::size_t index, const std::array<double, 3>& position) {
   constexpr const char* call = "set_target";
   std::vector<float>& targets = impl_->targets;
@@ -299,11 +305,7 @@ Status Simulation::apply_tool_force(std::size_t index, const std::array<double, 
   if (Status s = check_finite(call, "force", force); !s) return s;
   if (Status s = check_finite(call, "torque", torque); !s) return s;
   ToolBody& b = tools[index];
-  for (int k = 0; k < 3; ++k) {  // calls before one frame add up
-    b.force[k] += force[k];
-    b.torque[k] += torque[k];
-  }
-  return {};
+  return add_frame_force(b, force, torque, impl_->time_step, std::string(call) + ": tool " + std::to_string(index));
 }
 
 Result<ToolState> Simulation::tool_state(std::size_t index) const {
@@ -339,7 +341,7 @@ Status Simulation::apply_needle_force(std::size_t index, const std::array<double
   if (Status s = check_index(call, "needle", index, impl_->sutures ? impl_->sutures->needles() : 0); !s) return s;
   if (Status s = check_finite(call, "force", force); !s) return s;
   if (Status s = check_finite(call, "torque", torque); !s) return s;
-  return impl_->sutures->apply_force(index, force, torque);
+  return impl_->sutures->apply_force(index, force, torque, impl_->time_step);
 }
 
 Result<NeedleState> Simulation::needle_state(std::size_t index) const {

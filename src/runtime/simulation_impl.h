@@ -23,6 +23,7 @@
 #include "runtime/topology_editor.h"
 #include "runtime/scene_fluid.h"
 #include "sinew/divergence.h"
+#include "runtime/frame_warnings.h"
 #include "sinew/saved_state.h"
 #include "sinew/simulation.h"
 
@@ -180,6 +181,7 @@ struct Simulation::Impl {
   Status restore_state(const SavedState& state, const std::string& what);
 
   DivergenceSettings divergence;
+  FrameWarnings warnings;  ///< sinew/warnings.h (frame_warnings.cpp)
   /// What the checks keep between frames: the last frame's kinetic energy,
   /// the scene's movable mass and starting extent, the force term of the
   /// energy bound for the coming frame (set_particle_forces) and the frame being run.

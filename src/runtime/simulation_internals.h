@@ -24,6 +24,10 @@ struct SimulationInternals {
   static const Device& device(const Simulation& sim);
   static const FrameProgram& program(const Simulation& sim);
   static double frame_length(const Simulation& sim);  ///< SolverSettings::time_step [s]
+  /// Collider `index`'s pose as last set (where it is at the end of the
+  /// next frame; after a step and before a new pose, where it is now), in
+  /// the device's float32. [pre] index < the scene's colliders.
+  static Pose collider_pose(const Simulation& sim, std::size_t index);
   /// Appends a stage to the frame: in every phase it runs after the
   /// scene's own, and FrameStats::stages gains its profile.
   static void add_stage(Simulation& sim, std::unique_ptr<FrameStage> stage);

@@ -152,14 +152,12 @@ Status Sutures::set_pose(std::size_t index, const Vec3& position, const math::Qu
   return {};
 }
 
-Status Sutures::apply_force(std::size_t index, const Vec3& force, const Vec3& torque) {
+Status Sutures::apply_force(std::size_t index, const Vec3& force, const Vec3& torque, double dt) {
   Needle& n = needles_[index];
   if (n.desc.drive != NeedleDrive::force)
     return Error(ErrorCode::bad_parameter, "apply_needle_force: needle " + std::to_string(index) +
                                                " is kinematic (NeedleDrive::kinematic): use set_needle_pose");
-  n.body.force = math::add(n.body.force, force);  // calls before one frame add up
-  n.body.torque = math::add(n.body.torque, torque);
-  return {};
+  return add_frame_force(n.body, force, torque, dt, "apply_needle_force: needle " + std::to_string(index));
 }
 
 std::vector<Vec3> Sutures::curve_at(const Needle& n, bool end) const {

@@ -69,7 +69,8 @@ class Sutures {
   /// Adds a force [N] and torque [N m] (world frame, about its origin) on
   /// force-driven needle `index` for the next frame. [pre] index <
   /// needles(), both finite. Errors: a kinematic needle.
-  Status apply_force(std::size_t index, const math::Vec3& force, const math::Vec3& torque);
+  /// [in] dt: the frame's time step [s] (add_frame_force checks the move it makes).
+  Status apply_force(std::size_t index, const math::Vec3& force, const math::Vec3& torque, double dt);
 
   /// Before a frame: reads the positions, finds the tips' contacts,
   /// uploads the needles and the rows.

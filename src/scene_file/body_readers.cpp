@@ -118,7 +118,7 @@ void check_indices(const std::vector<std::array<std::uint32_t, N>>& elements, st
                             std::to_string(vertices) + ")");
 }
 
-// A tet body's "mesh": {"file", "scale"} | {"grid", "remove"} | {"vertices", "tets"}.
+// A tet body's "mesh": {"file", "scale", "translate"} | {"grid", "remove"} | {"vertices", "tets"}.
 void read_tet_mesh_source(const Json& v, const std::string& path, const Where& where, Context& ctx, TetMesh& out) {
   Object o(v, path, ctx);
   const int sources = o.has("file") + o.has("grid") + o.has("vertices");
@@ -126,6 +126,10 @@ void read_tet_mesh_source(const Json& v, const std::string& path, const Where& w
     return ctx.fail(ErrorCode::bad_input_file, path, "needs exactly one of \"file\", \"grid\" or \"vertices\"");
   double scale = 1.0;
   read_scale(o, scale);
+  // Placed where the scene needs it (a mesh file's own coordinates rarely
+  // are): added after the scale, as a C++ scene adds it to scaled vertices.
+  Vec3d translate{0.0, 0.0, 0.0};
+  o.read("translate", translate);
   if (o.has("file")) {
     const std::filesystem::path p = read_file_member(o, where, ctx);
     if (ctx.failed()) return;
@@ -151,6 +155,9 @@ void read_tet_mesh_source(const Json& v, const std::string& path, const Where& w
   }
   o.finish();
   if (!ctx.failed() && scale != 1.0) scale_mesh(out, scale);
+  if (!ctx.failed() && translate != Vec3d{0.0, 0.0, 0.0})
+    for (auto& vertex : out.vertices)
+      for (int k = 0; k < 3; ++k) vertex[k] += translate[k];
 }
 
 // A tri body's "mesh": {"file" (binary STL), "scale"} | {"vertices", "triangles"}.
@@ -226,9 +233,21 @@ void read_elastic(Object& o, Body& body) {
 
 std::filesystem::path resolve_file(const Where& where, const std::string& name, const std::string& path,
                                    Context& ctx) {
+  std::error_code ec;
+  if (name.starts_with(kDataPrefix)) {
+    const DataFolder data = data_folder();
+    const std::filesystem::path p = data.path / name.substr(kDataPrefix.size());
+    if (!std::filesystem::is_regular_file(p, ec))
+      ctx.fail(ErrorCode::bad_input_file, path,
+               p.string() + " is not a readable file (\"" + std::string(kDataPrefix) + "\" names are found in " +
+                   (data.from_environment ? "the environment variable SINEW_DATA_DIR's folder, " + data.path.string()
+                                          : "the build's data folder " + data.path.string() +
+                                                "; the environment variable SINEW_DATA_DIR names another") +
+                   ")");
+    return p;
+  }
   const std::filesystem::path p = std::filesystem::path(name).is_absolute() ? std::filesystem::path(name)
                                                                              : where.base_dir / name;
-  std::error_code ec;
   if (!std::filesystem::is_regular_file(p, ec))
     ctx.fail(ErrorCode::bad_input_file, path, p.string() + " is not a readable file");
   return p;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 #include "scene_file/json_fields.h"
@@ -17,9 +18,23 @@ struct Where {
   std::filesystem::path base_dir;
 };
 
-/// A file the document names: relative to the scene file's folder
-/// (absolute ones stay), and a regular file (not a folder, a device or a
-/// pipe a read would wait on), else an error at `path`.
+/// The prefix of a file name found in the data folder: "data:meshes/tet/x.node".
+inline constexpr std::string_view kDataPrefix = "data:";
+
+/// The data folder "data:" names are found in (data_folder.cpp).
+struct DataFolder {
+  std::filesystem::path path;
+  bool from_environment = false;  ///< SINEW_DATA_DIR was set (else the build's data folder)
+};
+/// The environment variable SINEW_DATA_DIR when set and not empty, else
+/// the data folder the library was built with (the build's SINEW_DATA_DIR,
+/// where the packed meshes are unpacked).
+DataFolder data_folder();
+
+/// A file the document names: "data:REST" is REST in data_folder(); others
+/// are relative to the scene file's folder (absolute ones stay); and a
+/// regular file (not a folder, a device or a pipe a read would wait on),
+/// else an error at `path` (for a "data:" name, saying where it looked).
 std::filesystem::path resolve_file(const Where& where, const std::string& name, const std::string& path,
                                    Context& ctx);
 /// The object's "file" member, read and resolved (resolve_file); empty

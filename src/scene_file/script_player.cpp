@@ -122,6 +122,15 @@ Result<TopologyEvent> topology_action(Simulation& sim, const ScriptAction& a) {
 }  // namespace
 
 Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::string>* events) {
+  std::vector<ScriptEvent> done;
+  if (Status s = before_frame(sim, frame, done); !s) return s;
+  if (events)
+    for (ScriptEvent& e : done)
+      if (!e.text.empty()) events->push_back(std::move(e.text));
+  return {};
+}
+
+Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<ScriptEvent>& events) {
   if (grasper_closed_.size() < sim.graspers().count()) grasper_closed_.resize(sim.graspers().count(), false);
   for (const ScriptTrack& t : script_.poses)
     if (Status s = pose_track(sim, t, interpolate_keys(t.keys, frame), grasper_closed_); !s) return s;
@@ -131,6 +140,8 @@ Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::s
     const ScriptAction& a = script_.actions[next_action_++];
     if (a.frame < frame) continue;  // a frame skipped by the caller
     const std::string at = "frame " + std::to_string(frame) + ": ";
+    ScriptEvent event;
+    event.frame = frame, event.kind = a.kind, event.index = a.index;
     switch (a.kind) {
       case ScriptActionKind::close_grasper:
       case ScriptActionKind::open_grasper: {
@@ -140,9 +151,9 @@ Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::s
                                                               : sim.graspers().open(*id);
         if (!held) return held.error();
         grasper_closed_[a.index] = a.kind == ScriptActionKind::close_grasper;
-        if (events)
-          events->push_back(at + (a.kind == ScriptActionKind::close_grasper ? "grasper closed on " : "grasper released ") +
-                            std::to_string(held->size()) + " vertices");
+        event.text = at + (a.kind == ScriptActionKind::close_grasper ? "grasper closed on " : "grasper released ") +
+                     std::to_string(held->size()) + " vertices";
+        event.particles = std::move(*held);
         break;
       }
       case ScriptActionKind::cut:
@@ -151,7 +162,8 @@ Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::s
         auto e = topology_action(sim, a);
         if (!e) return e.error();
         const char* what = a.kind == ScriptActionKind::cut ? "cut" : a.kind == ScriptActionKind::cauterize ? "cautery" : "removal";
-        if (events) events->push_back(at + describe(what, *e));
+        event.text = at + describe(what, *e);
+        event.topology = std::move(*e);
         break;
       }
       case ScriptActionKind::cut_collider: {
@@ -159,7 +171,8 @@ Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::s
         if (!id) return id.error();
         auto r = sim.tools().cut(*id, a.cutter, a.from, a.to);
         if (!r) return r.error();
-        if (events) events->push_back(at + "collider cut, " + std::to_string(r->removed_volume * 1e9) + " mm^3 removed");
+        event.text = at + "collider cut, " + std::to_string(r->removed_volume * 1e9) + " mm^3 removed";
+        event.collider_cut = *r;
         break;
       }
       case ScriptActionKind::set_emitter:
@@ -169,6 +182,7 @@ Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::s
         if (Status s = sim.fluid().set_sink(a.index, a.sink); !s) return s;
         break;
     }
+    events.push_back(std::move(event));
   }
   return {};
 }

@@ -2,7 +2,9 @@
 // Consumer.* tests): a small block of soft tissue, pinned on its x = 0 face,
 // sags under gravity on the cpu backend for a few frames. It fails unless
 // every position is finite and the block has sagged, and (when the build
-// says which version it expects) unless sinew/version.h agrees.
+// says which version it expects) unless sinew/version.h agrees; the
+// installed C API header (sinew/sinew.h) compiles as C++ and its library
+// says the same version.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -12,6 +14,7 @@
 
 #include <sinew/mesh.h>
 #include <sinew/simulation.h>
+#include <sinew/sinew.h>
 #include <sinew/version.h>
 
 int main() {
@@ -24,6 +27,11 @@ int main() {
     return 1;
   }
 #endif
+  if (sinew_version() != SINEW_VERSION) {
+    std::fprintf(stderr, "the C API's sinew_version() is %u, sinew/version.h says %d\n", unsigned(sinew_version()),
+                 SINEW_VERSION);
+    return 1;
+  }
 
   // 8 cm x 2 cm x 4 cm, 4 x 1 x 2 cells of 2 cm.
   auto mesh = sinew::make_tet_grid({.nx = 4, .ny = 1, .nz = 2, .cell_size = {0.02, 0.02, 0.02}});

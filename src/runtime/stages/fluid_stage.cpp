@@ -19,6 +19,7 @@ class FluidStage final : public FrameStage {
   }
   void report(StageProfile& profile) const override {
     profile.set("particles", sim_.fluid->solver->stats().particles);
+    profile.set("particles_capacity", sim_.fluid->solver->capacity());
     profile.set("steps", sim_.fluid->info.steps_per_frame);
   }
 

@@ -61,6 +61,8 @@ class MeshCollisionStage final : public FrameStage {
     const MeshCollision& collision = *sim_.mesh_collision;
     profile.set("contacts", collision.contacts());
     profile.set("colors", collision.colors());
+    profile.set("pairs", static_cast<double>(collision.candidate_pairs()));
+    profile.set("pairs_capacity", static_cast<double>(MeshCollision::pair_capacity()));
     profile.set("margin_m", collision.margin());
     profile.set("violation_m", collision.violation());
   }
