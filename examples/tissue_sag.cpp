@@ -5,9 +5,9 @@
 // lowest point within 1 mm of where it ends). The tissue is damped by a
 // velocity damping of 4 1/s (TetBodyDesc::velocity_damping: velocities decay
 // as exp(-4 t) in free motion), which lets it swing down past its sagged
-// shape once or twice and settle in ~1.3 s (a linear cantilever estimate of
+// shape once or twice and settle in ~1.6 s (a linear cantilever estimate of
 // the tip's static sag, q L^4 / (8 E I), is about 80 mm; the block ends at
-// ~99 mm). --velocity-damping 0 shows the undamped swing (60-110 mm for
+// ~75 mm). --velocity-damping 0 shows the undamped swing (35-85 mm for
 // seconds). Stiffness damping (--stiffness-damping TAU) is the physical,
 // Rayleigh-like one, but at this example's 20 substeps x 1 iteration each
 // sweep moves only 1 / (1 + tau / h) of the way to equilibrium, so a tau

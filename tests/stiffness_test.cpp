@@ -183,6 +183,33 @@ TEST_P(Stiffness, WarmStartUnderAShortBudgetStaysFinite) {
   EXPECT_GT(r.deflection, -0.08) << "the 8 cm cantilever folded over";
 }
 
+// The warm start with a cap too low to converge (100 sweeps at one
+// substep, a tolerance never met): every substep stops at the cap, far
+// from its tolerance, and passes no lambdas on. Carried on, they fed the
+// error back and this cantilever reached NaN at frame 42; dropped, it
+// stays finite and sags as far as 100 sweeps from rest let it, each frame
+// saying it did not converge.
+TEST(StiffnessCpu, WarmStartAtTheCapDropsItsLambdasAndStaysFinite) {
+  SolverSettings s = residual_mode(1, 1e-9);
+  s.max_iterations = 100;
+  auto sim = test::create_or_skip(cantilever(s), "cpu");
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  std::vector<float> x;
+  for (int f = 0; f < 60; ++f) {
+    ASSERT_TRUE(sim->step().ok());
+    const FrameStats& st = sim->last_frame();
+    EXPECT_EQ(st.stop, SolveStop::iteration_cap) << "frame " << f;
+    EXPECT_FALSE(st.converged()) << "frame " << f;
+    EXPECT_EQ(st.dropped_warm_starts, 1u) << "frame " << f;
+    EXPECT_TRUE(std::isfinite(st.checked_residual)) << "frame " << f;
+  }
+  ASSERT_TRUE(sim->read_positions(x).ok());
+  for (float v : x) ASSERT_TRUE(std::isfinite(v));
+  const double d = tip_deflection(cantilever(s), x);
+  EXPECT_LT(d, 0.0);
+  EXPECT_GT(d, -0.08) << "the 8 cm cantilever folded over";
+}
+
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }

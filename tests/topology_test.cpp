@@ -177,9 +177,12 @@ TEST_P(Topology, EveryColourStaysValidThroughManyRemovals) {
 TEST_P(Topology, AStripPulledPastItsThresholdTearsAndBelowItDoesNot) {
   // A strip of 10 x 1 x 1 cells pinned at both ends, its right end held
   // 30% (or 10%) beyond its rest length: tear_strain 0.2 tears the first
-  // within a frame and never the second.
+  // within a frame and never the second. 40 substeps: at 20 (a Courant
+  // number of 1.4 per substep for the 300 kPa network) the unresolved
+  // release from 10% overshot past 20% on some edge and tore.
   for (const double stretch : {0.3, 0.1}) {
     SceneDesc scene = pad(10, 1, 1, [](const Vec3d& p) { return p[0] < 1e-9 || p[0] > 10 * kCell - 1e-9; });
+    scene.solver.substeps = 40;
     TetBodyDesc& body = scene.tet_bodies[0];
     body.tear_strain = 0.2;
     for (const Vec3d& v : body.mesh.vertices) body.initial_vertices.push_back({v[0] * (1.0 + stretch), v[1], v[2]});

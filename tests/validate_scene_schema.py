@@ -32,6 +32,8 @@ base = json.loads((scenes / "tissue_sag.json").read_text())
 bad = {
     "unknown key": lambda s: s["tet_bodies"][0].update({"densty": 1}),
     "negative density": lambda s: s["tet_bodies"][0].update({"density": -1}),
+    # set_elastic refuses nu < 0.2 (a spring network cannot reach it).
+    "elastic poisson_ratio below 0.2": lambda s: s["tet_bodies"][0]["elastic"].update({"poisson_ratio": 0.1}),
     "unknown action": lambda s: s.update({"script": {"actions": [{"frame": 1, "do": "explode"}]}}),
 }
 for what, spoil in bad.items():

@@ -43,14 +43,22 @@ enum class TetMaterial { none, neo_hookean, stvk, corotational };
 /// A volumetric body simulated on a tet mesh with xPBD constraints.
 ///
 /// Distance constraints (one per mesh edge) resist stretch; volume
-/// constraints (one per tet) resist volume change. Compliances are given as
-/// the inverse of a modulus [1/Pa] and scaled per element so the body's
-/// response does not depend on how finely it is meshed:
-///  - edge e of rest length L with a share V_e of the volumes of its tets
+/// constraints (one per tet) resist volume change. Two ways to set their
+/// compliances:
+///  - set_elastic(E, nu) (calibrated_network): each tet's six edge springs
+///    and its volume stiffness are fitted to that tet's linear-elastic
+///    (constant-strain) stiffness for E and nu, and an edge's spring is the
+///    sum of its tets' (docs/materials.md: the fit, the nu it can reach,
+///    the accuracy measured against a linear-elastic solve of the same
+///    mesh). effective_moduli() reports the E and nu a body got.
+///  - distance_compliance and volume_compliance [1/Pa] by hand, scaled per
+///    element so the response does not depend on how finely it is meshed:
+///    edge e of rest length L with a share V_e of the volumes of its tets
 ///    (each tet gives V/6 to each of its 6 edges): alpha_e = c_d * L^2 / V_e
-///    [m/N], the spring k = E V_e / L^2 whose energy is (E/2) strain^2 V_e;
-///  - tet of rest volume V: alpha = c_v * V [m^3/Pa], i.e. the energy
-///    (K/2) (dV/V)^2 V with bulk modulus K = 1 / c_v.
+///    [m/N]; tet of rest volume V: alpha = c_v * V [m^3/Pa], the energy
+///    (K/2) (dV/V)^2 V with K = 1 / c_v. Such a network is not a material
+///    of modulus 1/c_d: on a regular grid its Young's modulus is about a
+///    quarter of 1/c_d (docs/materials.md).
 /// Compliance 0 makes a constraint rigid (solved as a hard constraint).
 struct TetBodyDesc {
   TetMesh mesh;                         ///< rest shape [m]; must pass check_tet_mesh
@@ -80,19 +88,53 @@ struct TetBodyDesc {
   /// (use velocity_damping there). Bodies with different taus get separate
   /// constraint blocks (more dispatches per sweep).
   double stiffness_damping = 0.0;
-  double youngs_modulus = 0.0;          ///< E [Pa], > 0 when material != none
-  double poisson_ratio = 0.0;           ///< nu, in (-1, 0.5) when material != none
+  double youngs_modulus = 0.0;          ///< E [Pa], > 0 when material != none or calibrated_network
+  double poisson_ratio = 0.0;           ///< nu, in (-1, 0.5) when material != none or calibrated_network
+  /// true (set by set_elastic): the distance and volume compliances come
+  /// from youngs_modulus and poisson_ratio, fitted per tet, and
+  /// distance_compliance and volume_compliance are ignored.
+  bool calibrated_network = false;
 
-  /// Sets both compliances from Young's modulus E [Pa] (> 0) and Poisson's
-  /// ratio nu (in (-1, 0.5)): c_d = 1/E, c_v = 3 (1 - 2 nu) / E. This is
-  /// the usual approximation of a linear material by an edge network plus
-  /// volume constraints, not an FEM material. Errors name the parameter.
+  /// Makes the distance + volume network approximate the linear material
+  /// of Young's modulus E [Pa] (> 0) and Poisson's ratio nu (in [0.2, 0.5))
+  /// in small strain: sets youngs_modulus, poisson_ratio and
+  /// calibrated_network. Each tet's springs and volume term are fitted to
+  /// its constant-strain stiffness, towards a target chosen so that the
+  /// body's mean stiffness has E, nu and the shear modulus along the axes
+  /// (effective_moduli reports them). An edge network is not isotropic, so
+  /// a body's response still differs from linear elasticity's on the same
+  /// mesh by up to about 30% depending on the load (docs/materials.md has
+  /// the measurements). nu below 0.2 is an error naming poisson_ratio:
+  /// springs are central forces (use set_material). Errors name the
+  /// parameter.
   Status set_elastic(double young, double poisson);
 
   /// Makes this an FEM body: sets material, E [Pa] and nu, and turns the
   /// distance and volume constraints off. Errors name the parameter.
   Status set_material(TetMaterial model, double young, double poisson);
 };
+
+/// Small-strain isotropic moduli.
+struct ElasticModuli {
+  double young = 0.0;    ///< Young's modulus E [Pa]
+  double poisson = 0.0;  ///< Poisson's ratio nu
+  double shear = 0.0;    ///< shear modulus G [Pa]
+  double bulk = 0.0;     ///< bulk modulus K [Pa]
+};
+
+/// What a tet body's distance + volume constraints amount to as a linear
+/// material along the coordinate axes: from the mean over its tets of the
+/// network's small-strain stiffness (springs and volume terms under a
+/// uniform strain, inverted to a compliance S), E = 1 / S_xxxx, nu =
+/// -E S_xxyy and G = 1 / (4 S_xyxy), each averaged over the three axes,
+/// and K. For set_elastic(E, nu) this is E, nu and E / (2 (1 + nu)) to
+/// within the fit (about 1e-3); for compliances set by hand it says what
+/// they mean (on a regular grid, E about a quarter of 1 / c_d). It is the
+/// mean of a uniform strain: a mesh whose nodes relax non-uniformly (not a
+/// regular grid) is softer (docs/materials.md). [in] body: a body with
+/// distance or volume constraints and a valid mesh. Errors name the
+/// parameter.
+Result<ElasticModuli> effective_moduli(const TetBodyDesc& body);
 
 /// Particles joined by distance constraints: a chain, or a suture thread.
 ///
@@ -426,8 +468,11 @@ struct SolverSettings {
   /// sweeps per frame); sweeping to a tolerance keeps each substep implicit.
   /// For the same reason a substep that stops at the time budget passes
   /// nothing on: the next substep starts from lambda = 0 (cold). One that
-  /// stops at max_iterations does pass its lambdas on (a cap far below what
-  /// converges carries the fixed mode's risk). Only for
+  /// stops at max_iterations passes its lambdas on only if its sweeps
+  /// lowered the residual and it ended within 10x residual_tolerance; else
+  /// it starts its successor cold too, so a cap far below what converges
+  /// stays finite at the fixed mode's softness (FrameStats::
+  /// dropped_warm_starts counts those substeps). Only for
   /// scenes of distance and volume constraints (tet bodies without an FEM
   /// material, line bodies without bending; no colliders, no mesh
   /// collision): others are an error naming this setting.

@@ -144,6 +144,17 @@ struct FrameStats {
   /// measure as residual_rms, also when measure_errors is off). 0 in fixed mode.
   double checked_residual = 0.0;
   std::uint32_t residual_checks = 0;  ///< residual mode: checks (round trips) in the last frame
+  /// Residual mode with SolverSettings::warm_start: substeps of the last
+  /// frame whose lambdas were not carried into the next substep (or
+  /// frame), because the substep ended at max_iterations with a residual no
+  /// lower than at its first check (not converging: carried on, such
+  /// lambdas diverged) — the time budget's stops are not counted.
+  std::uint32_t dropped_warm_starts = 0;
+  /// Whether the last frame's solve converged: every substep's residual
+  /// reached SolverSettings::residual_tolerance. Always false in fixed mode
+  /// (no residual is checked there; residual_rms says how far it was).
+  [[nodiscard]] bool converged() const { return stop == SolveStop::converged; }
+
   // ---- Per-feature figures, kept for one release: each is also a counter
   // of its stage (StageProfile::counters, FrameStats::counter), where new
   // figures go.

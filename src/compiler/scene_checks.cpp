@@ -6,6 +6,7 @@
 #include <string>
 
 #include "compiler/device_ranges.h"
+#include "compiler/edge_network.h"
 #include "contact_params.h"
 #include "math/vec3.h"
 #include "compiler/scene_compiler.h"
@@ -77,7 +78,7 @@ Status check_tet_body(const TetBodyDesc& b, const std::string& name) {
   if (Status s = non_negative(name + ".distance_compliance", b.distance_compliance); !s) return s;
   if (Status s = non_negative(name + ".volume_compliance", b.volume_compliance); !s) return s;
   if (Status s = check_damping(name, b.velocity_damping, b.stiffness_damping); !s) return s;
-  if (b.material != TetMaterial::none)
+  if (b.material != TetMaterial::none || (b.calibrated_network && (b.distance_constraints || b.volume_constraints)))
     if (Status s = check_elastic(name + ".", b.youngs_modulus, b.poisson_ratio); !s) return s;
   if (Status s = check_initial(name, b.initial_vertices, b.mesh.vertices.size()); !s) return s;
   return check_pinned(name, b.pinned, b.mesh.vertices.size());
@@ -376,8 +377,14 @@ Status check_mesh_collision(const SceneDesc& scene) {
 
 Status TetBodyDesc::set_elastic(double young, double poisson) {
   if (Status s = check_elastic("", young, poisson); !s) return s;
-  distance_compliance = 1.0 / young;
-  volume_compliance = 3.0 * (1.0 - 2.0 * poisson) / young;
+  if (poisson < kNetworkMinPoisson)
+    return Error(ErrorCode::bad_parameter,
+                 "poisson_ratio below " + str(kNetworkMinPoisson) + " (got " + str(poisson) +
+                     ") cannot be reached by a distance + volume network (its springs are central forces); "
+                     "use set_material for a lower Poisson's ratio");
+  youngs_modulus = young;
+  poisson_ratio = poisson;
+  calibrated_network = true;
   return {};
 }
 

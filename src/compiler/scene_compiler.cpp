@@ -11,6 +11,7 @@
 
 #include "coloring/greedy_coloring.h"
 #include "compiler/device_ranges.h"
+#include "compiler/edge_network.h"
 #include "compiler/particle_order.h"
 #include "compiler/solve_order.h"
 #include "contact_params.h"
@@ -41,12 +42,19 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
     for (std::uint32_t k : q) b.mass[first + k] += body.density * v / 4.0;
   }
 
+  // set_elastic: each tet's springs and volume term fitted to linear
+  // elasticity (compiler/edge_network.h); else the compliances as given.
+  std::vector<TetNetworkFit> fits;
+  if (body.calibrated_network && (body.distance_constraints || body.volume_constraints))
+    fits = fit_body_network(body.mesh, body.youngs_modulus, body.poisson_ratio).tets;
+
   if (body.volume_constraints) {
     RawConstraints& volume = b.volume_constraints(body.stiffness_damping);
     for (std::size_t t = 0; t < tets.size(); ++t) {
       for (std::uint32_t k : tets[t]) volume.particles.push_back(first + k);
-      const double alpha = body.volume_compliance * rest_volume[t];
-      if (Status s = check_device_compliance(name, ".volume_compliance", alpha, b.step); !s) return s;
+      const double alpha = fits.empty() ? body.volume_compliance * rest_volume[t] : 1.0 / fits[t].volume;
+      const char* field = fits.empty() ? ".volume_compliance" : ".youngs_modulus (its fitted volume alpha)";
+      if (Status s = check_device_compliance(name, field, alpha, b.step); !s) return s;
       volume.data.push_back(rest_volume[t]);
       volume.data.push_back(static_cast<float>(alpha));
     }
@@ -59,24 +67,33 @@ Status add_tet_body(SceneBuilder& b, const TetBodyDesc& body, const std::string&
     std::vector<Edge> edges;
     edges.reserve(tets.size() * 6);
     auto each_edge = [&](const auto& tet, auto&& fn) {
-      static constexpr int kPairs[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-      for (const auto& pr : kPairs) fn(Edge{std::min(tet[pr[0]], tet[pr[1]]), std::max(tet[pr[0]], tet[pr[1]])});
+      for (const auto& pr : kTetEdgePairs) fn(Edge{std::min(tet[pr[0]], tet[pr[1]]), std::max(tet[pr[0]], tet[pr[1]])});
     };
     for (const auto& tet : tets) each_edge(tet, [&](Edge e) { edges.push_back(e); });
     std::sort(edges.begin(), edges.end());
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    // Hand-set: the volume share V_e; calibrated: the spring k_e [N/m],
+    // each summed over the edge's tets in tet order (as the topology
+    // editor sums them again after a tet is removed).
     std::vector<double> share(edges.size(), 0.0);
-    for (std::size_t t = 0; t < tets.size(); ++t)
+    for (std::size_t t = 0; t < tets.size(); ++t) {
+      int local = 0;
       each_edge(tets[t], [&](Edge e) {
-        share[std::lower_bound(edges.begin(), edges.end(), e) - edges.begin()] += rest_volume[t] / 6.0;
+        share[std::lower_bound(edges.begin(), edges.end(), e) - edges.begin()] +=
+            fits.empty() ? rest_volume[t] / 6.0 : fits[t].edge[local];
+        ++local;
       });
+    }
     RawConstraints& distance = b.distance_constraints(body.stiffness_damping);
     for (std::size_t i = 0; i < edges.size(); ++i) {
       const float len = kernels::edge_length(b.positions[first + edges[i].first], b.positions[first + edges[i].second]);
       distance.particles.push_back(first + edges[i].first);
       distance.particles.push_back(first + edges[i].second);
-      const double alpha = body.distance_compliance * static_cast<double>(len) * len / share[i];  // c L^2 / V
-      if (Status s = check_device_compliance(name, ".distance_compliance", alpha, b.step); !s) return s;
+      // Hand-set: c L^2 / V; calibrated: 1 / k.
+      const double alpha =
+          fits.empty() ? body.distance_compliance * static_cast<double>(len) * len / share[i] : 1.0 / share[i];
+      const char* field = fits.empty() ? ".distance_compliance" : ".youngs_modulus (its fitted spring alpha)";
+      if (Status s = check_device_compliance(name, field, alpha, b.step); !s) return s;
       distance.data.push_back(len);
       distance.data.push_back(static_cast<float>(alpha));
     }

@@ -16,6 +16,10 @@
 #include <string>
 
 namespace sinew {
+
+// A substep stopped at max_iterations passes its lambdas on only if it
+// ended within this many times the residual tolerance (run_frame).
+constexpr double kCarryAtCap = 10.0;
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -249,12 +253,14 @@ Status SolveStepper::run_frame(Device& device, FrameStats& stats, SubstepHook* h
     if (Status st = run(device, end_, stats.device, false); !st) return st;
     stats.sweeps = sweeps;
     stats.stop = SolveStop::fixed;
+    stats.dropped_warm_starts = 0;
     return {};
   }
   if (!residual_mode_) {
     if (Status s = run(device, whole_, stats.device, true); !s) return s;
     stats.sweeps = std::uint64_t(solver_.substeps) * std::uint64_t(iterations);
     stats.stop = SolveStop::fixed;
+    stats.dropped_warm_starts = 0;
     return {};
   }
   const auto frame_start = Clock::now();
@@ -262,7 +268,7 @@ Status SolveStepper::run_frame(Device& device, FrameStats& stats, SubstepHook* h
   const int c = solver_.check_interval;
   SolveStop worst = SolveStop::converged;
   std::uint64_t sweeps_total = 0;
-  std::uint32_t checks = 0;
+  std::uint32_t checks = 0, cold = 0;
   CheckedResidual r;
   for (int s = 0; s < substeps; ++s) {
     const auto begin_start = Clock::now();
@@ -270,14 +276,20 @@ Status SolveStepper::run_frame(Device& device, FrameStats& stats, SubstepHook* h
     // lambdas, a few sweeps from 0, act like a late explicit force and a
     // stiff body diverges (measured: NaN within seconds at a 4.5 ms budget
     // on the 10,368-tet block); its successor starts from 0. A substep at
-    // the cap passes its lambdas on: thousands of sweeps leave them near
-    // the answer, and a cold start there can never get back (plain sweeps
-    // from 0 stall at a residual of ~2e-5 on that block).
+    // the cap passes its lambdas on when they are near the answer: its
+    // sweeps lowered the residual and it ended within kCarryAtCap times the
+    // tolerance (thousands of sweeps leave them there, and a cold start can
+    // never get back: plain sweeps from 0 stall at a residual of ~2e-5 on
+    // that block). Other capped substeps drop them (carried on, a stiff
+    // beam warm-started at one substep and capped every frame at 500 or
+    // 2000 sweeps reached NaN by frame 33-41; dropped, it stays finite at
+    // the softness of its sweeps, as in the fixed mode).
     const ProgramHandle first = begin_cold_.empty() || warm_ ? begin_[s] : begin_cold_[s];
     if (Status st = run(device, first, stats.device, s == 0); !st) return st;
     auto read = read_residual_check(device, check_);
     if (!read) return read.error();
     r = *read;
+    const double first_rms = r.rms;
     ++checks;
     const double begin_ms = ms_since(begin_start);
     int sweeps = iterations;
@@ -311,7 +323,10 @@ Status SolveStepper::run_frame(Device& device, FrameStats& stats, SubstepHook* h
       chunk_ms_ = ms_since(chunk_start);
       sweeps += c;
     }
-    warm_ = stop != SolveStop::time_budget;
+    const bool diverging = stop == SolveStop::iteration_cap &&
+                           !(r.rms < first_rms && r.rms <= kCarryAtCap * solver_.residual_tolerance);
+    warm_ = stop != SolveStop::time_budget && !diverging;
+    if (diverging) ++cold;
     if (rank(stop) > rank(worst)) worst = stop;
     sweeps_total += std::uint64_t(sweeps);
     if (per_substep_)
@@ -320,6 +335,7 @@ Status SolveStepper::run_frame(Device& device, FrameStats& stats, SubstepHook* h
   if (Status st = run(device, end_, stats.device, false); !st) return st;
   stats.sweeps = sweeps_total;
   stats.stop = worst;
+  stats.dropped_warm_starts = cold;
   stats.checked_residual = r.rms;
   stats.residual_checks = checks;
   return {};

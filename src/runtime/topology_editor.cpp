@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "compiler/edge_network.h"
 #include "math/thin_math.h"
 #include "mesh/tet_faces.h"
 #include "math/xpbd_math.h"
@@ -141,6 +142,9 @@ Result<std::unique_ptr<TopologyEditor>> TopologyEditor::create(const SceneDesc& 
     b.mass_density = desc.density;
     b.edge_depth = 1.0;
     b.distance_compliance = desc.distance_compliance;
+    if (desc.calibrated_network && desc.distance_constraints)
+      for (const TetNetworkFit& fit : fit_body_network(desc.mesh, desc.youngs_modulus, desc.poisson_ratio).tets)
+        b.edge_stiffness.push_back(fit.edge);
     b.tear_strain = desc.tear_strain;
     if (b.tear_strain > 0.0) b.edges = unique_edges({b.rest, b.corners, b.arity, b.alive, b.offsets, b.list});
     e->tets_.push_back(std::move(b));
@@ -264,8 +268,15 @@ double TopologyEditor::edge_share(const Body& b, std::uint32_t a, std::uint32_t 
   for (std::uint32_t i = b.offsets[a]; i < b.offsets[a + 1]; ++i) {
     const std::uint32_t e = b.list[i];
     const std::uint32_t* q = b.of(e);
-    if (b.alive[e] && std::find(q, q + b.arity, v) != q + b.arity)
+    if (!b.alive[e] || std::find(q, q + b.arity, v) == q + b.arity) continue;
+    if (b.edge_stiffness.empty()) {
       share += static_cast<double>(b.rest_measure[e]) / parts;  // as the compile sums it, in element order
+      continue;
+    }
+    for (int k = 0; k < 6; ++k) {  // calibrated: this tet's spring on the edge
+      const std::uint32_t s = q[kTetEdgePairs[k][0]], t = q[kTetEdgePairs[k][1]];
+      if ((s == a && t == v) || (s == v && t == a)) share += b.edge_stiffness[e][std::size_t(k)];
+    }
   }
   return share;
 }
@@ -389,7 +400,9 @@ Result<TopologyEvent> TopologyEditor::remove(Device& device, const XpbdBuffers& 
     float* data = &k.data[std::size_t{s.slot} * k.data_stride];
     const float len = data[0];
     const auto alpha =
-        static_cast<float>(b.distance_compliance * static_cast<double>(len) * len / (share * b.edge_depth));
+        b.edge_stiffness.empty()
+            ? static_cast<float>(b.distance_compliance * static_cast<double>(len) * len / (share * b.edge_depth))
+            : static_cast<float>(1.0 / share);
     if (alpha != data[1]) {
       data[1] = alpha;
       k.dirty.push_back(s.slot);

@@ -149,6 +149,10 @@ class TopologyEditor {
     double mass_density = 0.0;               // per unit measure: density (tets), density x thickness (triangles)
     double edge_depth = 1.0;                 // alpha_e = c_d L^2 / (share x edge_depth): 1 (tets), thickness (triangles)
     double distance_compliance = 0.0, tear_strain = 0.0;
+    // Calibrated tet bodies (TetBodyDesc::set_elastic): per tet, its six
+    // springs [N/m] (kTetEdgePairs order); an edge's alpha is 1 / (the sum
+    // over its live tets). Empty: alpha_e = c_d L^2 / (share x edge_depth).
+    std::vector<std::array<double, 6>> edge_stiffness;
     EdgeList edges;                          // its edges once each (bodies that tear)
     // Tet bodies with track_boundaries(): the boundary faces, wound
     // outward from their live tet, and each one's index there by its
@@ -181,7 +185,8 @@ class TopologyEditor {
   void swap_remove(std::uint32_t k, std::uint32_t slot);
   // The share of the live elements' measure an edge (vertices a, v of body)
   // holds: V_e [m^3] (a sixth of each tet's volume) or A_e [m^2] (a third
-  // of each triangle's area), summed in element order as the compile does.
+  // of each triangle's area), summed in element order as the compile does;
+  // for a calibrated tet body, the sum of its live tets' springs k_e [N/m].
   double edge_share(const Body& b, std::uint32_t a, std::uint32_t v) const;
   // After `removed` tets of tet body b died: each of their faces is on the
   // boundary when exactly one live tet has it (extract_boundary_surface's
