@@ -13,13 +13,13 @@ packages=(
   libembree-dev                       # CPU broad phase
   nlohmann-json3-dev libcli11-dev      # scene files, the sinew runner
   zlib1g-dev                          # compressed binary VTK output
-  python3-vtk9 xvfb                   # scripts/render_frames.py (offscreen under Xvfb), the output read back by VTK (tests)
+  python3-vtk9                        # scripts/render_frames.py (offscreen under Xvfb, below), the output read back by VTK (tests)
   python3-jsonschema                  # the scene files checked against their schema (tests)
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib  # the Python module, its tests, its plot example
   gnuplot-nox                         # plots in the reports
   doxygen                             # API reference (cmake --build build --target docs; optional)
   libglfw3-dev libgl-dev libimgui-dev libgl1-mesa-dri  # sinew view (docs/viewer.md)
-  xvfb xauth                          # sinew view's headless test (xvfb-run)
+  xvfb xauth                          # headless tests: sinew view and render_frames.py (xvfb-run)
 )
 
 missing=()
