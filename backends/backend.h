@@ -14,6 +14,9 @@
 // dispatch), and after every run the device reads all declared counters
 // back (a few words, copied at the end of the frame, no extra round trip)
 // and reports any that exceeded its capacity as a capacity_exceeded error.
+// A program's small results (the statistics, a residual check) travel the
+// same way as *end reads*: ranges copied after its last command and brought
+// back by the wait that ends it (FrameProgram::read_at_end).
 //
 // Backends: "cpu" (the reference; every dispatch runs in parallel with TBB),
 // "opencl" and "vulkan" (when built).
@@ -99,6 +102,16 @@ struct Counter {
   std::uint32_t capacity = 0;
 };
 
+/// Words of a device buffer read back when the program ends, with its
+/// counters: the frame's small results (the statistics' reductions) reach
+/// the host in the wait that ends the program, not in a round trip of their
+/// own (FrameProgram::read_at_end, Device::end_reads).
+struct EndRead {
+  BufferHandle buffer;
+  std::uint32_t word = 0;
+  std::uint32_t words = 0;
+};
+
 /// The ordered commands of one frame.
 class FrameProgram {
  public:
@@ -147,8 +160,21 @@ class FrameProgram {
     return static_cast<std::uint32_t>(counters_.size() - 1);
   }
 
+  /// Declares words [word, word + words) of `buffer` to be read back when
+  /// the program has run, after its last command (the device copies them
+  /// with the counters). Returns where they start in Device::end_reads().
+  std::uint32_t read_at_end(BufferHandle buffer, std::uint32_t word, std::uint32_t words) {
+    const std::uint32_t at = end_read_words_;
+    end_reads_.push_back({buffer, word, words});
+    end_read_words_ += words;
+    return at;
+  }
+
   [[nodiscard]] const std::vector<Command>& commands() const { return commands_; }
   [[nodiscard]] const std::vector<Counter>& counters() const { return counters_; }
+  [[nodiscard]] const std::vector<EndRead>& end_reads() const { return end_reads_; }
+  /// The end reads' words in all (the size of Device::end_reads()).
+  [[nodiscard]] std::uint32_t end_read_words() const { return end_read_words_; }
   [[nodiscard]] std::size_t dispatch_count() const;
   [[nodiscard]] std::size_t barrier_count() const;
   /// Dispatches of one kernel.
@@ -173,6 +199,8 @@ class FrameProgram {
 
   std::vector<Command> commands_;
   std::vector<Counter> counters_;
+  std::vector<EndRead> end_reads_;
+  std::uint32_t end_read_words_ = 0;
 };
 
 /// A program prepared by a device.
@@ -275,6 +303,12 @@ class Device {
   /// The counters of the last program waited for, in declaration order, as
   /// they were at the end of its run. Allocates nothing.
   [[nodiscard]] virtual std::span<const std::uint32_t> counters() const = 0;
+  /// The words the last program waited for declared with
+  /// FrameProgram::read_at_end, as they were at the end of its run, its
+  /// ranges one after another in declaration order; empty before a wait.
+  /// Their bytes count as read back (HostTransfers::read_bytes) in the wait
+  /// that brought them, with no wait or read of their own. Allocates nothing.
+  [[nodiscard]] virtual std::span<const std::uint32_t> end_reads() const = 0;
   /// [out] times: device time of the last program waited for; timed =
   /// false (and no error) where the device records no timestamps.
   /// Allocates nothing.
@@ -294,6 +328,8 @@ class Device {
   virtual Status read_buffer_impl(BufferHandle buffer, std::size_t offset, void* data, std::size_t bytes) = 0;
   virtual Status submit_impl(ProgramHandle program) = 0;
   virtual Status wait_impl() = 0;
+  /// A backend's wait_impl, for the end reads of the program it finished.
+  void count_end_reads(std::size_t words) { transfers_.read_bytes += 4 * words; }
 
  private:
   // A call that waits for the submission in flight (wait(), a write, the

@@ -109,6 +109,12 @@ Status check_program(const FrameProgram& program, std::span<const std::size_t> b
     const std::string who = "frame program counter " + std::to_string(index++) + " ('" + c.label + "')";
     if (Status s = check_words(who, "its buffer", c.buffer, c.word, 1, bytes); !s) return s;
   }
+  index = 0;
+  for (const EndRead& r : program.end_reads()) {
+    const std::string who = "frame program end read " + std::to_string(index++);
+    if (r.words == 0) return Error(ErrorCode::internal, who + ": reads no words");
+    if (Status s = check_words(who, "its buffer", r.buffer, r.word, r.words, bytes); !s) return s;
+  }
   std::size_t position = 0;
   for (const auto& command : program.commands()) {
     ++position;

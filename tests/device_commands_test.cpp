@@ -225,6 +225,38 @@ TEST_P(DeviceCommands, SubmitReturnsBeforeWaitAndCountersComeWithTheWait) {
   SINEW_ASSERT_OK(device->wait());  // nothing in flight: returns at once
 }
 
+// End reads come back with the wait that ends the program, after its last
+// command, one range after another — no read or wait of their own.
+TEST_P(DeviceCommands, EndReadsComeWithTheWaitAfterTheLastCommand) {
+  const BufferHandle a = words({1, 2, 3, 4, 5, 6});
+  const BufferHandle b = words({7, 8, 9});
+  FrameProgram program;
+  program.fill(a, 1, 2, 40);
+  program.barrier();
+  program.copy(a, 1, b, 0, 1);  // b[0] = 40, written after a's fill
+  EXPECT_EQ(program.read_at_end(a, 0, 4), 0u);
+  EXPECT_EQ(program.read_at_end(b, 0, 2), 4u);
+  EXPECT_EQ(program.end_read_words(), 6u);
+  auto prepared = device->create_program(program);
+  ASSERT_TRUE(prepared.ok()) << prepared.error().message();
+  for (int run = 0; run < 2; ++run) {
+    const HostTransfers before = device->transfers();
+    SINEW_ASSERT_OK(device->run_program(*prepared));
+    const HostTransfers after = device->transfers();
+    EXPECT_EQ(std::vector<std::uint32_t>(device->end_reads().begin(), device->end_reads().end()),
+              (std::vector<std::uint32_t>{1, 40, 40, 4, 40, 8}));
+    EXPECT_EQ(after.reads - before.reads, 0u) << "no read of their own";
+    EXPECT_EQ(after.waits - before.waits, 1u) << "the program's end";
+    EXPECT_EQ(after.read_bytes - before.read_bytes, 24u) << "counted as read back";
+  }
+  // A range past its buffer is an error naming it.
+  FrameProgram past;
+  past.read_at_end(b, 2, 2);
+  auto refused = device->create_program(past);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message().find("end read 0"), std::string::npos) << refused.error().message();
+}
+
 TEST_P(DeviceCommands, ResizeKeepsTheContentsAndProgramsFollowTheNewSize) {
   const BufferHandle a = words({1, 2, 3, 4});
   const BufferHandle b = words({0, 0, 0, 0});

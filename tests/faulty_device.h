@@ -64,6 +64,7 @@ class FaultyDevice final : public Device {
   }
   Status destroy_program(ProgramHandle program) override { return inner_->destroy_program(program); }
   std::span<const std::uint32_t> counters() const override { return inner_->counters(); }
+  std::span<const std::uint32_t> end_reads() const override { return inner_->end_reads(); }
   Status last_run_times(DeviceTimes& times) const override { return inner_->last_run_times(times); }
   DeviceObjects objects() const override { return inner_->objects(); }
 
@@ -84,6 +85,7 @@ class FaultyDevice final : public Device {
     // The real device still finishes what it was given: a lost wait leaves
     // nothing in flight behind the next call.
     Status real = inner_->wait();
+    count_end_reads(inner_->end_reads().size());  // they reach the host in this wait
     if (hit(Call::wait)) return fault(ErrorCode::device_lost);
     return real;
   }

@@ -234,20 +234,47 @@ TEST(FrameStage, HostTransfersAreCountedAlikeOnEveryBackend) {
   if (ran == 0) GTEST_SKIP() << "no GPU backend with a device here (the CPU's counts were checked)";
 }
 
-// A scene with no host-side stage reads only the statistics' words: one
-// read-back and the wait for the frame's program.
-TEST(FrameStage, APlainFrameReadsOnlyItsStatistics) {
+// A scene with no host-side stage waits once a frame: the statistics'
+// words come back with the program's end (its end read), not in a round
+// trip of their own — within the whole-frame-on-the-device budget of one
+// wait and 4 KB.
+TEST(FrameStage, APlainFrameWaitsOnceForItsProgramAndItsStatistics) {
   for (const std::string& backend : test::backends()) {
     if (!test::missing_device(backend).empty()) continue;
     auto sim = Simulation::create(hanging_block(), {.backend = backend, .quiet = true});
     ASSERT_TRUE(sim.ok()) << sim.error().message();
+    for (int f = 0; f < 2; ++f) {
+      SINEW_ASSERT_OK(sim->step());
+      const FrameStats& stats = sim->last_frame();
+      EXPECT_EQ(stats.host_reads, 0u) << backend << ": no read of its own";
+      EXPECT_EQ(stats.host_waits, 1u) << backend << ": the program's end";
+      EXPECT_EQ(stats.position_reads, 0u) << backend;
+      EXPECT_GT(stats.read_back_bytes, 0u) << backend << ": the statistics came back";
+      EXPECT_EQ(double(stats.read_back_bytes), stats.counter("solve", "read_bytes")) << backend;
+      EXPECT_LE(stats.read_back_bytes, 4096u) << backend << ": a few words, not the state";
+      EXPECT_GT(stats.kinetic_energy, 0.0) << backend << ": the statistics are this frame's";
+    }
+  }
+}
+
+// Residual mode runs a program per check: each check's residuals come back
+// with its program's end, so the frame waits once per program and reads
+// nothing on its own.
+TEST(FrameStage, ResidualChecksComeBackWithTheirPrograms) {
+  for (const std::string& backend : test::backends()) {
+    if (!test::missing_device(backend).empty()) continue;
+    SceneDesc scene = hanging_block();
+    scene.solver.residual_tolerance = 1e-5;
+    scene.solver.max_iterations = 64;
+    scene.solver.check_interval = 8;
+    auto sim = Simulation::create(scene, {.backend = backend, .quiet = true});
+    ASSERT_TRUE(sim.ok()) << sim.error().message();
     SINEW_ASSERT_OK(sim->step());
     const FrameStats& stats = sim->last_frame();
-    EXPECT_EQ(stats.host_reads, 1u) << backend;
-    EXPECT_EQ(stats.host_waits, 2u) << backend << ": the program's end, then the read-back";
-    EXPECT_EQ(stats.position_reads, 0u) << backend;
-    EXPECT_EQ(double(stats.read_back_bytes), stats.counter("statistics", "read_bytes")) << backend;
-    EXPECT_LT(stats.read_back_bytes, 16u * sim->info().particles) << backend << ": a few words, not the state";
+    ASSERT_GE(stats.residual_checks, 1u) << backend;
+    EXPECT_GT(stats.checked_residual, 0.0) << backend;
+    EXPECT_EQ(stats.host_reads, 0u) << backend;
+    EXPECT_EQ(stats.host_waits, stats.residual_checks + 1u) << backend << ": each check's program, then the frame's end";
   }
 }
 

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -59,16 +60,31 @@ class Progress {
 };
 
 // The mean wall time per stage over the run, and each stage's counters
-// in the last frame.
+// in the last frame; what the host read and waited for per frame; and,
+// where the backend records timestamps (Vulkan on a GPU, DeviceTimes), the
+// program's device time and its costliest kernels.
 struct Profile {
   std::vector<std::string> order;
   std::map<std::string, double> total_ms;
   std::map<std::string, std::vector<StageProfile::Counter>> last_counters;
+  std::uint64_t read_bytes = 0, host_waits = 0, max_read_bytes = 0, max_host_waits = 0;
+  int timed_frames = 0;
+  double device_ms = 0.0;
+  std::array<double, DeviceTimes::max_kernels> kernel_ms{};
   void add(const FrameStats& st) {
     for (const StageProfile& s : st.stages) {
       if (!total_ms.count(s.name)) order.push_back(s.name);
       total_ms[s.name] += s.ms;
       last_counters[s.name] = s.counters;
+    }
+    read_bytes += st.read_back_bytes;
+    host_waits += st.host_waits;
+    max_read_bytes = std::max<std::uint64_t>(max_read_bytes, st.read_back_bytes);
+    max_host_waits = std::max<std::uint64_t>(max_host_waits, st.host_waits);
+    if (st.device.timed) {
+      ++timed_frames;
+      device_ms += st.device.span_ms;
+      for (std::size_t k = 0; k < kernel_ms.size(); ++k) kernel_ms[k] += st.device.kernel_ms[k];
     }
   }
   void print(int frames, double total_wall_ms) const {
@@ -79,6 +95,20 @@ struct Profile {
       for (const auto& c : last_counters.at(name)) std::printf("  %s %g", c.name.c_str(), c.value);
       std::printf("\n");
     }
+    std::printf("host transfers per frame: %.0f bytes read back (most %llu), %.2f waits (most %llu)\n",
+                double(read_bytes) / frames, static_cast<unsigned long long>(max_read_bytes),
+                double(host_waits) / frames, static_cast<unsigned long long>(max_host_waits));
+    if (timed_frames == 0) return;
+    std::printf("device time: %.3f ms per frame (timestamps, %d frames); costliest kernels per frame:\n",
+                device_ms / timed_frames, timed_frames);
+    const auto names = kernel_names();
+    std::vector<std::size_t> by_time;
+    for (std::size_t k = 0; k < std::min(names.size(), kernel_ms.size()); ++k)
+      if (kernel_ms[k] > 0.0) by_time.push_back(k);
+    std::sort(by_time.begin(), by_time.end(), [&](std::size_t a, std::size_t b) { return kernel_ms[a] > kernel_ms[b]; });
+    for (std::size_t i = 0; i < std::min<std::size_t>(by_time.size(), 10); ++i)
+      std::printf("  %-32.*s %9.3f ms\n", static_cast<int>(names[by_time[i]].size()), names[by_time[i]].data(),
+                  kernel_ms[by_time[i]] / timed_frames);
   }
 };
 

@@ -177,6 +177,7 @@ struct CpuProgram {
   bool alone = false;  // nothing in it worth sharing: never wakes the team
   WidthChoice width;
   std::vector<const std::uint32_t*> counter_words;
+  std::vector<const std::uint32_t*> end_read_words;  // the first word of each end read
 };
 
 class CpuDevice final : public Device {
@@ -291,6 +292,10 @@ class CpuDevice final : public Device {
       p.width.record(on_team, std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count());
     counters_.resize(p.counter_words.size());
     for (std::size_t c = 0; c < counters_.size(); ++c) counters_[c] = *p.counter_words[c];
+    end_reads_.resize(p.source.end_read_words());
+    std::uint32_t* to = end_reads_.data();
+    for (std::size_t r = 0; r < p.end_read_words.size(); ++r)
+      to = std::copy_n(p.end_read_words[r], p.source.end_reads()[r].words, to);
     submitted_ = program.id;
     return {};
   }
@@ -299,10 +304,12 @@ class CpuDevice final : public Device {
     if (submitted_ == UINT32_MAX) return {};
     const CpuProgram& p = programs_[submitted_];
     submitted_ = UINT32_MAX;
+    count_end_reads(end_reads_.size());
     return check_counters(p.source.counters(), counters_);
   }
 
   std::span<const std::uint32_t> counters() const override { return counters_; }
+  std::span<const std::uint32_t> end_reads() const override { return end_reads_; }
 
   DeviceObjects objects() const override {
     DeviceObjects o;
@@ -379,6 +386,8 @@ class CpuDevice final : public Device {
     p.steps = std::move(steps);
     p.counter_words.clear();
     for (const Counter& c : p.source.counters()) p.counter_words.push_back(words(c.buffer, c.word));
+    p.end_read_words.clear();
+    for (const EndRead& r : p.source.end_reads()) p.end_read_words.push_back(words(r.buffer, r.word));
     p.resolved_at = generation_;
     return {};
   }
@@ -490,6 +499,7 @@ class CpuDevice final : public Device {
   std::uint64_t generation_ = 0;     // bumped by every resize and destroy
   std::vector<CpuProgram> programs_;
   std::vector<std::uint32_t> counters_;
+  std::vector<std::uint32_t> end_reads_;  // of the last program run
   std::uint32_t submitted_ = UINT32_MAX;
 };
 

@@ -79,14 +79,17 @@ struct CounterRead {
   std::size_t offset = 0;
 };
 
-// Held through a unique_ptr: the non-blocking counter reads of a submission
-// write into counter_values, which must not move while it is in flight.
+// Held through a unique_ptr: the non-blocking counter and end reads of a
+// submission write into counter_values and end_values, which must not move
+// while it is in flight.
 struct ClProgram {
   FrameProgram source;            // kept to resolve again after a buffer is resized or destroyed
   std::uint64_t resolved_at = 0;  // the device's generation the steps are from
   std::vector<ClStep> steps;
   std::vector<CounterRead> counter_reads;
   std::vector<std::uint32_t> counter_values;  // written by the reads of a submission
+  std::vector<CounterRead> end_reads;         // the first word of each end read
+  std::vector<std::uint32_t> end_values;      // written by the end reads of a submission
 };
 
 std::string step_name(const ClStep& s) {
@@ -234,6 +237,18 @@ class OpenclDevice final : public Device {
         return cl_error(err, "submit: reading counter '" + p.source.counters()[c].label + "'");
       }
     }
+    std::uint32_t* to = p.end_values.data();
+    for (std::size_t e = 0; e < p.end_reads.size(); ++e) {
+      const CounterRead& r = p.end_reads[e];
+      const std::uint32_t words = p.source.end_reads()[e].words;
+      if (const cl_int err = clEnqueueReadBuffer(queue_, r.mem, CL_FALSE, r.offset, std::size_t{words} * 4, to, 0,
+                                                 nullptr, nullptr);
+          err != CL_SUCCESS) {
+        clFinish(queue_);
+        return cl_error(err, "submit: end read " + std::to_string(e));
+      }
+      to += words;
+    }
     if (const cl_int err = clFlush(queue_); err != CL_SUCCESS) {
       clFinish(queue_);
       return cl_error(err, "submit: clFlush", ErrorCode::device_lost);
@@ -250,6 +265,7 @@ class OpenclDevice final : public Device {
   }
 
   std::span<const std::uint32_t> counters() const override { return counters_; }
+  std::span<const std::uint32_t> end_reads() const override { return end_reads_; }
 
   DeviceObjects objects() const override {
     DeviceObjects o;
@@ -295,6 +311,8 @@ class OpenclDevice final : public Device {
     if (const cl_int err = clFinish(queue_); err != CL_SUCCESS)
       return cl_error(err, "waiting for the frame program", ErrorCode::device_lost);
     counters_.assign(p.counter_values.begin(), p.counter_values.end());
+    end_reads_.assign(p.end_values.begin(), p.end_values.end());
+    count_end_reads(end_reads_.size());
     pending_status_ = check_counters(p.source.counters(), counters_);
     pending_ = true;
     return {};
@@ -357,6 +375,10 @@ class OpenclDevice final : public Device {
     for (const Counter& c : p.source.counters())
       p.counter_reads.push_back({buffers_[c.buffer.id].mem, std::size_t{c.word} * 4});
     p.counter_values.assign(p.counter_reads.size(), 0);
+    p.end_reads.clear();
+    for (const EndRead& r : p.source.end_reads())
+      p.end_reads.push_back({buffers_[r.buffer.id].mem, std::size_t{r.word} * 4});
+    p.end_values.assign(p.source.end_read_words(), 0);
     p.resolved_at = generation_;
     return {};
   }
@@ -410,6 +432,7 @@ class OpenclDevice final : public Device {
   bool pending_ = false;                  // a finished submission whose counter check wait() has not returned
   Status pending_status_;
   std::vector<std::uint32_t> counters_;
+  std::vector<std::uint32_t> end_reads_;  // of the last program finished
 };
 
 }  // namespace

@@ -157,6 +157,7 @@ class VulkanDeviceImpl final : public Device {
   }
 
   std::span<const std::uint32_t> counters() const override { return counters_; }
+  std::span<const std::uint32_t> end_reads() const override { return end_reads_; }
 
   Status last_run_times(DeviceTimes& out) const override {
     out = times_;
@@ -195,7 +196,8 @@ class VulkanDeviceImpl final : public Device {
     if (Status s = check_program(p.source, buffers_.sizes()); !s) return s;
     auto plan = plan_program(p.source, pipelines_, found_.properties.limits, found_.info.name);
     if (!plan) return plan.error();
-    Status s = recorder_.record(p.recording, *plan, p.source.counters(), pipelines_, buffers_.all());
+    Status s = recorder_.record(p.recording, *plan, p.source.counters(), p.source.end_reads(), pipelines_,
+                                buffers_.all());
     if (!s) {
       recorder_.destroy(p.recording);
       return s;
@@ -212,6 +214,8 @@ class VulkanDeviceImpl final : public Device {
     in_flight_ = UINT32_MAX;
     if (Status s = queue_.wait("waiting for the frame program"); !s) return s;
     recorder_.read_counters(p.recording, counters_);
+    recorder_.read_end_reads(p.recording, end_reads_);
+    count_end_reads(end_reads_.size());
     pending_status_ = check_counters(p.source.counters(), counters_);
     pending_ = true;
     times_status_ = recorder_.read_times(p.recording, times_);
@@ -247,6 +251,7 @@ class VulkanDeviceImpl final : public Device {
   bool pending_ = false;                  // a finished submission whose counter check wait() has not returned
   Status pending_status_;
   std::vector<std::uint32_t> counters_;  // of the last program waited for
+  std::vector<std::uint32_t> end_reads_;  // of the last program waited for
   DeviceTimes times_;                    // its timestamps, read when it was waited for
   Status times_status_;
 };

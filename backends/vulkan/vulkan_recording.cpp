@@ -97,7 +97,7 @@ void Recorder::destroy(Recording& r) {
   r = Recording{};
 }
 
-Status Recorder::make_buffers(Recording& r, const Plan& plan, std::size_t counters) {
+Status Recorder::make_buffers(Recording& r, const Plan& plan, std::size_t counters, std::size_t end_words) {
   if (plan.slots > 0) {
     r.args.label = "indirect arguments";
     r.args.size = (std::uint64_t{plan.slots} * 12 + 63) / 64 * 64;
@@ -108,9 +108,10 @@ Status Recorder::make_buffers(Recording& r, const Plan& plan, std::size_t counte
       return s;
   }
   r.counters = static_cast<std::uint32_t>(counters);
-  if (counters > 0) {
+  r.end_words = static_cast<std::uint32_t>(end_words);
+  if (counters + end_words > 0) {
     r.readback.label = "counter read-back";
-    r.readback.size = (counters * 4 + 63) / 64 * 64;
+    r.readback.size = ((counters + end_words) * 4 + 63) / 64 * 64;
     r.readback.bytes = r.readback.size;
     if (Status s = memory_->make_buffer(r.readback, VK_BUFFER_USAGE_TRANSFER_DST_BIT, kStaging,
                                         kStaging | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, "recording the frame program: counter read-back");
@@ -165,8 +166,11 @@ Result<std::vector<VkDescriptorSet>> Recorder::descriptor_sets(Recording& r, con
 }
 
 Status Recorder::record(Recording& r, const Plan& plan, std::span<const Counter> counters,
-                        const PipelineCache& pipelines, std::span<const Buffer> buffers) {
-  if (Status s = make_buffers(r, plan, counters.size()); !s) return s;
+                        std::span<const EndRead> end_reads, const PipelineCache& pipelines,
+                        std::span<const Buffer> buffers) {
+  std::size_t end_words = 0;
+  for (const EndRead& e : end_reads) end_words += e.words;
+  if (Status s = make_buffers(r, plan, counters.size(), end_words); !s) return s;
   auto made_sets = descriptor_sets(r, plan, pipelines, buffers);
   if (!made_sets) return made_sets.error();
 
@@ -198,7 +202,7 @@ Status Recorder::record(Recording& r, const Plan& plan, std::span<const Counter>
   full_barrier(cmd);  // after the previous submission and any transfer
   std::vector<Kernel> timed;
   record_steps(r, cmd, plan, *made_sets, pipelines, buffers, timed);
-  record_counter_reads(r, cmd, counters, buffers);
+  record_counter_reads(r, cmd, counters, end_reads, buffers);
   // Every write of the frame visible to the host: read_buffer of mapped
   // memory, the counters (staged reads and later frames order themselves
   // with their own opening barriers).
@@ -252,18 +256,31 @@ void Recorder::record_steps(const Recording& r, VkCommandBuffer cmd, const Plan&
 }
 
 void Recorder::record_counter_reads(const Recording& r, VkCommandBuffer cmd, std::span<const Counter> counters,
-                                    std::span<const Buffer> buffers) {
-  if (counters.empty()) return;
+                                    std::span<const EndRead> end_reads, std::span<const Buffer> buffers) {
+  if (counters.empty() && end_reads.empty()) return;
   memory_barrier(cmd, kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
   for (std::size_t c = 0; c < counters.size(); ++c) {
     const VkBufferCopy region{VkDeviceSize{counters[c].word} * 4, VkDeviceSize{c} * 4, 4};
     vkCmdCopyBuffer(cmd, buffers[counters[c].buffer.id].buffer, r.readback.buffer, 1, &region);
+  }
+  VkDeviceSize at = VkDeviceSize{r.counters} * 4;
+  for (const EndRead& e : end_reads) {
+    const VkBufferCopy region{VkDeviceSize{e.word} * 4, at, VkDeviceSize{e.words} * 4};
+    vkCmdCopyBuffer(cmd, buffers[e.buffer.id].buffer, r.readback.buffer, 1, &region);
+    at += region.size;
   }
 }
 
 void Recorder::read_counters(const Recording& r, std::vector<std::uint32_t>& values) const {
   values.resize(r.counters);
   if (r.counters) std::memcpy(values.data(), r.readback.mapped, std::size_t{r.counters} * 4);
+}
+
+void Recorder::read_end_reads(const Recording& r, std::vector<std::uint32_t>& values) const {
+  values.resize(r.end_words);
+  if (r.end_words)
+    std::memcpy(values.data(), static_cast<const std::uint32_t*>(r.readback.mapped) + r.counters,
+                std::size_t{r.end_words} * 4);
 }
 
 Status Recorder::read_times(const Recording& r, DeviceTimes& out) {

@@ -25,8 +25,9 @@ struct Recording {
   VkQueryPool queries = VK_NULL_HANDLE;  // two timestamps per dispatch
   std::vector<Kernel> timed;             // the kernel of each timed dispatch
   Buffer args;                           // indirect dispatch arguments: 3 words per slot
-  Buffer readback;                       // host-visible, mapped: one word per counter
-  std::uint32_t counters = 0;            // words of readback the recording writes
+  Buffer readback;                       // host-visible, mapped: one word per counter, then the end reads
+  std::uint32_t counters = 0;            // words of readback the counters take
+  std::uint32_t end_words = 0;           // words of readback the end reads take, after the counters
 };
 
 /// Owns the command pool of every program's command buffer; records
@@ -50,16 +51,18 @@ class Recorder {
 
   /// Makes r's buffers, descriptor pool and sets and query pool, and
   /// records its command buffer. [in] plan: from plan_program (its
-  /// pipelines made by `pipelines`); counters: the program's, read back at
-  /// the end of the recording; buffers: the device's, by id. On error r may
-  /// hold part of what it needs: destroy it.
-  Status record(Recording& r, const Plan& plan, std::span<const Counter> counters, const PipelineCache& pipelines,
-                std::span<const Buffer> buffers);
+  /// pipelines made by `pipelines`); counters and end_reads: the
+  /// program's, read back at the end of the recording; buffers: the
+  /// device's, by id. On error r may hold part of what it needs: destroy it.
+  Status record(Recording& r, const Plan& plan, std::span<const Counter> counters, std::span<const EndRead> end_reads,
+                const PipelineCache& pipelines, std::span<const Buffer> buffers);
   /// Releases everything r holds and empties it. [pre] r is not in flight.
   void destroy(Recording& r);
 
   /// [out] values: the counters as r's last run left them. [pre] that run waited for.
   void read_counters(const Recording& r, std::vector<std::uint32_t>& values) const;
+  /// [out] values: the end reads as r's last run left them. [pre] that run waited for.
+  void read_end_reads(const Recording& r, std::vector<std::uint32_t>& values) const;
   /// [out] out: the device time of r's last run from its timestamps (timed =
   /// false where r has none). [pre] that run waited for.
   Status read_times(const Recording& r, DeviceTimes& out);
@@ -70,13 +73,13 @@ class Recorder {
   std::uint32_t native() const { return native_; }
 
  private:
-  Status make_buffers(Recording& r, const Plan& plan, std::size_t counters);
+  Status make_buffers(Recording& r, const Plan& plan, std::size_t counters, std::size_t end_words);
   Result<std::vector<VkDescriptorSet>> descriptor_sets(Recording& r, const Plan& plan, const PipelineCache& pipelines,
                                                        std::span<const Buffer> buffers);
   void record_steps(const Recording& r, VkCommandBuffer cmd, const Plan& plan, std::span<const VkDescriptorSet> sets,
                     const PipelineCache& pipelines, std::span<const Buffer> buffers, std::vector<Kernel>& timed);
   void record_counter_reads(const Recording& r, VkCommandBuffer cmd, std::span<const Counter> counters,
-                            std::span<const Buffer> buffers);
+                            std::span<const EndRead> end_reads, std::span<const Buffer> buffers);
 
   VkDevice device_ = VK_NULL_HANDLE;
   Memory* memory_ = nullptr;

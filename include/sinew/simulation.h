@@ -116,7 +116,8 @@ struct FrameStats {
   std::uint32_t host_reads = 0;  ///< read-backs (round trips) in the last step()
   /// Times the last step() blocked on the device: every read-back, and
   /// every wait for a submitted program (each stage's share: its counter
-  /// "host_waits"). A frame that ran wholly on the device would wait once.
+  /// "host_waits"). A frame that runs wholly on the device waits once: its
+  /// statistics come back with the program's end.
   std::uint32_t host_waits = 0;
   /// RMS over all constraints of |C + alpha~ lambda| at the start of the
   /// frame's last sweep, each normalised by its rest value (rest length,

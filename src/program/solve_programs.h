@@ -81,7 +81,8 @@ class SolvePrograms {
   void append_measure(FrameProgram& program, int s) const;
   /// The velocity update of substep s.
   void append_update(FrameProgram& program, int s) const;
-  /// Measure, then reduce the residuals into check.results.
+  /// Measure, then reduce the residuals into check.results, declared as
+  /// the program's last end read (FrameProgram::read_at_end).
   void append_check(FrameProgram& program, int s, const ResidualCheck& check) const;
   /// The accelerator's step after sweep n (1-based): none, record or mix.
   struct ChebyshevStep {
@@ -112,7 +113,10 @@ Result<ChebyshevBuffers> make_chebyshev_buffers(Device& device, const CompiledSc
 /// The residual check's buffers.
 Result<ResidualCheck> make_residual_check(Device& device, const CompiledScene& scene);
 
-/// Reads the last check's 3 words per block.
-Result<CheckedResidual> read_residual_check(Device& device, ResidualCheck& check);
+/// Takes the last check's 3 words per block from what the program that ran
+/// it brought back (its last end read, declared by append_check), with no
+/// transfer of its own. [pre] the last program the device waited for ends
+/// with append_check. Errors (internal): that program brought back fewer words.
+Result<CheckedResidual> read_residual_check(const Device& device, ResidualCheck& check);
 
 }  // namespace sinew

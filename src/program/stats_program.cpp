@@ -222,12 +222,23 @@ void append_stats(FrameProgram& program, const StatsPlan& plan, const XpbdBuffer
     program.copy(plan.scratch, from, plan.results, result, words);
   });
   program.barrier();
+  if (plan.result_words > 0) program.read_at_end(plan.results, 0, plan.result_words);
 }
 
-Status read_stats(Device& device, StatsPlan& plan, DeviceStats& out) {
+Status collect_stats(const Device& device, StatsPlan& plan) {
   if (plan.result_words == 0) return {};
-  std::vector<float>& r = plan.read_back;
-  if (Status s = device.read_buffer(plan.results, 0, r.data(), r.size() * sizeof(float)); !s) return s;
+  const std::span<const std::uint32_t> words = device.end_reads();
+  if (words.size() < plan.result_words)
+    return Error(ErrorCode::internal, "statistics: the frame's last program brought back " +
+                                          std::to_string(words.size()) + " words, not its " +
+                                          std::to_string(plan.result_words) + " results");
+  std::memcpy(plan.read_back.data(), words.data() + (words.size() - plan.result_words), plan.result_words * 4);
+  return {};
+}
+
+Status read_stats(const StatsPlan& plan, DeviceStats& out) {
+  if (plan.result_words == 0) return {};
+  const std::vector<float>& r = plan.read_back;
   if (plan.errors) {
     out.residual_sum_squares = 0.0;
     out.residual_max = 0.0;

@@ -90,10 +90,18 @@ Status set_stats_faces(Device& device, StatsPlan& plan, const std::vector<std::a
 Status release_stats_plan(Device& device, StatsPlan& plan);
 
 /// Appends the statistics to the end of a frame program (after its last
-/// update of velocities). Nothing when the plan has neither errors nor tools.
+/// update of velocities), their results declared as the program's last end
+/// read (FrameProgram::read_at_end): they reach the host with the wait that
+/// ends the program. Nothing when the plan has neither errors nor tools.
 void append_stats(FrameProgram& program, const StatsPlan& plan, const XpbdBuffers& buffers);
 
-/// Reads the results of the last frame (one read of result_words words) into `out`.
-Status read_stats(Device& device, StatsPlan& plan, DeviceStats& out);
+/// Takes the results the frame's last program brought back (its last end
+/// read, Device::end_reads) into plan.read_back, with no transfer of its
+/// own. [pre] the last program the device waited for was made with
+/// append_stats. Errors (internal): that program brought back fewer words.
+Status collect_stats(const Device& device, StatsPlan& plan);
+
+/// Decodes the results collect_stats took into `out`.
+Status read_stats(const StatsPlan& plan, DeviceStats& out);
 
 }  // namespace sinew

@@ -1,7 +1,7 @@
 // statistics_stage.cpp — the frame's statistics as a stage: the device's
-// reductions (program/stats_program.h) read back after the solve (the tools'
-// reactions among them, which the tools stage takes after it), the errors
-// combined after the frame. FrameStats::measure_ms is this stage's time.
+// reductions (program/stats_program.h), which come back with the solve's
+// last wait, taken after the solve (the tools' reactions among them, which
+// the tools stage takes after it), the errors combined after the frame. FrameStats::measure_ms is this stage's time.
 #include <chrono>
 
 #include "runtime/stages/stages.h"
@@ -16,7 +16,10 @@ class StatisticsStage final : public FrameStage {
 
   Status after_solve(FrameContext& frame) override {
     const auto start = std::chrono::steady_clock::now();
-    if (Status s = read_stats(frame.device, sim_.stats_plan, sim_.device_stats); !s) return s;
+    // The results came back with the wait that ended the solve's last
+    // program (its end read): no round trip of their own.
+    if (Status s = collect_stats(frame.device, sim_.stats_plan); !s) return s;
+    if (Status s = read_stats(sim_.stats_plan, sim_.device_stats); !s) return s;
     frame.stats.measure_ms = ms_since(start);
     return {};
   }
