@@ -102,6 +102,10 @@ int main(int argc, char** argv) {
   for (const auto& name : stage_order)
     std::printf("%s,%.3f,%.3f,%.3f\n", name.c_str(), percentile(stage_ms[name], 0.5), percentile(stage_ms[name], 0.95),
                 percentile(stage_ms[name], 1.0));
+  // Each stage's own figures of the last frame (StageProfile::counters).
+  std::printf("stage,counter,last_frame\n");
+  for (const auto& p : st.stages)
+    for (const auto& k : p.counters) std::printf("%s,%s,%.6g\n", p.name.c_str(), k.name.c_str(), k.value);
   if (!haptics) return 0;
 
   // The grasper loop's timing, from its telemetry (after the first 100 ticks: the thread's start).

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
 #include "sinew/graspers.h"
@@ -68,12 +69,41 @@ ToolDesc capsule_tool(double radius, double half_height, const V3& position, con
   return t;
 }
 
+// The kidney at rest under gravity on its pins: kSettleFrames frames of the
+// body alone, damped by kSettleDamping. Why: released from its rest shape the
+// organ drops and swings (~1 m/s in its first 0.2 s at 10 kPa), and mesh
+// collision's motion margin (2 |v|max dt) then spans centimetres: millions of
+// candidate pairs a frame. An organ in a body starts at rest.
+constexpr int kSettleFrames = 90;
+constexpr double kSettleDamping = 20.0;  // [1/s]
+
+Result<std::vector<Vec3d>> settle(const TetBodyDesc& body, const RetractionSettings& settings) {
+  SceneDesc scene;
+  scene.gravity = {0.0, -9.81, 0.0};
+  scene.solver = {.time_step = 1.0 / 60.0, .substeps = settings.substeps, .iterations = settings.iterations,
+                  .measure_errors = false};
+  scene.tet_bodies.push_back(body);
+  scene.tet_bodies[0].velocity_damping = kSettleDamping;
+  auto sim = Simulation::create(scene, {.backend = settings.backend, .threads = settings.threads, .quiet = true});
+  if (!sim) return sim.error();
+  for (int f = 0; f < kSettleFrames; ++f)
+    if (auto st = sim->step(); !st) return st.error();
+  std::vector<float> x;
+  if (auto st = sim->read_positions(x); !st) return st.error();
+  std::vector<Vec3d> out(x.size() / 4);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {x[4 * i], x[4 * i + 1], x[4 * i + 2]};
+  return out;
+}
+
 }  // namespace
 
 Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const RetractionSettings& settings) {
   std::unique_ptr<RetractionScene> self(new RetractionScene());
   RetractionScene& s = *self;
   s.settings_ = settings;
+  if (!(settings.script_speed > 0.0 && std::isfinite(settings.script_speed)))
+    return Error(ErrorCode::bad_parameter,
+                 "retraction: script_speed must be finite and > 0 (got " + std::to_string(settings.script_speed) + ")");
   auto mesh = read_tet_mesh(settings.mesh);
   if (!mesh) return mesh.error();
   scale_mesh(*mesh, 1e-3);  // millimetres -> metres
@@ -88,12 +118,7 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
   // weight at a stress above a 10 kPa modulus, and its tets invert.
   const auto& v = body.mesh.vertices;
   double lo = 1e30;
-  std::uint32_t pole = 0, side = 0;
-  for (std::uint32_t i = 0; i < v.size(); ++i) {
-    lo = std::min(lo, v[i][2]);
-    if (v[i][1] > v[pole][1]) pole = i;
-    if (v[i][2] > v[side][2]) side = i;
-  }
+  for (const auto& p : v) lo = std::min(lo, p[2]);
   // Only the surface's vertices (the organ's capsule held to the wall): a pin
   // set cut through the volume by a plane leaves tets whose free vertex lies a
   // hair off their pinned face, which invert at once under the weight.
@@ -102,12 +127,21 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
     for (std::uint32_t i : f) on_surface[i] = 1;
   for (std::uint32_t i = 0; i < v.size(); ++i)
     if (on_surface[i] && v[i][2] < lo + kPinDepth) body.pinned.push_back(i);
+  auto settled = settle(body, settings);
+  if (!settled) return settled.error();
+  body.initial_vertices = std::move(*settled);
+  const auto& x0 = body.initial_vertices;
+  std::uint32_t pole = 0, side = 0;
+  for (std::uint32_t i = 0; i < x0.size(); ++i) {
+    if (x0[i][1] > x0[pole][1]) pole = i;
+    if (x0[i][2] > x0[side][2]) side = i;
+  }
   // The holds' compliance: their springs together kHoldStiffness, so that the
   // shaft (kToolMass) stays stable under their explicit pull at 60 Hz
   // (sqrt(k / M) dt = 0.75). The jaws' box holds the vertices inside it.
   std::size_t inside = 0;
-  for (const auto& p : v) {
-    const V3 d = sub(p, v[pole]);
+  for (const auto& p : x0) {
+    const V3 d = sub(p, x0[pole]);
     inside += std::abs(d[0]) <= kJawHalf[0] && std::abs(d[1]) <= kJawHalf[1] && std::abs(d[2]) <= kJawHalf[2];
   }
   s.hold_compliance_ = double(std::max<std::size_t>(inside, 1)) / kHoldStiffness;
@@ -117,7 +151,7 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
     const V3 ab = cross(a, b);
     s.rest_sign_.push_back(ab[0] * c[0] + ab[1] * c[1] + ab[2] * c[2] > 0 ? 1.0 : -1.0);
   }
-  const V3 pole_x = v[pole], side_x = v[side];
+  const V3 pole_x = x0[pole], side_x = x0[side];
 
   SceneDesc& scene = s.scene_;
   scene.gravity = {0.0, -9.81, 0.0};
@@ -148,12 +182,15 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
   // The haptic side: a scripted hand per tool, its loop and its bridge.
   using namespace haptics;
   s.clock_ = settings.realtime_haptics ? static_cast<Clock*>(&s.wall_clock_) : &s.virtual_clock_;
-  auto pull = [shaft_start](double t) {
+  const double speed = settings.script_speed;
+  auto pull = [shaft_start, speed](double t) {
+    t *= speed;
     ScriptedPose p;
     p.position = add(shaft_start, {0.0, kPull * ramp(t, kPullStart, kPullEnd), 0.0});
     return p;
   };
-  auto press = [probe_start](double t) {
+  auto press = [probe_start, speed](double t) {
+    t *= speed;
     ScriptedPose p;
     p.position = add(probe_start, {0.0, 0.0, -kPress * ramp(t, kPressStart, kPressEnd)});
     p.rotation = kProbeRotation;

@@ -54,6 +54,7 @@ struct RetractionSettings {
   bool measure_errors = false;     ///< SolverSettings::measure_errors
   bool realtime_haptics = false;   ///< loops on their own threads at wall-clock 1 kHz (above)
   bool realtime_priority = true;   ///< real time: ask for SCHED_FIFO for the loops' threads
+  double script_speed = 1.0;       ///< the hands' script runs this many times faster (> 0; the ctest's short run)
 };
 
 /// The scene in a few lines, for the programs' --help.
