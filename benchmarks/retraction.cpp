@@ -8,7 +8,8 @@
 //   e.g. bench_retraction cpu 180
 //
 // Prints CSV: a header and one line of the frame times (median, p95, worst
-// [ms]) and the scene's figures at the last frame; then the per-stage
+// [ms]; the median process CPU time; the 1-minute load average at the end)
+// and the scene's figures at the last frame; then the per-stage
 // profile (FrameStats::stages), one line per stage with its median and p95
 // [ms] over the frames. --haptics runs both haptic loops on their own threads
 // at 1 kHz of wall time while the frames run back to back (the solver using
@@ -19,6 +20,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <map>
 #include <string>
 #include <vector>
@@ -73,13 +76,23 @@ int main(int argc, char** argv) {
   sinew::examples::RetractionScene& r = **scene;
   if (haptics)
     if (auto st = r.start_haptics(); !st) return fail(st.error().message());
-  std::vector<double> frame_ms;
+  // Wall time, and the process's CPU time (every thread's): on a shared
+  // machine the latter is the frame's work without the time other jobs took
+  // (spinning barriers included).
+  auto cpu_now_ms = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+  };
+  std::vector<double> frame_ms, cpu_ms;
   std::map<std::string, std::vector<double>> stage_ms;
   std::vector<std::string> stage_order;
   for (int f = 0; f < frames; ++f) {
+    const double c0 = cpu_now_ms();
     const auto a = std::chrono::steady_clock::now();
     if (auto st = r.frame(); !st) return fail(st.error().message());
     frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+    cpu_ms.push_back(cpu_now_ms() - c0);
     for (const auto& p : r.sim().last_frame().stages) {
       if (!stage_ms.count(p.name)) stage_order.push_back(p.name);
       stage_ms[p.name].push_back(p.ms);
@@ -89,13 +102,14 @@ int main(int argc, char** argv) {
   auto c = r.check();
   if (!c) return fail(c.error().message());
   const auto& st = r.sim().last_frame();
-  std::printf("backend,particles,held,substeps,iterations,frames,median_ms,p95_ms,worst_ms,step_median_ms,"
-              "mesh_contacts,contact_violation_m,max_slip_m,pole_lift_m,grasp_force_y_n,device_force_y_n,"
+  std::printf("backend,particles,held,substeps,iterations,frames,median_ms,p95_ms,worst_ms,cpu_median_ms,"
+              "load_1min,mesh_contacts,contact_violation_m,max_slip_m,pole_lift_m,grasp_force_y_n,device_force_y_n,"
               "inverted_tets\n");
-  std::vector<double> step_ms;
-  std::printf("%s,%u,%zu,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%u,%.3e,%.3e,%.3e,%.4f,%.4f,%zu\n", s.backend.c_str(),
+  double load[1] = {0.0};
+  if (getloadavg(load, 1) != 1) load[0] = -1.0;
+  std::printf("%s,%u,%zu,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.2f,%u,%.3e,%.3e,%.3e,%.4f,%.4f,%zu\n", s.backend.c_str(),
               r.sim().info().particles, r.held().size(), s.substeps, s.iterations, frames, percentile(frame_ms, 0.5),
-              percentile(frame_ms, 0.95), percentile(frame_ms, 1.0), st.wall_ms, st.mesh_contacts,
+              percentile(frame_ms, 0.95), percentile(frame_ms, 1.0), percentile(cpu_ms, 0.5), load[0], st.mesh_contacts,
               c->contact_violation, c->max_slip, c->pole_lift, c->grasp_force[1], c->device_force[1],
               c->inverted_tets);
   std::printf("stage,median_ms,p95_ms,worst_ms\n");
