@@ -311,6 +311,7 @@ Status RetractionScene::frame() {
 }
 
 Status RetractionScene::measure_pull() {
+  if (auto st = sim_->read_positions(x_); !st) return st;
   pull_ = {};
   for (std::size_t k = 0; k < held_.size(); ++k) {
     const V3 target = add(jaws_.position, rotate(jaws_.rotation, held_local_[k]));
