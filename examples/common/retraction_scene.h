@@ -2,7 +2,7 @@
 // examples/retraction.cpp, benchmarks/retraction.cpp and its ctest: kidney_57k
 // (corotational FEM, pinned along its back, its own mesh self-collision
 // on) grasped at its upper pole by a grasper and pulled up while a capsule
-// probe presses its side, both tools driven by scripted haptic devices
+// probe presses its front, both tools driven by scripted haptic devices
 // through the haptic tool bridge (sinew/haptics/tool_bridge.h), 60 Hz frames.
 //
 // The grasper as a haptic tool. The bridge drives a rigid tool (ToolDesc), and
