@@ -1,0 +1,147 @@
+// bench_retraction — the reference scene S1 (examples/common/retraction_scene.h):
+// kidney_57k, corotational FEM, pinned along one side, grasped at its pole
+// and pulled while a capsule probe presses its side, mesh self-collision on,
+// both tools driven through the haptic tool bridge; 60 Hz frames. Times
+// whole frames (the loops' ticks, the tools' hand-off and step()).
+//
+//   bench_retraction BACKEND FRAMES [--mesh M] [--substeps N] [--iterations N] [--threads N] [--haptics]
+//   e.g. bench_retraction cpu 180
+//
+// Prints CSV: a header and one line of the frame times (median, p95, worst
+// [ms]; the median process CPU time; the 1-minute load average at the end)
+// and the scene's figures at the last frame; then the per-stage
+// profile (FrameStats::stages), one line per stage with its median and p95
+// [ms] over the frames. --haptics runs both haptic loops on their own threads
+// at 1 kHz of wall time while the frames run back to back (the solver using
+// every worker), and adds the grasper loop's timing: ticks, missed ticks
+// (tick-to-tick > 2 periods), period jitter p50/p99.9/max [us] and the age
+// of the state it rendered p50 [ms].
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "command_line.h"
+#include "retraction_scene.h"
+
+namespace {
+
+// Nearest-rank percentile q in [0, 1] of v (0 when empty).
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t k = static_cast<std::size_t>(std::ceil(q * double(v.size())));
+  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
+}
+
+int fail(const std::string& what) {
+  std::fprintf(stderr, "bench_retraction: %s\n", what.c_str());
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  sinew::examples::CommandLine cli(
+      "bench_retraction",
+      std::string(sinew::examples::kRetractionAbout) +
+          "Prints CSV: the frame times (median, p95, worst [ms]) and the per-stage profile.\n"
+          "e.g. bench_retraction cpu 180 --threads 2");
+  sinew::examples::RetractionSettings s{.mesh = std::string(SINEW_DATA_DIR) + "/meshes/tet/kidney_57k.node"};
+  int frames = 0;
+  bool haptics = false, self_collision = true;
+  cli.app().add_option("backend", s.backend, "Backend: cpu, opencl, vulkan or auto")
+      ->required()
+      ->check(CLI::IsMember({"auto", "cpu", "opencl", "vulkan"}));
+  cli.app().add_option("frames", frames, "Frames of 1/60 s to time")->required()->check(sinew::examples::at_least(1));
+  cli.app().add_option("--mesh", s.mesh, "The kidney's tet mesh (millimetres)");
+  cli.app().add_option("--substeps", s.substeps, "Substeps per frame")->check(sinew::examples::at_least(1));
+  cli.app().add_option("--iterations", s.iterations, "Iterations per substep")->check(sinew::examples::at_least(1));
+  cli.app().add_option("--threads", s.threads, "cpu backend worker threads (0: all)")->check(sinew::examples::at_least(0));
+  cli.app().add_option("--young", s.young, "Young's modulus [Pa]")->check(sinew::examples::greater_than(0));
+  cli.add_switch("--self-collision", self_collision, "The kidney's mesh self-collision");
+  cli.app().add_option("--poisson", s.poisson, "Poisson ratio")->check(CLI::Range(0.01, 0.49));
+  cli.app().add_flag("--haptics", haptics, "Both haptic loops on their own threads at 1 kHz of wall time; their timing");
+  if (auto exit = cli.parse(argc, argv)) return *exit;
+  s.self_collision = self_collision;
+  s.realtime_haptics = haptics;
+
+  auto scene = sinew::examples::RetractionScene::create(s);
+  if (!scene) return fail(scene.error().message());
+  sinew::examples::RetractionScene& r = **scene;
+  if (haptics)
+    if (auto st = r.start_haptics(); !st) return fail(st.error().message());
+  // Wall time, and the process's CPU time (every thread's): on a shared
+  // machine the latter is the frame's work without the time other jobs took
+  // (spinning barriers included).
+  auto cpu_now_ms = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+  };
+  std::vector<double> frame_ms, cpu_ms;
+  std::map<std::string, std::vector<double>> stage_ms;
+  std::vector<std::string> stage_order;
+  for (int f = 0; f < frames; ++f) {
+    const double c0 = cpu_now_ms();
+    const auto a = std::chrono::steady_clock::now();
+    if (auto st = r.frame(); !st) return fail(st.error().message());
+    frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+    cpu_ms.push_back(cpu_now_ms() - c0);
+    for (const auto& p : r.sim().last_frame().stages) {
+      if (!stage_ms.count(p.name)) stage_order.push_back(p.name);
+      stage_ms[p.name].push_back(p.ms);
+    }
+  }
+  r.stop_haptics();
+  auto c = r.check();
+  if (!c) return fail(c.error().message());
+  const auto& st = r.sim().last_frame();
+  std::printf("backend,particles,held,substeps,iterations,frames,median_ms,p95_ms,worst_ms,cpu_median_ms,"
+              "load_1min,mesh_contacts,contact_violation_m,max_slip_m,pole_lift_m,grasp_force_y_n,device_force_y_n,"
+              "inverted_tets\n");
+  double load[1] = {0.0};
+  if (getloadavg(load, 1) != 1) load[0] = -1.0;
+  std::printf("%s,%u,%zu,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.2f,%u,%.3e,%.3e,%.3e,%.4f,%.4f,%zu\n", s.backend.c_str(),
+              r.sim().info().particles, r.held().size(), s.substeps, s.iterations, frames, percentile(frame_ms, 0.5),
+              percentile(frame_ms, 0.95), percentile(frame_ms, 1.0), percentile(cpu_ms, 0.5), load[0], st.mesh_contacts,
+              c->contact_violation, c->max_slip, c->pole_lift, c->grasp_force[1], c->device_force[1],
+              c->inverted_tets);
+  std::printf("stage,median_ms,p95_ms,worst_ms\n");
+  for (const auto& name : stage_order)
+    std::printf("%s,%.3f,%.3f,%.3f\n", name.c_str(), percentile(stage_ms[name], 0.5), percentile(stage_ms[name], 0.95),
+                percentile(stage_ms[name], 1.0));
+  // Each stage's own figures of the last frame (StageProfile::counters).
+  std::printf("stage,counter,last_frame\n");
+  for (const auto& p : st.stages)
+    for (const auto& k : p.counters) std::printf("%s,%s,%.6g\n", p.name.c_str(), k.name.c_str(), k.value);
+  if (!haptics) return 0;
+
+  // The grasper loop's timing, from its telemetry (after the first 100 ticks: the thread's start).
+  std::vector<sinew::haptics::TickRecord> ticks;
+  if (auto t = r.grasper_loop().copy_telemetry(ticks); !t) return fail(t.error().message());
+  if (ticks.size() > 100) ticks.erase(ticks.begin(), ticks.begin() + 100);
+  if (ticks.size() < 2) return fail("too few haptic ticks: run more frames");
+  const double period_us = 1e3;
+  std::vector<double> jitter, age;
+  std::uint64_t missed = 0;
+  for (std::size_t i = 0; i < ticks.size(); ++i) {
+    age.push_back(1e3 * ticks[i].render_age);
+    if (i == 0) continue;
+    const double p = 1e-3 * double(ticks[i].start_ns - ticks[i - 1].start_ns);
+    jitter.push_back(std::abs(p - period_us));
+    if (p > 2 * period_us) ++missed;
+  }
+  const double span = 1e-9 * double(ticks.back().start_ns - ticks.front().start_ns);
+  std::printf("haptic_loop,scheduling,rate_hz,ticks,missed_ticks,jitter_p50_us,jitter_p99_9_us,jitter_max_us,"
+              "render_age_p50_ms\n");
+  std::printf("grasper,%s,%.3f,%zu,%llu,%.1f,%.1f,%.1f,%.3f\n", r.grasper_loop().scheduling().describe().c_str(),
+              double(ticks.size() - 1) / span, ticks.size(), static_cast<unsigned long long>(missed),
+              percentile(jitter, 0.5), percentile(jitter, 0.999), percentile(jitter, 1.0), percentile(age, 0.5));
+  return 0;
+}
