@@ -78,6 +78,8 @@
   SINEW_KERNEL(bvh_tree_pairs, 7, TreePairsParams, 0)                            \
   /* the device narrow phase (kernels/shared/narrow_phase_params.h) */           \
   SINEW_KERNEL(narrow_triangle_pairs, 6, TrianglePairsParams, 0)                \
+  /* the contacts' colouring (kernels/shared/contact_coloring_params.h) */      \
+  SINEW_KERNEL(contact_coloring, 8, ContactColoringParams, 0)                   \
   /* continuous collision queries (kernels/shared/ccd_params.h) */              \
   SINEW_KERNEL(ccd_queries, 3, CcdParams, 0)                                     \
   /* level sets (kernels/shared/level_set_params.h) */                          \
