@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <utility>
 #include <random>
 #include <string>
 #include <vector>
@@ -48,12 +50,40 @@ inline ContactSet random_contacts(std::uint32_t count, std::uint32_t particle_co
   return s;
 }
 
+/// The solver's pruning (runtime/mesh_collision.h, "nearest few"), on one
+/// body's contacts: a vertex-triangle contact kept when it is its vertex's
+/// nearest, an edge-edge contact when it is among the 4 nearest of both its edges.
+inline std::vector<collision::Contact> nearest_few(const std::vector<collision::Contact>& all) {
+  using Key = std::pair<std::uint64_t, float>;  // (the primitive, the distance)
+  std::map<std::uint64_t, std::vector<float>> near;
+  const auto edge = [](std::uint32_t a, std::uint32_t b) { return std::uint64_t{std::min(a, b)} << 32 | std::max(a, b); };
+  const auto keys = [&](const collision::Contact& c) {
+    if (c.kind == collision::Contact::Kind::vertex_triangle) return std::vector<Key>{{std::uint64_t{c.v[0]} | 1ull << 63, c.distance}};
+    return std::vector<Key>{{edge(c.v[0], c.v[1]), c.distance}, {edge(c.v[2], c.v[3]), c.distance}};
+  };
+  for (const auto& c : all)
+    for (const Key& k : keys(c)) near[k.first].push_back(k.second);
+  for (auto& [primitive, d] : near) std::sort(d.begin(), d.end());
+  std::vector<collision::Contact> kept;
+  for (const auto& c : all) {
+    bool keep = true;
+    for (const Key& k : keys(c)) {
+      const std::vector<float>& d = near[k.first];
+      const std::size_t rank = (k.first >> 63) != 0 ? 1 : 4;
+      keep = keep && k.second <= d[std::min(rank, d.size()) - 1];
+    }
+    if (keep) kept.push_back(c);
+  }
+  return kept;
+}
+
 /// The self-contacts of the kidney_57k boundary surface (19,126 triangles)
 /// bent by 3 mean edges so that folds come within `thickness_edges` mean
-/// edges of each other (the narrow phase, collision/narrow_phase.h), every
+/// edges of each other (the narrow phase, collision/narrow_phase.h), all
+/// of them or `pruned` as the solver prunes them (nearest_few), every
 /// vertex movable but those of the lowest `pinned` fraction of its height.
 /// [in] data: the data folder. Empty on a missing mesh.
-inline ContactSet kidney_contacts(const std::string& data, float thickness_edges, double pinned) {
+inline ContactSet kidney_contacts(const std::string& data, float thickness_edges, double pinned, bool pruned = false) {
   ContactSet s;
   auto mesh = read_tet_mesh(data + "/meshes/tet/kidney_57k.node");
   if (!mesh) return s;
@@ -94,6 +124,7 @@ inline ContactSet kidney_contacts(const std::string& data, float thickness_edges
   collision::self_overlapping_pairs(tree, collision::SharesVertex{triangles}, pairs);
   std::vector<collision::Contact> contacts;
   if (!collision::triangle_contacts(x, triangles, pairs, thickness, contacts).ok()) return s;
+  if (pruned) contacts = nearest_few(contacts);
   s.movable.resize(surface.vertices.size());
   for (std::size_t v = 0; v < s.movable.size(); ++v)
     s.movable[v] = rest[4 * v + 1] >= bottom + float(pinned) * (top - bottom) ? 1 : 0;

@@ -215,18 +215,21 @@ TEST_P(DeviceContactColoringTest, EqualsTheSequentialReferenceOnRandomSets) {
 
 // The real contacts of the kidney_57k surface bent so that its folds touch
 // (the narrow phase's vertex-triangle and edge-edge contacts at a third of
-// the mean edge), all its vertices movable at a cap of 64, or its lowest
-// fifth pinned at a cap of 12 that it overflows: the reference's colouring on every backend, the
+// the mean edge; all of them, or pruned to the nearest few as the solver
+// keeps them), all its vertices movable at a cap of 64, or its lowest fifth
+// pinned at a cap of 12 that it overflows: the reference's colouring on every backend, the
 // same words as the CPU's; the overflow named in the table.
 TEST_P(DeviceContactColoringTest, EqualsTheReferenceOnTheBentKidneysContacts) {
   struct KidneyCase {
+    bool pruned;
     double pinned;
     std::uint32_t colors;
   };
-  for (const KidneyCase& k : {KidneyCase{0.0, 64}, KidneyCase{0.2, 12}}) {
-    const ContactSet s = kidney_contacts(SINEW_DATA_DIR, 1.0f / 3.0f, k.pinned);
+  for (const KidneyCase& k : {KidneyCase{false, 0.0, 64}, KidneyCase{false, 0.2, 12}, KidneyCase{true, 0.0, 64}}) {
+    const ContactSet s = kidney_contacts(SINEW_DATA_DIR, 1.0f / 3.0f, k.pinned, k.pruned);
     ASSERT_GT(s.contacts(), 1000u) << "the bend should bring the kidney's folds within the thickness";
-    SCOPED_TRACE("pinned " + std::to_string(k.pinned) + ", cap " + std::to_string(k.colors));
+    SCOPED_TRACE(std::string(k.pruned ? "pruned" : "all") + ", pinned " + std::to_string(k.pinned) + ", cap " +
+                 std::to_string(k.colors));
     constexpr std::uint32_t rounds = 96;
     const DeviceRun got = color_on(GetParam(), s, k.colors, rounds);
     expect_equal_to_reference(s, got, k.colors, rounds);
@@ -238,9 +241,9 @@ TEST_P(DeviceContactColoringTest, EqualsTheReferenceOnTheBentKidneysContacts) {
     }
     auto reference = jones_plassmann_coloring(s.particles, s.movable, k.colors, rounds);
     ASSERT_TRUE(reference.ok());
-    std::printf("[ contact colouring ] %s: kidney %u contacts (pinned %.0f%%), cap %u: %u colours, %u in the "
+    std::printf("[ contact colouring ] %s: kidney %u contacts (%s, pinned %.0f%%), cap %u: %u colours, %u in the "
                 "overflow set (%u out of rounds), %u rounds used\n",
-                GetParam().c_str(), s.contacts(), 100.0 * k.pinned, k.colors, got.coloring.used_colors(),
+                GetParam().c_str(), s.contacts(), k.pruned ? "pruned" : "all", 100.0 * k.pinned, k.colors, got.coloring.used_colors(),
                 got.coloring.color_sizes.back(), got.coloring.out_of_rounds, reference->rounds_needed);
     if (k.colors == 12u) {
       EXPECT_GT(got.coloring.color_sizes.back(), 0u) << "12 colours should not hold this set";

@@ -6,6 +6,7 @@
 // atomics; the result does not depend on their order (see the header).
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cstdint>
 
 #include "contact_coloring_params.h"
@@ -72,15 +73,22 @@ void table_step(const ContactColoringParams& p, const Buffers& b) {
   }
 }
 
-// Colour k is taken when a movable particle's mask has bit k.
-bool taken(const ContactColoringParams& p, const Buffers& b, const std::uint32_t* v, std::uint32_t k) {
-  for (int q = 0; q < 4; ++q) {
-    if (!movable(b, v[q])) continue;
-    const std::uint32_t mask =
-        std::atomic_ref<std::uint32_t>(b.masks[std::size_t{v[q]} * p.mask_words + k / 32]).load(std::memory_order_relaxed);
-    if ((mask >> (k % 32) & 1u) != 0) return true;
+// Word w of the colours a contact's movable particles' masks hold.
+std::uint32_t used_word(const ContactColoringParams& p, const Buffers& b, const std::uint32_t* v, std::uint32_t w) {
+  std::uint32_t used = 0;
+  for (int q = 0; q < 4; ++q)
+    if (movable(b, v[q]))
+      used |= std::atomic_ref<std::uint32_t>(b.masks[std::size_t{v[q]} * p.mask_words + w]).load(std::memory_order_relaxed);
+  return used;
+}
+
+// The lowest colour below the cap none of them holds; p.colors if none.
+std::uint32_t lowest_free(const ContactColoringParams& p, const Buffers& b, const std::uint32_t* v) {
+  for (std::uint32_t w = 0; w < p.mask_words; ++w) {
+    const std::uint32_t k = 32 * w + static_cast<std::uint32_t>(std::countr_one(used_word(p, b, v, w)));
+    if (k < std::min(32 * (w + 1), p.colors)) return k;
   }
-  return false;
+  return p.colors;
 }
 
 // claim, decide or finish for item j of the round's list.
@@ -100,9 +108,7 @@ void round_step(const ContactColoringParams& p, const Buffers& b, std::uint32_t 
   if (p.step == SINEW_COLOR_STEP_CLAIM) {
     // Every colour below the cap taken already (the masks hold the last
     // round's colours): the overflow set now, without waiting for its turn.
-    bool full = true;
-    for (std::uint32_t k = 0; k < p.colors && full; ++k) full = taken(p, b, v, k);
-    if (full) {
+    if (lowest_free(p, b, v) == p.colors) {
       b.colour[contact] = p.colors;
       atomic_add(b.table[p.colors], 1);
       return;
@@ -122,8 +128,7 @@ void round_step(const ContactColoringParams& p, const Buffers& b, std::uint32_t 
     if (slot < p.capacity) b.lists[std::size_t{next} * p.capacity + slot] = contact;
     return;
   }
-  std::uint32_t chosen = 0;
-  while (chosen < p.colors && taken(p, b, v, chosen)) ++chosen;
+  const std::uint32_t chosen = lowest_free(p, b, v);
   b.colour[contact] = chosen;
   atomic_add(b.table[chosen], 1);
   if (chosen == p.colors) return;  // the overflow set holds no colour
