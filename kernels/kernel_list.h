@@ -48,7 +48,7 @@
   SINEW_KERNEL(xpbd_solve_point_attachment, 6, SolveParams, 0)                   \
   SINEW_KERNEL(xpbd_solve_contacts, 9, SolveParams, 0)                           \
   /* contacts between meshes (kernels/shared/mesh_contact_params.h) */           \
-  SINEW_KERNEL(xpbd_solve_mesh_contacts, 9, MeshContactParams, 0)                \
+  SINEW_KERNEL(xpbd_solve_mesh_contacts, 10, MeshContactParams, 0)               \
   SINEW_KERNEL(xpbd_mesh_contacts_jacobi, 10, MeshContactParams, 0)              \
   SINEW_KERNEL(xpbd_mesh_contacts_gather, 6, MeshContactParams, 0)               \
   /* needles and sutures (kernels/shared/suture_params.h) */                     \

@@ -27,6 +27,11 @@ namespace sinew::test {
 struct ContactSet {
   std::vector<std::uint32_t> particles;  ///< 4 per contact
   std::vector<std::uint8_t> movable;     ///< per particle
+  // The kidney's only: the particles' positions (xyzw, w the inverse mass:
+  // 1 or 0), each contact's coefficients c_k and normal (xyz, w = 0)
+  // (kernels/shared/mesh_contact_params.h), and the thickness [mesh units].
+  std::vector<float> positions, coefficients, normals;
+  float thickness = 0.0f;
   [[nodiscard]] std::uint32_t contacts() const { return static_cast<std::uint32_t>(particles.size() / 4); }
 };
 
@@ -128,7 +133,16 @@ inline ContactSet kidney_contacts(const std::string& data, float thickness_edges
   s.movable.resize(surface.vertices.size());
   for (std::size_t v = 0; v < s.movable.size(); ++v)
     s.movable[v] = rest[4 * v + 1] >= bottom + float(pinned) * (top - bottom) ? 1 : 0;
-  for (const collision::Contact& c : contacts) s.particles.insert(s.particles.end(), c.v.begin(), c.v.end());
+  for (const collision::Contact& c : contacts) {
+    s.particles.insert(s.particles.end(), c.v.begin(), c.v.end());
+    // Both weights of the second primitive negative (mesh_contact_params.h).
+    const bool vt = c.kind == collision::Contact::Kind::vertex_triangle;
+    s.coefficients.insert(s.coefficients.end(), {c.w[0], vt ? -c.w[1] : c.w[1], -c.w[2], -c.w[3]});
+    s.normals.insert(s.normals.end(), {c.normal[0], c.normal[1], c.normal[2], 0.0f});
+  }
+  s.positions = x;
+  for (std::size_t v = 0; v < s.movable.size(); ++v) s.positions[4 * v + 3] = s.movable[v] ? 1.0f : 0.0f;
+  s.thickness = thickness;
   return s;
 }
 
