@@ -20,6 +20,7 @@
 #include "accelerator_params.h"
 #include "bvh_params.h"
 #include "ccd_params.h"
+#include "contact_coloring_params.h"
 #include "fluid_coupling_params.h"
 #include "level_set_params.h"
 #include "narrow_phase_params.h"

@@ -48,7 +48,7 @@
   SINEW_KERNEL(xpbd_solve_point_attachment, 6, SolveParams, 0)                   \
   SINEW_KERNEL(xpbd_solve_contacts, 9, SolveParams, 0)                           \
   /* contacts between meshes (kernels/shared/mesh_contact_params.h) */           \
-  SINEW_KERNEL(xpbd_solve_mesh_contacts, 9, MeshContactParams, 0)                \
+  SINEW_KERNEL(xpbd_solve_mesh_contacts, 10, MeshContactParams, 0)               \
   SINEW_KERNEL(xpbd_mesh_contacts_jacobi, 10, MeshContactParams, 0)              \
   SINEW_KERNEL(xpbd_mesh_contacts_gather, 6, MeshContactParams, 0)               \
   /* needles and sutures (kernels/shared/suture_params.h) */                     \
@@ -78,6 +78,8 @@
   SINEW_KERNEL(bvh_tree_pairs, 7, TreePairsParams, 0)                            \
   /* the device narrow phase (kernels/shared/narrow_phase_params.h) */           \
   SINEW_KERNEL(narrow_triangle_pairs, 6, TrianglePairsParams, 0)                \
+  /* the contacts' colouring (kernels/shared/contact_coloring_params.h) */      \
+  SINEW_KERNEL(contact_coloring, 8, ContactColoringParams, 0)                   \
   /* continuous collision queries (kernels/shared/ccd_params.h) */              \
   SINEW_KERNEL(ccd_queries, 3, CcdParams, 0)                                     \
   /* level sets (kernels/shared/level_set_params.h) */                          \

@@ -118,10 +118,14 @@ void xpbd_solve_mesh_contacts(const void* params, std::byte* const* bindings, st
   auto* lambda = reinterpret_cast<float4*>(bindings[6]);
   auto* sum = reinterpret_cast<float4*>(bindings[7]);
   const auto* motion = reinterpret_cast<const float*>(bindings[8]);
+  const auto* order = reinterpret_cast<const std::uint32_t*>(bindings[9]);
   const std::uint32_t count = table[p.color];
   const std::uint32_t first = table[p.colors + p.color];
-  for (std::uint32_t item = begin; item < std::min(end, count); ++item) {
-    const std::uint32_t i = first + item;
+  // Item k solves slot k; serially, item 0 solves every slot in order.
+  const std::uint32_t from = p.serial != 0u ? 0u : begin;
+  const std::uint32_t to = p.serial != 0u ? (begin == 0u && end > 0u ? count : 0u) : std::min(end, count);
+  for (std::uint32_t item = from; item < to; ++item) {
+    const std::uint32_t i = p.ordered != 0u ? order[first + item] : first + item;
     const std::uint32_t* v = nullptr;
     float4 xk[4];
     const Step s = solve_item(i, p, bindings, sum, motion, v, xk);

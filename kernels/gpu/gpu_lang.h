@@ -79,6 +79,7 @@
 #define bits_float(u) as_float(u)
 #define atomic_add_u32(buf, index, value) atomic_add(&(buf)[index], (value))
 #define atomic_max_u32(buf, index, value) atomic_max(&(buf)[index], (value))
+#define atomic_or_u32(buf, index, value) atomic_or(&(buf)[index], (value))
 #define count_leading_zeros(x) ((int)clz((uint)(x)))
 
 #else
@@ -120,6 +121,7 @@
 #define fabs(x) abs(x)
 #define atomic_add_u32(buf, index, value) atomicAdd((buf)[index], (value))
 #define atomic_max_u32(buf, index, value) atomicMax((buf)[index], (value))
+#define atomic_or_u32(buf, index, value) atomicOr((buf)[index], (value))
 /* 32 for 0, like OpenCL's clz (findMSB(0) is -1). */
 #define count_leading_zeros(x) (31 - findMSB(uint(x)))
 #endif

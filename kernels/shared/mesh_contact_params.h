@@ -66,6 +66,17 @@
  *     segments with a rigid tool, whose reaction they are
  *     (src/runtime/mesh_collision.h, add_tool_reactions).
  *   8 motion float per contact [in]: m above [m].
+ *   9 order uint per slot [in], read when `ordered`: the contact at each
+ *     slot of the table's colours (the device's colouring,
+ *     src/coloring/device_contact_coloring.h: the contacts stay where the
+ *     host wrote them, in any order, and slot s solves contact order[s];
+ *     their lambdas are the contacts', not the slots').
+ * With `serial`, one work item solves the colour's contacts one after
+ * another in slot order (the device colouring's overflow set, whose
+ * contacts may share particles: a Gauss-Seidel pass over them; launched
+ * for one item, the count from the table). On lavapipe a shader
+ * invocation's loops stop after 65,535 iterations in all: keep the
+ * overflow set well below that.
  * xpbd_mesh_contacts_jacobi takes the same bindings 0-6, its corrections
  * at 7, the lambda sum at 8 and the motion at 9. */
 #ifndef SINEW_MESH_CONTACT_PARAMS_H
@@ -87,9 +98,9 @@ SINEW_STRUCT_BEGIN(MeshContactParams)
   float static_friction;   /* mu_s */
   float dynamic_friction;  /* mu_k <= mu_s */
   float substep_end;       /* fraction of the frame done at the end of this substep, in (0, 1] (the motion) */
+  uint ordered;            /* 1: slot s solves contact order[s] (binding 9); 0: contact s */
+  uint serial;             /* 1: one item solves the colour's contacts in order (xpbd_solve_mesh_contacts) */
   uint pad0;               /* 16-byte size */
-  uint pad1;
-  uint pad2;
 SINEW_STRUCT_END(MeshContactParams)
 
 #ifdef __cplusplus

@@ -119,6 +119,48 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene) {
   return b;
 }
 
+void append_contact_colors(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                           BufferHandle table, BufferHandle order, std::span<const std::uint32_t> counters,
+                           kernels::MeshContactParams m) {
+  for (std::uint32_t k = 0; k < counters.size(); ++k) {
+    m.color = k;
+    program.dispatch_indirect(Kernel::xpbd_solve_mesh_contacts, counters[k],
+                              {buffers.position, buffers.previous, table, contacts.particles, contacts.coefficients,
+                               contacts.normals, contacts.lambda, contacts.lambda_sum, contacts.motion, order},
+                              m);
+    program.barrier();
+  }
+}
+
+std::vector<std::uint32_t> declare_device_color_counters(FrameProgram& program, const DeviceColorTable& colored) {
+  std::vector<std::uint32_t> counters;
+  for (std::uint32_t k = 0; k < colored.colors; ++k)
+    counters.push_back(program.counter("mesh contacts of device colour " + std::to_string(k), colored.table, k,
+                                       colored.capacity));
+  return counters;
+}
+
+void append_device_colored_sweep(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                                 const DeviceColorTable& colored, std::span<const std::uint32_t> counters,
+                                 kernels::MeshContactParams m) {
+  m.colors = colored.colors + 1;
+  m.ordered = 1;
+  append_contact_colors(program, buffers, contacts, colored.table, colored.order, counters, m);
+  append_serial_contact_color(program, buffers, contacts, colored.table, colored.order, colored.colors, m);
+}
+
+void append_serial_contact_color(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                                 BufferHandle table, BufferHandle order, std::uint32_t color,
+                                 kernels::MeshContactParams m) {
+  m.color = color;
+  m.serial = 1;
+  program.dispatch(Kernel::xpbd_solve_mesh_contacts, 1,
+                   {buffers.position, buffers.previous, table, contacts.particles, contacts.coefficients,
+                    contacts.normals, contacts.lambda, contacts.lambda_sum, contacts.motion, order},
+                   m);
+  program.barrier();
+}
+
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
                                 const std::array<double, 3>& gravity, SweepExtras extras) {
   const MeshContactBuffers* mesh_contacts = extras.mesh_contacts;
@@ -194,15 +236,9 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
                                     m);
           program.barrier();
         }
-        for (std::uint32_t k = 0; !mesh_contacts->jacobi && k < mesh_contacts->colors; ++k) {
-          m.color = k;
-          program.dispatch_indirect(Kernel::xpbd_solve_mesh_contacts, contact_counters[k],
-                                    {buffers.position, buffers.previous, mesh_contacts->table,
-                                     mesh_contacts->particles, mesh_contacts->coefficients, mesh_contacts->normals,
-                                     mesh_contacts->lambda, mesh_contacts->lambda_sum, mesh_contacts->motion},
-                                    m);
-          program.barrier();
-        }
+        if (!mesh_contacts->jacobi)
+          append_contact_colors(program, buffers, *mesh_contacts, mesh_contacts->table, mesh_contacts->table,
+                                contact_counters, m);
       }
       if (const SutureBuffers* sutures = extras.sutures) {  // last: they hold the tissue on the needles
         kernels::SutureParams q{};

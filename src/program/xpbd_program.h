@@ -7,6 +7,10 @@
 #include "backends/backend.h"
 #include "mesh_contact_params.h"
 
+#include <cstdint>
+#include <span>
+#include <vector>
+
 namespace sinew {
 
 /// The device buffers of one constraint block.
@@ -57,6 +61,45 @@ struct SweepExtras {
   const MeshContactBuffers* mesh_contacts = nullptr;
   const SutureBuffers* sutures = nullptr;
 };
+
+/// Appends one dispatch of xpbd_solve_mesh_contacts per colour k <
+/// counters.size() (indirect over counter k, a barrier after each), with
+/// `m` (colour set per dispatch). [in] table: the counts and firsts the
+/// kernel reads (mesh_contact_params.h); order: its binding 9 (read when
+/// m.ordered; any buffer otherwise).
+void append_contact_colors(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                           BufferHandle table, BufferHandle order, std::span<const std::uint32_t> counters,
+                           kernels::MeshContactParams m);
+
+/// Appends one work item of xpbd_solve_mesh_contacts that solves colour
+/// `color`'s contacts one after another (m.serial; the device colouring's
+/// overflow set), then a barrier. [in] table, order, m: as above.
+void append_serial_contact_color(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                                 BufferHandle table, BufferHandle order, std::uint32_t color,
+                                 kernels::MeshContactParams m);
+
+/// Contacts coloured on the device (coloring/device_contact_coloring.h):
+/// its table and order, its cap and capacity.
+struct DeviceColorTable {
+  BufferHandle table, order;
+  std::uint32_t colors = 0;    ///< the cap; the table holds colors + 1 (the overflow set last)
+  std::uint32_t capacity = 0;  ///< contacts
+};
+
+/// Declares the counters of the device's colours below the cap (table
+/// words 0 .. colors - 1, capacity: all contacts); returns their indices.
+std::vector<std::uint32_t> declare_device_color_counters(FrameProgram& program, const DeviceColorTable& colored);
+
+/// One sweep over contacts coloured on the device: each colour below the
+/// cap dispatched indirectly (its count a device word, `counters` from
+/// declare_device_color_counters), the slots read through the colouring's
+/// order (the contacts stay where they were written), then the overflow set
+/// by one work item, one contact after another. [in] m: thickness,
+/// compliance, friction, inv_h2, reset_lambda and substep_end as for the
+/// host's colours.
+void append_device_colored_sweep(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                                 const DeviceColorTable& colored, std::span<const std::uint32_t> counters,
+                                 kernels::MeshContactParams m);
 
 /// Creates the buffers on `device` and uploads the compiled scene.
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
