@@ -24,7 +24,7 @@ namespace sinew {
 /// queue has timestamps (on by default on GPUs; SINEW_VULKAN_TIMESTAMPS);
 /// the CPU and OpenCL backends record none (timed stays false).
 struct DeviceTimes {
-  static constexpr std::size_t max_kernels = 64;  ///< kernels timed at most (the arrays' size)
+  static constexpr std::size_t max_kernels = 128;  ///< kernels timed at most (the arrays' size)
   bool timed = false;  ///< whether the backend recorded timestamps for this run
   double span_ms = 0.0;  ///< first timestamp to last [ms]: the program's time on the device
   /// Per kernel (indexed like kernel_names()), summed over its dispatches [ms].
