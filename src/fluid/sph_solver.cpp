@@ -509,8 +509,10 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
   flow.clear2 = float(0.75 * spacing_) * float(0.75 * spacing_);
 
   FrameProgram step;
+  // The particle-wise kernels run over the live particles (counts[0]), not the slots.
+  const std::uint32_t live = g.live_points(step);
   if (moving) {
-    step.dispatch(Kernel::sph_boundary_move, n, {b.counts, b.points, velocity_, boundary_position_, boundary_velocity_}, flow);
+    step.dispatch_indirect(Kernel::sph_boundary_move, live, {b.counts, b.points, velocity_, boundary_position_, boundary_velocity_}, flow);
     step.barrier();
   }
   if (have_emitters) {
@@ -530,7 +532,7 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
     // Flags, their compaction into the kept indices (count in counts[1]),
     // the kept particles packed into the sorted arrays (free until the
     // grid's gather), copied back with their count.
-    step.dispatch(Kernel::sph_sink_flags, n, {b.counts, b.points, sinks_, flags_}, flow);
+    step.dispatch_indirect(Kernel::sph_sink_flags, live, {b.counts, b.points, sinks_, flags_}, flow);
     step.barrier();
     append_compact(step, {b.counts, 0, n}, flags_, BufferHandle{}, kept_, {b.counts, 1, n}, "sph particles kept",
                    compact_scratch_);
@@ -562,22 +564,23 @@ void SphSolver::append_pbf(FrameProgram& step) const {
   const NeighbourGrid& g = *grid_;
   const NeighbourGridBuffers& b = g.buffers();
   const std::uint32_t n = slots_;
-  step.dispatch(Kernel::pbf_predict, n, {b.counts, b.points, velocity_, previous_}, pbf_params_);
+  const std::uint32_t live = g.live_points(step);
+  step.dispatch_indirect(Kernel::pbf_predict, live, {b.counts, b.points, velocity_, previous_}, pbf_params_);
   step.barrier();
   g.append_grid(step);
-  step.dispatch(Kernel::sph_gather, n, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
+  step.dispatch_indirect(Kernel::sph_gather, live, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
   step.barrier();
   for (int it = 0; it < iterations_; ++it) {
-    step.dispatch(Kernel::pbf_lambda, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, lambda_},
+    step.dispatch_indirect(Kernel::pbf_lambda, live, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, lambda_},
                   pbf_params_);
     step.barrier();
-    step.dispatch(Kernel::pbf_delta, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, lambda_, moved_},
+    step.dispatch_indirect(Kernel::pbf_delta, live, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, lambda_, moved_},
                   pbf_params_);
     step.barrier();
     step.copy(moved_, 0, b.sorted_points, 0, 4 * n);
     step.barrier();
   }
-  step.dispatch(Kernel::pbf_finish, n,
+  step.dispatch_indirect(Kernel::pbf_finish, live,
                 {b.counts, b.sorted_points, b.order, previous_, sorted_velocity_, b.points, velocity_, speed2_,
                  pressure_},
                 pbf_params_);
@@ -587,25 +590,25 @@ void SphSolver::append_pbf(FrameProgram& step) const {
 void SphSolver::append_wcsph(FrameProgram& step, bool forces) const {
   const NeighbourGrid& g = *grid_;
   const NeighbourGridBuffers& b = g.buffers();
-  const std::uint32_t n = slots_;
+  const std::uint32_t live = g.live_points(step);
   // The grid, the density, the velocities in the grid's order, the forces and the motion.
   g.append_grid(step);
   append_sph_density(step, g, params_, density_);
-  step.dispatch(Kernel::sph_gather, n, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
+  step.dispatch_indirect(Kernel::sph_gather, live, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
   if (tension_)  // reads the densities and sorted points, as the gather does not write them
-    step.dispatch(Kernel::sph_normals, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_},
+    step.dispatch_indirect(Kernel::sph_normals, live, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_},
                   tension_params_);
   step.barrier();
-  step.dispatch(Kernel::sph_step, n,
+  step.dispatch_indirect(Kernel::sph_step, live,
                 {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, b.points, velocity_,
                  pressure_, speed2_},
                 params_);
   if (forces)  // reads what sph_step reads, writes only the impulses: no barrier between them
-    step.dispatch(Kernel::sph_boundary_force, n,
+    step.dispatch_indirect(Kernel::sph_boundary_force, live,
                   {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, impulse_}, params_);
   step.barrier();
   if (tension_) {  // a further acceleration over the step, added to sph_step's results
-    step.dispatch(Kernel::sph_tension, n,
+    step.dispatch_indirect(Kernel::sph_tension, live,
                   {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_, b.points, velocity_},
                   tension_params_);
     step.barrier();
