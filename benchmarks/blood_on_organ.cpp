@@ -31,6 +31,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bleeding_organ_scene.h"
 #include "command_line.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
@@ -46,61 +47,6 @@ int fail(const std::string& what) {
   std::fprintf(stderr, "blood_on_organ: %s\n", what.c_str());
   return 1;
 }
-
-// Which points lie inside the tet mesh at positions x (xyzw per vertex):
-// each tet's bounding box is binned on a uniform grid of `cell` [m]; a
-// point is tested against the tets of its cell with barycentric
-// coordinates (all >= 0).
-class TetContainment {
- public:
-  TetContainment(const sinew::TetMesh& mesh, const std::vector<float>& x, double cell) : mesh_(mesh), x_(x), cell_(cell) {
-    for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
-      V3 lo{1e30, 1e30, 1e30}, hi{-1e30, -1e30, -1e30};
-      for (std::uint32_t v : mesh.tets[t])
-        for (int a = 0; a < 3; ++a) {
-          lo[a] = std::min(lo[a], double(x[4 * v + a]));
-          hi[a] = std::max(hi[a], double(x[4 * v + a]));
-        }
-      const auto l = key(lo), h = key(hi);
-      for (long i = l[0]; i <= h[0]; ++i)
-        for (long j = l[1]; j <= h[1]; ++j)
-          for (long k = l[2]; k <= h[2]; ++k) bins_[pack({i, j, k})].push_back(t);
-    }
-  }
-  bool inside(const V3& p) const {
-    const auto it = bins_.find(pack(key(p)));
-    if (it == bins_.end()) return false;
-    for (std::uint32_t t : it->second)
-      if (in_tet(t, p)) return true;
-    return false;
-  }
-
- private:
-  std::array<long, 3> key(const V3& p) const {
-    return {long(std::floor(p[0] / cell_)), long(std::floor(p[1] / cell_)), long(std::floor(p[2] / cell_))};
-  }
-  static long long pack(const std::array<long, 3>& k) {
-    return ((long long)(k[0] & 0xfffff) << 40) | ((long long)(k[1] & 0xfffff) << 20) | (long long)(k[2] & 0xfffff);
-  }
-  V3 at(std::uint32_t v) const { return {x_[4 * v], x_[4 * v + 1], x_[4 * v + 2]}; }
-  bool in_tet(std::uint32_t t, const V3& p) const {
-    const auto& T = mesh_.tets[t];
-    const V3 a = at(T[0]), b = at(T[1]), c = at(T[2]), d = at(T[3]);
-    auto sub = [](const V3& u, const V3& v) { return V3{u[0] - v[0], u[1] - v[1], u[2] - v[2]}; };
-    auto det = [](const V3& u, const V3& v, const V3& w) {
-      return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
-    };
-    const V3 e1 = sub(b, a), e2 = sub(c, a), e3 = sub(d, a), r = sub(p, a);
-    const double vol = det(e1, e2, e3);
-    if (vol == 0.0) return false;
-    const double l1 = det(r, e2, e3) / vol, l2 = det(e1, r, e3) / vol, l3 = det(e1, e2, r) / vol;
-    return l1 >= 0 && l2 >= 0 && l3 >= 0 && l1 + l2 + l3 <= 1;
-  }
-  const sinew::TetMesh& mesh_;
-  const std::vector<float>& x_;
-  double cell_;
-  std::unordered_map<long long, std::vector<std::uint32_t>> bins_;
-};
 
 }  // namespace
 
@@ -193,7 +139,7 @@ int main(int argc, char** argv) {
 
     if (auto s = fluid.read(q); !s) return fail(s.error().message());
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
-    const TetContainment kidney(*mesh, x, 4e-3);
+    const sinew::examples::TetContainment kidney(*mesh, x, sim->info().tet_body_first_particle[0], 4e-3);
     // The film: fluid particles in a 3 mm cell next to one holding a
     // surface vertex (within 3-6 mm of the surface).
     auto pack = [](long i, long j, long k) {

@@ -93,7 +93,8 @@
   SINEW_KERNEL(sph_density, 5, SphParams, 0)                                    \
   SINEW_KERNEL(sph_gather, 4, SphParams, 0)                                     \
   SINEW_KERNEL(sph_step, 10, SphParams, 0)                                      \
-  SINEW_KERNEL(sph_boundary_force, 7, SphParams, 0)                             \
+  SINEW_KERNEL(sph_fluid_cells, 4, SphParams, 0)                                \
+  SINEW_KERNEL(sph_boundary_force, 8, SphParams, 0)                             \
   /* surface tension (kernels/shared/sph_tension_params.h) */                   \
   SINEW_KERNEL(sph_normals, 6, TensionParams, 0)                                \
   SINEW_KERNEL(sph_tension, 8, TensionParams, 0)                                \

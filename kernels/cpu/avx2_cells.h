@@ -25,6 +25,11 @@ inline std::uint32_t spread10(std::uint32_t v) {
   return v;
 }
 
+/// A cell's bucket (neighbour_math.h): the Morton interleave of its coordinates' low bits, masked.
+inline std::uint32_t bucket_of(int cx, int cy, int cz, std::uint32_t mask) {
+  return ((spread10(std::uint32_t(cx)) << 2) | (spread10(std::uint32_t(cy)) << 1) | spread10(std::uint32_t(cz))) & mask;
+}
+
 /// The 27 cells' runs around one cell (dz outermost, as the reference visits
 /// them), looked up once per cell: the particles of a cell are next to each
 /// other in sorted order, so the next particles usually share them. A run
@@ -48,8 +53,7 @@ struct CellRuns {
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx, ++v) {
           const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          const std::uint32_t b =
-              ((spread10(std::uint32_t(cx)) << 2) | (spread10(std::uint32_t(cy)) << 1) | spread10(std::uint32_t(cz))) & mask;
+          const std::uint32_t b = bucket_of(cx, cy, cz, mask);
           Run& r = runs[v];
           r = {ranges[3 * std::size_t{b}], ranges[3 * std::size_t{b} + 1], ranges[3 * std::size_t{b} + 2] != 0, cx, cy, cz};
           const int* rc = cells + 4 * std::size_t{r.begin};

@@ -144,6 +144,21 @@ void sph_step(const void* params, std::byte* const* bindings, std::uint32_t begi
   }
 }
 
+void sph_fluid_cells(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
+  const auto& p = *static_cast<const SphParams*>(params);
+  const u32 n = cells::count_of(p, bindings[0]);
+  const auto* points = reinterpret_cast<const float*>(bindings[1]);
+  const auto* cells = reinterpret_cast<const int*>(bindings[2]);
+  auto* near = reinterpret_cast<u32*>(bindings[3]);
+  for (u32 s = begin; s < end && s < n; ++s) {
+    if (!(points[4 * std::size_t{s} + 3] > 0.0f)) continue;  // a boundary particle
+    const int* c = cells + 4 * std::size_t{s};
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) near[cells::bucket_of(c[0] + dx, c[1] + dy, c[2] + dz, p.table_mask)] = 1u;
+  }
+}
+
 void sph_boundary_force(const void* params, std::byte* const* bindings, std::uint32_t begin, std::uint32_t end) {
   const auto& p = *static_cast<const SphParams*>(params);
   const u32 n = cells::count_of(p, bindings[0]);
@@ -153,9 +168,12 @@ void sph_boundary_force(const void* params, std::byte* const* bindings, std::uin
   const auto* density = reinterpret_cast<const float*>(bindings[4]);
   const auto* sorted_velocity = reinterpret_cast<const float*>(bindings[5]);
   auto* impulse = reinterpret_cast<float*>(bindings[6]);
+  const auto* near = reinterpret_cast<const u32*>(bindings[7]);
   for (u32 s = begin; s < end && s < n; ++s) {
     const float* x = points + 4 * std::size_t{s};
     if (x[3] > 0.0f) continue;  // a fluid particle
+    const int* own = cells + 4 * std::size_t{s};
+    if (near[cells::bucket_of(own[0], own[1], own[2], p.table_mask)] == 0u) continue;  // no fluid within h
     const float* w = sorted_velocity + 4 * std::size_t{s};
     const float psi = -x[3];
     const int* c = cells + 4 * std::size_t{s};

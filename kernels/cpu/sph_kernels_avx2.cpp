@@ -264,6 +264,7 @@ void sph_boundary_force_avx2(const void* params, std::byte* const* bindings, std
   const auto* density = reinterpret_cast<const float*>(bindings[4]);
   const auto* sorted_velocity = reinterpret_cast<const float*>(bindings[5]);
   auto* impulse = reinterpret_cast<float*>(bindings[6]);
+  const auto* near = reinterpret_cast<const u32*>(bindings[7]);
   const __m256 h2 = _mm256_set1_ps(p.h2), inv_l = _mm256_set1_ps(p.inv_l), zero = _mm256_setzero_ps();
   const __m256 grad_sigma = _mm256_set1_ps(p.grad_sigma), eta2 = _mm256_set1_ps(p.eta2);
   const __m256 minus_boundary = _mm256_set1_ps(-p.boundary_viscosity);
@@ -282,7 +283,8 @@ void sph_boundary_force_avx2(const void* params, std::byte* const* bindings, std
       any_boundary = any_boundary || !(points[4 * std::size_t{s + k} + 3] > 0.0f);
       ++k;
     }
-    if (!any_boundary) {
+    // No boundary particle, or no fluid in the 27 cells around (sph_fluid_cells).
+    if (!any_boundary || near[bucket_of(c[0], c[1], c[2], p.table_mask)] == 0u) {
       s += k;
       continue;
     }

@@ -22,7 +22,7 @@ kernels::SphParams sph_params(const NeighbourGrid& grid, double support) {
 void append_sph_density(FrameProgram& program, const NeighbourGrid& grid, const kernels::SphParams& params,
                         BufferHandle density) {
   const NeighbourGridBuffers& b = grid.buffers();
-  program.dispatch(Kernel::sph_density, grid.capacity(), {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density},
+  program.dispatch_indirect(Kernel::sph_density, grid.live_points(program), {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density},
                    params);
   program.barrier();
 }

@@ -167,9 +167,10 @@ void SphSolver::state_buffers(std::vector<std::pair<BufferHandle, std::size_t>>&
 
 SphSolver::~SphSolver() {
   if (have_program_) (void)device_.destroy_program(program_);
+  if (have_rest_program_) (void)device_.destroy_program(rest_program_);
   for (BufferHandle h : {velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_, state_, emitters_,
                          emit_flags_, previous_, lambda_, moved_, normals_, pattern_, sinks_, flags_, kept_, compact_scratch_, boundary_position_, boundary_velocity_,
-                         impulse_})
+                         impulse_, near_})
     if (h.valid()) (void)device_.destroy_buffer(h);
   grid_.reset();
 }
@@ -360,6 +361,12 @@ Result<std::unique_ptr<SphSolver>> SphSolver::create(Device& device, const Fluid
     *b.handle = *buffer;
     m.sized_.emplace_back(*buffer, b.bytes);  // what a saved state holds (state_buffers)
   }
+  if (desc.boundary_forces && m.boundary_ > 0) {
+    // Rebuilt every step (sph_fluid_cells), so no part of a saved state.
+    auto near = device.create_buffer(4 * std::size_t{g.buckets()}, "sph buckets near the fluid");
+    if (!near) return near.error();
+    m.near_ = *near;
+  }
   kernels::SphParams p = sph_params(g, h);
   p.rho0 = float(settings.rest_density);
   p.stiffness = float(settings.rest_density * settings.speed_of_sound * settings.speed_of_sound / 7.0);
@@ -508,50 +515,66 @@ Status SphSolver::build_program(bool have_sinks, bool have_emitters, bool moving
   flow.table_mask = g.buckets() - 1;
   flow.clear2 = float(0.75 * spacing_) * float(0.75 * spacing_);
 
-  FrameProgram step;
-  if (moving) {
-    step.dispatch(Kernel::sph_boundary_move, n, {b.counts, b.points, velocity_, boundary_position_, boundary_velocity_}, flow);
-    step.barrier();
-  }
-  if (have_emitters) {
-    // Before the sinks: the points are still in the last grid's order, which
-    // sph_emit_flags searches for room.
-    step.dispatch(Kernel::sph_emit_flags, std::max(flow.pattern, 1u),
-                  {b.counts, b.points, b.sorted_cells, b.ranges, emitters_, pattern_, state_, emit_flags_}, flow);
-    step.barrier();
-    step.dispatch(Kernel::sph_emit, std::max(flow.pattern, 1u),
-                  {b.counts, b.points, velocity_, emitters_, pattern_, state_, emit_flags_}, flow);
-    step.barrier();
-    step.dispatch(Kernel::sph_emit_commit, 1, {b.counts, emitters_, state_, emit_flags_}, flow);
-    step.barrier();
-    step.counter("sph particles (fluid capacity + boundary particles)", state_, 3, n);
-  }
-  if (have_sinks) {
-    // Flags, their compaction into the kept indices (count in counts[1]),
-    // the kept particles packed into the sorted arrays (free until the
-    // grid's gather), copied back with their count.
-    step.dispatch(Kernel::sph_sink_flags, n, {b.counts, b.points, sinks_, flags_}, flow);
-    step.barrier();
-    append_compact(step, {b.counts, 0, n}, flags_, BufferHandle{}, kept_, {b.counts, 1, n}, "sph particles kept",
-                   compact_scratch_);
-    step.dispatch(Kernel::sph_pack, n, {b.counts, kept_, b.points, velocity_, b.sorted_points, sorted_velocity_, state_}, flow);
-    step.barrier();
-    step.copy(b.sorted_points, 0, b.points, 0, 4 * n);
-    step.copy(sorted_velocity_, 0, velocity_, 0, 4 * n);
-    step.copy(b.counts, 1, b.counts, 0, 1);
-    step.barrier();
-  }
-  if (pbf_) {
-    append_pbf(step);
-  } else {
-    append_wcsph(step, forces);
-  }
-  // The fastest particle, for the speed check after the steps.
-  max_word_ = append_reduce(step, {b.counts, 0, n}, ReduceOp::max_f32, {speed2_, 0}, 1, {scratch_, 0});
-  auto program = device_.create_program(step);
+  // Two programs when the boundary moves: the first step of a step() call
+  // moves it to the host's (or the tissue's) latest pose; the others need
+  // not, as nothing changes that pose within a call and sph_step copies
+  // boundary particles unchanged (the same floats, one kernel over every
+  // particle less per step).
+  auto make = [&](bool move) -> Result<ProgramHandle> {
+    FrameProgram step;
+    // The particle-wise kernels run over the live particles (counts[0]), not the slots.
+    const std::uint32_t live = g.live_points(step);
+    if (move) {
+      step.dispatch_indirect(Kernel::sph_boundary_move, live, {b.counts, b.points, velocity_, boundary_position_, boundary_velocity_}, flow);
+      step.barrier();
+    }
+    if (have_emitters) {
+      // Before the sinks: the points are still in the last grid's order, which
+      // sph_emit_flags searches for room.
+      step.dispatch(Kernel::sph_emit_flags, std::max(flow.pattern, 1u),
+                    {b.counts, b.points, b.sorted_cells, b.ranges, emitters_, pattern_, state_, emit_flags_}, flow);
+      step.barrier();
+      step.dispatch(Kernel::sph_emit, std::max(flow.pattern, 1u),
+                    {b.counts, b.points, velocity_, emitters_, pattern_, state_, emit_flags_}, flow);
+      step.barrier();
+      step.dispatch(Kernel::sph_emit_commit, 1, {b.counts, emitters_, state_, emit_flags_}, flow);
+      step.barrier();
+      step.counter("sph particles (fluid capacity + boundary particles)", state_, 3, n);
+    }
+    if (have_sinks) {
+      // Flags, their compaction into the kept indices (count in counts[1]),
+      // the kept particles packed into the sorted arrays (free until the
+      // grid's gather), copied back with their count.
+      step.dispatch_indirect(Kernel::sph_sink_flags, live, {b.counts, b.points, sinks_, flags_}, flow);
+      step.barrier();
+      append_compact(step, {b.counts, 0, n}, flags_, BufferHandle{}, kept_, {b.counts, 1, n}, "sph particles kept",
+                     compact_scratch_);
+      step.dispatch(Kernel::sph_pack, n, {b.counts, kept_, b.points, velocity_, b.sorted_points, sorted_velocity_, state_}, flow);
+      step.barrier();
+      step.copy(b.sorted_points, 0, b.points, 0, 4 * n);
+      step.copy(sorted_velocity_, 0, velocity_, 0, 4 * n);
+      step.copy(b.counts, 1, b.counts, 0, 1);
+      step.barrier();
+    }
+    if (pbf_) {
+      append_pbf(step);
+    } else {
+      append_wcsph(step, forces);
+    }
+    // The fastest particle, for the speed check after the steps.
+    max_word_ = append_reduce(step, {b.counts, 0, n}, ReduceOp::max_f32, {speed2_, 0}, 1, {scratch_, 0});
+    return device_.create_program(step);
+  };
+  auto program = make(moving);
   if (!program) return program.error();
   program_ = *program;
   have_program_ = true;
+  if (moving) {
+    auto rest = make(false);
+    if (!rest) return rest.error();
+    rest_program_ = *rest;
+    have_rest_program_ = true;
+  }
   return {};
 }
 
@@ -562,22 +585,23 @@ void SphSolver::append_pbf(FrameProgram& step) const {
   const NeighbourGrid& g = *grid_;
   const NeighbourGridBuffers& b = g.buffers();
   const std::uint32_t n = slots_;
-  step.dispatch(Kernel::pbf_predict, n, {b.counts, b.points, velocity_, previous_}, pbf_params_);
+  const std::uint32_t live = g.live_points(step);
+  step.dispatch_indirect(Kernel::pbf_predict, live, {b.counts, b.points, velocity_, previous_}, pbf_params_);
   step.barrier();
   g.append_grid(step);
-  step.dispatch(Kernel::sph_gather, n, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
+  step.dispatch_indirect(Kernel::sph_gather, live, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
   step.barrier();
   for (int it = 0; it < iterations_; ++it) {
-    step.dispatch(Kernel::pbf_lambda, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, lambda_},
+    step.dispatch_indirect(Kernel::pbf_lambda, live, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, lambda_},
                   pbf_params_);
     step.barrier();
-    step.dispatch(Kernel::pbf_delta, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, lambda_, moved_},
+    step.dispatch_indirect(Kernel::pbf_delta, live, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, lambda_, moved_},
                   pbf_params_);
     step.barrier();
     step.copy(moved_, 0, b.sorted_points, 0, 4 * n);
     step.barrier();
   }
-  step.dispatch(Kernel::pbf_finish, n,
+  step.dispatch_indirect(Kernel::pbf_finish, live,
                 {b.counts, b.sorted_points, b.order, previous_, sorted_velocity_, b.points, velocity_, speed2_,
                  pressure_},
                 pbf_params_);
@@ -587,25 +611,29 @@ void SphSolver::append_pbf(FrameProgram& step) const {
 void SphSolver::append_wcsph(FrameProgram& step, bool forces) const {
   const NeighbourGrid& g = *grid_;
   const NeighbourGridBuffers& b = g.buffers();
-  const std::uint32_t n = slots_;
+  const std::uint32_t live = g.live_points(step);
   // The grid, the density, the velocities in the grid's order, the forces and the motion.
+  if (forces) step.fill(near_, 0, g.buckets(), 0u);  // before the grid's closing barrier
   g.append_grid(step);
+  if (forces)  // the buckets near the fluid, beside the density (sph_params.h: sph_fluid_cells)
+    step.dispatch_indirect(Kernel::sph_fluid_cells, live, {b.counts, b.sorted_points, b.sorted_cells, near_}, params_);
   append_sph_density(step, g, params_, density_);
-  step.dispatch(Kernel::sph_gather, n, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
+  step.dispatch_indirect(Kernel::sph_gather, live, {b.counts, b.order, velocity_, sorted_velocity_}, params_);
   if (tension_)  // reads the densities and sorted points, as the gather does not write them
-    step.dispatch(Kernel::sph_normals, n, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_},
+    step.dispatch_indirect(Kernel::sph_normals, live, {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_},
                   tension_params_);
   step.barrier();
-  step.dispatch(Kernel::sph_step, n,
+  step.dispatch_indirect(Kernel::sph_step, live,
                 {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, b.points, velocity_,
                  pressure_, speed2_},
                 params_);
   if (forces)  // reads what sph_step reads, writes only the impulses: no barrier between them
-    step.dispatch(Kernel::sph_boundary_force, n,
-                  {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, impulse_}, params_);
+    step.dispatch_indirect(Kernel::sph_boundary_force, live,
+                  {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, sorted_velocity_, impulse_, near_},
+                           params_);
   step.barrier();
   if (tension_) {  // a further acceleration over the step, added to sph_step's results
-    step.dispatch(Kernel::sph_tension, n,
+    step.dispatch_indirect(Kernel::sph_tension, live,
                   {b.counts, b.sorted_points, b.sorted_cells, b.ranges, density_, normals_, b.points, velocity_},
                   tension_params_);
     step.barrier();
@@ -633,7 +661,7 @@ Status SphSolver::step(int steps) {
                                                    std::to_string(next_id_) + " made since create)");
   Status ran;
   for (int k = 0; k < steps; ++k) {
-    Status one = device_.run_program(program_);
+    Status one = device_.run_program(k > 0 && have_rest_program_ ? rest_program_ : program_);
     // A capacity error leaves a consistent step (what fits was made): count
     // it, go on with the steps asked for, and report it after them.
     const bool overflow = !one && one.error().code() == ErrorCode::capacity_exceeded;

@@ -7,7 +7,7 @@
 //   sph_sink_flags, compaction, sph_pack, copies
 //                          the particles inside sinks removed (sinks)
 //   the grid               sorted by cell (neighbour_grid.h)
-//   sph_density, sph_gather, sph_step [+ sph_boundary_force]
+//   sph_density, sph_gather, sph_step [+ sph_fluid_cells, sph_boundary_force]
 //   reduce                 the fastest particle, for the CFL check
 // A scene without sinks, emitters or a moving boundary runs none of their
 // kernels. The particle count n lives on the device (the grid's counts[0])
@@ -113,6 +113,7 @@ class SphSolver {
   BufferHandle velocity_, sorted_velocity_, density_, pressure_, speed2_, scratch_;
   BufferHandle state_, emitters_, emit_flags_, pattern_, sinks_, flags_, kept_, compact_scratch_;
   BufferHandle boundary_position_, boundary_velocity_, impulse_;
+  BufferHandle near_;  // uint per grid bucket: 1 where fluid lies in the 27 cells around (sph_fluid_cells)
   BufferHandle previous_, lambda_, moved_;  // pbf
   BufferHandle normals_;                    // surface tension
   kernels::TensionParams tension_params_{};
@@ -124,6 +125,8 @@ class SphSolver {
   double speed_of_sound_ = 0.0, time_step_ = 0.0, h_ = 0.0, spacing_ = 0.0, mass_ = 0.0;
   ProgramHandle program_{};
   bool have_program_ = false;
+  ProgramHandle rest_program_{};  // a step() call's later steps, without sph_boundary_move (moving boundaries)
+  bool have_rest_program_ = false;
   kernels::SphParams params_{};
   std::uint32_t boundary_ = 0, capacity_ = 0, slots_ = 0;
   std::vector<FluidEmitter> emitters_desc_;

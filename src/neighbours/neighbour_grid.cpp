@@ -108,18 +108,24 @@ kernels::NeighbourParams NeighbourGrid::params() const {
   return p;
 }
 
+std::uint32_t NeighbourGrid::live_points(FrameProgram& program) const {
+  return program.counter("neighbour points", b_.counts, 0, capacity_);
+}
+
 void NeighbourGrid::append_grid(FrameProgram& program) const {
   const NeighbourGridBuffers& b = b_;
   const kernels::NeighbourParams p = params();
+  const std::uint32_t live = live_points(program);
   program.fill(b.ranges, 0, 3 * buckets_, 0u);
-  program.dispatch(Kernel::nbr_cells, capacity_, {b.counts, b.points, b.keys, b.order, b.cells}, p);
+  program.dispatch_indirect(Kernel::nbr_cells, live, {b.counts, b.points, b.keys, b.order, b.cells}, p);
   program.barrier();
   // Only the bucket's bits are sorted (table_bits_ of 32: fewer passes).
   append_radix_sort(program, {b.counts, 0, capacity_}, 32, b.keys, b.order, b.keys_tmp, b.order_tmp, {b.scratch, 0},
                     table_bits_);
   program.barrier();
-  program.dispatch(Kernel::nbr_ranges, capacity_, {b.counts, b.keys, b.order, b.cells, b.ranges}, p);
-  program.dispatch(Kernel::nbr_gather, capacity_, {b.counts, b.order, b.points, b.cells, b.sorted_points, b.sorted_cells}, p);
+  program.dispatch_indirect(Kernel::nbr_ranges, live, {b.counts, b.keys, b.order, b.cells, b.ranges}, p);
+  program.dispatch_indirect(Kernel::nbr_gather, live,
+                            {b.counts, b.order, b.points, b.cells, b.sorted_points, b.sorted_cells}, p);
   program.barrier();
 }
 
@@ -140,8 +146,9 @@ Status NeighbourGrid::build_program() {
 
   FrameProgram program;
   append_grid(program);
+  const std::uint32_t live = live_points(program);
   p.mode = 0;
-  program.dispatch(Kernel::nbr_query, capacity_,
+  program.dispatch_indirect(Kernel::nbr_query, live,
                    {b.counts, b.sorted_points, b.sorted_cells, b.ranges, b.order, b.lists, b.neighbours}, p);
   program.barrier();
   // The counts become each list's offset; the total is the pairs' counter.
@@ -149,9 +156,9 @@ Status NeighbourGrid::build_program() {
       append_exclusive_scan(program, {b.counts, 0, capacity_}, {b.lists, 0}, {b.lists, 0}, {b.scratch, 0});
   program.copy(b.scratch, total, b.counts, 1, 1);
   program.barrier();
-  program.counter("neighbour pairs", b.counts, 1, pair_capacity_);
+  pairs_counter_ = program.counter("neighbour pairs", b.counts, 1, pair_capacity_);
   p.mode = 1;
-  program.dispatch(Kernel::nbr_query, capacity_,
+  program.dispatch_indirect(Kernel::nbr_query, live,
                    {b.counts, b.sorted_points, b.sorted_cells, b.ranges, b.order, b.lists, b.neighbours}, p);
   program.barrier();
   auto made = device_.create_program(program);
@@ -185,7 +192,7 @@ Status NeighbourGrid::run_grid() { return device_.run_program(grid_program_); }
 
 std::uint32_t NeighbourGrid::pairs() const {
   const std::span<const std::uint32_t> c = device_.counters();
-  return c.empty() ? 0u : c[0];
+  return pairs_counter_ < c.size() ? c[pairs_counter_] : 0u;
 }
 
 Status NeighbourGrid::grow_pairs(std::uint32_t pair_capacity) {

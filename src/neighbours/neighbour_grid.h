@@ -70,7 +70,15 @@ class NeighbourGrid {
 
   /// Appends the grid's part of the program (up to nbr_gather, ending with a
   /// barrier) to another program: a solver's step that visits the cells.
+  /// Its dispatches run over the live point count (live_points).
   void append_grid(FrameProgram& program) const;
+  /// Declares the point count counts[0] a counter of `program` (at most
+  /// capacity()) and returns its index, for dispatch_indirect: a dispatch
+  /// over the live points rather than the capacity. Why: on a GPU no work
+  /// item past the count is launched, and on the CPU the team splits the
+  /// live points between its threads (a dispatch over the capacity gave
+  /// them all to the first thread when fewer than half the slots were live).
+  std::uint32_t live_points(FrameProgram& program) const;
 
   [[nodiscard]] const NeighbourGridBuffers& buffers() const { return b_; }
   [[nodiscard]] std::uint32_t capacity() const { return capacity_; }
@@ -95,6 +103,7 @@ class NeighbourGrid {
   std::uint32_t capacity_ = 0, pair_capacity_ = 0, buckets_ = 0, table_bits_ = 0;
   float inv_cell_ = 0.0f, radius2_ = 0.0f;
   ProgramHandle program_{}, grid_program_{};
+  std::uint32_t pairs_counter_ = 0;  // the index of the counter "neighbour pairs" in program_
   bool have_program_ = false, have_grid_program_ = false;
 };
 
