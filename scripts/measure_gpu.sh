@@ -7,8 +7,8 @@
 # nine minutes on a 16-core GPU machine:
 #   1. the agreement tests of every backend-parameterised suite (numbers from
 #      a backend that disagrees with cpu are worthless);
-#   2. the cube (xpbd and Neo-Hookean), mesh-contact and dispatch benchmarks, the
-#      retraction scene, and the organ step on kidney_57k and liver_382k, on
+#   2. the cube (xpbd and Neo-Hookean), mesh-contact, contact-colouring and
+#      dispatch benchmarks, the retraction and bleeding reference scenes, and the organ step on kidney_57k and liver_382k, on
 #      opencl and vulkan (cpu alongside);
 #   3. every scene file under scenes/ through the runner on opencl and vulkan:
 #      its per-stage profile, what the host read back and waited for per
@@ -113,7 +113,10 @@ if wants benchmarks; then
   runs dispatch 60 "$bin/bench_dispatch" --benchmark_out="$results/dispatch.csv" --benchmark_out_format=csv
   for backend in cpu opencl vulkan; do
     runs "retraction_${backend}" 90 "$bin/bench_retraction" "$backend" 60
+    runs "bleeding_organ_${backend}" 90 "$bin/bleeding_organ" --backend "$backend" --frames 60
   done
+  runs contact_coloring 120 "$bin/bench_contact_coloring" --benchmark_out="$results/contact_coloring.csv" \
+    --benchmark_out_format=csv
   for mesh in kidney_57k liver_382k; do
     for backend in cpu opencl vulkan; do
       runs "organ_step_${mesh}_${backend}" 90 "$bin/organ_step" "$backend" "$data_dir/meshes/tet/$mesh.node" 30
@@ -134,7 +137,7 @@ fi
 
 if wants examples; then
   scratch=$(mktemp -d)
-  for example in organ_contact retraction suturing cholecystectomy bleeding bone_burr haptic_drag; do
+  for example in organ_contact retraction bleeding_kidney suturing cholecystectomy bleeding bone_burr haptic_drag; do
     for backend in opencl vulkan; do
       runs "example_${example}_${backend}" 90 "$bin/$example" --backend "$backend" --out "$scratch/$example"
     done

@@ -8,7 +8,7 @@
 #   scripts/pack_for_device.sh [BUILD_DIR] [OUT_DIR]   (defaults: build, .gpu)
 # Build the programs first:
 #   cmake --build build --target sinew_runner bench_cube bench_dispatch organ_step error_vs_time \
-#     bench_mesh_contacts bench_retraction organ_contact retraction suturing cholecystectomy bleeding bone_burr haptic_drag \
+#     bench_mesh_contacts bench_retraction bleeding_organ bench_contact_coloring organ_contact retraction bleeding_kidney suturing cholecystectomy bleeding bone_burr haptic_drag \
 #     test_backends test_xpbd test_collision test_fluid test_tissue test_topology test_robustness
 # The GPU machine's own driver supplies the OpenCL ICD and Vulkan ICD files;
 # the meshes travel packed in the repository's data/ and measure_gpu.sh unpacks
@@ -20,8 +20,8 @@ build=${1:-build}
 out=${2:-.gpu}
 programs=(apps/sinew/sinew
           benchmarks/bench_cube benchmarks/bench_dispatch benchmarks/organ_step benchmarks/error_vs_time
-          benchmarks/bench_mesh_contacts benchmarks/bench_retraction
-          examples/organ_contact examples/retraction examples/suturing examples/cholecystectomy examples/bleeding examples/bone_burr
+          benchmarks/bench_mesh_contacts benchmarks/bench_retraction benchmarks/bleeding_organ benchmarks/bench_contact_coloring
+          examples/organ_contact examples/retraction examples/bleeding_kidney examples/suturing examples/cholecystectomy examples/bleeding examples/bone_burr
           examples/haptic_drag
           tests/test_backends tests/test_xpbd tests/test_collision tests/test_fluid tests/test_tissue
           tests/test_topology tests/test_robustness)
