@@ -46,6 +46,7 @@
    * colliders, contact impulses, level-set grids */                             \
   SINEW_KERNEL(xpbd_solve_attachment, 6, SolveParams, 0)                         \
   SINEW_KERNEL(xpbd_solve_point_attachment, 6, SolveParams, 0)                   \
+  SINEW_KERNEL(xpbd_solve_body_attachment, 5, SolveParams, 0)                    \
   SINEW_KERNEL(xpbd_solve_contacts, 9, SolveParams, 0)                           \
   /* contacts between meshes (kernels/shared/mesh_contact_params.h) */           \
   SINEW_KERNEL(xpbd_solve_mesh_contacts, 10, MeshContactParams, 0)               \

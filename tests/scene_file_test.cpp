@@ -111,6 +111,34 @@ TEST(SceneFile, ErrorsNameTheJsonPathAndTheRule) {
   EXPECT_EQ(error_of("{}").rfind("/: ", 0), 0u);
 }
 
+// "body_attachments": BodyAttachmentDesc's fields, the break force
+// infinite when left out; errors at their JSON path.
+TEST(SceneFile, BodyAttachmentsReadWithTheirFieldsAndErrors) {
+  const auto with = [](const std::string& link) {
+    std::string s = block_scene();
+    return s.substr(0, s.size() - 1) + R"(, "body_attachments": [)" + link + "]}";
+  };
+  auto file = parse_scene_json(with(R"({"a": {"body_kind": "tet", "body": 0, "vertices": [5], "weights": [1]},
+      "b": {"body": 0, "vertices": [6, 7], "weights": [0.25, 0.75]}, "compliance": 1e-4})"), kScenes);
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  ASSERT_EQ(file->scene.body_attachments.size(), 1u);
+  const BodyAttachmentDesc& a = file->scene.body_attachments[0];
+  EXPECT_EQ(a.a.vertices, std::vector<std::uint32_t>{5});
+  EXPECT_EQ(a.b.vertices, (std::vector<std::uint32_t>{6, 7}));
+  EXPECT_EQ(a.b.weights, (std::vector<double>{0.25, 0.75}));
+  EXPECT_EQ(a.compliance, 1e-4);
+  EXPECT_TRUE(std::isinf(a.break_force));
+  EXPECT_TRUE(Simulation::create(file->scene, {.backend = "cpu", .quiet = true}).ok());
+  EXPECT_EQ(error_of(with(R"({"a": {"vertices": [5], "weights": [0.5]}, "b": {"vertices": [6], "weights": [1]}})"))
+                .rfind("/body_attachments/0/a/weights", 0),
+            0u);
+  EXPECT_EQ(error_of(with(R"({"a": {"vertices": [5], "weights": [1]}, "b": {"vertices": [6], "weights": [1]},
+                              "break_force": -1})"))
+                .rfind("/body_attachments/0/break_force", 0),
+            0u);
+  EXPECT_EQ(error_of(with(R"({"a": {"vertices": [5], "weights": [1]}})")), "/body_attachments/0/b: is required");
+}
+
 // A "data:" file name is found in SINEW_DATA_DIR when the environment sets
 // it, else in the build's data folder; a missing one names the variable.
 TEST(SceneFile, DataNamesResolveInTheDataFolder) {

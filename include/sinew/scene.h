@@ -8,6 +8,7 @@
 #include <array>
 #include <optional>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "sinew/fluid.h"
@@ -287,6 +288,38 @@ struct AttachmentDesc {
   VertexRef vertex;           ///< the vertex held
   std::uint32_t target = 0;   ///< index into SceneDesc::targets
   double compliance = 0.0;    ///< [m/N], >= 0
+};
+
+/// A point of a body given by barycentric weights over up to four of its
+/// vertices: p = sum_k weights[k] x(vertices[k]). A point inside a tet uses
+/// its 4 vertices, inside a triangle 3, on a segment 2, on a vertex 1.
+struct BarycentricPoint {
+  BodyKind body_kind = BodyKind::tet;   ///< the kind of body
+  std::uint32_t body = 0;               ///< index into the scene's bodies of that kind
+  std::vector<std::uint32_t> vertices;  ///< 1 to 4 distinct vertices of that body
+  std::vector<double> weights;          ///< one per vertex, finite, summing to 1 (within 1e-6)
+};
+
+/// Two bodies attached to each other, two ways: a zero-length xPBD
+/// constraint C = |p_a - p_b| between a barycentric point of each (Macklin,
+/// Mueller and Chentanez, "XPBD", MIG 2016), solved in every sweep after the
+/// bodies' own constraints. Each side feels the other's pull: a membrane
+/// attached to an organ lifts it when pulled, and the organ's weight hangs
+/// on the membrane. Connective tissue, vessels on organs and mesentery are
+/// many such attachments (docs/attachments.md).
+///
+/// The attachment breaks, for good, in the first iteration whose constraint
+/// force |lambda| / h^2 [N] (lambda the multiplier accumulated in the
+/// substep, h the substep) exceeds `break_force`. The device detects it:
+/// a flag word in the attachment's data is set by the solve kernel and the
+/// attachment is skipped from then on; the host reads nothing back.
+struct BodyAttachmentDesc {
+  BarycentricPoint a;        ///< the point on the first body
+  BarycentricPoint b;        ///< the point on the second (no vertex shared with a)
+  /// [m/N], >= 0: the attachment stretches by compliance x force; 0 is rigid.
+  double compliance = 0.0;
+  /// [N], > 0; infinity (the default) never breaks.
+  double break_force = std::numeric_limits<double>::infinity();
 };
 
 /// A rigid tool's shape (ToolDesc::shape).
@@ -669,6 +702,7 @@ struct SceneDesc {
   std::vector<ColliderDesc> colliders;     ///< kinematic shapes (Tools::collider reaches them by index)
   std::vector<std::array<double, 3>> targets;       ///< initial kinematic target positions [m]
   std::vector<AttachmentDesc> attachments; ///< vertices held to targets
+  std::vector<BodyAttachmentDesc> body_attachments;  ///< points of two bodies attached to each other
   std::vector<ToolDesc> tools;             ///< rigid tools driven by force
   std::vector<NeedleDesc> needles;         ///< suture needles and their threads
   std::vector<GrasperDesc> graspers;       ///< graspers (Graspers closes them)

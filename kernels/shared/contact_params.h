@@ -111,7 +111,25 @@
  * gradient w_k n for particle k, n = (p - target) / C; Delta lambda =
  * (-C - alpha~ lambda) / (sum w_k^2 w(x_k) + alpha~), x_k += w(x_k) w_k
  * Delta lambda n (w(x_k) the inverse mass); nothing done where C == 0 or
- * every particle is immovable; residual |C + alpha~ lambda| in metres. */
+ * every particle is immovable; residual |C + alpha~ lambda| in metres.
+ *
+ * ------------------------------------------------------------ xpbd_solve_body_attachment
+ * Two bodies attached two ways (BodyAttachmentDesc): a barycentric point of
+ * each, p_a = sum_k wa_k x(a_k), p_b = sum_k wb_k x(b_k), up to 4 particles
+ * each: arity 8 (a_0..a_3, b_0..b_3; an unused slot repeats the side's
+ * first particle with weight 0 and is never written); no two in one colour
+ * share a movable particle. bindings: 0-4 standard (data as float4).
+ * data: SINEW_BODY_ATTACHMENT_DATA_STRIDE floats: [0-3] wa, [4-7] wb,
+ *   [8] compliance alpha [m/N], [9] break force [N] (0: never breaks),
+ *   [10] broken flag (0 or 1; the kernel sets it [in/out]), [11] 0.
+ * C = |p_a - p_b| (zero rest length), n = (p_a - p_b) / C, gradient wa_k n
+ * for a_k and -wb_k n for b_k; Delta lambda = (-C - alpha~ lambda) /
+ * (sum wa_k^2 w(a_k) + sum wb_k^2 w(b_k) + alpha~), a_k += w(a_k) wa_k
+ * Delta lambda n, b_k -= w(b_k) wb_k Delta lambda n. Then, when the break
+ * force is not 0 and |lambda| / h^2 > break force, the flag is set: from
+ * the next solve on, a broken attachment does nothing (lambda 0, residual
+ * 0). Nothing moves where C == 0 or every particle is immovable; residual
+ * |C + alpha~ lambda| in metres. */
 #ifndef SINEW_CONTACT_PARAMS_H
 #define SINEW_CONTACT_PARAMS_H
 
@@ -143,6 +161,7 @@
 #define SINEW_CONTACT_IMPULSE_FLOAT4S 5
 #define SINEW_ATTACHMENT_DATA_STRIDE 2
 #define SINEW_POINT_ATTACHMENT_DATA_STRIDE 8
+#define SINEW_BODY_ATTACHMENT_DATA_STRIDE 12
 
 #ifdef __cplusplus
 namespace sinew::kernels {

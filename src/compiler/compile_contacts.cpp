@@ -3,6 +3,7 @@
 // (kernels/shared/contact_params.h), one contact constraint per movable
 // particle and one attachment constraint per attached vertex.
 // Called after every body has been added, so the particle layout is final.
+#include <cmath>
 #include <cstring>
 #include <array>
 #include <limits>
@@ -210,6 +211,29 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     attachments.particles.push_back(particle);
     attachments.data.push_back(static_cast<float>(a.target));
     attachments.data.push_back(static_cast<float>(a.compliance));
+  }
+
+  // Attachments between bodies (xpbd_solve_body_attachment): 4 particle
+  // slots a side, an unused slot repeating the side's first particle with
+  // weight 0 (the kernel never writes it). The colouring keeps two
+  // attachments of one movable particle in different colours.
+  for (const BodyAttachmentDesc& a : scene.body_attachments) {
+    RawConstraints& links =
+        b.constraints(Kernel::xpbd_solve_body_attachment, 8, SINEW_BODY_ATTACHMENT_DATA_STRIDE);
+    std::array<float, 8> weights{};
+    for (int side = 0; side < 2; ++side) {
+      const BarycentricPoint& point = side == 0 ? a.a : a.b;
+      const std::uint32_t first = first_particle(out, VertexRef{point.body_kind, point.body, 0});
+      for (std::size_t k = 0; k < 4; ++k) {
+        const bool used = k < point.vertices.size();
+        links.particles.push_back(first + point.vertices[used ? k : 0]);
+        weights[4 * side + k] = used ? static_cast<float>(point.weights[k]) : 0.0f;
+      }
+    }
+    links.data.insert(links.data.end(), weights.begin(), weights.end());
+    // A break force of infinity is stored as 0: "never" (no infinity on the device).
+    const float break_force = std::isfinite(a.break_force) ? static_cast<float>(a.break_force) : 0.0f;
+    links.data.insert(links.data.end(), {static_cast<float>(a.compliance), break_force, 0.0f, 0.0f});
   }
   return {};
 }

@@ -111,6 +111,7 @@ Status check_device_ranges(const SceneDesc& scene) {
   if (Status s = check_all(scene.tools, "tools", compliance); !s) return s;
   if (Status s = check_all(scene.needles, "needles", compliance); !s) return s;
   if (Status s = check_all(scene.attachments, "attachments", compliance); !s) return s;
+  if (Status s = check_all(scene.body_attachments, "body_attachments", compliance); !s) return s;
   if (Status s = check_all(scene.graspers, "graspers", compliance); !s) return s;
   if (scene.mesh_collision.enabled)
     if (Status s = each("mesh_collision", scene.mesh_collision.compliance); !s) return s;

@@ -20,6 +20,15 @@ std::string number_text(double v) {
   return s.str();
 }
 
+std::size_t vertex_count(const SceneDesc& scene, const VertexRef& ref) {
+  switch (ref.body_kind) {
+    case BodyKind::tet: return ref.body < scene.tet_bodies.size() ? scene.tet_bodies[ref.body].mesh.vertices.size() : 0;
+    case BodyKind::tri: return ref.body < scene.tri_bodies.size() ? scene.tri_bodies[ref.body].mesh.vertices.size() : 0;
+    case BodyKind::line: return ref.body < scene.line_bodies.size() ? scene.line_bodies[ref.body].vertices.size() : 0;
+  }
+  return 0;
+}
+
 namespace {
 
 std::string str(double v) { return number_text(v); }
@@ -314,15 +323,6 @@ Status check_needle(const SceneDesc& scene, const NeedleDesc& n, const std::stri
   return {};
 }
 
-std::size_t vertex_count(const SceneDesc& scene, const VertexRef& ref) {
-  switch (ref.body_kind) {
-    case BodyKind::tet: return ref.body < scene.tet_bodies.size() ? scene.tet_bodies[ref.body].mesh.vertices.size() : 0;
-    case BodyKind::tri: return ref.body < scene.tri_bodies.size() ? scene.tri_bodies[ref.body].mesh.vertices.size() : 0;
-    case BodyKind::line: return ref.body < scene.line_bodies.size() ? scene.line_bodies[ref.body].vertices.size() : 0;
-  }
-  return 0;
-}
-
 Status check_attachment(const SceneDesc& scene, const AttachmentDesc& a, const std::string& name) {
   const std::size_t n = vertex_count(scene, a.vertex);
   if (n == 0)
@@ -502,6 +502,7 @@ Status check_scene(const SceneDesc& scene) {
   for (std::size_t i = 0; i < scene.attachments.size(); ++i)
     if (Status s = check_attachment(scene, scene.attachments[i], "attachments[" + std::to_string(i) + "]"); !s)
       return s;
+  if (Status s = check_body_attachments(scene); !s) return s;
   // Last, on values known finite: what the device makes of them in float,
   // and the caps on a frame's work (device_ranges.h).
   return check_device_ranges(scene);

@@ -160,6 +160,14 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
 /// check_scene (fluid_checks.cpp).
 Status check_scene_fluid(const SceneDesc& scene);
 
+/// The vertices of the body `ref` names (its vertex is not read), or 0 when
+/// the scene has no such body (scene_checks.cpp).
+std::size_t vertex_count(const SceneDesc& scene, const VertexRef& ref);
+
+/// SceneDesc::body_attachments' parameters (BodyAttachmentDesc); part of
+/// check_scene (body_attachment_checks.cpp).
+Status check_body_attachments(const SceneDesc& scene);
+
 /// Checks (check_scene) and compiles a scene. Errors name the parameter.
 Result<CompiledScene> compile_scene(const SceneDesc& scene);
 

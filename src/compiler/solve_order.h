@@ -10,6 +10,8 @@
 //    materials, then thin bodies and threads. Their order among themselves
 //    is the one the Kernel enum used to impose; it is kept because any other
 //    order gives other bits, not because one is physically better;
+//  - attachments between bodies after them (they couple bodies, as a
+//    body's own constraints couple its particles), before the graspers;
 //  - attachments (a grasper holding a vertex) after them, so a held vertex
 //    ends each sweep at its target however the tissue pulls on it;
 //  - contacts last, so a sweep ends with no particle inside a collider or a
@@ -37,6 +39,7 @@ inline constexpr Kernel kSolveOrder[] = {
     Kernel::xpbd_solve_area,          // thin bodies
     Kernel::xpbd_solve_dihedral,
     Kernel::xpbd_solve_line_bending,  // threads
+    Kernel::xpbd_solve_body_attachment,  // bodies attached to each other: between bodies, before graspers
     Kernel::xpbd_solve_attachment,    // graspers: after the bodies
     Kernel::xpbd_solve_point_attachment,  // graspers' points inside triangles
     Kernel::xpbd_solve_contacts,      // colliders and tools: last, they win

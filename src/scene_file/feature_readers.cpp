@@ -1,5 +1,6 @@
 // feature_readers.cpp — a scene file's solver settings, colliders, level
-// sets, tools, needles, graspers, attachments and mesh collision. Keys are
+// sets, tools, needles, graspers, attachments (to targets and between
+// bodies) and mesh collision. Keys are
 // the fields of the structs in sinew/scene.h, enumerators their names.
 #include <cmath>
 
@@ -193,6 +194,44 @@ void read_attachment(const Json& v, const std::string& path, Context& ctx, Attac
   }
   o.read("target", out.target, true);
   o.read("compliance", out.compliance);
+  o.finish();
+}
+
+namespace {
+
+// {"body_kind", "body", "vertices": [1 to 4 indices], "weights": [as many numbers]}.
+void read_barycentric_point(Object& parent, const std::string& key, Context& ctx, BarycentricPoint& out) {
+  const Json* r = parent.find(key);
+  if (!r) {
+    if (!ctx.failed()) ctx.fail(ErrorCode::bad_input_file, parent.path(key), "is required");
+    return;
+  }
+  Object o(*r, parent.path(key), ctx);
+  if (const Json* k = o.find("body_kind")) read_body_kind(*k, o.path("body_kind"), ctx, out.body_kind);
+  o.read("body", out.body);
+  if (const Json* vs = o.find("vertices"))
+    read_array(*vs, o.path("vertices"), ctx, [&](const Json& e, const std::string& p) {
+      read_uint32(e, p, ctx, out.vertices.emplace_back());
+    });
+  else if (!ctx.failed())
+    ctx.fail(ErrorCode::bad_input_file, o.path("vertices"), "is required");
+  if (const Json* ws = o.find("weights"))
+    read_array(*ws, o.path("weights"), ctx, [&](const Json& e, const std::string& p) {
+      read_double(e, p, ctx, out.weights.emplace_back());
+    });
+  else if (!ctx.failed())
+    ctx.fail(ErrorCode::bad_input_file, o.path("weights"), "is required");
+  o.finish();
+}
+
+}  // namespace
+
+void read_body_attachment(const Json& v, const std::string& path, Context& ctx, BodyAttachmentDesc& out) {
+  Object o(v, path, ctx);
+  read_barycentric_point(o, "a", ctx, out.a);
+  read_barycentric_point(o, "b", ctx, out.b);
+  o.read("compliance", out.compliance);
+  o.read("break_force", out.break_force);  // absent: infinity, never breaks
   o.finish();
 }
 

@@ -171,8 +171,9 @@ void Object::read(const std::string& key, std::array<double, 4>& out, bool requi
 }
 
 const std::initializer_list<std::string_view> kSceneRoots = {
-    "gravity", "solver", "tet_bodies", "tri_bodies", "line_bodies", "colliders", "targets", "attachments",
-    "tools", "needles", "graspers", "mesh_collision", "external_forces", "topology_changes", "fluid"};
+    "gravity",     "solver",           "tet_bodies", "tri_bodies", "line_bodies",    "colliders",
+    "targets",     "attachments",      "body_attachments", "tools", "needles",   "graspers",
+    "mesh_collision", "external_forces", "topology_changes", "fluid"};
 
 std::pair<std::string, std::string> split_scene_message(const std::string& message,
                                                         std::initializer_list<std::string_view> roots) {

@@ -60,6 +60,7 @@ void read_tool(const Json& v, const std::string& path, const Where& where, Conte
 void read_needle(const Json& v, const std::string& path, Context& ctx, NeedleDesc& out);
 void read_grasper(const Json& v, const std::string& path, Context& ctx, GrasperDesc& out);
 void read_attachment(const Json& v, const std::string& path, Context& ctx, AttachmentDesc& out);
+void read_body_attachment(const Json& v, const std::string& path, Context& ctx, BodyAttachmentDesc& out);
 void read_mesh_collision(const Json& v, const std::string& path, Context& ctx, MeshCollisionDesc& out);
 void read_body_kind(const Json& v, const std::string& path, Context& ctx, BodyKind& out);
 void read_pose(Object& o, Pose& out);

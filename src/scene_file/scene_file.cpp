@@ -90,6 +90,10 @@ Result<SceneFile> read_document(const Json& doc, const scene_file::Where& where)
   read_list(root, "attachments", scene.attachments, [&](const Json& e, const std::string& p, AttachmentDesc& a) {
     scene_file::read_attachment(e, p, ctx, a);
   });
+  read_list(root, "body_attachments", scene.body_attachments,
+            [&](const Json& e, const std::string& p, BodyAttachmentDesc& a) {
+              scene_file::read_body_attachment(e, p, ctx, a);
+            });
   read_list(root, "tools", scene.tools, [&](const Json& e, const std::string& p, ToolDesc& t) {
     scene_file::read_tool(e, p, where, ctx, t);
   });
