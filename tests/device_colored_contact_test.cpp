@@ -135,7 +135,7 @@ TEST_P(DeviceColoredContacts, DroppedBlocksRestOnEachOtherInTheResidualMode) {
   scene.solver.residual_tolerance = 1e-4;
   scene.solver.max_iterations = 12;
   scene.solver.check_interval = 2;
-  const BlocksRun got = run_blocks(scene, GetParam(), 80);
+  const BlocksRun got = run_blocks(scene, GetParam(), 60);
   ASSERT_FALSE(got.x.empty());
   std::printf("[%s] residual mode, device colours: depth %.3g mm, lowest %.4f m, %u contacts in %u colours\n",
               GetParam().c_str(), got.depth * 1e3, got.lowest_upper, got.last.mesh_contacts,
