@@ -1,4 +1,4 @@
-// mesh_contact_benchmark.cpp — the two schedules of the contacts between
+// mesh_contact_benchmark.cpp — the three schedules of the contacts between
 // meshes (MeshCollisionDesc::schedule, issue 12 part 3) on the tests' two
 // contact scenes, measured on convergence and cost:
 //   blocks  a 3 cm block dropped onto a 4 cm block (120 frames, 2 s);
@@ -32,11 +32,14 @@ using bench::backend;
 
 void BM_MeshContacts(benchmark::State& state) {
   const bool fold = state.range(0) == 1;
-  const auto schedule = state.range(1) == 1 ? ContactSchedule::jacobi : ContactSchedule::colored;
+  constexpr ContactSchedule schedules[] = {ContactSchedule::colored, ContactSchedule::jacobi,
+                                           ContactSchedule::device_colored};
+  constexpr const char* schedule_names[] = {"colored", "jacobi", "device_colored"};
+  const ContactSchedule schedule = schedules[state.range(1)];
   const SceneDesc scene = fold ? test::FoldedStrip::scene(schedule) : test::dropped_blocks_scene(schedule);
   const int frames = fold ? 2 * test::FoldedStrip::fold_frames : 120;
   std::vector<double> wall, collision;
-  double penetration = 0.0, violation = 0.0, contacts = 0.0, colors = 0.0;
+  double penetration = 0.0, violation = 0.0, contacts = 0.0, colors = 0.0, overflow = 0.0;
   for (auto _ : state) {
     auto sim = Simulation::create(scene, {.backend = backend(), .quiet = true});
     if (!sim) {
@@ -46,7 +49,7 @@ void BM_MeshContacts(benchmark::State& state) {
     std::vector<float> x;
     wall.clear();
     collision.clear();
-    penetration = violation = contacts = colors = 0.0;
+    penetration = violation = contacts = colors = overflow = 0.0;
     for (int f = 0; f < frames; ++f) {
       if (fold)
         for (int k = 0; k <= test::FoldedStrip::nz; ++k)
@@ -61,6 +64,7 @@ void BM_MeshContacts(benchmark::State& state) {
       violation = std::max(violation, st.contact_violation);
       contacts += st.mesh_contacts;
       colors += st.mesh_contact_colors;
+      overflow += st.mesh_contact_overflow;
       state.PauseTiming();
       if (fold && f % 6 == 5) {
         (void)sim->read_positions(x);
@@ -82,16 +86,18 @@ void BM_MeshContacts(benchmark::State& state) {
   state.counters["violation_mm"] = 1e3 * violation;
   state.counters["contacts"] = contacts / frames;
   state.counters["colors"] = colors / frames;
-  state.SetLabel(std::string(fold ? "fold" : "blocks") + (schedule == ContactSchedule::jacobi ? "/jacobi" : "/colored"));
+  state.counters["overflow"] = overflow / frames;  // device_colored only
+  state.SetLabel(std::string(fold ? "fold/" : "blocks/") + schedule_names[state.range(1)]);
 }
 
+// schedule: 0 colored (host), 1 jacobi, 2 device_colored.
 BENCHMARK(BM_MeshContacts)
-    ->ArgsProduct({{0, 1}, {0, 1}})
-    ->ArgNames({"scene", "jacobi"})
+    ->ArgsProduct({{0, 1}, {0, 1, 2}})
+    ->ArgNames({"scene", "schedule"})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
 SINEW_BENCHMARK_MAIN("bench_mesh_contacts",
-                     "The two schedules of the contacts between meshes on the tests' contact scenes (a block dropped on a\nblock, a membrane folded onto itself): wall time per frame, its collision part, penetration.")
+                     "The three schedules of the contacts between meshes on the tests' contact scenes (a block dropped on a\nblock, a membrane folded onto itself): wall time per frame, its collision part, penetration.")

@@ -562,8 +562,17 @@ struct SolverSettings {
 ///  - jacobi: every contact solved from the same positions, then each
 ///    particle moved by the mean of its contacts' corrections (Macklin et
 ///    al., "Unified Particle Physics", 2014, section 4.2): two dispatches
-///    per sweep however many colours the contacts would need.
-enum class ContactSchedule { colored, jacobi };
+///    per sweep however many colours the contacts would need;
+///  - device_colored: coloured on the device at the frame's start
+///    (Jones and Plassmann's parallel colouring, docs/collision.md), at
+///    most MeshCollisionDesc::device_colors colours, one indirect dispatch
+///    per colour (its count never comes to the host), and the contacts
+///    left over (an overflow set: no colour below the cap free, or still
+///    undecided after MeshCollisionDesc::device_rounds rounds) solved one
+///    after another after the colours. Meant for GPUs: on CPU devices it
+///    is slower than host colouring. Not with `continuous` (its contacts
+///    are coloured on the host; an error names both).
+enum class ContactSchedule { colored, jacobi, device_colored };
 
 /// Contacts between the bodies' meshes and within them (SceneDesc::mesh_collision; docs/collision.md).
 struct MeshCollisionDesc {
@@ -634,6 +643,19 @@ struct MeshCollisionDesc {
   /// Repair rounds per substep before the fail-safe stops the touching
   /// particles, >= 0 (0: stop them at once, no repair sweeps).
   int continuous_repairs = 4;
+  /// ContactSchedule::device_colored: the most colours, in [1, 128]. Every
+  /// colour is a dependent dispatch in every sweep; the contacts that find
+  /// all of them taken by neighbours go to the overflow set, solved one by
+  /// one (FrameStats::mesh_contact_overflow counts them). The pruned
+  /// self-contacts of the bent kidney_57k surface need 39 colours; at 32,
+  /// 36 of their 9,031 overflow (benchmarks/contact_coloring_benchmark.cpp).
+  std::uint32_t device_colors = 32;
+  /// ContactSchedule::device_colored: the colouring's rounds per frame, in
+  /// [1, 254] (two dispatches each). A contact is decided in the round
+  /// after its last neighbour of higher priority, so a set needs at least
+  /// as many rounds as the most contacts on one movable particle; those
+  /// still undecided join the overflow set.
+  std::uint32_t device_rounds = 128;
 };
 
 /// A grasper: jaws that hold whatever vertices they close on

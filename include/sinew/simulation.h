@@ -164,7 +164,14 @@ struct FrameStats {
   /// were found within [m], and the wall time [ms] of reading the
   /// particles back, finding, colouring and uploading them (part of wall_ms).
   std::uint32_t mesh_contacts = 0;
-  std::uint32_t mesh_contact_colors = 0;  ///< 0 with ContactSchedule::jacobi
+  /// Colours the contacts took: with ContactSchedule::device_colored the
+  /// device's colours below the cap that hold contacts (counted on the
+  /// device, brought back by the frame's wait), the overflow set not
+  /// included; 0 with ContactSchedule::jacobi.
+  std::uint32_t mesh_contact_colors = 0;
+  /// ContactSchedule::device_colored: the contacts of the overflow set
+  /// (solved one after another after the colours); 0 otherwise.
+  std::uint32_t mesh_contact_overflow = 0;
   double collision_margin = 0.0;  ///< the motion margin the mesh contacts were found within [m]
   double collision_ms = 0.0;      ///< reading back, finding, colouring and uploading the mesh contacts [ms]
   /// The deepest any of the frame's mesh contacts ended inside the

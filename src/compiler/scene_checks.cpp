@@ -353,11 +353,22 @@ Status check_mesh_collision(const SceneDesc& scene) {
     return Error(ErrorCode::bad_parameter,
                  "mesh_collision.enabled is not supported with solver.chebyshev_rho > 0 (got " +
                      str(scene.solver.chebyshev_rho) + ")");
+  if (c.device_colors < 1 || c.device_colors > 128)
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.device_colors must be in [1, 128] (got " + std::to_string(c.device_colors) + ")");
+  if (c.device_rounds < 1 || c.device_rounds > 254)
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.device_rounds must be in [1, 254] (got " + std::to_string(c.device_rounds) + ")");
   if (!c.continuous) return {};
   if (c.continuous_repairs < 0)
     return Error(ErrorCode::bad_parameter,
                  "mesh_collision.continuous_repairs must be >= 0 (got " + std::to_string(c.continuous_repairs) + ")");
   // CCD contacts join the frame's in colours of their own, appended mid-frame.
+  if (c.schedule == ContactSchedule::device_colored)
+    return Error(ErrorCode::bad_parameter,
+                 "mesh_collision.continuous is not supported with mesh_collision.schedule = "
+                 "ContactSchedule::device_colored (continuous collision's contacts are coloured on the host); "
+                 "use ContactSchedule::colored");
   if (c.schedule != ContactSchedule::colored)
     return Error(ErrorCode::bad_parameter,
                  "mesh_collision.continuous needs mesh_collision.schedule = ContactSchedule::colored");

@@ -187,7 +187,16 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   // Mesh contacts: colour k's count is word k of the table, which the host
   // writes before each frame (at most the capacity, checked after the run).
   std::vector<std::uint32_t> contact_counters;
-  if (mesh_contacts && mesh_contacts->jacobi) {
+  DeviceColorTable device_colors;
+  if (mesh_contacts && mesh_contacts->device_colored) {
+    // Once per frame, before anything moves the particles (the colouring
+    // reads only their inverse masses): its counters come first
+    // (DeviceColoringCounters), then the colours'.
+    const DeviceContactColoring& c = mesh_contacts->coloring;
+    append_device_contact_coloring(program, c, mesh_contacts->particles, buffers.position);
+    device_colors = {c.table, c.order, c.colors, c.capacity};
+    contact_counters = declare_device_color_counters(program, device_colors);
+  } else if (mesh_contacts && mesh_contacts->jacobi) {
     contact_counters.push_back(program.counter("mesh contacts", mesh_contacts->table, 0, mesh_contacts->capacity));
     contact_counters.push_back(program.counter("particles touched by mesh contacts", mesh_contacts->table, 1,
                                                mesh_contacts->touched_capacity));
@@ -236,7 +245,9 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
                                     m);
           program.barrier();
         }
-        if (!mesh_contacts->jacobi)
+        if (mesh_contacts->device_colored)
+          append_device_colored_sweep(program, buffers, *mesh_contacts, device_colors, contact_counters, m);
+        else if (!mesh_contacts->jacobi)
           append_contact_colors(program, buffers, *mesh_contacts, mesh_contacts->table, mesh_contacts->table,
                                 contact_counters, m);
       }

@@ -5,6 +5,7 @@
 
 #include "compiler/scene_compiler.h"
 #include "backends/backend.h"
+#include "coloring/device_contact_coloring.h"
 #include "mesh_contact_params.h"
 
 #include <cstdint>
@@ -46,6 +47,12 @@ struct MeshContactBuffers {
   bool jacobi = false;
   BufferHandle delta, touched, offsets, slots;
   std::uint32_t touched_capacity = 0;
+  /// ContactSchedule::device_colored: the contacts lie uncoloured in their
+  /// slots and `coloring` colours them on the device at the frame's start
+  /// (its table's count word written by the host); `table` and `colors`
+  /// are then unused by the solve.
+  bool device_colored = false;
+  DeviceContactColoring coloring;
   kernels::MeshContactParams params{};  ///< thickness, compliance, friction (the rest set per dispatch)
 };
 
@@ -109,8 +116,21 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
 /// xpbd_external_force (and a barrier) before its predict.
 /// With mesh contacts, every sweep ends with one indirect dispatch per
 /// contact colour (counts from its table, declared as counters); with
-/// sutures, then one dispatch of one item for all their rows.
+/// sutures, then one dispatch of one item for all their rows. With
+/// MeshContactBuffers::device_colored the frame starts with the contacts'
+/// colouring (append_device_contact_coloring) and every sweep ends with
+/// append_device_colored_sweep; the program's first counters are then the
+/// colouring's, in device_coloring_counter() order.
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
                                 const std::array<double, 3>& gravity, SweepExtras extras = {});
+
+/// The device-coloured frame program's counters (build_xpbd_program; the
+/// stepper's programs declare the whole frame's in the same order): the
+/// contacts coloured, the overflow set and colour k < cap.
+struct DeviceColoringCounters {
+  static constexpr std::uint32_t contacts = 0;
+  static constexpr std::uint32_t overflow = 3;
+  static constexpr std::uint32_t first_color = 4;
+};
 
 }  // namespace sinew

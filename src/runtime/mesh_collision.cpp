@@ -120,6 +120,8 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
         std::tuple{&b.offsets, b.jacobi ? std::size_t{b.touched_capacity + 1} * 4 : 16, "mesh contact offsets"},
         std::tuple{&b.slots, b.jacobi ? contact_bytes : 16, "mesh contact slots"}})
     if (Status s = make(device, bytes, label, *handle); !s) return s.error();
+  if (mc->desc_.schedule == ContactSchedule::device_colored)
+    if (Status s = mc->make_device_coloring(device); !s) return s.error();
   if (mc->desc_.continuous) {
     // Room for the touches of continuous collision detection (append_contacts).
     mc->reserve_colors_ = kContinuousColors;
@@ -132,8 +134,38 @@ Result<std::unique_ptr<MeshCollision>> MeshCollision::create(const SceneDesc& sc
   return mc;
 }
 
+Status MeshCollision::make_device_coloring(Device& device) {
+  MeshContactBuffers& b = buffers_;
+  if (b.device_colored)
+    if (Status s = destroy_device_contact_coloring(device, b.coloring); !s) return s;
+  b.device_colored = false;  // until the new buffers exist
+  auto made = make_device_contact_coloring(device, b.capacity, static_cast<std::uint32_t>(movable_.size()),
+                                           desc_.device_colors, desc_.device_rounds);
+  if (!made) return made.error();
+  b.coloring = *made;
+  b.device_colored = true;
+  return {};
+}
+
+Status MeshCollision::take_counters(std::span<const std::uint32_t> counters) {
+  if (!buffers_.device_colored) return {};
+  const std::uint32_t cap = buffers_.coloring.colors;
+  if (counters.size() < DeviceColoringCounters::first_color + cap)
+    return Error(ErrorCode::internal, "internal: the frame program has " + std::to_string(counters.size()) +
+                                          " counters, fewer than the contacts' device colouring declares");
+  color_count_ = 0;
+  for (std::uint32_t k = 0; k < cap; ++k)
+    if (counters[DeviceColoringCounters::first_color + k] > 0) color_count_ = k + 1;
+  overflow_count_ = counters[DeviceColoringCounters::overflow];
+  return {};
+}
+
 Status MeshCollision::release(Device& device) {
   MeshContactBuffers& b = buffers_;
+  if (b.device_colored) {
+    if (Status s = destroy_device_contact_coloring(device, b.coloring); !s) return s;
+    b.device_colored = false;
+  }
   for (BufferHandle* h : {&b.table, &b.particles, &b.coefficients, &b.normals, &b.lambda, &b.lambda_sum, &b.motion,
                           &b.delta, &b.touched, &b.offsets, &b.slots})
     if (h->valid()) {

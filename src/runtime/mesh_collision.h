@@ -153,7 +153,18 @@ class MeshCollision {
 
   [[nodiscard]] const MeshContactBuffers& buffers() const { return buffers_; }
   [[nodiscard]] std::uint32_t contacts() const { return contact_count_; }  ///< this frame's
-  [[nodiscard]] std::uint32_t colors() const { return color_count_; }      ///< this frame's
+  /// This frame's colours (ContactSchedule::device_colored: the device's
+  /// colours below the cap holding contacts, known once take_counters had
+  /// the frame's counters; the overflow set not included).
+  [[nodiscard]] std::uint32_t colors() const { return color_count_; }
+  /// ContactSchedule::device_colored: this frame's contacts in the overflow set (after take_counters).
+  [[nodiscard]] std::uint32_t overflow() const { return overflow_count_; }
+  /// ContactSchedule::device_colored: takes the colours and the overflow
+  /// set from the counters of the frame program that just ran (its first
+  /// counters are the colouring's, DeviceColoringCounters), brought back
+  /// by its wait: no transfer of its own. Other schedules: nothing.
+  /// Errors (internal): fewer counters than the colouring declares.
+  Status take_counters(std::span<const std::uint32_t> counters);
   /// The last detection's candidate pairs of primitives (within the reach), at most pair_capacity().
   [[nodiscard]] std::size_t candidate_pairs() const { return pairs_.size(); }
   /// The most candidate pairs a detection may find; past it the frame fails with capacity_exceeded.
@@ -234,7 +245,9 @@ class MeshCollision {
   void candidate_pairs(std::vector<BodyTree>& a, std::span<const std::uint32_t> indices,
                        const std::vector<BodyTree>& b, std::vector<collision::Pair>& pairs);
   MeshContactBuffers buffers_;
-  std::uint32_t contact_count_ = 0, color_count_ = 0;
+  std::uint32_t contact_count_ = 0, color_count_ = 0, overflow_count_ = 0;
+  // ContactSchedule::device_colored: (re)makes buffers_.coloring for buffers_.capacity contacts.
+  Status make_device_coloring(Device& device);
   // Continuous collision's contacts (append_contacts): the colours and
   // slots kept free beyond the frame's, the frame's additions and their
   // slots, the colours they take, and whether the last frame needed more.

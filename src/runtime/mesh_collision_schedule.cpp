@@ -3,7 +3,9 @@
 // kept, the buffers grown where the frame needs more room, the contacts
 // coloured (greedy, coloring/greedy_coloring.h) and laid out colour-sorted
 // (or in order, with each particle's correction slots, for the Jacobi
-// schedule), then written to the device. Continuous collision's contacts
+// schedule, or for ContactSchedule::device_colored, whose frame program
+// colours them on the device: coloring/device_contact_coloring.h), then
+// written to the device. Continuous collision's contacts
 // join them later in the frame, in the colours kept free beyond the
 // frame's (append_contacts).
 #include "runtime/mesh_collision.h"
@@ -90,6 +92,10 @@ Status MeshCollision::make_room(Device& device, std::uint32_t count, bool& grew)
     }
     b.capacity = capacity;
     grew = true;
+    // The colouring's capacity is part of its program (its init step and
+    // sort): new buffers, and the program made again (grew).
+    if (desc_.schedule == ContactSchedule::device_colored)
+      if (Status s = make_device_coloring(device); !s) return s;
   }
   return {};
 }
@@ -101,8 +107,11 @@ Status MeshCollision::assign_slots(Device& device, std::uint32_t count, std::vec
                                    bool& grew) {
   MeshContactBuffers& b = buffers_;
   const std::vector<std::uint32_t>& vertices = contact_particles_;
-  if (b.jacobi) {
-    color_count_ = 0;
+  if (b.jacobi || b.device_colored) {
+    // In their kept order: the device colours them (device_colored; the
+    // colours are known after the frame, take_counters) or solves them all
+    // at once (Jacobi).
+    color_count_ = overflow_count_ = 0;
     for (std::uint32_t k = 0; k < count; ++k) slot_of[k] = k;
     table_.assign(std::size_t{2} * b.colors, 0);
     table_[0] = count;
@@ -195,7 +204,12 @@ Status MeshCollision::upload_jacobi(Device& device) {
 // The colour table and the contacts, written to the device.
 Status MeshCollision::upload_contacts(Device& device, std::uint32_t count) {
   MeshContactBuffers& b = buffers_;
-  if (Status s = device.write_buffer(b.table, 0, table_.data(), table_.size() * 4); !s) return s;
+  if (b.device_colored) {  // the contacts to colour: the colouring's table, which the solve reads
+    const DeviceContactColoring& c = b.coloring;
+    if (Status s = device.write_buffer(c.table, std::size_t{c.count_word()} * 4, &count, 4); !s) return s;
+  } else if (Status s = device.write_buffer(b.table, 0, table_.data(), table_.size() * 4); !s) {
+    return s;
+  }
   if (count > 0) {
     const std::size_t bytes = std::size_t{count} * 16;
     if (Status s = device.write_buffer(b.particles, 0, upload_particles_.data(), bytes); !s) return s;

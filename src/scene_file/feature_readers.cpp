@@ -239,7 +239,9 @@ void read_mesh_collision(const Json& v, const std::string& path, Context& ctx, M
   Object o(v, path, ctx);
   o.read("enabled", out.enabled);
   if (const Json* s = o.find("schedule"))
-    read_enum(*s, o.path("schedule"), ctx, {{"colored", ContactSchedule::colored}, {"jacobi", ContactSchedule::jacobi}},
+    read_enum(*s, o.path("schedule"), ctx, {{"colored", ContactSchedule::colored},
+                                                  {"jacobi", ContactSchedule::jacobi},
+                                                  {"device_colored", ContactSchedule::device_colored}},
               out.schedule);
   o.read("thickness", out.thickness);
   o.read("margin", out.margin);
@@ -251,6 +253,8 @@ void read_mesh_collision(const Json& v, const std::string& path, Context& ctx, M
   o.read("dynamic_friction", out.dynamic_friction);
   o.read("continuous", out.continuous);
   o.read("continuous_repairs", out.continuous_repairs);
+  o.read("device_colors", out.device_colors);
+  o.read("device_rounds", out.device_rounds);
   o.finish();
 }
 

@@ -34,6 +34,9 @@ class MeshCollisionStage final : public FrameStage {
   Status after_solve(FrameContext& frame) override {
     if (Status s = sim_.mesh_collision->after_frame(frame.device, sim_.buffers); !s) return s;
     frame.stats.contact_violation = sim_.mesh_collision->violation();
+    // Coloured on the device, the colours are known after the solve (MeshCollision::take_counters).
+    frame.stats.mesh_contact_colors = sim_.mesh_collision->colors();
+    frame.stats.mesh_contact_overflow = sim_.mesh_collision->overflow();
     return {};
   }
 
@@ -61,6 +64,7 @@ class MeshCollisionStage final : public FrameStage {
     const MeshCollision& collision = *sim_.mesh_collision;
     profile.set("contacts", collision.contacts());
     profile.set("colors", collision.colors());
+    profile.set("overflow", collision.overflow());
     profile.set("pairs", static_cast<double>(collision.candidate_pairs()));
     profile.set("pairs_capacity", static_cast<double>(MeshCollision::pair_capacity()));
     profile.set("margin_m", collision.margin());

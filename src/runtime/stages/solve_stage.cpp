@@ -13,6 +13,16 @@ class SolveStage final : public FrameStage {
 
   Status solve(FrameContext& frame) override {
     sim_.positions_mirror.changed();  // whatever the host held is the frame's start
+    if (Status s = run(frame); !s) return s;
+    // The contacts' device colours came back with the last program's wait
+    // (its counters): taken now, before a later stage runs another program.
+    if (sim_.mesh_collision) return sim_.mesh_collision->take_counters(frame.device.counters());
+    return {};
+  }
+
+
+ private:
+  Status run(FrameContext& frame) {
     if (sim_.stepper) return sim_.stepper->run_frame(frame.device, frame.stats, sim_.continuous.get());
     if (Status s = frame.device.run_program(sim_.prepared); !s) return s;
     if (Status s = frame.device.last_run_times(frame.stats.device); !s) return s;
@@ -20,8 +30,6 @@ class SolveStage final : public FrameStage {
     return {};
   }
 
-
- private:
   Simulation::Impl& sim_;
 };
 
