@@ -8,6 +8,7 @@
 // a frame that failed half-way, a stage's error or the device's, and keeping
 // a topology change made before).
 #include <limits>
+#include <utility>
 
 #include "faulty_device.h"
 #include "robustness_scenes.h"
@@ -209,13 +210,18 @@ TEST_P(DivergenceTest, FailedFrameRollsBackAndTheSceneGoesOn) {
 TEST_P(DivergenceTest, InjectedDeviceFaultsRollBackBitwise) {
   // The device itself fails in the middle of frame 5 (tests/faulty_device.h):
   // a submission, a wait or a read-back. Each time the scene goes back to
-  // frame 4 and continues as the run that never failed.
-  const SceneDesc scene = test::robustness_block();
-  const std::vector<test::Snapshot> expected = uninterrupted(scene, GetParam(), 6);
-  ASSERT_EQ(expected.size(), 7u);
+  // frame 4 and continues as the run that never failed. A plain frame reads
+  // nothing on its own (its statistics come with the wait); with mesh
+  // collision the frame reads the positions back, so the read-back fails there.
+  const SceneDesc plain = test::robustness_block();
+  SceneDesc reading = plain;
+  reading.mesh_collision.enabled = true;
+  reading.mesh_collision.self_collision = true;
   using Call = test::FaultyDevice::Call;
-  for (Call call : {Call::submit, Call::wait, Call::read_buffer}) {
+  for (auto [call, scene] : {std::pair{Call::submit, plain}, {Call::wait, plain}, {Call::read_buffer, reading}}) {
     SCOPED_TRACE(test::FaultyDevice::name(call));
+    const std::vector<test::Snapshot> expected = uninterrupted(scene, GetParam(), 6);
+    ASSERT_EQ(expected.size(), 7u);
     auto real = create_device({.backend = GetParam(), .quiet = true});
     ASSERT_TRUE(real.ok()) << real.error().message();
     auto faulty = std::make_unique<test::FaultyDevice>(std::move(*real));
