@@ -425,6 +425,20 @@ TEST_P(DeviceContactColoringTest, MoreContactsThanTheCapacityIsANamedError) {
   EXPECT_NE(got.run.error().message().find("300"), std::string::npos) << got.run.error().message();
 }
 
+// An overflow set larger than one invocation's loop can solve on every
+// device (lavapipe breaks loops after 65,535 iterations) is a named error,
+// not a partial serial pass: 62,000 contacts on 64 particles at a cap of one
+// colour leave almost all of them to the overflow set.
+TEST_P(DeviceContactColoringTest, AnOverflowSetTooLargeToSolveIsANamedError) {
+  const ContactSet s = random_contacts(62000, 64, 0.0, 11);
+  const DeviceRun got = color_on(GetParam(), s, 1, 4);
+  ASSERT_FALSE(got.run.ok());
+  EXPECT_EQ(got.run.error().code(), ErrorCode::capacity_exceeded);
+  EXPECT_NE(got.run.error().message().find("contacts in the overflow set"), std::string::npos)
+      << got.run.error().message();
+  EXPECT_NE(got.run.error().message().find("of capacity 60000"), std::string::npos) << got.run.error().message();
+}
+
 TEST_P(DeviceContactColoringTest, BadSettingsAreNamed) {
   auto device = create_device({.backend = GetParam(), .quiet = true});
   ASSERT_TRUE(device.ok());
