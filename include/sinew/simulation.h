@@ -144,7 +144,7 @@ struct FrameStats {
   /// frame's last substep (what the tolerance was compared with; the same
   /// measure as residual_rms, also when measure_errors is off). 0 in fixed mode.
   double checked_residual = 0.0;
-  std::uint32_t residual_checks = 0;  ///< residual mode: checks (round trips) in the last frame
+  std::uint32_t residual_checks = 0;  ///< residual mode: checks in the last frame (a program each, its residuals brought back by its wait)
   /// Residual mode with SolverSettings::warm_start: substeps of the last
   /// frame whose lambdas were not carried into the next substep (or
   /// frame), because the substep ended at max_iterations with a residual no
