@@ -13,6 +13,7 @@
 #include <string>
 
 #include "math/vec3.h"
+#include "sinew/haptics/local_contacts.h"
 
 namespace sinew::haptics {
 
@@ -54,6 +55,7 @@ HapticLoop::HapticLoop(const HapticLoopSettings& settings, HapticDevice& device,
                        FeedbackChannel& feedback, Clock& clock)
     : settings_(settings), device_(device), snapshots_(snapshots), feedback_(feedback), clock_(clock),
       period_ns_(std::max<std::int64_t>(1, seconds_to_ns(1.0 / settings.rate_hz))), coupling_(settings.coupling),
+      drive_coupling_(settings.coupling),
       watchdog_(settings.watchdog), ring_(settings.telemetry_capacity) {  // value-initialised: pages touched
   // Its own id in every feedback: a later loop on the same channel starts
   // its impulse integral at zero, and the bridge must not difference the two.
@@ -157,8 +159,34 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   if (gain < 1.0) flags |= kFading;
 
   // 5. Virtual coupling through the safety chain; 6. the device.
-  const CouplingOutput out = have_sample_ ? coupling_.evaluate(sample_, tool_, gain)
-                                          : coupling_.evaluate(DeviceSample{}, RenderedTool{}, gain);
+  const DeviceSample no_sample{};
+  const RenderedTool no_tool{};
+  const DeviceSample& device = have_sample_ ? sample_ : no_sample;
+  const RenderedTool& tool = have_sample_ ? tool_ : no_tool;
+  CouplingOutput out, drive;
+  Vec3 rendered_position = tool_.position;
+  LocalContactSolution contacts{};
+  if (settings_.local_contacts) {
+    // The device gets the coupling to the proxy solved against the newest
+    // local contact model (its velocity: the device's, as the proxy follows
+    // it, d proxy / d device); the physics' tool keeps the coupling to its
+    // interpolated state.
+    RenderedTool proxy = tool;
+    if (tool.valid()) {
+      contacts = local_.render(history_.newest().local_contacts, history_.newest().sequence, device.position,
+                               prev_rendered_force_, settings_.coupling.stiffness);
+      const auto& m = contacts.sensitivity;
+      const Vec3& v = device.velocity;
+      proxy.position = contacts.proxy;
+      proxy.velocity = {m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
+                        m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
+      rendered_position = proxy.position;
+    }
+    out = coupling_.evaluate(device, proxy, gain);
+    drive = drive_coupling_.evaluate(device, tool, gain);
+  } else {
+    out = drive = coupling_.evaluate(device, tool, gain);
+  }
   flags |= out.flags;
   if (out.flags & kNonFinite) bump(counters_.non_finite);
   if (out.flags & kClamped) bump(counters_.clamped);
@@ -174,15 +202,17 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   const std::uint64_t tick_no = counters_.ticks.load(std::memory_order_relaxed) + 1;
   fb_.ticks = tick_no;
   fb_.time_ns = start;
-  fb_.force = out.force;
-  fb_.torque = out.torque;
+  fb_.force = drive.force;
+  fb_.torque = drive.torque;
+  fb_.rendered_force = out.force;
   fb_.device_position = sample_.position;
   fb_.device_rotation = sample_.rotation;
   fb_.gain = gain;
   fb_.flags = flags;
   feedback_.publish(fb_);
-  prev_force_ = out.force;
-  prev_torque_ = out.torque;
+  prev_force_ = drive.force;
+  prev_torque_ = drive.torque;
+  prev_rendered_force_ = out.force;
   prev_start_ns_ = start;
   have_prev_tick_ = true;
   if (watchdog_.stalls() != counters_.stalls.load(std::memory_order_relaxed))
@@ -193,7 +223,10 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   rec.snapshot_age = tool_.valid() ? tool_.snapshot_age : inf;
   rec.render_age = tool_.valid() ? tool_.render_age : inf;
   rec.device_position = sample_.position;
-  rec.tool_position = tool_.position;
+  rec.tool_position = rendered_position;
+  rec.contact_energy = contacts.energy;
+  rec.local_contacts = contacts.active;
+  rec.contact_gap_offset = local_.gap_offset();
   rec.raw_force = out.raw_force;
   rec.force = out.force;
   rec.gain = gain;
@@ -238,9 +271,11 @@ void HapticLoop::stop() noexcept {
   // The device held zero force since; a restart ramps up from zero again,
   // and its first tick takes one period as its dt (not the stopped time:
   // that would ramp the gain straight to 1 and count a missed deadline).
-  prev_force_ = prev_torque_ = {0.0, 0.0, 0.0};
+  prev_force_ = prev_torque_ = prev_rendered_force_ = {0.0, 0.0, 0.0};
   have_prev_tick_ = false;
+  local_.reset();
   coupling_.reset();
+  drive_coupling_.reset();
   watchdog_.reset();
   release_cpu_latency(qos_fd_);
   qos_fd_ = -1;

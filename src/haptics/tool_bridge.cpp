@@ -66,6 +66,14 @@ Status HapticToolBridge::apply_feedback(Simulation& sim) {
   return sim.apply_tool_force(tool_, f, t);
 }
 
+Status HapticToolBridge::set_local_contacts(LocalContactBuilder builder) {
+  if (builder.tool() != tool_)
+    return Error(ErrorCode::bad_parameter, "local contacts built for tool " + std::to_string(builder.tool()) +
+                                               " given to the bridge of tool " + std::to_string(tool_));
+  builder_ = std::move(builder);
+  return {};
+}
+
 Status HapticToolBridge::publish(const Simulation& sim) {
   auto state = sim.tool_state(tool_);
   if (!state) return state.error();
@@ -83,6 +91,11 @@ Status HapticToolBridge::publish(const Simulation& sim) {
   const double f = math::norm(s.contact_force);
   s.in_contact = f > 0.0 ? 1u : 0u;
   s.contact_normal = f > 0.0 ? math::mul(s.contact_force, 1.0 / f) : Vec3{0.0, 0.0, 0.0};
+  if (builder_) {
+    if (auto r = sim.read_positions(positions_); !r) return r;
+    s.local_contacts = builder_->build(positions_, *state);
+  }
+  last_model_ = s.local_contacts;
   snapshots_.publish(s);
   return {};
 }

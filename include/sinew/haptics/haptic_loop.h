@@ -28,6 +28,7 @@
 
 #include "sinew/haptics/clock.h"
 #include "sinew/haptics/haptic_device.h"
+#include "sinew/haptics/local_contacts.h"
 #include "sinew/haptics/snapshot_channel.h"
 #include "sinew/haptics/snapshot_interpolator.h"
 #include "sinew/haptics/virtual_coupling.h"
@@ -65,6 +66,14 @@ struct HapticLoopSettings {
   CouplingParams coupling;            ///< the virtual coupling and force limits
   WatchdogParams watchdog;            ///< when stale state fades the force out
   InterpolationParams interpolation;  ///< how the tool's state is interpolated between snapshots
+  /// Render the newest snapshot's local contact model (local_contacts.h):
+  /// each tick solves a proxy of the tool against the contact planes the
+  /// physics published (HapticToolBridge::set_local_contacts) and commands
+  /// the coupling to the proxy, so contact stiffness is felt at the tick
+  /// rate; in free space the proxy is the device (nothing is rendered).
+  /// The physics' tool is still driven by the coupling to the interpolated
+  /// tool (CouplingFeedback::force). Off: the device gets that coupling.
+  bool local_contacts = false;
   /// Called once on the loop thread before its first tick (outside the
   /// tick: it may allocate); e.g. to mark the thread for an allocation counter.
   std::function<void()> on_thread_start;
@@ -95,10 +104,15 @@ struct TickRecord {
   double snapshot_age = 0.0;     ///< age of the newest snapshot at start [s] (infinity: none)
   double render_age = 0.0;       ///< age of the state rendered [s]
   Vec3 device_position{};        ///< [m]
-  Vec3 tool_position{};          ///< rendered [m]
+  Vec3 tool_position{};          ///< rendered [m] (the proxy, when local contacts are rendered)
   Vec3 raw_force{};              ///< coupling before the safety chain [N]
   Vec3 force{};                  ///< commanded to the device [N]
   double gain = 0.0;             ///< watchdog gain
+  /// Local contacts: the energy stored in the coupling and the contact
+  /// planes at this tick, V(device) of local_contacts.h [J]; 0 otherwise.
+  double contact_energy = 0.0;
+  std::uint32_t local_contacts = 0;  ///< local contacts pushing the proxy this tick
+  double contact_gap_offset = 0.0;   ///< the planes' passivity offset this tick [m] (LocalContactRenderer)
   std::uint32_t flags = 0;       ///< TickFlags
   std::uint32_t device_buttons = 0;  ///< the device's buttons, one bit each
 };
@@ -194,11 +208,14 @@ class HapticLoop {
   DeviceSample sample_{};
   bool have_sample_ = false;
   RenderedTool tool_{};
-  VirtualCoupling coupling_;
+  VirtualCoupling coupling_;        // to the device
+  VirtualCoupling drive_coupling_;  // to the physics' tool, when local contacts are rendered
   Watchdog watchdog_;
   bool have_prev_tick_ = false;
   std::int64_t prev_start_ns_ = 0;
   Vec3 prev_force_{}, prev_torque_{};
+  Vec3 prev_rendered_force_{};      // commanded to the device by the previous tick
+  LocalContactRenderer local_;
   CouplingFeedback fb_{};
   std::vector<TickRecord> ring_;  // preallocated
   std::uint64_t recorded_ = 0;

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 
+#include "sinew/haptics/local_contacts.h"
 #include "sinew/haptics/seqlock_channel.h"
 
 namespace sinew::haptics {
@@ -43,6 +44,10 @@ struct HapticSnapshot {
   Vec3 contact_normal{};
   ///@}
   std::uint64_t in_contact = 0;  ///< 1 when |contact_force| > 0
+  /// The contacts near the tool as planes for the haptic thread to solve
+  /// at every tick (local_contacts.h; HapticLoopSettings::local_contacts);
+  /// count 0 when the bridge publishes none.
+  LocalContactModel local_contacts{};
 };
 
 /// What the haptic loop produced (haptics -> physics), published every tick.
@@ -55,10 +60,16 @@ struct CouplingFeedback {
   std::uint64_t loop = 0;       ///< which HapticLoop published it: 1, 2, ... one per loop created in the process
   std::uint64_t ticks = 0;      ///< ticks done (the newest tick's number)
   std::int64_t time_ns = 0;     ///< start of the newest tick, on the loop's clock [ns]
-  Vec3 impulse{};               ///< integral of the device force up to time_ns [N s]
-  Vec3 angular_impulse{};       ///< integral of the device torque up to time_ns [N m s]
-  Vec3 force{};                 ///< device force of the newest tick [N] (held until the next)
-  Vec3 torque{};                ///< device torque of the newest tick [N m]
+  Vec3 impulse{};               ///< integral of the coupling force (`force`) up to time_ns [N s]
+  Vec3 angular_impulse{};       ///< integral of the coupling torque up to time_ns [N m s]
+  /// The newest tick's coupling force between the device and the tool [N]
+  /// (held until the next), whose opposite the tool gets; the device was
+  /// commanded it too, unless the loop renders local contacts
+  /// (HapticLoopSettings::local_contacts: the device then gets
+  /// rendered_force). `impulse` integrates this force.
+  Vec3 force{};
+  Vec3 torque{};                ///< the coupling's torque of the newest tick [N m]
+  Vec3 rendered_force{};        ///< what the device was commanded in the newest tick [N]
   Vec3 device_position{};       ///< newest device sample [m]
   Quat device_rotation{1.0, 0.0, 0.0, 0.0};  ///< newest device sample's orientation
   double gain = 0.0;            ///< watchdog gain of the newest tick, in [0, 1]

@@ -16,8 +16,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <vector>
 
 #include "sinew/haptics/clock.h"
+#include "sinew/haptics/local_contact_builder.h"
 #include "sinew/haptics/snapshot_channel.h"
 #include "sinew/result.h"
 #include "sinew/simulation.h"
@@ -55,8 +58,17 @@ class HapticToolBridge {
   /// apply minus that tick's force and torque.
   Status apply_feedback(Simulation& sim);
   /// After Simulation::step(): publishes the tool's state as a HapticSnapshot
-  /// stamped with the clock's now.
+  /// stamped with the clock's now, with the local contact model when one
+  /// is set (set_local_contacts; it reads the positions back).
   Status publish(const Simulation& sim);
+
+  /// From now on publish() adds the contacts near the tool as a local
+  /// contact model (local_contact_builder.h), for a loop that renders them
+  /// (HapticLoopSettings::local_contacts). [in] builder: made for this
+  /// bridge's tool (an error otherwise).
+  Status set_local_contacts(LocalContactBuilder builder);
+  /// The model published last (count 0 when none).
+  [[nodiscard]] const LocalContactModel& last_local_contacts() const { return last_model_; }
 
   /// Minus the mean device force (and torque) last applied to the tool
   /// [N, N m], without the damping of set_damping.
@@ -77,6 +89,9 @@ class HapticToolBridge {
   double damping_ = 0.0, angular_damping_ = 0.0;
   std::uint64_t missing_ = 0;
   std::uint64_t sequence_ = 0;
+  std::optional<LocalContactBuilder> builder_;
+  std::vector<float> positions_;  // publish()'s read-back, kept to avoid reallocating
+  LocalContactModel last_model_{};
 };
 
 }  // namespace sinew::haptics
