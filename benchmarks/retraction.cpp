@@ -44,6 +44,54 @@ int fail(const std::string& what) {
   return 1;
 }
 
+// The probe's press as its hand felt it, from the probe loop's telemetry:
+// the force along the press (-z: the push is +z) before the device reached
+// the kidney (the coupling's pull alone), how soon after it the push rose
+// past 1 mN above that, its peak over the force held at the end, and the
+// least energy the rendering kept over any 100-tick window (< 0: created).
+// [in] path: also writes every tick as CSV when not empty.
+sinew::Status report_probe(sinew::examples::RetractionScene& r, const sinew::examples::RetractionSettings& s,
+                           const std::string& path) {
+  std::vector<sinew::haptics::TickRecord> t;
+  if (auto st = r.probe_loop().copy_telemetry(t); !st) return st;
+  if (t.size() < 2) return sinew::Error(sinew::ErrorCode::bad_parameter, "too few probe ticks");
+  const double t0 = 1e-9 * double(t.front().start_ns) - 1e-3, contact = sinew::examples::probe_contact_time() / s.script_speed;
+  auto sec = [&](const sinew::haptics::TickRecord& k) { return 1e-9 * double(k.start_ns) - t0; };
+  double before = 0.0, onset = -1.0, peak = 0.0, kept = INFINITY;
+  for (const auto& k : t)
+    if (sec(k) < contact) before = std::max(before, k.force[2]);
+  std::vector<double> put_in(t.size(), 0.0);
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (onset < 0.0 && sec(t[i]) >= contact && t[i].force[2] > before + 1e-3) onset = sec(t[i]) - contact;
+    if (sec(t[i]) >= contact) peak = std::max(peak, t[i].force[2]);
+    if (i == 0) continue;
+    double w = 0.0;
+    for (int c = 0; c < 3; ++c) w -= t[i - 1].force[c] * (t[i].device_position[c] - t[i - 1].device_position[c]);
+    put_in[i] = put_in[i - 1] + w;
+    if (i >= 100)
+      kept = std::min(kept, (put_in[i] - put_in[i - 100]) - (t[i].contact_energy - t[i - 100].contact_energy));
+  }
+  auto probe = r.sim().tools().tool(1);
+  if (!probe) return probe.error();
+  auto state = r.sim().tools().state(*probe);
+  if (!state) return state.error();
+  const double held = t.back().force[2];
+  std::printf("probe,local_contacts,contact_s,force_before_contact_n,onset_ms,held_force_n,physics_contact_force_n,"
+              "peak_over_held,least_window_energy_j\n");
+  std::printf("probe,%d,%.4f,%.4f,%.1f,%.4f,%.4f,%.4f,%.3e\n", s.local_contacts ? 1 : 0, contact, before,
+              onset < 0.0 ? -1.0 : 1e3 * onset, held, state->contact_force[2], held > 0.0 ? peak / held - 1.0 : 0.0,
+              s.local_contacts ? kept : NAN);
+  if (path.empty()) return {};
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) return sinew::Error(sinew::ErrorCode::bad_input_file, "cannot write " + path);
+  std::fprintf(f, "t_s,device_z_m,rendered_z_m,force_z_n,contact_energy_j,local_contacts,gap_offset_m\n");
+  for (const auto& k : t)
+    std::fprintf(f, "%.4f,%.6f,%.6f,%.6f,%.6e,%u,%.3e\n", sec(k), k.device_position[2], k.tool_position[2], k.force[2],
+                 k.contact_energy, k.local_contacts, k.contact_gap_offset);
+  std::fclose(f);
+  return {};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -67,6 +115,9 @@ int main(int argc, char** argv) {
   cli.add_switch("--self-collision", self_collision, "The kidney's mesh self-collision");
   cli.app().add_option("--poisson", s.poisson, "Poisson ratio")->check(CLI::Range(0.01, 0.49));
   cli.app().add_flag("--haptics", haptics, "Both haptic loops on their own threads at 1 kHz of wall time; their timing");
+  std::string probe_trace;
+  cli.app().add_flag("--local-contacts", s.local_contacts, "The probe's loop renders the local contact model");
+  cli.app().add_option("--probe-trace", probe_trace, "Write the probe loop's ticks (force against time) as CSV");
   if (auto exit = cli.parse(argc, argv)) return *exit;
   s.self_collision = self_collision;
   s.realtime_haptics = haptics;
@@ -120,28 +171,34 @@ int main(int argc, char** argv) {
   std::printf("stage,counter,last_frame\n");
   for (const auto& p : st.stages)
     for (const auto& k : p.counters) std::printf("%s,%s,%.6g\n", p.name.c_str(), k.name.c_str(), k.value);
+  if (!probe_trace.empty() || !haptics)
+    if (auto rep = report_probe(r, s, probe_trace); !rep) return fail(rep.error().message());
   if (!haptics) return 0;
 
-  // The grasper loop's timing, from its telemetry (after the first 100 ticks: the thread's start).
-  std::vector<sinew::haptics::TickRecord> ticks;
-  if (auto t = r.grasper_loop().copy_telemetry(ticks); !t) return fail(t.error().message());
-  if (ticks.size() > 100) ticks.erase(ticks.begin(), ticks.begin() + 100);
-  if (ticks.size() < 2) return fail("too few haptic ticks: run more frames");
-  const double period_us = 1e3;
-  std::vector<double> jitter, age;
-  std::uint64_t missed = 0;
-  for (std::size_t i = 0; i < ticks.size(); ++i) {
-    age.push_back(1e3 * ticks[i].render_age);
-    if (i == 0) continue;
-    const double p = 1e-3 * double(ticks[i].start_ns - ticks[i - 1].start_ns);
-    jitter.push_back(std::abs(p - period_us));
-    if (p > 2 * period_us) ++missed;
-  }
-  const double span = 1e-9 * double(ticks.back().start_ns - ticks.front().start_ns);
+  // Each loop's timing, from its telemetry (after the first 100 ticks: the thread's start).
   std::printf("haptic_loop,scheduling,rate_hz,ticks,missed_ticks,jitter_p50_us,jitter_p99_9_us,jitter_max_us,"
               "render_age_p50_ms\n");
-  std::printf("grasper,%s,%.3f,%zu,%llu,%.1f,%.1f,%.1f,%.3f\n", r.grasper_loop().scheduling().describe().c_str(),
-              double(ticks.size() - 1) / span, ticks.size(), static_cast<unsigned long long>(missed),
-              percentile(jitter, 0.5), percentile(jitter, 0.999), percentile(jitter, 1.0), percentile(age, 0.5));
+  for (int hand = 0; hand < 2; ++hand) {
+    sinew::haptics::HapticLoop& loop = hand == 0 ? r.grasper_loop() : r.probe_loop();
+    std::vector<sinew::haptics::TickRecord> ticks;
+    if (auto t = loop.copy_telemetry(ticks); !t) return fail(t.error().message());
+    if (ticks.size() > 100) ticks.erase(ticks.begin(), ticks.begin() + 100);
+    if (ticks.size() < 2) return fail("too few haptic ticks: run more frames");
+    const double period_us = 1e3;
+    std::vector<double> jitter, age;
+    std::uint64_t missed = 0;
+    for (std::size_t i = 0; i < ticks.size(); ++i) {
+      age.push_back(1e3 * ticks[i].render_age);
+      if (i == 0) continue;
+      const double p = 1e-3 * double(ticks[i].start_ns - ticks[i - 1].start_ns);
+      jitter.push_back(std::abs(p - period_us));
+      if (p > 2 * period_us) ++missed;
+    }
+    const double span = 1e-9 * double(ticks.back().start_ns - ticks.front().start_ns);
+    std::printf("%s,%s,%.3f,%zu,%llu,%.1f,%.1f,%.1f,%.3f\n", hand == 0 ? "grasper" : "probe",
+                loop.scheduling().describe().c_str(), double(ticks.size() - 1) / span, ticks.size(),
+                static_cast<unsigned long long>(missed), percentile(jitter, 0.5), percentile(jitter, 0.999),
+                percentile(jitter, 1.0), percentile(age, 0.5));
+  }
   return 0;
 }

@@ -46,7 +46,6 @@ double ramp(double t, double a, double b) {
 constexpr double kShaftRadius = 0.003, kShaftHalfHeight = 0.015;
 constexpr double kProbeRadius = 0.005, kProbeHalfHeight = 0.015;
 constexpr double kToolMass = 0.3;          // [kg] each, heavy against the tissue's ~20 mg particles
-constexpr double kGap = 0.002;             // [m] between the jaws' top and the shaft, and the probe's tip and the tissue
 constexpr V3 kJawHalf{0.003, 0.0025, 0.003};  // [m]
 constexpr double kHoldStiffness = 600.0;   // [N/m], all the holds together (the pull is read from these springs)
 constexpr double kPinDepth = 0.008;        // [m]
@@ -179,14 +178,14 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
   scene.tet_bodies.push_back(std::move(body));
   // Tool 0: the grasper's shaft, straight above the upper pole (y up), the
   // jaws' box centred on the pole's top vertex.
-  const double shaft_above = kJawHalf[1] + kGap + kShaftRadius + kShaftHalfHeight;
+  const double shaft_above = kJawHalf[1] + kToolGap + kShaftRadius + kShaftHalfHeight;
   s.jaw_offset_ = {0.0, -shaft_above, 0.0};
   s.jaw_half_ = kJawHalf;
   const V3 shaft_start = add(pole_x, {0.0, shaft_above, 0.0});
   scene.tools.push_back(capsule_tool(kShaftRadius, kShaftHalfHeight, shaft_start, {1, 0, 0, 0}));
-  // Tool 1: the probe, its tip kGap off the front (the side of greatest z), pressing
+  // Tool 1: the probe, its tip kToolGap off the front (the side of greatest z), pressing
   // along -z towards the pinned back.
-  const V3 probe_start = add(side_x, {0.0, 0.0, kGap + kProbeRadius + kProbeHalfHeight});
+  const V3 probe_start = add(side_x, {0.0, 0.0, kToolGap + kProbeRadius + kProbeHalfHeight});
   scene.tools.push_back(capsule_tool(kProbeRadius, kProbeHalfHeight, probe_start, kProbeRotation));
   scene.graspers.push_back({.capacity = 256, .point_capacity = 0, .compliance = s.hold_compliance_});
   scene.mesh_collision.enabled = true;
@@ -221,6 +220,7 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
     hs.realtime = settings.realtime_priority;
     // Damps the tool's swing on the coupling spring; passive (B > K T / 2 at 1 kHz).
     hs.coupling.damping = 3.0;
+    hs.local_contacts = i == 1 && settings.local_contacts;
     auto loop = HapticLoop::create(hs, *s.devices_[i], s.snapshots_[i], s.feedback_[i], *s.clock_);
     if (!loop) return loop.error();
     s.loops_.push_back(std::move(*loop));
@@ -230,6 +230,11 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
     // on the 500 N/m coupling; damping here acts without that delay
     // (tool_bridge.h; 20 x dt / M = 1.1 < 2).
     if (auto st = s.bridges_[i]->set_damping(20.0, 2e-3); !st) return st.error();
+    if (hs.local_contacts) {
+      auto builder = LocalContactBuilder::create(s.scene_, s.sim_->info(), i);
+      if (!builder) return builder.error();
+      if (auto st = s.bridges_[i]->set_local_contacts(std::move(*builder)); !st) return st.error();
+    }
     if (auto st = s.bridges_[i]->publish(*s.sim_); !st) return st.error();
   }
   if (auto st = s.grasp(); !st) return st.error();
@@ -240,6 +245,10 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
 }
 
 RetractionScene::~RetractionScene() { stop_haptics(); }
+
+double probe_contact_time() {
+  return kPressStart + (kPressEnd - kPressStart) * std::acos(1.0 - 2.0 * kToolGap / kPress) / M_PI;
+}
 
 Status RetractionScene::grasp() {
   auto tool = sim_->tools().tool(0);

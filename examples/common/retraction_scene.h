@@ -55,6 +55,9 @@ struct RetractionSettings {
   bool realtime_haptics = false;   ///< loops on their own threads at wall-clock 1 kHz (above)
   bool realtime_priority = true;   ///< real time: ask for SCHED_FIFO for the loops' threads
   double script_speed = 1.0;       ///< the hands' script runs this many times faster (> 0; the ctest's short run)
+  /// The probe's loop renders the local contact model (HapticLoopSettings::local_contacts)
+  /// that its bridge publishes (LocalContactBuilder, default settings).
+  bool local_contacts = false;
 };
 
 /// The scene in a few lines, for the programs' --help.
@@ -68,6 +71,11 @@ inline constexpr const char* kRetractionAbout =
 /// [kPullStart, kPullEnd]; the probe presses kPress [m] over [kPressStart, kPressEnd]; then both hold.
 inline constexpr double kPull = 0.015, kPullStart = 0.2, kPullEnd = 1.4;
 inline constexpr double kPress = 0.010, kPressStart = 0.1, kPressEnd = 0.9;
+/// The gap [m] between the probe's tip and the kidney (and the grasper's jaws and shaft) at the start.
+inline constexpr double kToolGap = 0.002;
+/// When the probe's device reaches the kidney [s of script time]: the
+/// press ramp 0.5 - 0.5 cos(pi u) has covered kToolGap.
+double probe_contact_time();
 
 /// What one frame's physics checks measure (RetractionScene::check).
 struct RetractionCheck {
