@@ -24,17 +24,11 @@
 #include "sinew/haptics/device_plugin_abi.h"
 #include "circle_plugin_record.h"
 
-#ifndef TEST_PLUGIN_ABI_VERSION
-#define TEST_PLUGIN_ABI_VERSION SINEW_HAPTIC_PLUGIN_ABI_VERSION
-#endif
-#ifdef TEST_PLUGIN_NULL_SAMPLE
-#undef TEST_PLUGIN_NULL_SAMPLE
-#define TEST_PLUGIN_NULL_SAMPLE 1
+#if defined(TEST_PLUGIN_ABI_VERSION) || defined(TEST_PLUGIN_STRUCT_SIZE) || defined(TEST_PLUGIN_NULL_SAMPLE) || \
+    defined(TEST_PLUGIN_NO_ENTRY)
+#define TEST_PLUGIN_BROKEN_TABLE 1
 #else
-#define TEST_PLUGIN_NULL_SAMPLE 0
-#endif
-#ifndef TEST_PLUGIN_STRUCT_SIZE
-#define TEST_PLUGIN_STRUCT_SIZE sizeof(sinew_haptic_plugin_v1)
+#define TEST_PLUGIN_BROKEN_TABLE 0
 #endif
 
 #define DEVICE_COUNT 2u
@@ -184,28 +178,50 @@ static double update_rate_hz(const sinew_haptic_device* d) {
 
 static uint32_t degrees_of_freedom(const sinew_haptic_device* d) { return d->index == 0 ? 6u : 3u; }
 
+/* The table sinew reads: every call set, and this header's version and size. */
 static const sinew_haptic_plugin_v1 table = {
-    TEST_PLUGIN_ABI_VERSION,
-    (uint32_t)TEST_PLUGIN_STRUCT_SIZE,
-    "circle",
-    device_count,
-    device_name,
-    open_device,
-    close_device,
-    start,
-    stop,
-    TEST_PLUGIN_NULL_SAMPLE ? NULL : sample,
-    command,
-    update_rate_hz,
-    degrees_of_freedom,
+    .abi_version = SINEW_HAPTIC_PLUGIN_ABI_VERSION,
+    .struct_size = sizeof(sinew_haptic_plugin_v1),
+    .name = "circle",
+    .device_count = device_count,
+    .device_name = device_name,
+    .open = open_device,
+    .close = close_device,
+    .start = start,
+    .stop = stop,
+    .sample = sample,
+    .command = command,
+    .update_rate_hz = update_rate_hz,
+    .degrees_of_freedom = degrees_of_freedom,
 };
 
+#if !TEST_PLUGIN_BROKEN_TABLE
+SINEW_HAPTIC_PLUGIN_EXPORT const sinew_haptic_plugin_v1* sinew_haptic_plugin_entry(void) { return &table; }
+#else
+/* The broken variants: the table above, spoilt as the define says. */
+static sinew_haptic_plugin_v1 broken;
+static const sinew_haptic_plugin_v1* broken_table(void) {
+  broken = table;
+#ifdef TEST_PLUGIN_ABI_VERSION
+  broken.abi_version = TEST_PLUGIN_ABI_VERSION;
+#endif
+#ifdef TEST_PLUGIN_STRUCT_SIZE
+  broken.struct_size = TEST_PLUGIN_STRUCT_SIZE;
+#endif
+#ifdef TEST_PLUGIN_NULL_SAMPLE
+  broken.sample = NULL;
+#endif
+  return &broken;
+}
 #ifdef TEST_PLUGIN_NO_ENTRY
 /* Misnamed: sinew finds no sinew_haptic_plugin_entry. */
 SINEW_HAPTIC_PLUGIN_EXPORT const sinew_haptic_plugin_v1* sinew_haptic_plugin_entry_misnamed(void);
-SINEW_HAPTIC_PLUGIN_EXPORT const sinew_haptic_plugin_v1* sinew_haptic_plugin_entry_misnamed(void) { return &table; }
+SINEW_HAPTIC_PLUGIN_EXPORT const sinew_haptic_plugin_v1* sinew_haptic_plugin_entry_misnamed(void) {
+  return broken_table();
+}
 #else
-SINEW_HAPTIC_PLUGIN_EXPORT const sinew_haptic_plugin_v1* sinew_haptic_plugin_entry(void) { return &table; }
+SINEW_HAPTIC_PLUGIN_EXPORT const sinew_haptic_plugin_v1* sinew_haptic_plugin_entry(void) { return broken_table(); }
+#endif
 #endif
 
 /* The test's window into the plug-in: device `index`'s record. 0, or 1 for
