@@ -279,6 +279,20 @@ TEST(HapticsPluginErrors, TableTooSmall) {
       << e.message();
 }
 
+// Append-only within a version: a table larger than this sinew's (a plug-in
+// built against a newer header of version 1) loads and works.
+TEST(HapticsPlugin, LargerTableOfTheSameVersionLoads) {
+  auto plugin = DevicePlugin::load(TEST_PLUGIN_NEWER_TABLE);
+  ASSERT_TRUE(plugin.ok()) << plugin.error().message();
+  EXPECT_EQ((*plugin)->struct_size(), sizeof(sinew_haptic_plugin_v1) + 16);
+  auto device = (*plugin)->open("circle");
+  ASSERT_TRUE(device.ok()) << device.error().message();
+  ASSERT_TRUE((*device)->start(0).ok());
+  DeviceSample s;
+  EXPECT_TRUE((*device)->sample(0, s));
+  EXPECT_NEAR(s.position[0], 0.01, 1e-15);
+}
+
 TEST(HapticsPluginErrors, NullFunctionPointerNamed) {
   const sinew::Error e = load_error(TEST_PLUGIN_NULL_SAMPLE);
   EXPECT_EQ(e.code(), ErrorCode::bad_input_file);

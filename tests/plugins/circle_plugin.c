@@ -12,7 +12,8 @@
  *
  * Built several times (tests/CMakeLists.txt), the broken variants chosen
  * by a define: TEST_PLUGIN_ABI_VERSION (a wrong version), TEST_PLUGIN_NO_ENTRY
- * (the entry point misnamed), TEST_PLUGIN_STRUCT_SIZE (too small a table),
+ * (the entry point misnamed), TEST_PLUGIN_STRUCT_SIZE (too small a table;
+ * or a larger one, as from a newer header of the same version, which loads),
  * TEST_PLUGIN_NULL_SAMPLE (a null function pointer), TEST_PLUGIN_OPEN_FAILS
  * (every open fails with the plug-in's own message), TEST_PLUGIN_UNRESOLVED
  * (a symbol no library defines: RTLD_NOW refuses it at load). */
@@ -198,7 +199,7 @@ static const sinew_haptic_plugin_v1 table = {
 #if !TEST_PLUGIN_BROKEN_TABLE
 SINEW_HAPTIC_PLUGIN_EXPORT const sinew_haptic_plugin_v1* sinew_haptic_plugin_entry(void) { return &table; }
 #else
-/* The broken variants: the table above, spoilt as the define says. */
+/* The variants: the table above, altered as the define says. */
 static sinew_haptic_plugin_v1 broken;
 static const sinew_haptic_plugin_v1* broken_table(void) {
   broken = table;

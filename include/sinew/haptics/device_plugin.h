@@ -81,7 +81,11 @@ class DevicePlugin {
   /// undefined symbol); it has no sinew_haptic_plugin_entry; the entry
   /// returned NULL; "plug-in X has ABI version N; this sinew reads version
   /// 1"; struct_size smaller than version 1's table; a null name or
-  /// function pointer (named).
+  /// function pointer (named). Loading one file twice gives the same
+  /// library (dlopen counts references): the plug-in's global state is
+  /// shared. DevicePlugin's calls are for the application's threads, not
+  /// the real-time tick (they allocate and call the plug-in's non-real-time
+  /// functions).
   static Result<std::unique_ptr<DevicePlugin>> load(const std::string& path);
   ~DevicePlugin();
   DevicePlugin(const DevicePlugin&) = delete;
