@@ -109,6 +109,10 @@ endif()
 if(SINEW_OPENVDB)
   sinew_pc_dependency(sinew::openvdb "")
 endif()
+# dlopen for the haptic device plug-ins (-ldl; nothing where libc has it).
+foreach(library IN LISTS CMAKE_DL_LIBS)
+  sinew_pc_link_flags(${library})
+endforeach()
 list(JOIN SINEW_PC_REQUIRES_PRIVATE ", " SINEW_PC_REQUIRES_PRIVATE)
 list(JOIN SINEW_PC_LIBS_PRIVATE " " SINEW_PC_LIBS_PRIVATE)
 

@@ -1,10 +1,12 @@
 // check_info_commands.cpp — `sinew check` (a scene file read and checked,
-// nothing run) and `sinew info` (the backends built in and their devices).
+// nothing run) and `sinew info` (the backends built in and their devices,
+// and the haptic device plug-ins named with --haptic-plugin).
 #include <cstdio>
 #include <string>
 
 #include "commands.h"
 #include "sinew/device.h"
+#include "sinew/haptics/device_plugin.h"
 #include "sinew/mesh.h"
 #include "sinew/scene_file.h"
 #include "sinew/simulation.h"
@@ -43,7 +45,28 @@ int check_scene_file(const std::string& scene) {
   return 0;
 }
 
-int print_info() {
+namespace {
+// One plug-in: its name, ABI and devices, or why it does not load. Returns
+// whether it loaded and listed.
+bool print_haptic_plugin(const std::string& path) {
+  auto plugin = haptics::DevicePlugin::load(path);
+  if (!plugin) {
+    std::printf("%s\n", plugin.error().message().c_str());
+    return false;
+  }
+  auto devices = (*plugin)->devices();
+  if (!devices) {
+    std::printf("%s\n", devices.error().message().c_str());
+    return false;
+  }
+  std::printf("haptic plug-in %s: \"%s\", ABI version %u, %zu device%s\n", path.c_str(), (*plugin)->name().c_str(),
+              unsigned((*plugin)->abi_version()), devices->size(), devices->size() == 1 ? "" : "s");
+  for (std::size_t i = 0; i < devices->size(); ++i) std::printf("  %zu: %s\n", i, (*devices)[i].c_str());
+  return true;
+}
+}  // namespace
+
+int print_info(const std::vector<std::string>& haptic_plugins) {
   std::printf("sinew %s\nbackends built in:", SINEW_VERSION_STRING);
   for (const std::string& b : built_backends()) std::printf(" %s", b.c_str());
   std::printf("\n");
@@ -66,7 +89,9 @@ int print_info() {
       if (at != std::string::npos) std::printf("%s devices:%s\n", b.c_str(), m.substr(at + 8).c_str());
     }
   }
-  return 0;
+  bool plugins_ok = true;
+  for (const std::string& path : haptic_plugins) plugins_ok = print_haptic_plugin(path) && plugins_ok;
+  return plugins_ok ? 0 : 1;
 }
 
 }  // namespace sinew::cli

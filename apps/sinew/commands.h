@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace sinew::cli {
 
@@ -50,8 +51,10 @@ struct ViewOptions {
 int run_scene(const RunOptions& options);
 /// Reads and checks the scene file without running it; prints what it holds.
 int check_scene_file(const std::string& scene);
-/// Prints the version, the backends built in and the devices each finds.
-int print_info();
+/// Prints the version, the backends built in and the devices each finds;
+/// then each haptic device plug-in of `haptic_plugins` (paths), loaded, with
+/// its devices. Returns 1 when a plug-in does not load or list, else 0.
+int print_info(const std::vector<std::string>& haptic_plugins = {});
 /// Opens a window onto the scene as it runs (docs/viewer.md); returns the
 /// exit status (0, or 1 on an error: the scene, the backend, no display).
 int view_scene(const ViewOptions& options);

@@ -3,6 +3,9 @@
 // `sinew view` (docs/viewer.md), each with --help (CLI11).
 #include <CLI/CLI.hpp>
 
+#include <string>
+#include <vector>
+
 #include "commands.h"
 #include "sinew/version.h"
 
@@ -31,7 +34,10 @@ int main(int argc, char** argv) {
   CLI::App* check_cmd = app.add_subcommand("check", "Validate a scene file without running it");
   check_cmd->add_option("scene", check_path, "The scene file (JSON)")->required()->check(CLI::ExistingFile);
 
+  std::vector<std::string> haptic_plugins;
   CLI::App* info_cmd = app.add_subcommand("info", "List the backends built in and the devices each finds");
+  info_cmd->add_option("--haptic-plugin", haptic_plugins,
+                       "Also load this haptic device plug-in and list its devices (repeatable; docs/haptics.md)");
 
 #ifdef SINEW_HAVE_VIEWER
   sinew::cli::ViewOptions view;
@@ -64,7 +70,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (*run_cmd) return sinew::cli::run_scene(run);
   if (*check_cmd) return sinew::cli::check_scene_file(check_path);
-  if (*info_cmd) return sinew::cli::print_info();
+  if (*info_cmd) return sinew::cli::print_info(haptic_plugins);
 #ifdef SINEW_HAVE_VIEWER
   if (*view_cmd) return sinew::cli::view_scene(view);
 #endif

@@ -4,7 +4,8 @@
 // every position is finite and the block has sagged, and (when the build
 // says which version it expects) unless sinew/version.h agrees; the
 // installed C API header (sinew/sinew.h) compiles as C++ and its library
-// says the same version.
+// says the same version. The haptic plug-in loader links (dlopen comes with
+// the package's link flags) and names a missing library as an error.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include <sinew/haptics/device_plugin.h>
 #include <sinew/mesh.h>
 #include <sinew/simulation.h>
 #include <sinew/sinew.h>
@@ -63,5 +65,12 @@ int main() {
   std::printf("%zu particles on %s, lowest point after %d frames: %.2f mm\n", x.size() / 4,
               sim->backend_name().c_str(), frames, 1e3 * lowest);
   if (lowest > -1e-3f) { std::fprintf(stderr, "the block did not sag (lowest point %g m)\n", lowest); return 1; }
+
+  auto plugin = sinew::haptics::DevicePlugin::load("/nonexistent/sinew_consumer_plugin.so");
+  if (plugin || plugin.error().code() != sinew::ErrorCode::bad_input_file) {
+    std::fprintf(stderr, "loading a missing haptic plug-in did not fail with bad_input_file\n");
+    return 1;
+  }
+  std::printf("missing haptic plug-in: %s\n", plugin.error().message().c_str());
   return 0;
 }

@@ -11,7 +11,10 @@
 // positions means a force scale s on forces, so power is preserved) and hand
 // it to the SDK. sample() and command() run inside the real-time tick: no
 // allocation, lock, I/O or logging there. Devices with their own servo
-// scheduler can instead call HapticLoop::tick() from that scheduler.
+// scheduler can instead call HapticLoop::tick() from that scheduler. To keep
+// the SDK out of the application's build, write the driver as a plug-in
+// against the C ABI of sinew/haptics/device_plugin_abi.h instead and load
+// it at run time (sinew/haptics/device_plugin.h).
 #pragma once
 
 #include <cstdint>
