@@ -47,8 +47,9 @@ int fail(const std::string& what) {
 // The probe's press as its hand felt it, from the probe loop's telemetry:
 // the force along the press (-z: the push is +z) before the device reached
 // the kidney (the coupling's pull alone), how soon after it the push rose
-// past 1 mN above that, its peak over the force held at the end, and the
-// least energy the rendering kept over any 100-tick window (< 0: created).
+// past 1 mN above that, its peak over the force held at the end, its
+// largest fall from one tick to the next while pressing in, and the least
+// energy the rendering kept over any 100-tick window (< 0: created).
 // [in] path: also writes every tick as CSV when not empty.
 sinew::Status report_probe(sinew::examples::RetractionScene& r, const sinew::examples::RetractionSettings& s,
                            const std::string& path) {
@@ -57,7 +58,8 @@ sinew::Status report_probe(sinew::examples::RetractionScene& r, const sinew::exa
   if (t.size() < 2) return sinew::Error(sinew::ErrorCode::bad_parameter, "too few probe ticks");
   const double t0 = 1e-9 * double(t.front().start_ns) - 1e-3, contact = sinew::examples::probe_contact_time() / s.script_speed;
   auto sec = [&](const sinew::haptics::TickRecord& k) { return 1e-9 * double(k.start_ns) - t0; };
-  double before = 0.0, onset = -1.0, peak = 0.0, kept = INFINITY;
+  const double press_end = sinew::examples::kPressEnd / s.script_speed;
+  double before = 0.0, onset = -1.0, peak = 0.0, kept = INFINITY, fall = 0.0;
   for (const auto& k : t)
     if (sec(k) < contact) before = std::max(before, k.force[2]);
   std::vector<double> put_in(t.size(), 0.0);
@@ -65,6 +67,7 @@ sinew::Status report_probe(sinew::examples::RetractionScene& r, const sinew::exa
     if (onset < 0.0 && sec(t[i]) >= contact && t[i].force[2] > before + 1e-3) onset = sec(t[i]) - contact;
     if (sec(t[i]) >= contact) peak = std::max(peak, t[i].force[2]);
     if (i == 0) continue;
+    if (sec(t[i]) > contact && sec(t[i]) <= press_end) fall = std::max(fall, t[i - 1].force[2] - t[i].force[2]);
     double w = 0.0;
     for (int c = 0; c < 3; ++c) w -= t[i - 1].force[c] * (t[i].device_position[c] - t[i - 1].device_position[c]);
     put_in[i] = put_in[i - 1] + w;
@@ -77,10 +80,10 @@ sinew::Status report_probe(sinew::examples::RetractionScene& r, const sinew::exa
   if (!state) return state.error();
   const double held = t.back().force[2];
   std::printf("probe,local_contacts,contact_s,force_before_contact_n,onset_ms,held_force_n,physics_contact_force_n,"
-              "peak_over_held,least_window_energy_j\n");
-  std::printf("probe,%d,%.4f,%.4f,%.1f,%.4f,%.4f,%.4f,%.3e\n", s.local_contacts ? 1 : 0, contact, before,
+              "peak_over_held,largest_fall_pressing_n,least_window_energy_j\n");
+  std::printf("probe,%d,%.4f,%.4f,%.1f,%.4f,%.4f,%.4f,%.4f,%.3e\n", s.local_contacts ? 1 : 0, contact, before,
               onset < 0.0 ? -1.0 : 1e3 * onset, held, state->contact_force[2], held > 0.0 ? peak / held - 1.0 : 0.0,
-              s.local_contacts ? kept : NAN);
+              fall, s.local_contacts ? kept : NAN);
   if (path.empty()) return {};
   FILE* f = std::fopen(path.c_str(), "w");
   if (!f) return sinew::Error(sinew::ErrorCode::bad_input_file, "cannot write " + path);

@@ -331,6 +331,14 @@ TEST(LocalContactPress, TheForceRisesWithinATickOfContactAndSettlesOnThePhysics)
     }
   std::printf("local model: held force within [%.4f, %.4f] N\n", lo, hi);
   EXPECT_LE(hi - lo, 0.05 * f_end);
+  // Pressing in, the push never falls back by more than 5% of the held
+  // force from one tick to the next (the frames' models join smoothly).
+  double drop = 0.0;
+  for (std::size_t k = 1; k < run.ticks.size(); ++k)
+    if (seconds_of(run.ticks[k]) > kContactTime && seconds_of(run.ticks[k]) < hold)
+      drop = std::max(drop, run.ticks[k - 1].force[2] - run.ticks[k].force[2]);
+  std::printf("local model: largest fall of the push while pressing %.4f N\n", drop);
+  EXPECT_LE(drop, 0.05 * f_end);
 }
 
 TEST(LocalContactPress, TheRenderingCreatesNoEnergyOverAnyHundredTicks) {

@@ -75,49 +75,84 @@ Result<LocalContactBuilder> LocalContactBuilder::create(const SceneDesc& scene, 
         return bad("tet_bodies[" + std::to_string(body) +
                    "] has no youngs_modulus/poisson_ratio to estimate its contact stiffness from; give "
                    "LocalContactSettings::stiffness [N/m]");
-      k = 2.0 * t.radius * e / (1.0 - nu * nu);
+      k = 2.0 * t.radius * e / (1.0 - nu * nu);  // the flat punch of radius r: a full contact
+      b.body_modulus_.push_back(e / (1.0 - nu * nu));
+    } else {
+      b.body_modulus_.push_back(0.0);
     }
     b.body_stiffness_.push_back(k);
     const std::uint32_t first = info.tet_body_first_particle[body];
-    const TriMesh surface = extract_boundary_surface(d.mesh);
-    // The boundary's vertices, each with its triangles (CSR).
-    std::vector<std::uint32_t> slot(d.mesh.vertices.size(), UINT32_MAX);
-    std::vector<std::uint32_t> counts;
-    const std::size_t base = b.vertices_.size();
-    for (const auto& tri : surface.triangles)
-      for (std::uint32_t v : tri) {
-        if (slot[v] == UINT32_MAX) {
-          slot[v] = std::uint32_t(b.vertices_.size() - base);
-          b.vertices_.push_back({first + v, std::uint32_t(body), 0, 0});
-          counts.push_back(0);
+    // The boundary's vertices, each once.
+    std::vector<char> seen(d.mesh.vertices.size(), 0);
+    for (const auto& tri : extract_boundary_surface(d.mesh).triangles)
+      for (std::uint32_t v : tri)
+        if (!seen[v]) {
+          seen[v] = 1;
+          b.vertices_.push_back({first + v, std::uint32_t(body)});
         }
-        ++counts[slot[v]];
-      }
-    const std::size_t tri_base = b.triangles_.size();
-    for (const auto& tri : surface.triangles) b.triangles_.push_back({first + tri[0], first + tri[1], first + tri[2]});
-    std::uint32_t offset = std::uint32_t(b.vertex_triangles_.size());
-    for (std::size_t i = 0; i < counts.size(); ++i) {
-      b.vertices_[base + i].first = offset;
-      offset += counts[i];
-    }
-    b.vertex_triangles_.resize(offset);
-    for (std::size_t ti = 0; ti < surface.triangles.size(); ++ti)
-      for (std::uint32_t v : surface.triangles[ti]) {
-        SurfaceVertex& sv = b.vertices_[base + slot[v]];
-        b.vertex_triangles_[sv.first + sv.count++] = std::uint32_t(tri_base + ti);
-      }
   }
   return b;
 }
 
-LocalContactModel LocalContactBuilder::build(const std::vector<float>& xyzw, const ToolState& tool) const {
+// Hertz: a sphere of radius R pressed delta into a half-space of plane
+// strain modulus E* = E / (1 - nu^2) carries F = 4/3 E* sqrt(R) delta^(3/2)
+// over a contact of radius a = sqrt(R delta); its stiffness dF/ddelta is
+// 2 E* a (Johnson 1985, 4.2), which reaches the flat punch's 2 E* R when
+// a = R. The depth follows from the frame's force; a plane not yet touched
+// gets the stiffness at delta = R / 10 (the contact's start, not zero).
+double LocalContactBuilder::stiffness(std::uint32_t body, double force) const {
+  const double e_star = body_modulus_[body];
+  if (e_star == 0.0) return body_stiffness_[body];  // LocalContactSettings::stiffness
+  const double r = radius_;
+  const double delta = std::max(std::pow(3.0 * force / (4.0 * e_star * std::sqrt(r)), 2.0 / 3.0), 0.1 * r);
+  return 2.0 * e_star * std::min(std::sqrt(r * delta), r);
+}
+
+// The tissue's stiffness as the frames show it: the least-squares slope of
+// the force against the tool's depth along it over the last kStiffnessFrames
+// frames in contact, once the depths span at least r / 100 and the slope is
+// positive. The stiffness used is the greatest such slope of the contact so
+// far, or Hertz's estimate (stiffness()) where that is more. Never lowered
+// within a contact, for two reasons: a softer plane at the same force
+// stores more energy (f^2 / 2k), which the renderer would have to take back
+// from the hand (LocalContactRenderer), and the frames' force stops growing
+// while the tool still sinks in (the solver settling, the tissue creeping):
+// a slope that is the tissue's relaxation, not its stiffness.
+double LocalContactBuilder::region_stiffness(std::uint32_t body, double force, const std::array<double, 3>& position,
+                                             const std::array<double, 3>& force_vector) {
+  if (settings_.stiffness > 0.0) return settings_.stiffness;
+  history_[history_next_ % kStiffnessFrames] = {position[0], position[1], position[2], force};
+  ++history_next_;
+  const std::size_t n = std::min<std::size_t>(history_next_, kStiffnessFrames);
+  const V3 dir = math::mul(force_vector, 1.0 / force);
+  double mean_s = 0.0, mean_f = 0.0, lo = INFINITY, hi = -INFINITY;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double depth = -math::dot(dir, V3{history_[i][0], history_[i][1], history_[i][2]});
+    mean_s += depth / double(n);
+    mean_f += history_[i][3] / double(n);
+    lo = std::min(lo, depth);
+    hi = std::max(hi, depth);
+  }
+  if (n >= 3 && hi - lo >= 0.01 * radius_) {
+    double sf = 0.0, ss = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double depth = -math::dot(dir, V3{history_[i][0], history_[i][1], history_[i][2]}) - mean_s;
+      sf += depth * (history_[i][3] - mean_f);
+      ss += depth * depth;
+    }
+    if (sf > 0.0) measured_ = std::max(measured_, sf / ss);
+  }
+  return std::max(measured_, stiffness(body, force));
+}
+
+LocalContactModel LocalContactBuilder::build(const std::vector<float>& xyzw, const ToolState& tool) {
   LocalContactModel model;
   model.tool_position = tool.position;
   const V3 axis = math::rotate(tool.rotation, V3{0.0, half_height_, 0.0});
   const V3 end_a = math::sub(tool.position, axis), end_b = math::add(tool.position, axis);
   const double reach = radius_ + settings_.margin;
 
-  // 1. Candidates: boundary vertices within the margin, with their gaps.
+  // 1. Candidates: boundary vertices within the margin, with their gaps and planes.
   struct Candidate {
     double gap;
     V3 point, normal;
@@ -127,20 +162,13 @@ LocalContactModel LocalContactBuilder::build(const std::vector<float>& xyzw, con
   for (const SurfaceVertex& v : vertices_) {
     if (4 * std::size_t(v.particle) + 3 >= xyzw.size()) continue;
     const V3 p = particle(xyzw, v.particle);
-    const V3 d = math::sub(p, closest_on_segment(end_a, end_b, p));
-    if (!(math::dot(d, d) < reach * reach)) continue;
-    V3 n{0.0, 0.0, 0.0};  // area-weighted: the cross products' sum
-    for (std::uint32_t k = 0; k < v.count; ++k) {
-      const auto& t = triangles_[vertex_triangles_[v.first + k]];
-      const V3 a = particle(xyzw, t[0]);
-      n = math::add(n, math::cross(math::sub(particle(xyzw, t[1]), a), math::sub(particle(xyzw, t[2]), a)));
-    }
-    const double len = math::norm(n);
-    if (!(len > 0.0) || !std::isfinite(len)) continue;
-    n = math::mul(n, 1.0 / len);
-    // The capsule's deepest point along -n: the axis end lower along n, minus r n.
-    const V3& low = math::dot(n, end_a) < math::dot(n, end_b) ? end_a : end_b;
-    candidates.push_back({math::dot(n, math::sub(low, p)) - radius_, p, n, v.body});
+    const V3 d = math::sub(closest_on_segment(end_a, end_b, p), p);  // from the vertex to the tool's axis
+    const double dist = math::norm(d);
+    if (!(dist < reach) || !(dist > 0.0)) continue;
+    // The plane through the vertex facing the tool's axis, the way the
+    // solver's contact pushes the vertex; the gap is the vertex's distance
+    // from the tool's surface.
+    candidates.push_back({dist - radius_, p, math::mul(d, 1.0 / dist), v.body});
   }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.gap < b.gap; });
 
@@ -156,36 +184,41 @@ LocalContactModel LocalContactBuilder::build(const std::vector<float>& xyzw, con
     out.point = c.point;
     out.normal = c.normal;
     out.gap = c.gap;
-    out.stiffness = body_stiffness_[c.body];
+    out.stiffness = stiffness(c.body, 0.0);
+    out.body = c.body;
     out.friction = friction_;
   }
 
-  // 3. The frame's force over the touching planes: min |sum f_i n_i - F|^2,
-  // f >= 0, by projected Gauss-Seidel (each n_i is unit: the diagonal is 1).
-  // The nearest plane always qualifies: a frame's force is never dropped
-  // for want of a plane close enough.
+  // 3. The frame's force. The planes within touch distance (and the
+  // nearest, however far: a frame's force is never dropped for want of a
+  // plane) are where the tool touched; the tissue there answered with one
+  // force, so they become one plane along it, at the depth |F| / k that
+  // makes the plane push |F| at the frame's pose. The others are where the
+  // tool may touch next; they start at its surface or beyond (a plane the
+  // frame found no push on must not push at once).
   const V3 f_total = tool.contact_force;
-  std::array<double, kMaxLocalContacts> f{};
-  const double touch = model.count > 0 ? std::max(settings_.touch_distance, model.contacts[0].gap) : 0.0;
-  if (math::dot(f_total, f_total) > 0.0) {
-    for (int sweep = 0; sweep < 50; ++sweep)
-      for (std::uint64_t i = 0; i < model.count; ++i) {
-        const LocalContact& c = model.contacts[i];
-        if (!(c.gap <= touch)) continue;
-        V3 r = f_total;
-        for (std::uint64_t j = 0; j < model.count; ++j)
-          if (j != i) r = math::sub(r, math::mul(model.contacts[j].normal, f[j]));
-        f[i] = std::max(0.0, math::dot(r, c.normal));
-      }
+  const double f = math::norm(f_total);
+  LocalContactModel merged;
+  merged.tool_position = model.tool_position;
+  if (f > 0.0 && model.count > 0) {
+    const double touch = std::max(settings_.touch_distance, model.contacts[0].gap);
+    LocalContact region = model.contacts[0];
+    region.normal = math::mul(f_total, 1.0 / f);
+    region.force = f;
+    region.stiffness = region_stiffness(std::uint32_t(region.body), f, tool.position, f_total);
+    region.gap = -f / region.stiffness;
+    merged.contacts[merged.count++] = region;
+    for (std::uint64_t i = 1; i < model.count; ++i)
+      if (model.contacts[i].gap > touch) merged.contacts[merged.count++] = model.contacts[i];
+  } else {
+    merged.count = model.count;
+    merged.contacts = model.contacts;
+    measured_ = 0.0;  // out of contact: the next contact is measured afresh
+    history_next_ = 0;
   }
-  for (std::uint64_t i = 0; i < model.count; ++i) {
-    LocalContact& c = model.contacts[i];
-    c.force = f[i];
-    // With a force: the gap that makes the plane push f_i at the frame's
-    // pose. Without: the tissue starts at the tool's surface or beyond (a
-    // plane the frame found no push on must not push at once).
-    c.gap = f[i] > 0.0 ? -f[i] / c.stiffness : std::max(c.gap, 0.0);
-  }
+  for (std::uint64_t i = 0; i < merged.count; ++i)
+    if (!(merged.contacts[i].force > 0.0)) merged.contacts[i].gap = std::max(merged.contacts[i].gap, 0.0);
+  model = merged;
   return model;
 }
 

@@ -9,26 +9,39 @@
 // How a frame's model is made (build()):
 //  1. candidates: the tet bodies' boundary vertices (their surfaces at
 //     creation) within `margin` of the capsule's surface;
-//  2. planes: each candidate's plane has its vertex normal (area-weighted
-//     over its surface triangles at the frame's positions) and its gap is
-//     the distance from the plane to the capsule's deepest point along the
-//     normal; taken nearest first, a candidate whose normal lies within
-//     `max_normal_angle` of a plane already kept adds nothing (that plane
-//     stands for it), else it makes a new plane, up to `max_contacts`;
-//  3. forces: the frame's contact force on the tool (ToolState::contact_force)
-//     is split over the planes within `touch_distance` (and the nearest
-//     plane, however far) as the non-negative
-//     least-squares fit sum_i f_i n_i ~ F; a plane carrying f_i gets the
-//     gap -f_i / k_i (the model then reproduces the frame's force at the
-//     frame's pose), one carrying none a gap of at least 0;
-//  4. stiffness: `stiffness` when > 0, else the body's flat-punch stiffness
-//     k = 2 r E / (1 - nu^2) (a rigid circular punch of the capsule's radius
-//     r on an elastic half-space; K. L. Johnson, "Contact Mechanics", 1985,
-//     section 3.8), from the body's youngs_modulus and poisson_ratio.
+//  2. planes: each candidate's plane faces the tool's axis (its normal is
+//     the direction from the vertex to the axis's nearest point, the way
+//     the solver's contact pushes the vertex) and its gap is the vertex's
+//     distance from the tool's surface; taken nearest first, a candidate
+//     whose normal lies within `max_normal_angle` of a plane already kept
+//     adds nothing (that plane stands for it), else it makes a new plane,
+//     up to `max_contacts`;
+//  3. forces: the planes within `touch_distance` of the tool (and the
+//     nearest, however far) are where it touched; they become one plane
+//     along the frame's contact force F on the tool
+//     (ToolState::contact_force) with the gap -|F| / k, so the model
+//     reproduces the frame's force at the frame's pose. (A corner the tool
+//     presses into is then one plane along the resultant.) The other planes
+//     are where the tool may touch next, each with a gap of at least 0;
+//  4. stiffness: `stiffness` when > 0; else the greater of two
+//     estimates, never lowered within a contact (a softer plane at the same
+//     force would store more energy, and a force that stops growing while
+//     the tool sinks in is the tissue relaxing, not softening):
+//     - measured: the greatest least-squares slope of the frames' force
+//       against the tool's depth along it over the last 10 frames in
+//       contact (when their depths span at least r / 100);
+//     - Hertz's for a sphere of the capsule's radius r on an elastic
+//       half-space (K. L. Johnson, "Contact Mechanics", 1985, 4.2): 2 E* a
+//       with E* = E / (1 - nu^2) from the body's youngs_modulus and
+//       poisson_ratio and the contact radius a = sqrt(r delta), the depth
+//       delta following from the force F = 4/3 E* sqrt(r) delta^(3/2), at
+//       least r / 10 (the only estimate for a plane not yet touched), at
+//       most the flat punch's 2 E* r (a = r; section 3.8).
 // The positions are read with Simulation::read_positions (a host copy; on
 // a GPU backend, a read-back per frame).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -66,26 +79,35 @@ class LocalContactBuilder {
 
   /// [in] xyzw: every particle's position (Simulation::read_positions);
   /// [in] tool: the tool's state at the frame's end. Returns the model.
-  [[nodiscard]] LocalContactModel build(const std::vector<float>& xyzw, const ToolState& tool) const;
+  /// Keeps the stiffness measured over the frames (4. above): call it once
+  /// per frame, in order.
+  [[nodiscard]] LocalContactModel build(const std::vector<float>& xyzw, const ToolState& tool);
 
   [[nodiscard]] std::size_t tool() const { return tool_; }
   [[nodiscard]] const LocalContactSettings& settings() const { return settings_; }
-  /// The stiffness each tet body's contacts get [N/m].
+  /// The stiffness each tet body's contacts get at most [N/m] (a full contact: the flat punch).
   [[nodiscard]] const std::vector<double>& body_stiffness() const { return body_stiffness_; }
 
  private:
   struct SurfaceVertex {
     std::uint32_t particle = 0;  // global particle index
     std::uint32_t body = 0;      // tet body
-    std::uint32_t first = 0, count = 0;  // its triangles in vertex_triangles_
   };
   std::size_t tool_ = 0;
   LocalContactSettings settings_;
   double radius_ = 0.0, half_height_ = 0.0, friction_ = 0.0;
-  std::vector<double> body_stiffness_;
-  std::vector<SurfaceVertex> vertices_;
-  std::vector<std::array<std::uint32_t, 3>> triangles_;  // global particle indices
-  std::vector<std::uint32_t> vertex_triangles_;          // per vertex, its triangles (CSR)
+  std::vector<double> body_stiffness_;  // the most: the flat punch's, or LocalContactSettings::stiffness
+  std::vector<double> body_modulus_;     // E / (1 - nu^2) [Pa]; 0: the fixed LocalContactSettings::stiffness
+  [[nodiscard]] double stiffness(std::uint32_t body, double force) const;
+  double region_stiffness(std::uint32_t body, double force, const std::array<double, 3>& position,
+                          const std::array<double, 3>& force_vector);
+  // The stiffness measured over the frames in contact (0: none yet), from
+  // the last frames' tool positions and contact forces (x, y, z, |F|).
+  static constexpr std::size_t kStiffnessFrames = 10;
+  double measured_ = 0.0;
+  std::array<std::array<double, 4>, kStiffnessFrames> history_{};
+  std::size_t history_next_ = 0;
+  std::vector<SurfaceVertex> vertices_;  // the tet bodies' boundary vertices
 };
 
 }  // namespace sinew::haptics

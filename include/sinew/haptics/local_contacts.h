@@ -52,6 +52,7 @@ struct LocalContact {
   double stiffness = 0.0;          ///< of the tissue there [N/m], > 0
   double force = 0.0;              ///< the physics' push along normal at publication [N], >= 0
   double friction = 0.0;           ///< Coulomb coefficient of the tool's contacts (published, not rendered by solve_local_contacts)
+  std::uint64_t body = 0;          ///< the tet body it lies on (SceneDesc::tet_bodies index)
 };
 
 /// The contacts near one tool at the end of one physics frame.
