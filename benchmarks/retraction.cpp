@@ -120,10 +120,15 @@ int main(int argc, char** argv) {
   cli.app().add_flag("--haptics", haptics, "Both haptic loops on their own threads at 1 kHz of wall time; their timing");
   std::string probe_trace;
   cli.app().add_flag("--local-contacts", s.local_contacts, "The probe's loop renders the local contact model");
+  std::vector<int> haptic_cpus;
+  cli.app()
+      .add_option("--haptic-cpus", haptic_cpus, "--haptics: pin the grasper's and the probe's loops to these two CPUs")
+      ->expected(2);
   cli.app().add_option("--probe-trace", probe_trace, "Write the probe loop's ticks (force against time) as CSV");
   if (auto exit = cli.parse(argc, argv)) return *exit;
   s.self_collision = self_collision;
   s.realtime_haptics = haptics;
+  if (haptic_cpus.size() == 2) s.haptic_cpus = {haptic_cpus[0], haptic_cpus[1]};
 
   auto scene = sinew::examples::RetractionScene::create(s);
   if (!scene) return fail(scene.error().message());
@@ -198,7 +203,7 @@ int main(int argc, char** argv) {
       if (p > 2 * period_us) ++missed;
     }
     const double span = 1e-9 * double(ticks.back().start_ns - ticks.front().start_ns);
-    std::printf("%s,%s,%.3f,%zu,%llu,%.1f,%.1f,%.1f,%.3f\n", hand == 0 ? "grasper" : "probe",
+    std::printf("%s,\"%s\",%.3f,%zu,%llu,%.1f,%.1f,%.1f,%.3f\n", hand == 0 ? "grasper" : "probe",
                 loop.scheduling().describe().c_str(), double(ticks.size() - 1) / span, ticks.size(),
                 static_cast<unsigned long long>(missed), percentile(jitter, 0.5), percentile(jitter, 0.999),
                 percentile(jitter, 1.0), percentile(age, 0.5));

@@ -221,6 +221,7 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
     // Damps the tool's swing on the coupling spring; passive (B > K T / 2 at 1 kHz).
     hs.coupling.damping = 3.0;
     hs.local_contacts = i == 1 && settings.local_contacts;
+    hs.cpu = settings.haptic_cpus[i];
     auto loop = HapticLoop::create(hs, *s.devices_[i], s.snapshots_[i], s.feedback_[i], *s.clock_);
     if (!loop) return loop.error();
     s.loops_.push_back(std::move(*loop));

@@ -58,6 +58,8 @@ struct RetractionSettings {
   /// The probe's loop renders the local contact model (HapticLoopSettings::local_contacts)
   /// that its bridge publishes (LocalContactBuilder, default settings).
   bool local_contacts = false;
+  /// Real time: pin the grasper's and the probe's loop threads to these CPUs (-1: not pinned).
+  std::array<int, 2> haptic_cpus{-1, -1};
 };
 
 /// The scene in a few lines, for the programs' --help.
