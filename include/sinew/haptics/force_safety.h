@@ -32,6 +32,9 @@ enum TickFlags : std::uint32_t {
   kExtrapolated = 1u << 7,  ///< state extrapolated past the newest snapshot
   kHeld = 1u << 8,          ///< state held at the extrapolation horizon
   kMissedDeadline = 1u << 9,  ///< this tick started more than 2 periods after the previous one
+  /// The passivity observer's: the cumulative energy is below
+  /// -tolerance (passivity_observer.h). A bit apart from the others.
+  kPassivityViolation = 1u << 16,
 };
 
 /// The non-finite / clamp / gain / slew chain for one 3-vector (a force or
