@@ -35,7 +35,7 @@ ScriptedPose in_and_out(double t) {
   return p;
 }
 
-struct Run {
+struct LoopRun {
   std::vector<TickRecord> ticks;
   HapticCounters counters;
   double most_feedback_torque = 0.0;    // |CouplingFeedback::torque| [N m]
@@ -43,9 +43,9 @@ struct Run {
 };
 
 // The loop against a tool resting at the origin for `seconds`.
-Run against_resting_tool(HapticDevice& device, const HapticLoopSettings& settings, double seconds) {
+LoopRun against_resting_tool(HapticDevice& device, const HapticLoopSettings& settings, double seconds) {
   VirtualRig rig(device, settings);
-  Run run;
+  LoopRun run;
   const int n = static_cast<int>(seconds * 1000.0 + 0.5);
   for (int i = 0; i < n; ++i) run.ticks.push_back(rig.step());
   run.counters = rig.loop->counters();
@@ -54,7 +54,7 @@ Run against_resting_tool(HapticDevice& device, const HapticLoopSettings& setting
 
 TEST(HapticsPassivity, SpringDamperAgainstARestingToolStaysPassive) {
   ScriptedDevice device(in_and_out);
-  const Run run = against_resting_tool(device, {}, kRest + 5.0);  // 10 cycles
+  const LoopRun run = against_resting_tool(device, {}, kRest + 5.0);  // 10 cycles
   double least = 0.0, least_window = 0.0;
   for (const TickRecord& r : run.ticks) {
     least = std::min(least, r.passivity_energy);
@@ -81,8 +81,7 @@ TEST(HapticsPassivity, SampledSpringIsActiveByHalfKSumOfSquaredSteps) {
   settings.coupling.rotational_damping = 0.0;
   settings.passivity.tolerance = 1e-4;
   ScriptedDevice device(in_and_out);
-  const double seconds = kRest + 5.0;
-  const Run run = against_resting_tool(device, settings, seconds);
+  const LoopRun run = against_resting_tool(device, settings, kRest + 5.001);  // to the end of the 10th cycle
   const double k = settings.coupling.stiffness, kr = settings.coupling.rotational_stiffness;
   double squares = 0.0, turn_squares = 0.0;
   std::uint64_t first_violation = 0;
@@ -120,7 +119,7 @@ TEST(HapticsPassivity, SampledSpringIsActiveByHalfKSumOfSquaredSteps) {
 // A tool that leads the hand by a phase `lead` (as a motor would drive it)
 // pushes the hand along its motion: the environment gives out energy it
 // never received. In translation (`turn` false) or in rotation about z.
-Run leading_tool(const HapticLoopSettings& settings, bool turn, double lead) {
+LoopRun leading_tool(const HapticLoopSettings& settings, bool turn, double lead) {
   const double amplitude = turn ? 0.5 : kAmplitude;  // [rad] or [m]
   auto pose_at = [=](double t, double phase) {
     ScriptedPose p;
@@ -133,7 +132,7 @@ Run leading_tool(const HapticLoopSettings& settings, bool turn, double lead) {
   };
   ScriptedDevice device([=](double t) { return pose_at(t, 0.0); });
   VirtualRig rig(device, settings);
-  Run run;
+  LoopRun run;
   for (int i = 0; i < static_cast<int>((kRest + 2.5) * 1000.0); ++i) {
     // The tool's state at the next snapshot (published by step() when a frame is due).
     const double t = rig.clock.now_ns() * 1e-9;
@@ -154,7 +153,7 @@ Run leading_tool(const HapticLoopSettings& settings, bool turn, double lead) {
 }
 
 TEST(HapticsPassivity, ToolLeadingTheHandIsFlagged) {
-  const Run run = leading_tool({}, false, 0.8);
+  const LoopRun run = leading_tool({}, false, 0.8);
   std::uint64_t flagged = 0;
   for (const TickRecord& r : run.ticks) flagged += (r.flags & kPassivityViolation) ? 1 : 0;
   EXPECT_GT(run.counters.passivity_violations, 100u);
@@ -169,7 +168,7 @@ TEST(HapticsPassivity, ToolLeadingTheHandIsFlagged) {
 // rotational energy crosses the port (none flagged), while the feedback
 // still carries the coupling torque to the tool.
 TEST(HapticsPassivity, ThreeDofDeviceGetsNoTorqueButTheToolDoes) {
-  const Run six = leading_tool({}, true, 0.8);
+  const LoopRun six = leading_tool({}, true, 0.8);
   EXPECT_GT(six.counters.passivity_violations, 100u);
   EXPECT_LT(six.counters.passivity_energy, -0.005);
   double most_torque = 0.0;
@@ -178,7 +177,7 @@ TEST(HapticsPassivity, ThreeDofDeviceGetsNoTorqueButTheToolDoes) {
 
   HapticLoopSettings three;
   three.degrees_of_freedom = 3;
-  const Run run = leading_tool(three, true, 0.8);
+  const LoopRun run = leading_tool(three, true, 0.8);
   for (const TickRecord& r : run.ticks) {
     ASSERT_EQ(r.torque, (Vec3{0.0, 0.0, 0.0})) << "tick " << r.tick;
     ASSERT_EQ(r.passivity_energy, 0.0) << "tick " << r.tick;  // no force either: the device only turns

@@ -120,6 +120,7 @@ struct Figures {
   double max_tip_speed = 0.0;       // [m/s] of its lower end
   double max_tilt_sweep = 0.0;      // [rad] of the shaft during the first sweep
   double max_trocar_force = 0.0;    // [N]
+  double max_contact_force = 0.0;   // [N] the tissue's push on the tool
   double depth_min = 1.0, depth_max = 0.0;  // [m] the centre below the port, in and out
   double hold_turn_error = 0.0;     // [rad] the tool's rotation against the hand's at the end
   double hold_depth_error = 0.0;    // [m]
@@ -171,6 +172,7 @@ Figures drive(bool block, bool trocar) {
       f.depth_max = std::max(f.depth_max, along);
     }
     f.max_trocar_force = std::max(f.max_trocar_force, std::sqrt(dot(s->trocar_force, s->trocar_force)));
+    f.max_contact_force = std::max(f.max_contact_force, std::sqrt(dot(s->contact_force, s->contact_force)));
     if (frame == frames - 1) {
       const Quat& q = s->rotation;
       const Quat rel = qmul(q, {kHoldTurn[0], -kHoldTurn[1], -kHoldTurn[2], -kHoldTurn[3]});
@@ -184,9 +186,9 @@ Figures drive(bool block, bool trocar) {
 void report(const char* where, const Figures& f) {
   std::printf("%s: pivot to shaft line max %.3g m (fastest sweep %.3g m); sideways speed at the pivot max %.3g m/s; "
               "tool centre up to %.3g m/s, tip up to %.3g m/s; tilt in the sweep %.3g rad; port force up to %.3g N; "
-              "insertion %.4g..%.4g m; hold: rotation error %.3g rad, depth error %.3g m\n",
+              "tissue's push up to %.3g N; insertion %.4g..%.4g m; hold: rotation error %.3g rad, depth error %.3g m\n",
               where, f.max_pivot_distance, f.max_pivot_distance_fastest, f.max_sideways_speed, f.max_tool_speed,
-              f.max_tip_speed, f.max_tilt_sweep, f.max_trocar_force, f.depth_min, f.depth_max, f.hold_turn_error,
+              f.max_tip_speed, f.max_tilt_sweep, f.max_trocar_force, f.max_contact_force, f.depth_min, f.depth_max, f.hold_turn_error,
               f.hold_depth_error);
 }
 
@@ -211,6 +213,7 @@ TEST(Trocar, HoldsTheShaftThroughThePivotOverATissueBlock) {
   const Figures f = drive(true, true);
   report("trocar, over a tissue block", f);
   expect_held_and_following(f);
+  EXPECT_GT(f.max_contact_force, 0.5) << "the tip pressed into the tissue [N]";
 }
 
 // The same hand without a trocar carries the shaft far off the pivot: the
@@ -264,7 +267,8 @@ TEST(Trocar, SceneFilesReadIt) {
   ASSERT_FALSE(unknown.ok());
   auto off = sinew::parse_scene_json(tool + R"("trocar": {"pivot": [0.02, 0.1, 0]}}]})", ".");
   ASSERT_FALSE(off.ok());
-  EXPECT_NE(off.error().message().find("tools[0].trocar"), std::string::npos) << off.error().message();
+  EXPECT_NE(off.error().message().find("/tools/0/trocar: the tool's initial shaft line"), std::string::npos)
+      << off.error().message();
 }
 
 }  // namespace

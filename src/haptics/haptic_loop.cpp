@@ -58,7 +58,8 @@ HapticLoop::HapticLoop(const HapticLoopSettings& settings, HapticDevice& device,
                        FeedbackChannel& feedback, Clock& clock)
     : settings_(settings), device_(device), snapshots_(snapshots), feedback_(feedback), clock_(clock),
       period_ns_(std::max<std::int64_t>(1, seconds_to_ns(1.0 / settings.rate_hz))), coupling_(settings.coupling),
-      watchdog_(settings.watchdog), passivity_(settings.passivity), ring_(settings.telemetry_capacity) {  // value-initialised: pages touched
+      watchdog_(settings.watchdog), passivity_(settings.passivity),
+      ring_(settings.telemetry_capacity) {  // value-initialised: pages touched
   // Its own id in every feedback: a later loop on the same channel starts
   // its impulse integral at zero, and the bridge must not difference the two.
   static std::atomic<std::uint64_t> loops{0};
