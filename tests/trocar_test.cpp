@@ -1,11 +1,12 @@
 // A laparoscopic instrument through a trocar (ToolDesc::trocar), driven by
 // a scripted hand through the haptic loop (virtual clock, manual ticks) and
 // the tool bridge: swept fast sideways, in and out, turned about the port,
-// over a tissue block and in free space. Every frame the shaft line passes
-// within 0.1 mm of the pivot and the shaft's point at the pivot has no
-// sideways velocity; insertion and rotation about the pivot still follow
-// the hand; without the trocar the same sweep carries the shaft centimetres
-// off the port. Bad trocars are named errors, in code and in scene files.
+// over a tissue block, against a slanted floor collider and in free space.
+// Every frame the shaft line passes within 0.1 mm of the pivot and the
+// shaft's point at the pivot has no sideways velocity; insertion and
+// rotation about the pivot still follow the hand; without the trocar the
+// same sweep carries the shaft centimetres off the port. Bad trocars are
+// named errors, in code and in scene files.
 #include <gtest/gtest.h>
 
 #include <algorithm>
