@@ -4,12 +4,14 @@
 // by exactly K/2 sum |dx|^2 per closed cycle; a tool that leads the hand
 // (an environment that makes energy) is flagged, in translation and in
 // rotation; a 3-DOF device gets exactly zero torque and exchanges no
-// rotational energy, while the tool still gets the coupling torque.
+// rotational energy, while the tool still gets the coupling torque; the
+// passivity controller damps what an active environment gives out.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "haptics_test_support.h"
@@ -211,6 +213,38 @@ TEST(HapticsPassivity, ThreeDofDeviceIsCommandedExactlyZeroTorque) {
   EXPECT_LT(fb.torque[2], -0.01) << "the coupling's torque on the device side, handed to the tool";
 }
 
+// The passivity controller: against the tool that leads the hand, its
+// damper dissipates what the environment gives out, so the cumulative
+// energy stays near zero; against a passive rendering it never engages.
+TEST(HapticsPassivity, ControllerDampsWhatTheEnvironmentCreates) {
+  const LoopRun off = leading_tool({}, false, 0.8);
+  HapticLoopSettings settings;
+  settings.passivity.controller = true;
+  settings.passivity.max_damping = 50.0;
+  const LoopRun on = leading_tool(settings, false, 0.8);
+  std::uint64_t damped = 0;
+  for (const TickRecord& r : on.ticks) damped += (r.flags & kPassivityDamping) ? 1 : 0;
+  EXPECT_GT(damped, 100u);
+  EXPECT_LT(on.counters.passivity_violations, off.counters.passivity_violations / 10);
+  EXPECT_GT(on.counters.passivity_energy, -0.01);
+  std::printf("passivity controller (max 50 N s/m) against the leading tool: E = %.4g J (off: %.4g J), %llu ticks "
+              "flagged (off: %llu), damper on in %llu ticks\n",
+              on.counters.passivity_energy, off.counters.passivity_energy,
+              static_cast<unsigned long long>(on.counters.passivity_violations),
+              static_cast<unsigned long long>(off.counters.passivity_violations),
+              static_cast<unsigned long long>(damped));
+
+  ScriptedDevice plain_device(in_and_out), controlled_device(in_and_out);
+  const LoopRun plain = against_resting_tool(plain_device, {}, kRest + 2.0);
+  const LoopRun controlled = against_resting_tool(controlled_device, settings, kRest + 2.0);
+  ASSERT_EQ(plain.ticks.size(), controlled.ticks.size());
+  for (std::size_t i = 0; i < plain.ticks.size(); ++i) {
+    ASSERT_FALSE(controlled.ticks[i].flags & kPassivityDamping) << "tick " << i + 1;
+    ASSERT_EQ(controlled.ticks[i].force, plain.ticks[i].force) << "tick " << i + 1;
+    ASSERT_EQ(controlled.ticks[i].torque, plain.ticks[i].torque) << "tick " << i + 1;
+  }
+}
+
 TEST(HapticsPassivity, BadSettingsAreNamed) {
   HapticLoopSettings s;
   s.degrees_of_freedom = 4;
@@ -227,6 +261,16 @@ TEST(HapticsPassivity, BadSettingsAreNamed) {
   e = check(s);
   ASSERT_FALSE(e.ok());
   EXPECT_NE(e.error().message().find("passivity.tolerance"), std::string::npos);
+  s = {};
+  s.passivity.max_damping = -1.0;
+  e = check(s);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.error().message().find("passivity.max_damping"), std::string::npos);
+  s = {};
+  s.passivity.max_rotational_damping = std::numeric_limits<double>::infinity();
+  e = check(s);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.error().message().find("passivity.max_rotational_damping"), std::string::npos);
 }
 
 }  // namespace

@@ -114,16 +114,24 @@ inline void bump(std::atomic<std::uint64_t>& a, std::uint64_t by = 1) {
 }
 }  // namespace
 
-std::uint32_t HapticLoop::observe_passivity(const Vec3& force, const Vec3& torque, TickRecord& rec) noexcept {
+std::uint32_t HapticLoop::observe_passivity(Vec3& force, Vec3& torque, TickRecord& rec) noexcept {
   // The device's pose this tick (the previous sample when none came: no motion).
+  std::uint32_t flags = 0;
+  const PassivityParams& ps = settings_.passivity;
+  const CouplingParams& c = settings_.coupling;
+  if (ps.controller && have_sample_ &&
+      passivity_.control(sample_.position, sample_.rotation, sample_.velocity, sample_.angular_velocity,
+                         ns_to_seconds(period_ns_), c.max_force, c.max_torque, settings_.degrees_of_freedom == 6,
+                         force, torque))
+    flags |= kPassivityDamping;
   const PassivityReading p = passivity_.observe(sample_.position, sample_.rotation, force, torque);
   rec.passivity_energy = p.energy;
   rec.window_energy = p.window_energy;
   counters_.energy.store(p.energy, std::memory_order_relaxed);
   counters_.min_window.store(passivity_.min_window_energy(), std::memory_order_relaxed);
-  if (!p.violation) return 0;
+  if (!p.violation) return flags;
   bump(counters_.passivity);
-  return kPassivityViolation;
+  return flags | kPassivityViolation;
 }
 
 TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) noexcept {
@@ -181,10 +189,12 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   if (out.flags & kNonFinite) bump(counters_.non_finite);
   if (out.flags & kClamped) bump(counters_.clamped);
   if (out.flags & kSlewLimited) bump(counters_.slewed);
-  // A 3-DOF device gets no torque; the feedback below still carries it to the tool.
-  const Vec3 device_torque = settings_.degrees_of_freedom == 6 ? out.torque : Vec3{0.0, 0.0, 0.0};
-  device_.command(out.force, device_torque, start);
-  flags |= observe_passivity(out.force, device_torque, rec);
+  // A 3-DOF device gets no torque; the feedback below still carries it to
+  // the tool. The passivity controller's damper goes to the device only.
+  Vec3 device_force = out.force;
+  Vec3 device_torque = settings_.degrees_of_freedom == 6 ? out.torque : Vec3{0.0, 0.0, 0.0};
+  flags |= observe_passivity(device_force, device_torque, rec);
+  device_.command(device_force, device_torque, start);
 
   // 7. Feedback: the impulse integral (zero-order hold of the previous tick's
   // output up to now), then this tick's output.
@@ -216,7 +226,7 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   rec.device_position = sample_.position;
   rec.tool_position = tool_.position;
   rec.raw_force = out.raw_force;
-  rec.force = out.force;
+  rec.force = device_force;
   rec.torque = device_torque;
   rec.gain = gain;
   rec.flags = flags;

@@ -35,6 +35,7 @@ enum TickFlags : std::uint32_t {
   /// The passivity observer's: the cumulative energy is below
   /// -tolerance (passivity_observer.h). A bit apart from the others.
   kPassivityViolation = 1u << 16,
+  kPassivityDamping = 1u << 17,  ///< the passivity controller added a damper to the device's command
 };
 
 /// The non-finite / clamp / gain / slew chain for one 3-vector (a force or

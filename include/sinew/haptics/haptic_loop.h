@@ -105,7 +105,7 @@ struct TickRecord {
   Vec3 device_position{};        ///< [m]
   Vec3 tool_position{};          ///< rendered [m]
   Vec3 raw_force{};              ///< coupling before the safety chain [N]
-  Vec3 force{};                  ///< commanded to the device [N]
+  Vec3 force{};                  ///< commanded to the device [N] (with the passivity controller's damper)
   Vec3 torque{};                 ///< commanded to the device [N m] (zero with degrees_of_freedom 3)
   double passivity_energy = 0.0;  ///< cumulative energy put into the environment since the start [J] (passivity_observer.h)
   double window_energy = 0.0;     ///< of it, over the last passivity.window ticks [J]
@@ -188,9 +188,10 @@ class HapticLoop {
   HapticLoop(const HapticLoopSettings& settings, HapticDevice& device, SnapshotChannel& snapshots,
              FeedbackChannel& feedback, Clock& clock);
   TickRecord tick_at(std::int64_t scheduled_ns, bool use_scheduled) noexcept;
-  // The passivity observer for this tick's command; fills rec's energies and
-  // returns kPassivityViolation or 0.
-  std::uint32_t observe_passivity(const Vec3& force, const Vec3& torque, TickRecord& rec) noexcept;
+  // The passivity controller (when on) on [in,out] force and torque, then
+  // the observer on the command; fills rec's energies and returns
+  // kPassivityViolation and kPassivityDamping bits.
+  std::uint32_t observe_passivity(Vec3& force, Vec3& torque, TickRecord& rec) noexcept;
   void run();
   struct AtomicCounters {
     std::atomic<std::uint64_t> ticks{0}, missed{0}, skipped{0}, non_finite{0}, clamped{0}, slewed{0}, stale{0},

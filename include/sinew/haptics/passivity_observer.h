@@ -42,6 +42,17 @@
 //    observer of Hannaford and Ryu).
 //  - A 3-DOF device (HapticLoopSettings::degrees_of_freedom = 3) is
 //    commanded no torque: its rotation exchanges no energy with the port.
+//
+// The passivity controller (off by default; PassivityParams::controller),
+// Hannaford and Ryu's variable damper at the device: before a tick's
+// command, the energy including the interval just ended, E(n), and that of
+// the coming interval if the device kept its velocity, -T (F . v + T . w),
+// are added up; when the sum P is negative, a damper -alpha v (then
+// -alpha_r w for what is left) is added to the device's command, with
+// alpha |v|^2 T (+ alpha_r |w|^2 T) = -P, each damping at most its
+// max_damping. It acts on the device only (the tool's feedback is the
+// coupling's), is clamped with the coupling's force to max_force and
+// max_torque, but is not slew-limited: it engages at once, as in the paper.
 #pragma once
 
 #include <cstddef>
@@ -64,6 +75,11 @@ struct PassivityParams {
   /// before a tick counts as a violation (room for rounding and for a
   /// loop that starts slightly stretched).
   double tolerance = 1e-3;
+  /// Run the passivity controller (see above): a damper at the device
+  /// that dissipates the energy the observer finds missing.
+  bool controller = false;
+  double max_damping = 5.0;              ///< its largest alpha [N s/m], finite, >= 0
+  double max_rotational_damping = 5e-3;  ///< its largest alpha_r [N m s/rad], finite, >= 0
 };
 /// Errors name the bad parameter.
 Status check(const PassivityParams& params);
@@ -89,6 +105,16 @@ class PassivityObserver {
   /// construction or reset() only records the pose (no interval yet).
   PassivityReading observe(const Vec3& position, const Quat& rotation, const Vec3& force,
                            const Vec3& torque) noexcept;
+  /// The passivity controller (see above), before this tick's observe():
+  /// [in] position, rotation, velocity [m/s], angular_velocity [rad/s]: the
+  /// device now; [in] period: the tick period T [s]; [in,out] force [N],
+  /// torque [N m]: the command, with the damper added; [in] max_force,
+  /// max_torque: their clamps; [in] render_torque: false for a 3-DOF
+  /// device (no rotational damper). Returns whether a damper was added
+  /// (never before the first observe(), never with a zero velocity).
+  bool control(const Vec3& position, const Quat& rotation, const Vec3& velocity, const Vec3& angular_velocity,
+               double period, double max_force, double max_torque, bool render_torque, Vec3& force,
+               Vec3& torque) const noexcept;
   /// Starts over: E = 0, empty window, no previous pose (HapticLoop::stop()).
   void reset() noexcept;
 
