@@ -11,7 +11,8 @@
 // Steps 3-4 are convex combinations of values inside the clamp ball, so the
 // output never exceeds `max`. A fading watchdog is therefore also
 // slew-limited (smooth), and an interpolation jump (a late snapshot) is
-// spread over a few ticks.
+// spread over a few ticks. The passivity controller, when on, adds its
+// damper after this chain, clamped but not slew-limited (passivity_observer.h).
 #pragma once
 
 #include <cstdint>
