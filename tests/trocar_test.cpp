@@ -201,10 +201,11 @@ Figures drive(Around around, bool trocar) {
 void report(const char* where, const Figures& f) {
   std::printf("%s: pivot to shaft line max %.3g m (fastest sweep %.3g m); sideways speed at the pivot max %.3g m/s; "
               "tool centre up to %.3g m/s, tip up to %.3g m/s; tilt in the sweep %.3g rad; port force up to %.3g N; "
-              "tissue's push up to %.3g N; tip to the slanted floor's plane min %.4g m; insertion %.4g..%.4g m; hold: rotation error %.3g rad, depth error %.3g m\n",
+              "tissue's push up to %.3g N; tip to the slanted floor's plane min %.4g m; insertion %.4g..%.4g m; "
+              "hold: rotation error %.3g rad, depth error %.3g m\n",
               where, f.max_pivot_distance, f.max_pivot_distance_fastest, f.max_sideways_speed, f.max_tool_speed,
-              f.max_tip_speed, f.max_tilt_sweep, f.max_trocar_force, f.max_contact_force, f.min_floor_distance, f.depth_min, f.depth_max, f.hold_turn_error,
-              f.hold_depth_error);
+              f.max_tip_speed, f.max_tilt_sweep, f.max_trocar_force, f.max_contact_force, f.min_floor_distance,
+              f.depth_min, f.depth_max, f.hold_turn_error, f.hold_depth_error);
 }
 
 void expect_held_and_following(const Figures& f, bool free_hold = true) {

@@ -65,7 +65,8 @@ bool PassivityObserver::control(const Vec3& position, const Quat& rotation, cons
   const double alpha = v2 > 0.0 ? std::min(p_.max_damping, deficit / (period * v2)) : 0.0;
   const double left = deficit - alpha * v2 * period;
   // A 3-DOF device is commanded no torque: no rotational damper either.
-  const double alpha_r = render_torque && w2 > 0.0 && left > 0.0 ? std::min(p_.max_rotational_damping, left / (period * w2)) : 0.0;
+  const double alpha_r =
+      render_torque && w2 > 0.0 && left > 0.0 ? std::min(p_.max_rotational_damping, left / (period * w2)) : 0.0;
   if (!(alpha > 0.0) && !(alpha_r > 0.0)) return false;
   force = clamp_length(math::sub(force, math::mul(velocity, alpha)), max_force);
   if (alpha_r > 0.0) torque = clamp_length(math::sub(torque, math::mul(angular_velocity, alpha_r)), max_torque);

@@ -105,7 +105,8 @@ void hold_trocar(ToolBody& b, double dt, double stiffness) {
   // from the pivot to the shaft line is zero to rounding afterwards.
   b.position = math::add(b.position, trocar_offset(b.pivot, math::rotate(b.rotation, b.shaft_axis), b.position));
   M3 inverse;
-  if (invert(world_inertia(b, stiffness), inverse)) apply_trocar_impulse(b, effective_mass(b, stiffness), inverse, dt);
+  if (invert(world_inertia(b, stiffness), inverse))
+    apply_trocar_impulse(b, effective_mass(b, stiffness), inverse, dt);
 }
 
 // One semi-implicit Euler step of the tool over dt.

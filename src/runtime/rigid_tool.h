@@ -13,7 +13,9 @@
 //     frame n-1: v += dt F / M, x += dt v; the angular velocity likewise
 //     from the torque (inertia in the body frame, the gyroscopic term
 //     implicit), q += dt/2 (0, omega) q. The tool's collider then moves
-//     from its old to its new pose across frame n's substeps.
+//     from its old to its new pose across frame n's substeps. A tool
+//     through a trocar is held through its pivot after that motion and
+//     again after its contacts with the colliders (hold_trocar; trocar.h).
 //  2. during frame n the tool is an infinitely heavy kinematic collider: the
 //     particles it touches are pushed out and dragged by friction, and each
 //     correction's impulse (with its moment about the tool's centre) is

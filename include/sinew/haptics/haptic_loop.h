@@ -107,7 +107,8 @@ struct TickRecord {
   Vec3 raw_force{};              ///< coupling before the safety chain [N]
   Vec3 force{};                  ///< commanded to the device [N] (with the passivity controller's damper)
   Vec3 torque{};                 ///< commanded to the device [N m] (zero with degrees_of_freedom 3)
-  double passivity_energy = 0.0;  ///< cumulative energy put into the environment since the start [J] (passivity_observer.h)
+  /// Cumulative energy put into the environment since the start [J] (passivity_observer.h).
+  double passivity_energy = 0.0;
   double window_energy = 0.0;     ///< of it, over the last passivity.window ticks [J]
   double gain = 0.0;             ///< watchdog gain
   std::uint32_t flags = 0;       ///< TickFlags
