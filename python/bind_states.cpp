@@ -20,7 +20,9 @@ void bind_states(py::module_& m) {
       .def_readonly("penalty_force", &ToolState::penalty_force, "a level-set tool's penalty [N]")
       .def_readonly("penalty_torque", &ToolState::penalty_torque, "[N m]")
       .def_readonly("penalty_points", &ToolState::penalty_points)
-      .def_readonly("penalty_depth", &ToolState::penalty_depth, "[m]");
+      .def_readonly("penalty_depth", &ToolState::penalty_depth, "[m]")
+      .def_readonly("trocar_force", &ToolState::trocar_force, "what its trocar pushed it with, last frame [N]")
+      .def_readonly("trocar_torque", &ToolState::trocar_torque, "its moment about the tool's centre [N m]");
 
   py::class_<Puncture>(m, "Puncture", "A tissue point held on a needle or its thread (sinew::Puncture).")
       .def_property_readonly("body_kind", [](const Puncture& p) { return body_kind_name(p.body_kind); }, "'tet' or 'tri'")

@@ -334,6 +334,25 @@ enum class ToolShape {
   level_set,
 };
 
+/// A trocar (laparoscopic port) a tool's shaft passes through
+/// (ToolDesc::trocar): a point fixed in the world that the tool's shaft
+/// line, centre + R axis s for every s, always passes through. The tool
+/// stays free to turn about the pivot (all three axes, including the roll
+/// about its shaft) and to slide along its shaft (insertion); motion of the
+/// shaft sideways at the pivot is removed.
+struct TrocarDesc {
+  std::array<double, 3> pivot{0.0, 0.0, 0.0};  ///< the port, world frame [m], finite
+  /// The shaft's direction in the tool's frame, through its centre; finite
+  /// and non-zero (normalised when the scene is created). A capsule's
+  /// shaft is its y axis, {0, 1, 0} (the default).
+  std::array<double, 3> axis{0.0, 1.0, 0.0};
+};
+
+/// How far a tool's initial shaft line may pass from its trocar's pivot
+/// [m]: within it, the initial pose is projected onto the constraint when
+/// the scene is created; beyond it, a named error.
+inline constexpr double kTrocarPoseTolerance = 1e-5;
+
 /// A rigid tool with mass and inertia, driven by a force and torque
 /// (Simulation::apply_tool_force) and pushed back by what it touches. Its
 /// contacts with particles are solved like a collider's of its shape; the
@@ -355,6 +374,27 @@ enum class ToolShape {
 /// filled. Continuous collision (MeshCollisionDesc::continuous) sweeps
 /// capsule tools only: a level-set tool meets particles and faces at the
 /// substeps' poses.
+///
+/// A tool with a trocar (a laparoscopic instrument through its port) has
+/// its shaft held through the pivot every frame, after its motion is
+/// integrated (Cline and Pai, "Post-stabilization for rigid body
+/// simulation with contact and constraints", ICRA 2003): first an impulse
+/// at the pivot removes the sideways velocity of the tool's point there,
+/// including the part the angular velocity makes, through the tool's
+/// mass and inertia, so a sideways push on the tool turns it about the
+/// port as a real instrument turns (the tip swings the other way) instead
+/// of being cancelled; then the pose is moved straight across the shaft
+/// by the small drift the rotation's integration left, so the shaft line
+/// passes through the pivot to rounding, and the impulse is applied again
+/// at the new pose, so the tool does not fight the constraint next frame.
+/// After the tools are pushed out of the colliders (which may move them
+/// sideways), the pose and velocity are held to the port again: the port
+/// wins over a collider. What the port pushed the tool with is reported
+/// (ToolState::trocar_force, trocar_torque); a hand coupled to the tool
+/// (haptics/tool_bridge.h) feels it through the coupling, whose spring
+/// stretches as the port holds the tool back. The initial pose must put
+/// the shaft line within kTrocarPoseTolerance of the pivot (a named
+/// error otherwise); the rest is projected when the scene is created.
 struct ToolDesc {
   ToolShape shape = ToolShape::capsule;  ///< a capsule, or a level set's shape
   double radius = 0.005;                                ///< capsule [m], > 0
@@ -372,6 +412,8 @@ struct ToolDesc {
   double static_friction = 0.3;                         ///< of its contacts, >= 0
   double dynamic_friction = 0.2;                        ///< of its contacts, >= 0, <= static_friction
   double compliance = 0.0;                              ///< of its contacts [m/N]
+  /// A trocar its shaft passes through (see above); none by default.
+  std::optional<TrocarDesc> trocar;
 };
 
 /// How a needle moves (NeedleDesc::drive).

@@ -33,6 +33,13 @@ struct ToolState {
   ///@}
   std::uint32_t penalty_points = 0;  ///< a level-set tool's surface points inside other shapes then
   double penalty_depth = 0.0;        ///< the deepest one's depth [m]
+  /// What a tool's trocar (ToolDesc::trocar) pushed it with over the last
+  /// frame [N], at the pivot, sideways to the shaft, and its moment about
+  /// the tool's centre [N m]; zero without a trocar.
+  ///@{
+  std::array<double, 3> trocar_force{};
+  std::array<double, 3> trocar_torque{};
+  ///@}
 };
 
 /// A handle on a Simulation's tools, colliders and targets; a view of the

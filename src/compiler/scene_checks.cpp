@@ -264,6 +264,27 @@ Status check_collider(const ColliderDesc& c, const std::string& name) {
   return non_negative(name + ".compliance", c.compliance);
 }
 
+// A trocar: a finite pivot, a finite non-zero axis, and the tool's initial
+// shaft line through the pivot within kTrocarPoseTolerance (scene.h).
+Status check_trocar(const TrocarDesc& t, const Vec3d& position, const std::array<double, 4>& rotation,
+                    const std::string& name) {
+  if (Status s = finite3(name + ".pivot", t.pivot); !s) return s;
+  if (Status s = finite3(name + ".axis", t.axis); !s) return s;
+  const double length = std::sqrt(math::dot(t.axis, t.axis));
+  if (!(length > 0.0) || !std::isfinite(length))
+    return Error(ErrorCode::bad_parameter, name + ".axis must be non-zero (the shaft's direction in the tool frame)");
+  const Vec3d u = math::rotate(rotation, math::mul(t.axis, 1.0 / length));
+  const Vec3d to_pivot = math::sub(t.pivot, position);
+  const Vec3d across = math::sub(to_pivot, math::mul(u, math::dot(u, to_pivot)));
+  const double miss = std::sqrt(math::dot(across, across));
+  if (!(miss <= kTrocarPoseTolerance))
+    return Error(ErrorCode::bad_parameter,
+                 name + ": the tool's initial shaft line (position + rotation * axis * s) passes " + str(miss) +
+                     " m from the pivot; it must pass within " + str(kTrocarPoseTolerance) +
+                     " m (place the tool on the line through the pivot)");
+  return {};
+}
+
 Status check_tool(const ToolDesc& t, const std::string& name) {
   if (t.shape == ToolShape::capsule) {
     if (Status s = positive(name + ".radius", t.radius); !s) return s;
@@ -284,7 +305,9 @@ Status check_tool(const ToolDesc& t, const std::string& name) {
   if (Status s = finite3(name + ".position", t.position); !s) return s;
   if (Status s = unit_quaternion(name + ".rotation", t.rotation); !s) return s;
   if (Status s = check_friction(name, t.static_friction, t.dynamic_friction); !s) return s;
-  return non_negative(name + ".compliance", t.compliance);
+  if (Status s = non_negative(name + ".compliance", t.compliance); !s) return s;
+  if (!t.trocar) return {};
+  return check_trocar(*t.trocar, t.position, t.rotation, name + ".trocar");
 }
 
 Status check_needle(const SceneDesc& scene, const NeedleDesc& n, const std::string& name) {

@@ -33,6 +33,10 @@ Status check(const HapticLoopSettings& s) {
                  "telemetry_capacity must be in 1.." + std::to_string(kMaxTelemetryCapacity) + " ticks (got " +
                  std::to_string(s.telemetry_capacity) + ")");
   if (s.snapshot_read_attempts < 1) return Error(ErrorCode::bad_parameter, "snapshot_read_attempts must be >= 1");
+  if (s.degrees_of_freedom != 3 && s.degrees_of_freedom != 6)
+    return Error(ErrorCode::bad_parameter, "degrees_of_freedom must be 3 (force only) or 6 (force and torque) (got " +
+                                               std::to_string(s.degrees_of_freedom) + ")");
+  if (auto st = check(s.passivity); !st) return st;
   if (auto st = check(s.coupling); !st) return st;
   if (auto st = check(s.watchdog); !st) return st;
   return check(s.interpolation);
@@ -56,7 +60,8 @@ HapticLoop::HapticLoop(const HapticLoopSettings& settings, HapticDevice& device,
     : settings_(settings), device_(device), snapshots_(snapshots), feedback_(feedback), clock_(clock),
       period_ns_(std::max<std::int64_t>(1, seconds_to_ns(1.0 / settings.rate_hz))), coupling_(settings.coupling),
       drive_coupling_(settings.coupling),
-      watchdog_(settings.watchdog), ring_(settings.telemetry_capacity) {  // value-initialised: pages touched
+      watchdog_(settings.watchdog), passivity_(settings.passivity),
+      ring_(settings.telemetry_capacity) {  // value-initialised: pages touched
   // Its own id in every feedback: a later loop on the same channel starts
   // its impulse integral at zero, and the bridge must not difference the two.
   static std::atomic<std::uint64_t> loops{0};
@@ -70,7 +75,8 @@ HapticCounters HapticLoop::counters() const {
   const AtomicCounters& c = counters_;
   return {r(c.ticks),      r(c.missed),        r(c.skipped),         r(c.non_finite),
           r(c.clamped),    r(c.slewed),        r(c.stale),           r(c.stalls),
-          r(c.read_failures), r(c.device_failures), r(c.snapshots)};
+          r(c.read_failures), r(c.device_failures), r(c.snapshots),  r(c.passivity),
+          c.energy.load(std::memory_order_relaxed), c.min_window.load(std::memory_order_relaxed)};
 }
 
 Status HapticLoop::copy_telemetry(std::vector<TickRecord>& out) const {
@@ -109,6 +115,26 @@ inline void bump(std::atomic<std::uint64_t>& a, std::uint64_t by = 1) {
   a.store(a.load(std::memory_order_relaxed) + by, std::memory_order_relaxed);
 }
 }  // namespace
+
+std::uint32_t HapticLoop::observe_passivity(Vec3& force, Vec3& torque, TickRecord& rec) noexcept {
+  // The device's pose this tick (the previous sample when none came: no motion).
+  std::uint32_t flags = 0;
+  const PassivityParams& ps = settings_.passivity;
+  const CouplingParams& c = settings_.coupling;
+  if (ps.controller && have_sample_ &&
+      passivity_.control(sample_.position, sample_.rotation, sample_.velocity, sample_.angular_velocity,
+                         ns_to_seconds(period_ns_), c.max_force, c.max_torque, settings_.degrees_of_freedom == 6,
+                         force, torque))
+    flags |= kPassivityDamping;
+  const PassivityReading p = passivity_.observe(sample_.position, sample_.rotation, force, torque);
+  rec.passivity_energy = p.energy;
+  rec.window_energy = p.window_energy;
+  counters_.energy.store(p.energy, std::memory_order_relaxed);
+  counters_.min_window.store(passivity_.min_window_energy(), std::memory_order_relaxed);
+  if (!p.violation) return flags;
+  bump(counters_.passivity);
+  return flags | kPassivityViolation;
+}
 
 TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) noexcept {
   const std::int64_t start = clock_.now_ns();
@@ -191,7 +217,12 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   if (out.flags & kNonFinite) bump(counters_.non_finite);
   if (out.flags & kClamped) bump(counters_.clamped);
   if (out.flags & kSlewLimited) bump(counters_.slewed);
-  device_.command(out.force, out.torque, start);
+  // A 3-DOF device gets no torque; the feedback below still carries it to
+  // the tool. The passivity controller's damper goes to the device only.
+  Vec3 device_force = out.force;
+  Vec3 device_torque = settings_.degrees_of_freedom == 6 ? out.torque : Vec3{0.0, 0.0, 0.0};
+  flags |= observe_passivity(device_force, device_torque, rec);
+  device_.command(device_force, device_torque, start);
 
   // 7. Feedback: the impulse integral (zero-order hold of the previous tick's
   // output up to now), then this tick's output.
@@ -228,7 +259,8 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   rec.local_contacts = contacts.active;
   rec.contact_gap_offset = local_.gap_offset();
   rec.raw_force = out.raw_force;
-  rec.force = out.force;
+  rec.force = device_force;
+  rec.torque = device_torque;
   rec.gain = gain;
   rec.flags = flags;
   rec.device_buttons = sample_.buttons;
@@ -277,6 +309,7 @@ void HapticLoop::stop() noexcept {
   coupling_.reset();
   drive_coupling_.reset();
   watchdog_.reset();
+  passivity_.reset();  // the device held zero force since; the energy it saw is history
   release_cpu_latency(qos_fd_);
   qos_fd_ = -1;
   running_.store(false, std::memory_order_release);

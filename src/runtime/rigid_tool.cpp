@@ -9,6 +9,7 @@
 
 #include "compiler/device_ranges.h"
 #include "math/vec3.h"
+#include "runtime/trocar.h"
 
 namespace sinew {
 namespace {
@@ -53,7 +54,60 @@ V3 gyroscopic_step(const V3& inertia, const V3& w, double dt) {
   return math::sub(w, step);
 }
 
+// The tool's world inertia R I R^T plus the touching particles' scaled
+// inertia about its centre (see integrate_tool).
+M3 world_inertia(const ToolBody& b, double stiffness) {
+  M3 a;
+  for (int c = 0; c < 3; ++c) {
+    V3 e{0.0, 0.0, 0.0};
+    e[c] = 1.0;
+    V3 local = math::rotate(math::conj(b.rotation), e);
+    for (int k = 0; k < 3; ++k) local[k] *= b.inertia[k];
+    const V3 column = math::rotate(b.rotation, local);
+    for (int r = 0; r < 3; ++r) a[r][c] = column[r] + stiffness * b.touching_inertia[3 * r + c];
+  }
+  return a;
+}
+
+// The tool's mass, raised where needed to the least mass that keeps
+// explicit Euler inside its stability bound against K (see integrate_tool).
+double effective_mass(const ToolBody& b, double stiffness) {
+  return std::max(b.mass, 0.25 * stiffness * b.touching_mass);
+}
+
+// A^-1 by columns (A symmetric positive definite); false when singular.
+bool invert(const M3& a, M3& inverse) {
+  for (int c = 0; c < 3; ++c) {
+    V3 e{0.0, 0.0, 0.0}, x{0.0, 0.0, 0.0};
+    e[c] = 1.0;
+    if (!solve3(a, e, x)) return false;
+    for (int r = 0; r < 3; ++r) inverse[r][c] = x[r];
+  }
+  return true;
+}
+
+// The trocar's impulse on the tool's velocities at its current pose, added
+// to what the port pushed over the frame.
+void apply_trocar_impulse(ToolBody& b, double mass, const M3& inverse_inertia, double dt) {
+  const V3 u = math::rotate(b.rotation, b.shaft_axis);
+  const TrocarImpulse j =
+      hold_trocar_velocity(b.pivot, u, b.position, mass, inverse_inertia, b.velocity, b.angular_velocity);
+  b.trocar_force = math::add(b.trocar_force, math::mul(j.linear, 1.0 / dt));
+  b.trocar_torque = math::add(b.trocar_torque, math::mul(j.angular, 1.0 / dt));
+}
+
 }  // namespace
+
+void hold_trocar(ToolBody& b, double dt, double stiffness) {
+  if (!b.trocar) return;
+  // The shaft straight across onto the pivot (the drift of the rotation's
+  // integration, or a collider's push): the axis is kept, so the distance
+  // from the pivot to the shaft line is zero to rounding afterwards.
+  b.position = math::add(b.position, trocar_offset(b.pivot, math::rotate(b.rotation, b.shaft_axis), b.position));
+  M3 inverse;
+  if (invert(world_inertia(b, stiffness), inverse))
+    apply_trocar_impulse(b, effective_mass(b, stiffness), inverse, dt);
+}
 
 // One semi-implicit Euler step of the tool over dt.
 //
@@ -82,19 +136,11 @@ void integrate_tool(ToolBody& b, double dt, double stiffness) {
   // Translation: the tool's own mass, raised where needed to the least
   // mass that keeps explicit Euler inside its stability bound against K:
   // dt^2 K / M <= 4 with dt^2 K = n_it n_sub^2 sum m_i (see above).
-  const double mass = std::max(b.mass, 0.25 * stiffness * b.touching_mass);
+  const double mass = effective_mass(b, stiffness);
   for (int k = 0; k < 3; ++k) b.velocity[k] += dt * force[k] / mass;
   // The tool's inertia in the world frame, R I R^T, plus the touching
   // particles' scaled inertia about its centre.
-  M3 a;
-  for (int c = 0; c < 3; ++c) {
-    V3 e{0.0, 0.0, 0.0};
-    e[c] = 1.0;
-    V3 local = math::rotate(math::conj(b.rotation), e);
-    for (int k = 0; k < 3; ++k) local[k] *= b.inertia[k];
-    const V3 column = math::rotate(b.rotation, local);
-    for (int r = 0; r < 3; ++r) a[r][c] = column[r] + stiffness * b.touching_inertia[3 * r + c];
-  }
+  const M3 a = world_inertia(b, stiffness);
   V3 dw{0.0, 0.0, 0.0};
   if (solve3(a, math::mul(torque, dt), dw))  // a is symmetric positive definite: inertia > 0
     b.angular_velocity = math::add(b.angular_velocity, dw);
@@ -103,6 +149,14 @@ void integrate_tool(ToolBody& b, double dt, double stiffness) {
   // GDC 2015): explicitly, a free tumbling tool would gain energy.
   b.angular_velocity = math::rotate(
       b.rotation, gyroscopic_step(b.inertia, math::rotate(math::conj(b.rotation), b.angular_velocity), dt));
+  // A trocar: the shaft's sideways velocity at the pivot is removed before
+  // the pose moves (the velocity half of Cline and Pai's post-stabilisation;
+  // trocar.h), so a sideways force turns the tool about the port.
+  if (b.trocar) {
+    b.trocar_force = b.trocar_torque = V3{0.0, 0.0, 0.0};
+    M3 inverse;
+    if (invert(a, inverse)) apply_trocar_impulse(b, mass, inverse, dt);
+  }
 
   b.position = math::add(b.position, math::mul(b.velocity, dt));
   // q += dt/2 (0, omega) q, then |q| = 1 again.
@@ -114,6 +168,9 @@ void integrate_tool(ToolBody& b, double dt, double stiffness) {
   for (double& c : r) c /= norm;
   b.rotation = r;
   b.force = b.torque = V3{0.0, 0.0, 0.0};
+  // The position half: the drift the first-order rotation left, projected
+  // out, and the velocity held again at the new pose.
+  hold_trocar(b, dt, stiffness);
 }
 
 Status add_frame_force(ToolBody& b, const math::Vec3& force, const math::Vec3& torque, double dt, const std::string& who) {

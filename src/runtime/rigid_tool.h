@@ -13,7 +13,9 @@
 //     frame n-1: v += dt F / M, x += dt v; the angular velocity likewise
 //     from the torque (inertia in the body frame, the gyroscopic term
 //     implicit), q += dt/2 (0, omega) q. The tool's collider then moves
-//     from its old to its new pose across frame n's substeps.
+//     from its old to its new pose across frame n's substeps. A tool
+//     through a trocar is held through its pivot after that motion and
+//     again after its contacts with the colliders (hold_trocar; trocar.h).
 //  2. during frame n the tool is an infinitely heavy kinematic collider: the
 //     particles it touches are pushed out and dragged by friction, and each
 //     correction's impulse (with its moment about the tool's centre) is
@@ -98,6 +100,12 @@ struct ToolBody {
   V3 penalty_force{}, penalty_torque{};  ///< at the start of the last frame [N], about its centre [N m]
   std::uint32_t penalty_points = 0;      ///< its points inside another shape then
   double penalty_depth = 0.0;            ///< the deepest one's depth [m]
+
+  // A tool through a trocar (ToolDesc::trocar; trocar.h).
+  bool trocar = false;
+  V3 pivot{};                  ///< world [m]
+  V3 shaft_axis{0.0, 1.0, 0.0};  ///< unit, tool frame
+  V3 trocar_force{}, trocar_torque{};  ///< the port's push over the last frame [N], about its centre [N m]
 };
 
 /// One semi-implicit Euler step of the tool over dt [s] from the applied
@@ -105,7 +113,15 @@ struct ToolBody {
 /// coupling force and torque, stabilised by the touching particles' mass and
 /// inertia (see rigid_tool.cpp). `stiffness` is n_it n_sub^2 (iterations
 /// times substeps squared).
+/// A tool with a trocar is then held through its pivot (hold_trocar).
 void integrate_tool(ToolBody& b, double dt, double stiffness);
+
+/// A tool with a trocar (b.trocar): moves it straight across its shaft so
+/// the shaft line passes through the pivot, then removes the sideways
+/// velocity of its point at the pivot by an impulse there, through the
+/// mass and inertia integrate_tool uses (trocar.h); the impulse over [in]
+/// dt [s] is added to b.trocar_force and b.trocar_torque. Nothing without a trocar.
+void hold_trocar(ToolBody& b, double dt, double stiffness);
 
 /// Adds [in] force [N] and torque [N m] to what acts on `b` during the
 /// next frame of [in] dt [s] (calls before one frame add up). Errors

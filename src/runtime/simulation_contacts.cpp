@@ -40,6 +40,7 @@
 #include "runtime/simulation_internals.h"
 #include "runtime/tool_contacts.h"
 #include "runtime/tool_penalty.h"
+#include "runtime/trocar.h"
 
 namespace sinew {
 namespace {
@@ -132,6 +133,12 @@ Status Simulation::Impl::init_contacts(const SceneDesc& scene, const CompiledSce
     b.radius = d.radius;
     b.half_height = d.half_height;
     b.dynamic_friction = d.dynamic_friction;
+    if (d.trocar) {  // checked: the shaft line within kTrocarPoseTolerance of the pivot, the axis non-zero
+      b.trocar = true;
+      b.pivot = d.trocar->pivot;
+      b.shaft_axis = math::mul(d.trocar->axis, 1.0 / std::sqrt(math::dot(d.trocar->axis, d.trocar->axis)));
+      b.position = math::add(b.position, trocar_offset(b.pivot, math::rotate(b.rotation, b.shaft_axis), b.position));
+    }
     if (d.shape == ToolShape::level_set) {
       // Its point shell: the level set's zero surface, a third of each
       // triangle's area to each corner (tool_penalty.h).
@@ -199,6 +206,8 @@ Status Simulation::Impl::before_frame() {
   for (ToolBody& b : c.tools) integrate_tool(b, time_step, double(c.iterations) * c.substeps * c.substeps);
   // The tools against the colliders where those end this frame, and each other.
   if (!c.tools.empty()) resolve_tool_contacts(c.tools, collider_shapes(), time_step);
+  // A collider may have pushed a tool sideways through its port: the port wins.
+  for (ToolBody& b : c.tools) hold_trocar(b, time_step, double(c.iterations) * c.substeps * c.substeps);
   for (std::size_t t = 0; t < c.tools.size(); ++t) {
     const ToolBody& b = c.tools[t];
     const std::size_t at = entry_at(c.colliders + t);
@@ -323,6 +332,8 @@ Result<ToolState> Simulation::tool_state(std::size_t index) const {
   state.penalty_torque = b.penalty_torque;
   state.penalty_points = b.penalty_points;
   state.penalty_depth = b.penalty_depth;
+  state.trocar_force = b.trocar_force;
+  state.trocar_torque = b.trocar_torque;
   return state;
 }
 

@@ -141,6 +141,14 @@ void read_tool(const Json& v, const std::string& path, const Where& where, Conte
   o.read("static_friction", out.static_friction);
   o.read("dynamic_friction", out.dynamic_friction);
   o.read("compliance", out.compliance);
+  if (const Json* t = o.find("trocar")) {
+    Object trocar(*t, o.path("trocar"), ctx);
+    TrocarDesc& d = out.trocar.emplace();
+    if (trocar.find("pivot")) trocar.read("pivot", d.pivot);
+    else if (!ctx.failed()) ctx.fail(ErrorCode::bad_input_file, trocar.path("pivot"), "is required");
+    trocar.read("axis", d.axis);
+    trocar.finish();
+  }
   o.finish();
 }
 

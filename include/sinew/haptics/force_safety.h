@@ -11,7 +11,8 @@
 // Steps 3-4 are convex combinations of values inside the clamp ball, so the
 // output never exceeds `max`. A fading watchdog is therefore also
 // slew-limited (smooth), and an interpolation jump (a late snapshot) is
-// spread over a few ticks.
+// spread over a few ticks. The passivity controller, when on, adds its
+// damper after this chain, clamped but not slew-limited (passivity_observer.h).
 #pragma once
 
 #include <cstdint>
@@ -32,6 +33,10 @@ enum TickFlags : std::uint32_t {
   kExtrapolated = 1u << 7,  ///< state extrapolated past the newest snapshot
   kHeld = 1u << 8,          ///< state held at the extrapolation horizon
   kMissedDeadline = 1u << 9,  ///< this tick started more than 2 periods after the previous one
+  /// The passivity observer's: the cumulative energy is below
+  /// -tolerance (passivity_observer.h). A bit apart from the others.
+  kPassivityViolation = 1u << 16,
+  kPassivityDamping = 1u << 17,  ///< the passivity controller added a damper to the device's command
 };
 
 /// The non-finite / clamp / gain / slew chain for one 3-vector (a force or

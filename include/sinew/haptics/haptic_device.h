@@ -55,7 +55,8 @@ class HapticDevice {
   /// loop then keeps the previous one and its watchdog sees it age).
   virtual bool sample(std::int64_t now_ns, DeviceSample& out) noexcept = 0;
   /// Commands the force [N] and torque [N m] (world frame) applied to the
-  /// user's hand until the next command; a 3-DOF device ignores torque.
+  /// user's hand until the next command. A loop set up for a 3-DOF device
+  /// (HapticLoopSettings::degrees_of_freedom = 3) commands exactly zero torque.
   virtual void command(const Vec3& force, const Vec3& torque, std::int64_t now_ns) noexcept = 0;
 };
 

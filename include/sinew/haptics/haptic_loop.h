@@ -29,6 +29,7 @@
 #include "sinew/haptics/clock.h"
 #include "sinew/haptics/haptic_device.h"
 #include "sinew/haptics/local_contacts.h"
+#include "sinew/haptics/passivity_observer.h"
 #include "sinew/haptics/snapshot_channel.h"
 #include "sinew/haptics/snapshot_interpolator.h"
 #include "sinew/haptics/virtual_coupling.h"
@@ -74,6 +75,13 @@ struct HapticLoopSettings {
   /// The physics' tool is still driven by the coupling to the interpolated
   /// tool (CouplingFeedback::force). Off: the device gets that coupling.
   bool local_contacts = false;
+  /// The device's degrees of freedom rendered: 6 (force and torque) or 3
+  /// (force only, for a device without torque actuators, e.g. a Touch).
+  /// With 3 the device is commanded exactly zero torque; the coupling's
+  /// torque still goes to the simulated tool through the feedback, so the
+  /// tool keeps following the device's measured rotation.
+  int degrees_of_freedom = 6;
+  PassivityParams passivity;  ///< the passivity observer's window and tolerance (passivity_observer.h)
   /// Called once on the loop thread before its first tick (outside the
   /// tick: it may allocate); e.g. to mark the thread for an allocation counter.
   std::function<void()> on_thread_start;
@@ -106,7 +114,11 @@ struct TickRecord {
   Vec3 device_position{};        ///< [m]
   Vec3 tool_position{};          ///< rendered [m] (the proxy, when local contacts are rendered)
   Vec3 raw_force{};              ///< coupling before the safety chain [N]
-  Vec3 force{};                  ///< commanded to the device [N]
+  Vec3 force{};                  ///< commanded to the device [N] (with the passivity controller's damper)
+  Vec3 torque{};                 ///< commanded to the device [N m] (zero with degrees_of_freedom 3)
+  /// Cumulative energy put into the environment since the start [J] (passivity_observer.h).
+  double passivity_energy = 0.0;
+  double window_energy = 0.0;     ///< of it, over the last passivity.window ticks [J]
   double gain = 0.0;             ///< watchdog gain
   /// Local contacts: the energy stored in the coupling and the contact
   /// planes at this tick, V(device) of local_contacts.h [J]; 0 otherwise.
@@ -130,6 +142,9 @@ struct HapticCounters {
   std::uint64_t snapshot_read_failures = 0;  ///< ticks whose bounded seqlock read gave up
   std::uint64_t device_failures = 0;   ///< ticks without a device sample
   std::uint64_t snapshots_received = 0;  ///< new snapshots read from the channel
+  std::uint64_t passivity_violations = 0;  ///< ticks whose cumulative energy was below -passivity.tolerance
+  double passivity_energy = 0.0;   ///< the cumulative energy put into the environment [J]
+  double min_window_energy = 0.0;  ///< the least energy of any passivity.window ticks so far [J]
 };
 
 /// The haptic servo loop: each tick samples the device, interpolates the
@@ -188,10 +203,15 @@ class HapticLoop {
   HapticLoop(const HapticLoopSettings& settings, HapticDevice& device, SnapshotChannel& snapshots,
              FeedbackChannel& feedback, Clock& clock);
   TickRecord tick_at(std::int64_t scheduled_ns, bool use_scheduled) noexcept;
+  // The passivity controller (when on) on [in,out] force and torque, then
+  // the observer on the command; fills rec's energies and returns
+  // kPassivityViolation and kPassivityDamping bits.
+  std::uint32_t observe_passivity(Vec3& force, Vec3& torque, TickRecord& rec) noexcept;
   void run();
   struct AtomicCounters {
     std::atomic<std::uint64_t> ticks{0}, missed{0}, skipped{0}, non_finite{0}, clamped{0}, slewed{0}, stale{0},
-        stalls{0}, read_failures{0}, device_failures{0}, snapshots{0};
+        stalls{0}, read_failures{0}, device_failures{0}, snapshots{0}, passivity{0};
+    std::atomic<double> energy{0.0}, min_window{0.0};
   };
 
   HapticLoopSettings settings_;
@@ -211,6 +231,7 @@ class HapticLoop {
   VirtualCoupling coupling_;        // to the device
   VirtualCoupling drive_coupling_;  // to the physics' tool, when local contacts are rendered
   Watchdog watchdog_;
+  PassivityObserver passivity_;
   bool have_prev_tick_ = false;
   std::int64_t prev_start_ns_ = 0;
   Vec3 prev_force_{}, prev_torque_{};

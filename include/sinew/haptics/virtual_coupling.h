@@ -19,8 +19,9 @@
 //   T = K_r rotvec(q_tool q_dev^-1) + B_r (w_tool - w_dev)
 // rotvec(q) = the rotation vector (axis * angle, angle in [0, pi]) of q.
 // The tool receives -F, -T (snapshot_channel.h). Both go through the safety
-// chain (force_safety.h). A 3-DOF device (the Touch) renders F only; the
-// torque still orients the simulated tool.
+// chain (force_safety.h). A 3-DOF device (the Touch) renders F only
+// (HapticLoopSettings::degrees_of_freedom = 3: it is commanded zero
+// torque); the torque still orients the simulated tool.
 //
 // Defaults for a 3D Systems Touch-class device (3D Systems, "Touch haptic
 // device" specification sheet): max exertable force at nominal position
