@@ -48,8 +48,9 @@ int fail(const std::string& what) {
 // the force along the press (-z: the push is +z) before the device reached
 // the kidney (the coupling's pull alone), how soon after it the push rose
 // past 1 mN above that, its peak over the force held at the end, its
-// largest fall from one tick to the next while pressing in, and the least
-// energy the rendering kept over any 100-tick window (< 0: created).
+// largest fall from one tick to the next while pressing in, the least
+// energy the local model kept over any 100-tick window (< 0: created), and
+// the passivity observer's violations (HapticCounters).
 // [in] path: also writes every tick as CSV when not empty.
 sinew::Status report_probe(sinew::examples::RetractionScene& r, const sinew::examples::RetractionSettings& s,
                            const std::string& path) {
@@ -80,10 +81,11 @@ sinew::Status report_probe(sinew::examples::RetractionScene& r, const sinew::exa
   if (!state) return state.error();
   const double held = t.back().force[2];
   std::printf("probe,local_contacts,contact_s,force_before_contact_n,onset_ms,held_force_n,physics_contact_force_n,"
-              "peak_over_held,largest_fall_pressing_n,least_window_energy_j\n");
-  std::printf("probe,%d,%.4f,%.4f,%.1f,%.4f,%.4f,%.4f,%.4f,%.3e\n", s.local_contacts ? 1 : 0, contact, before,
+              "peak_over_held,largest_fall_pressing_n,least_window_energy_j,passivity_violations\n");
+  std::printf("probe,%d,%.4f,%.4f,%.1f,%.4f,%.4f,%.4f,%.4f,%.3e,%llu\n", s.local_contacts ? 1 : 0, contact, before,
               onset < 0.0 ? -1.0 : 1e3 * onset, held, state->contact_force[2], held > 0.0 ? peak / held - 1.0 : 0.0,
-              fall, s.local_contacts ? kept : NAN);
+              fall, s.local_contacts ? kept : NAN,
+              static_cast<unsigned long long>(r.probe_loop().counters().passivity_violations));
   if (path.empty()) return {};
   FILE* f = std::fopen(path.c_str(), "w");
   if (!f) return sinew::Error(sinew::ErrorCode::bad_input_file, "cannot write " + path);
