@@ -58,7 +58,8 @@ TEST_P(Agreement, BodyAttachmentKernel) {
         const float broken = i % 23 == 11 ? 1.0f : 0.0f;
         breakable += brk > 0.0f && broken == 0.0f;
         data.insert(data.end(), w, w + 8);
-        data.insert(data.end(), {i % 3 == 0 ? 0.0f : alpha(rng), brk, broken, 0.0f});
+        const float rest = i % 2 == 1 ? 0.01f * unit(rng) : 0.0f;  // [m]: half with a rest length
+        data.insert(data.end(), {i % 3 == 0 ? 0.0f : alpha(rng), brk, broken, rest});
         lambda.push_back(lam(rng));
       }
       KernelCase c{Kernel::xpbd_solve_body_attachment, count, {}, {}};

@@ -323,6 +323,51 @@ std::string error_of(const SceneDesc& scene) {
   return s.ok() ? std::string("accepted") : s.error().message();
 }
 
+// Block B hung 5 mm below pinned block A, each vertex of B's top face
+// attached to the A vertex 5 mm above it with that rest length: connective
+// tissue bridging a gap. B hangs at the gap instead of being pulled shut,
+// and A still carries B's weight.
+TEST(BodyAttachments, ARestLengthHoldsTheGapBetweenTheBodies) {
+  constexpr double kGap = 0.005;
+  SceneDesc scene;
+  scene.solver = solver();
+  TetBodyDesc a = block(4, 2, 4, {0.0, 0.02, 0.0}, 5e3);
+  a.pinned = at_height(a.mesh, 0.04);
+  scene.tet_bodies.push_back(a);
+  TetBodyDesc b = block(4, 2, 4, {0.0, -kGap, 0.0}, 5e3);
+  for (std::uint32_t v : at_height(b.mesh, 0.02 - kGap)) {
+    BodyAttachmentDesc link;
+    const Vec3d above{b.mesh.vertices[v][0], 0.02, b.mesh.vertices[v][2]};
+    link.a = {BodyKind::tet, 0, {vertex_at(a.mesh, above)}, {1.0}};
+    link.b = {BodyKind::tet, 1, {v}, {1.0}};
+    link.rest_length = kGap;
+    scene.body_attachments.push_back(link);
+  }
+  scene.tet_bodies.push_back(b);
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  SINEW_ASSERT_OK(sim);
+  for (int f = 0; f < 60; ++f) SINEW_ASSERT_OK(sim->step());
+  const std::vector<float> x = positions(*sim);
+  const std::size_t na = a.mesh.vertices.size();
+  double lo = INFINITY, hi = 0.0;
+  for (const BodyAttachmentDesc& l : scene.body_attachments) {
+    const float* p = &x[4 * l.a.vertices[0]];
+    const float* q = &x[4 * (na + l.b.vertices[0])];
+    const double gap = std::hypot(double(p[0]) - q[0], double(p[1]) - q[1], double(p[2]) - q[2]);
+    lo = std::min(lo, gap);
+    hi = std::max(hi, gap);
+  }
+  std::printf("[ measured ] rest length %.1f mm: the attached points %.4f to %.4f mm apart after 1 s\n", kGap * 1e3,
+              lo * 1e3, hi * 1e3);
+  EXPECT_NEAR(lo, kGap, 1e-4);
+  EXPECT_NEAR(hi, kGap, 1e-4);
+  double drop_b = 0.0;
+  const std::size_t nb = b.mesh.vertices.size();
+  for (std::size_t v = 0; v < nb; ++v) drop_b += (b.mesh.vertices[v][1] - x[4 * (na + v) + 1]) / double(nb);
+  EXPECT_GT(drop_b, 0.0);
+  EXPECT_LT(drop_b, 5e-3) << "B hangs from A at the gap";
+}
+
 TEST(BodyAttachments, BadInputNamesTheField) {
   const SceneDesc good = hanging_blocks(true);
   ASSERT_EQ(error_of(good), "accepted");
@@ -351,6 +396,10 @@ TEST(BodyAttachments, BadInputNamesTheField) {
   EXPECT_PRED2(has, spoiled([](BodyAttachmentDesc& a) { a.break_force = NAN; }), "body_attachments[0].break_force");
   EXPECT_PRED2(has, spoiled([](BodyAttachmentDesc& a) { a.break_force = 1e300; }), "body_attachments[0].break_force");
   EXPECT_PRED2(has, spoiled([](BodyAttachmentDesc& a) { a.b = a.a; }), "body_attachments[0]: vertex");
+  EXPECT_PRED2(has, spoiled([](BodyAttachmentDesc& a) { a.rest_length = -1e-3; }), "body_attachments[0].rest_length");
+  EXPECT_PRED2(has, spoiled([](BodyAttachmentDesc& a) { a.rest_length = NAN; }), "body_attachments[0].rest_length");
+  EXPECT_PRED2(has, spoiled([](BodyAttachmentDesc& a) { a.rest_length = 1e300; }), "body_attachments[0].rest_length");
+  EXPECT_PRED2(has, spoiled([](BodyAttachmentDesc& a) { a.rest_length = 1e-300; }), "body_attachments[0].rest_length");
   // And the Simulation refuses it the same way (nothing crashes).
   SceneDesc s = good;
   s.body_attachments[0].a.weights = {2.0};

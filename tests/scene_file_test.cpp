@@ -119,7 +119,7 @@ TEST(SceneFile, BodyAttachmentsReadWithTheirFieldsAndErrors) {
     return s.substr(0, s.size() - 1) + R"(, "body_attachments": [)" + link + "]}";
   };
   auto file = parse_scene_json(with(R"({"a": {"body_kind": "tet", "body": 0, "vertices": [5], "weights": [1]},
-      "b": {"body": 0, "vertices": [6, 7], "weights": [0.25, 0.75]}, "compliance": 1e-4})"), kScenes);
+      "b": {"body": 0, "vertices": [6, 7], "weights": [0.25, 0.75]}, "compliance": 1e-4, "rest_length": 0.002})"), kScenes);
   ASSERT_TRUE(file.ok()) << file.error().message();
   ASSERT_EQ(file->scene.body_attachments.size(), 1u);
   const BodyAttachmentDesc& a = file->scene.body_attachments[0];
@@ -128,6 +128,7 @@ TEST(SceneFile, BodyAttachmentsReadWithTheirFieldsAndErrors) {
   EXPECT_EQ(a.b.weights, (std::vector<double>{0.25, 0.75}));
   EXPECT_EQ(a.compliance, 1e-4);
   EXPECT_TRUE(std::isinf(a.break_force));
+  EXPECT_EQ(a.rest_length, 0.002);
   EXPECT_TRUE(Simulation::create(file->scene, {.backend = "cpu", .quiet = true}).ok());
   EXPECT_EQ(error_of(with(R"({"a": {"vertices": [5], "weights": [0.5]}, "b": {"vertices": [6], "weights": [1]}})"))
                 .rfind("/body_attachments/0/a/weights", 0),
@@ -135,6 +136,10 @@ TEST(SceneFile, BodyAttachmentsReadWithTheirFieldsAndErrors) {
   EXPECT_EQ(error_of(with(R"({"a": {"vertices": [5], "weights": [1]}, "b": {"vertices": [6], "weights": [1]},
                               "break_force": -1})"))
                 .rfind("/body_attachments/0/break_force", 0),
+            0u);
+  EXPECT_EQ(error_of(with(R"({"a": {"vertices": [5], "weights": [1]}, "b": {"vertices": [6], "weights": [1]},
+                              "rest_length": -0.001})"))
+                .rfind("/body_attachments/0/rest_length", 0),
             0u);
   EXPECT_EQ(error_of(with(R"({"a": {"vertices": [5], "weights": [1]}})")), "/body_attachments/0/b: is required");
 }

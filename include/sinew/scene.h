@@ -300,9 +300,10 @@ struct BarycentricPoint {
   std::vector<double> weights;          ///< one per vertex, finite, summing to 1 (within 1e-6)
 };
 
-/// Two bodies attached to each other, two ways: a zero-length xPBD
-/// constraint C = |p_a - p_b| between a barycentric point of each (Macklin,
-/// Mueller and Chentanez, "XPBD", MIG 2016), solved in every sweep after the
+/// Two bodies attached to each other, two ways: an xPBD distance
+/// constraint C = |p_a - p_b| - rest_length between a barycentric point of
+/// each (Macklin, Mueller and Chentanez, "XPBD", MIG 2016; rest_length 0
+/// holds the points together), solved in every sweep after the
 /// bodies' own constraints. Each side feels the other's pull: a membrane
 /// attached to an organ lifts it when pulled, and the organ's weight hangs
 /// on the membrane. Connective tissue, vessels on organs and mesentery are
@@ -320,6 +321,11 @@ struct BodyAttachmentDesc {
   double compliance = 0.0;
   /// [N], > 0; infinity (the default) never breaks.
   double break_force = std::numeric_limits<double>::infinity();
+  /// [m], >= 0: the distance the attachment holds the two points at (0:
+  /// together). Give two points that lie apart at rest their distance then:
+  /// connective tissue that bridges a gap. With a rest length the
+  /// attachment pushes as well as pulls (a strut, not a string).
+  double rest_length = 0.0;
 };
 
 /// A rigid tool's shape (ToolDesc::shape).

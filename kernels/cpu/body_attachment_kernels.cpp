@@ -1,6 +1,7 @@
 // body_attachment_kernels.cpp — CPU reference kernel of the attachments
-// between two bodies (BodyAttachmentDesc): a zero-length constraint between
-// a barycentric point of each body, with a breaking force.
+// between two bodies (BodyAttachmentDesc): a distance constraint
+// |p_a - p_b| - rest length between a barycentric point of each body, with
+// a breaking force.
 // Macklin, Mueller, Chentanez, "XPBD: Position-Based Simulation of Compliant
 // Constrained Dynamics", MIG 2016 (the multiplier update and lambda / h^2 as
 // the constraint force); the barycentric points as in iMSTK's
@@ -27,7 +28,7 @@ void xpbd_solve_body_attachment(const void* params, std::byte* const* bindings, 
   const auto& p = *static_cast<const SolveParams*>(params);
   auto* x = reinterpret_cast<float4*>(bindings[0]);
   const auto* idx = reinterpret_cast<const std::uint32_t*>(bindings[1]);
-  auto* data = reinterpret_cast<float4*>(bindings[2]);  // wa, wb, (alpha, break force, broken, 0)
+  auto* data = reinterpret_cast<float4*>(bindings[2]);  // wa, wb, (alpha, break force, broken, rest length)
   auto* lambda = reinterpret_cast<float*>(bindings[3]);
   auto* residual = reinterpret_cast<float*>(bindings[4]);
   for (std::uint32_t i = p.first + begin; i < p.first + end; ++i) {
@@ -44,24 +45,25 @@ void xpbd_solve_body_attachment(const void* params, std::byte* const* bindings, 
     const float4 pa = add_scaled3(add_scaled3(add_scaled3(wa.x * a0, wa.y, a1), wa.z, a2), wa.w, a3);
     const float4 pb = add_scaled3(add_scaled3(add_scaled3(wb.x * b0, wb.y, b1), wb.z, b2), wb.w, b3);
     const float4 d = xyz(pa - pb);
-    const float c = length3(d);  // zero rest length
+    const float len = length3(d);
+    const float c = len - extra.w;  // extra.w: the rest length
     const float alpha_t = extra.x * p.inv_h2;
     const float lambda_i = p.reset_lambda ? 0.0f : lambda[i];
     if (p.measure_only) {
-      residual[i] = std::abs(c + alpha_t * lambda_i);  // [m]: no rest value to normalise by
+      residual[i] = std::abs(c + alpha_t * lambda_i);  // [m]: not normalised (the rest length may be 0)
       continue;
     }
     const float weight_a = wa.x * wa.x * a0.w + wa.y * wa.y * a1.w + wa.z * wa.z * a2.w + wa.w * wa.w * a3.w;
     const float weight_b = wb.x * wb.x * b0.w + wb.y * wb.y * b1.w + wb.z * wb.z * b2.w + wb.w * wb.w * b3.w;
     const float weight = weight_a + weight_b;
-    // On each other the gradient is undefined and C = 0; with every
-    // particle immovable nothing can move.
-    if (!(c > 0.0f) || !(weight > 0.0f)) {
+    // On each other the gradient is undefined (and C = 0 at rest length
+    // 0); with every particle immovable nothing can move.
+    if (!(len > 0.0f) || !(weight > 0.0f)) {
       lambda[i] = lambda_i;
       continue;
     }
     const float dlambda = (-c - alpha_t * lambda_i) / (weight + alpha_t);
-    const float s = dlambda / c;  // along d: the unit normal's step
+    const float s = dlambda / len;  // along d: the unit normal's step
     // A zero weight (an unused slot, which repeats the side's first
     // particle) writes nothing, so no particle is written twice.
     if (a0.w > 0.0f && wa.x != 0.0f) x[q[0]] = add_scaled3(a0, a0.w * wa.x * s, d);

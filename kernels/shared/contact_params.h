@@ -121,8 +121,8 @@
  * share a movable particle. bindings: 0-4 standard (data as float4).
  * data: SINEW_BODY_ATTACHMENT_DATA_STRIDE floats: [0-3] wa, [4-7] wb,
  *   [8] compliance alpha [m/N], [9] break force [N] (0: never breaks),
- *   [10] broken flag (0 or 1; the kernel sets it [in/out]), [11] 0.
- * C = |p_a - p_b| (zero rest length), n = (p_a - p_b) / C, gradient wa_k n
+ *   [10] broken flag (0 or 1; the kernel sets it [in/out]), [11] rest length L [m].
+ * C = |p_a - p_b| - L, n = (p_a - p_b) / |p_a - p_b|, gradient wa_k n
  * for a_k and -wb_k n for b_k; Delta lambda = (-C - alpha~ lambda) /
  * (sum wa_k^2 w(a_k) + sum wb_k^2 w(b_k) + alpha~), a_k += w(a_k) wa_k
  * Delta lambda n, b_k -= w(b_k) wb_k Delta lambda n. Then, when the break

@@ -72,6 +72,11 @@ Status check_body_attachment(const SceneDesc& scene, const BodyAttachmentDesc& a
                                          static_cast<float>(a.break_force) >= std::numeric_limits<float>::min())))
     return Error(ErrorCode::bad_parameter, name + ".break_force must be > 0 [N] and a normal float32, or infinity "
                                                   "(never breaks) (got " + str(a.break_force) + ")");
+  // 0, or a finite float32 (the device's) that is not rounded to zero.
+  if (!(a.rest_length >= 0.0) || !std::isfinite(static_cast<float>(a.rest_length)) ||
+      (a.rest_length > 0.0 && !(static_cast<float>(a.rest_length) >= std::numeric_limits<float>::min())))
+    return Error(ErrorCode::bad_parameter, name + ".rest_length must be >= 0 [m] and 0 or a normal float32 (got " +
+                                               str(a.rest_length) + ")");
   return {};
 }
 

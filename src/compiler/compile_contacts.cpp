@@ -233,7 +233,8 @@ Status add_contacts(SceneBuilder& b, const SceneDesc& scene, CompiledScene& out)
     links.data.insert(links.data.end(), weights.begin(), weights.end());
     // A break force of infinity is stored as 0: "never" (no infinity on the device).
     const float break_force = std::isfinite(a.break_force) ? static_cast<float>(a.break_force) : 0.0f;
-    links.data.insert(links.data.end(), {static_cast<float>(a.compliance), break_force, 0.0f, 0.0f});
+    links.data.insert(links.data.end(),
+                      {static_cast<float>(a.compliance), break_force, 0.0f, static_cast<float>(a.rest_length)});
   }
   return {};
 }

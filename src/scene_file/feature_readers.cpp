@@ -240,6 +240,7 @@ void read_body_attachment(const Json& v, const std::string& path, Context& ctx, 
   read_barycentric_point(o, "b", ctx, out.b);
   o.read("compliance", out.compliance);
   o.read("break_force", out.break_force);  // absent: infinity, never breaks
+  o.read("rest_length", out.rest_length);  // absent: 0, the points held together
   o.finish();
 }
 
