@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "haptics_block_scene.h"
 #include "haptics_test_support.h"
 #include "sinew/haptics/local_contact_builder.h"
 #include "sinew/haptics/local_contacts.h"
@@ -126,29 +127,16 @@ TEST(LocalContactSolve, AContactWithoutStiffnessIsSkipped) {
   EXPECT_EQ(norm3(s.force), 0.0);
 }
 
-// The press rig: a tissue block (40 x 40 x 20 mm, corotational, 10 kPa,
-// its bottom pinned, no gravity so it rests at its rest shape with its top
-// at z = 20 mm) and a horizontal capsule probe driven by a scripted device
+// The press rig: the tissue block (haptics_block_scene.h) and a horizontal capsule probe driven by a scripted device
 // through a HapticLoop (1 kHz on a virtual clock) and a HapticToolBridge
 // (60 Hz frames): the device comes down at 20 mm/s from 2 mm above the
 // top, presses 4 mm in, then holds.
-constexpr double kTop = 0.020, kRadius = 0.005, kStart = 0.002, kSpeed = 0.020, kDepth = 0.004;
-constexpr double kYoung = 10e3, kPoisson = 0.45;
+constexpr double kTop = kBlockTop, kRadius = 0.005, kStart = 0.002, kSpeed = 0.020, kDepth = 0.004;
+constexpr double kYoung = kBlockYoung, kPoisson = kBlockPoisson;
 const Quat kHorizontal{M_SQRT1_2, 0.0, 0.0, M_SQRT1_2};  // the capsule's y axis along x
 
 SceneDesc press_scene() {
-  SceneDesc scene;
-  scene.gravity = {0.0, 0.0, 0.0};
-  scene.solver.time_step = 1.0 / 60.0;
-  scene.solver.substeps = 10;
-  scene.solver.iterations = 2;
-  TetBodyDesc body;
-  body.mesh = *make_tet_grid({.nx = 8, .ny = 8, .nz = 4, .origin = {-0.02, -0.02, 0.0}, .cell_size = {0.005, 0.005, 0.005}});
-  body.density = 1060.0;
-  EXPECT_TRUE(body.set_material(TetMaterial::corotational, kYoung, kPoisson).ok());
-  for (std::uint32_t i = 0; i < body.mesh.vertices.size(); ++i)
-    if (body.mesh.vertices[i][2] == 0.0) body.pinned.push_back(i);
-  scene.tet_bodies.push_back(std::move(body));
+  SceneDesc scene = block_press_scene();
   ToolDesc probe;
   probe.radius = kRadius;
   probe.half_height = 0.01;
