@@ -5,6 +5,7 @@
 // whole frames (the loops' ticks, the tools' hand-off and step()).
 //
 //   bench_retraction BACKEND FRAMES [--mesh M] [--substeps N] [--iterations N] [--threads N] [--haptics]
+//                    [--haptic-cpus C0 C1] [--local-contacts] [--probe-trace FILE]
 //   e.g. bench_retraction cpu 180
 //
 // Prints CSV: a header and one line of the frame times (median, p95, worst
@@ -13,9 +14,11 @@
 // profile (FrameStats::stages), one line per stage with its median and p95
 // [ms] over the frames. --haptics runs both haptic loops on their own threads
 // at 1 kHz of wall time while the frames run back to back (the solver using
-// every worker), and adds the grasper loop's timing: ticks, missed ticks
+// every worker), and adds each loop's timing: ticks, missed ticks
 // (tick-to-tick > 2 periods), period jitter p50/p99.9/max [us] and the age
-// of the state it rendered p50 [ms].
+// of the state it rendered p50 [ms]. Every run prints the probe's press as
+// its hand felt it (report_probe below); --local-contacts renders it with
+// the local contact model, --probe-trace writes its every tick as CSV.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
