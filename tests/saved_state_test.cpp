@@ -123,6 +123,74 @@ void expect_restore_bitwise(const SceneDesc& scene, const std::string& backend, 
   EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored in a new Simulation, on " << backend;
 }
 
+// A grasper closed on the block's top and lifting it: the hold (which
+// particles and surface points, where in the jaws' frame) is in the state.
+// Restored into the same Simulation after the grasper was opened, and into
+// a new one whose grasper never closed, the run goes on bitwise.
+TEST_P(SavedStateTest, RestoreWithAClosedGrasperIsBitwise) {
+  SceneDesc scene = test::robustness_block();
+  scene.graspers.push_back({.capacity = 16, .point_capacity = 8});
+  const auto jaws_at = [](int frame) {
+    return Pose{.position = {0.03, 0.02 + 0.001 * (frame - 4), 0.01}, .rotation = {1, 0, 0, 0}};
+  };
+  const auto lift = [&](Simulation& sim, int from, int to) {
+    for (int f = from; f <= to; ++f) {
+      test::drive(sim, f);
+      SINEW_ASSERT_OK(sim.graspers().move(*sim.graspers().grasper(0), jaws_at(f)));
+      SINEW_ASSERT_OK(sim.step());
+    }
+  };
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 1, 4);
+  auto held = sim->graspers().close(*sim->graspers().grasper(0), jaws_at(4), {0.006, 0.006, 0.015});
+  ASSERT_TRUE(held.ok()) << held.error().message();
+  ASSERT_FALSE(held->empty());
+  lift(*sim, 5, 10);
+  SavedState at10;
+  SINEW_ASSERT_OK(sim->save_state(at10));
+  const std::string file = tmp_path("grasper_" + GetParam() + ".state");
+  SINEW_ASSERT_OK(sim->save_state(file));
+  const Snapshot frame10 = snapshot(*sim);
+  lift(*sim, 11, 20);
+  const Snapshot frame20 = snapshot(*sim);
+  ASSERT_FALSE(same_bits(frame10, frame20));
+
+  // The same Simulation, its grasper opened since the save.
+  ASSERT_TRUE(sim->graspers().open(*sim->graspers().grasper(0)).ok());
+  SINEW_ASSERT_OK(sim->restore_state(at10));
+  EXPECT_TRUE(same_bits(snapshot(*sim), frame10));
+  lift(*sim, 11, 20);
+  EXPECT_TRUE(same_bits(snapshot(*sim), frame20)) << "restored after opening the grasper, on " << GetParam();
+
+  // A new Simulation whose grasper never closed, from the file.
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok()) << fresh.error().message();
+  SINEW_ASSERT_OK(fresh->restore_state(file));
+  lift(*fresh, 11, 20);
+  EXPECT_TRUE(same_bits(snapshot(*fresh), frame20)) << "restored from a file in a new Simulation, on " << GetParam();
+  // It holds what it held: opening it releases the same particles.
+  auto released = fresh->graspers().open(*fresh->graspers().grasper(0));
+  ASSERT_TRUE(released.ok());
+  EXPECT_EQ(*released, *held);
+
+  // And a state saved with the grasper open opens a closed one.
+  SavedState open_state;
+  auto other = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(other.ok());
+  run(*other, 1, 4);
+  SINEW_ASSERT_OK(other->save_state(open_state));
+  run(*other, 5, 8);
+  const Snapshot open8 = snapshot(*other);
+  auto again = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(again.ok());
+  run(*again, 1, 4);
+  ASSERT_TRUE(again->graspers().close(*again->graspers().grasper(0), jaws_at(4), {0.006, 0.006, 0.015}).ok());
+  SINEW_ASSERT_OK(again->restore_state(open_state));
+  run(*again, 5, 8);
+  EXPECT_TRUE(same_bits(snapshot(*again), open8)) << "an open grasper's state, on " << GetParam();
+}
+
 TEST_P(SavedStateTest, RestoreWithMeshCollisionIsBitwise) {
   // Two blocks dropped onto each other: the contacts of the frames after
   // the restore are found again from the restored positions.

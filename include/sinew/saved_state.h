@@ -5,8 +5,9 @@
 // velocities, every constraint's multiplier (lambda) and residual, the
 // particle forces set for the next frame, the colliders' and kinematic
 // targets' poses, the rigid tools' motion and reactions, a fluid's
-// particles, grid, counts and emitters, the frame count and the divergence
-// checks' history. Restoring it into the Simulation it
+// particles, grid, counts and emitters, each grasper's hold (open, or the
+// particles and surface points it holds and where in its frame), the frame
+// count and the divergence checks' history. Restoring it into the Simulation it
 // came from, or into a new Simulation made from the same SceneDesc on the
 // same backend, and stepping gives bitwise the positions of the run that
 // was never interrupted.
@@ -17,13 +18,14 @@
 // same topology: restoring across a topology change (a cut, tear,
 // cautery or removal made after the save, or before it in another
 // Simulation) is an error that says so. Not saved yet, so save_state is an
-// error that names them: needles and sutures, and a closed grasper's hold.
+// error that names them: needles and sutures.
 //
-// File format, version 2 (all integers little-endian as the host writes
+// File format, version 3 (all integers little-endian as the host writes
 // them, which the byte-order word checks):
 //   8 bytes   magic "sinewst\x1a"
-//   uint32    format version (2; version 1 lacks the mesh collision's
-//             velocities, see docs/robustness.md)
+//   uint32    format version (3; version 1 lacks the mesh collision's
+//             velocities, see docs/robustness.md; versions 1 and 2 lack the
+//             graspers' holds: they restore every grasper open)
 //   uint32    byte order 0x01020304
 //   uint64    payload size [bytes]
 //   uint64    FNV-1a 64 hash of the payload
@@ -43,7 +45,7 @@
 namespace sinew {
 
 /// The format version written now; files of this version or older are read.
-inline constexpr std::uint32_t kSavedStateVersion = 2;
+inline constexpr std::uint32_t kSavedStateVersion = 3;
 
 struct SavedState {
   /// The header and payload, as in the file.

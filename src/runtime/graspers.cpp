@@ -168,16 +168,30 @@ Result<std::vector<std::uint32_t>> GrasperHolds::close(Device& device, const Xpb
     e.start_z = e.end_z = static_cast<float>(x[2]);
     store_words(targets, target * kTargetFloats, e);
   };
-  std::vector<std::uint32_t> slots(held.size());
-  for (std::size_t i = 0; i < held.size(); ++i) {
-    slots[i] = order.device_of[held[i]];
+  for (std::size_t i = 0; i < held.size(); ++i)
     set_target(g.first_target + static_cast<std::uint32_t>(i),
                {xyzw[4 * held[i]], xyzw[4 * held[i] + 1], xyzw[4 * held[i] + 2]});
-  }
+  // Each point's target: the point now, its offset placed by the pose.
+  for (std::size_t i = 0; i < points.size(); ++i)
+    set_target(g.point_first_target + static_cast<std::uint32_t>(i), place(pose, point_offsets[i]));
+  if (Status s = write_slots(device, buffers, shape, order, g, held, points); !s) return s.error();
+  g.closed = true;
+  g.held = held;
+  g.points = std::move(points);
+  g.offsets = std::move(offsets);
+  g.offsets.insert(g.offsets.end(), point_offsets.begin(), point_offsets.end());
+  return held;
+}
+
+Status GrasperHolds::write_slots(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+                                 const ParticleOrder& order, const Grasper& g, std::span<const std::uint32_t> held,
+                                 std::span<const HeldPoint> points) const {
+  std::vector<std::uint32_t> slots(held.size());
+  for (std::size_t i = 0; i < held.size(); ++i) slots[i] = order.device_of[held[i]];
   if (!slots.empty())
     if (Status s = device.write_buffer(buffers.blocks[g.block].particles, 0, slots.data(), slots.size() * 4); !s)
-      return s.error();
-  // Each point's triangle, weights and target (the point now: its offset placed by the pose).
+      return s;
+  // Each point's triangle, weights and target.
   if (!points.empty()) {
     std::vector<std::uint32_t> triangles;
     std::vector<float> data;
@@ -188,20 +202,52 @@ Result<std::vector<std::uint32_t>> GrasperHolds::close(Device& device, const Xpb
       data.insert(data.end(), {static_cast<float>(points[i].weights[0]), static_cast<float>(points[i].weights[1]),
                                static_cast<float>(points[i].weights[2]), static_cast<float>(g.compliance),
                                static_cast<float>(target), 0.0f, 0.0f, 0.0f});
-      set_target(g.point_first_target + static_cast<std::uint32_t>(i), place(pose, point_offsets[i]));
     }
     const BlockBuffers& b = buffers.blocks[g.point_block];
-    if (Status s = device.write_buffer(b.particles, 0, triangles.data(), triangles.size() * 4); !s) return s.error();
-    if (Status s = device.write_buffer(b.data, 0, data.data(), data.size() * 4); !s) return s.error();
-    shape.blocks[g.point_block].color_counts = {static_cast<std::uint32_t>(points.size())};
+    if (Status s = device.write_buffer(b.particles, 0, triangles.data(), triangles.size() * 4); !s) return s;
+    if (Status s = device.write_buffer(b.data, 0, data.data(), data.size() * 4); !s) return s;
   }
+  if (g.point_block != UINT32_MAX) shape.blocks[g.point_block].color_counts = {static_cast<std::uint32_t>(points.size())};
   shape.blocks[g.block].color_counts = {static_cast<std::uint32_t>(held.size())};
-  g.closed = true;
-  g.held = held;
-  g.points = std::move(points);
-  g.offsets = std::move(offsets);
-  g.offsets.insert(g.offsets.end(), point_offsets.begin(), point_offsets.end());
-  return held;
+  return {};
+}
+
+GrasperHolds::Hold GrasperHolds::hold(std::size_t index) const {
+  const Grasper& g = graspers_[index];
+  return {g.closed, g.held, g.points, g.offsets};
+}
+
+Status GrasperHolds::check(std::size_t index, const Hold& hold, std::size_t particles, const std::string& what) const {
+  const Grasper& g = graspers_[index];
+  const std::string name = what + ": grasper " + std::to_string(index);
+  if (!hold.closed && (!hold.held.empty() || !hold.points.empty() || !hold.offsets.empty()))
+    return Error(ErrorCode::bad_input_file, name + " is open but holds particles");
+  if (hold.held.size() > g.capacity || hold.points.size() > g.point_capacity)
+    return Error(ErrorCode::bad_input_file, name + " holds " + std::to_string(hold.held.size()) + " particles and " +
+                                                std::to_string(hold.points.size()) + " points, past its capacities " +
+                                                std::to_string(g.capacity) + " and " + std::to_string(g.point_capacity));
+  if (hold.offsets.size() != hold.held.size() + hold.points.size())
+    return Error(ErrorCode::bad_input_file, name + " has " + std::to_string(hold.offsets.size()) + " offsets for " +
+                                                std::to_string(hold.held.size() + hold.points.size()) + " holds");
+  for (std::uint32_t p : hold.held)
+    if (p >= particles) return Error(ErrorCode::bad_input_file, name + " holds particle " + std::to_string(p) + " of " +
+                                                                    std::to_string(particles));
+  for (const HeldPoint& q : hold.points)
+    for (std::uint32_t p : q.particles)
+      if (p >= particles) return Error(ErrorCode::bad_input_file, name + "'s point has particle " + std::to_string(p) +
+                                                                     " of " + std::to_string(particles));
+  return {};
+}
+
+Status GrasperHolds::restore(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
+                             const ParticleOrder& order, std::size_t index, const Hold& hold) {
+  Grasper& g = graspers_[index];
+  if (Status s = write_slots(device, buffers, shape, order, g, hold.held, hold.points); !s) return s;
+  g.closed = hold.closed;
+  g.held = hold.held;
+  g.points = hold.points;
+  g.offsets = hold.offsets;
+  return {};
 }
 
 void GrasperHolds::move(std::vector<float>& targets, std::size_t index, const Pose& pose) {

@@ -32,6 +32,14 @@ namespace sinew {
 
 class GrasperHolds {
  public:
+  /// What one grasper holds: the state a saved state carries for it.
+  struct Hold {
+    bool closed = false;
+    std::vector<std::uint32_t> held;              ///< user particles
+    std::vector<HeldPoint> points;                ///< surface points
+    std::vector<std::array<double, 3>> offsets;   ///< each held particle's, then each point's, in the grasper's frame [m]
+  };
+
   GrasperHolds(const SceneDesc& scene, const CompiledScene& compiled);
 
   [[nodiscard]] std::size_t count() const { return graspers_.size(); }
@@ -75,6 +83,19 @@ class GrasperHolds {
   Result<std::vector<std::uint32_t>> open(Device& device, const XpbdBuffers& buffers, CompiledScene& shape,
                                           std::size_t index);
 
+  /// Grasper `index`'s hold, for a saved state.
+  [[nodiscard]] Hold hold(std::size_t index) const;
+  /// Whether `hold` fits grasper `index` of a scene of `particles`
+  /// particles (capacities, particle indices, one offset per held particle
+  /// and point); errors name `what` and the rule. Changes nothing.
+  Status check(std::size_t index, const Hold& hold, std::size_t particles, const std::string& what) const;
+  /// Makes grasper `index` hold `hold` (checked by check()): its slots on
+  /// the device and its counts in `shape`, as close() leaves them, or open.
+  /// The targets and the multipliers are the caller's (a saved state holds
+  /// them). The caller rebuilds the frame program.
+  Status restore(Device& device, const XpbdBuffers& buffers, CompiledScene& shape, const ParticleOrder& order,
+                 std::size_t index, const Hold& hold);
+
  private:
   struct Grasper {
     std::uint32_t block = 0, first_target = 0, capacity = 0;
@@ -85,6 +106,10 @@ class GrasperHolds {
     std::vector<HeldPoint> points;      // surface points
     std::vector<std::array<double, 3>> offsets;     // each held particle's, then each point's, in the grasper's frame [m]
   };
+  // The held particles' slots and the points' triangles and data on the
+  // device, and the blocks' counts in shape (close() and restore()).
+  Status write_slots(Device& device, const XpbdBuffers& buffers, CompiledScene& shape, const ParticleOrder& order,
+                     const Grasper& g, std::span<const std::uint32_t> held, std::span<const HeldPoint> points) const;
   std::vector<Grasper> graspers_;
   std::vector<TetMesh> tet_meshes_;  // the scene's tet bodies (their boundaries, for surface())
   std::vector<std::uint32_t> tet_first_;

@@ -45,9 +45,6 @@ Status check_saveable(const Simulation::Impl& im, const char* call) {
                  std::string(call) + ": " + what + " is not part of a saved state yet, so this scene cannot be saved");
   };
   if (im.sutures) return unsupported("a needle (SceneDesc::needles)");
-  if (im.graspers)
-    for (std::size_t g = 0; g < im.graspers->count(); ++g)
-      if (im.graspers->closed(g)) return unsupported("grasper " + std::to_string(g) + "'s hold (it is closed)");
   return {};
 }
 
@@ -119,6 +116,24 @@ Status Simulation::Impl::save_state(SavedState& out, const char* call) {
     w.value(fluid->solver->host_state());
     w.array(std::span<const FluidEmitter>(fluid->solver->emitter_settings()));
   }
+  if (graspers) {  // since version 3: each grasper's hold (open, or what it holds)
+    w.value(static_cast<std::uint64_t>(graspers->count()));
+    for (std::size_t g = 0; g < graspers->count(); ++g) {
+      const GrasperHolds::Hold h = graspers->hold(g);
+      std::vector<std::uint32_t> point_particles;
+      std::vector<double> point_weights, offsets;
+      for (const HeldPoint& p : h.points) {
+        point_particles.insert(point_particles.end(), p.particles.begin(), p.particles.end());
+        point_weights.insert(point_weights.end(), p.weights.begin(), p.weights.end());
+      }
+      for (const auto& o : h.offsets) offsets.insert(offsets.end(), o.begin(), o.end());
+      w.value(static_cast<std::uint8_t>(h.closed));
+      w.array(std::span<const std::uint32_t>(h.held));
+      w.array(std::span<const std::uint32_t>(point_particles));
+      w.array(std::span<const double>(point_weights));
+      w.array(std::span<const double>(offsets));
+    }
+  }
   w.finish();
   return {};
 }
@@ -182,6 +197,34 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
     if (Status s = r.array(emitters, n, "fluid emitters"); !s) return s;
     if (emitters.size() != n) return r.mismatch("fluid emitters", emitters.size(), n);
   }
+  // Version 3 added the graspers' holds; an older state was saved with
+  // every grasper open (closed ones could not be saved then).
+  std::vector<GrasperHolds::Hold> holds(graspers ? graspers->count() : 0);
+  if (graspers && version >= 3) {
+    std::uint64_t count = 0;
+    if (Status s = r.value(count); !s) return s;
+    if (count != holds.size()) return r.mismatch("graspers", count, holds.size());
+    const std::size_t particles = order.device_of.size();
+    for (std::size_t g = 0; g < holds.size(); ++g) {
+      GrasperHolds::Hold& h = holds[g];
+      std::uint8_t closed = 0;
+      std::vector<std::uint32_t> point_particles;
+      std::vector<double> point_weights, offsets;
+      for (Status s : {r.value(closed), r.array(h.held, particles, "held particles"),
+                       r.array(point_particles, 3 * particles, "held points' particles"),
+                       r.array(point_weights, 3 * particles, "held points' weights"),
+                       r.array(offsets, 3 * (2 * particles), "held offsets")})
+        if (!s) return s;
+      if (point_particles.size() % 3 != 0 || point_weights.size() != point_particles.size() || offsets.size() % 3 != 0)
+        return Error(ErrorCode::bad_input_file, what + ": grasper " + std::to_string(g) + "'s held points are malformed");
+      h.closed = closed != 0;
+      for (std::size_t i = 0; i < point_particles.size(); i += 3)
+        h.points.push_back({{point_particles[i], point_particles[i + 1], point_particles[i + 2]},
+                            {point_weights[i], point_weights[i + 1], point_weights[i + 2]}});
+      for (std::size_t i = 0; i < offsets.size(); i += 3) h.offsets.push_back({offsets[i], offsets[i + 1], offsets[i + 2]});
+      if (Status s = graspers->check(g, h, particles, what); !s) return s;
+    }
+  }
   if (!r.done()) return Error(ErrorCode::bad_input_file, what + ": the saved state has bytes past its end");
 
   for (std::size_t i = 0; i < saved.size(); ++i)
@@ -213,6 +256,11 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
   if (mesh_collision)
     if (Status s = mesh_collision->restore_velocities(std::move(mesh_velocities)); !s) return s;
   tears.clear();
+  if (graspers) {  // what each grasper held when saved, and the program that solves it
+    for (std::size_t g = 0; g < holds.size(); ++g)
+      if (Status s = graspers->restore(*device, buffers, program_shape, order, g, holds[g]); !s) return s;
+    if (Status s = rebuild_program(); !s) return s;
+  }
   return {};
 }
 
