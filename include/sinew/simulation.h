@@ -257,7 +257,7 @@ class Simulation {
   /// bytes replaced (their capacity reused: saving every frame allocates
   /// nothing after the first). Reads the particles' buffers and multipliers
   /// back from the device (and a fluid's particles and grid). Errors: a scene with what a state
-  /// cannot hold yet (needles, a closed grasper; bad_parameter naming it), a device error.
+  /// cannot hold yet (needles; bad_parameter naming it), a device error.
   Status save_state(SavedState& out);
   /// [in] state: from save_state of this scene (this Simulation, or one made
   /// from the same SceneDesc); the next step() continues from it bitwise as

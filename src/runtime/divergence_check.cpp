@@ -38,8 +38,8 @@ Divergence diagnose(const FrameStats& f, double bound, const DivergenceSettings&
 
 }  // namespace
 
-// A checkpoint that cannot be saved (a grasper closed since the policy was
-// set) is no reason to fail the frame: the last one stays, and the first
+// A checkpoint that cannot be saved (a scene with needles; a device error)
+// is no reason to fail the frame: the last one stays, and the first
 // failure in a row is logged.
 void Simulation::Impl::checkpoint() {
   const Status saved = save_state(last_good, "roll-back checkpoint");
