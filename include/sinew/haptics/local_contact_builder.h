@@ -57,7 +57,7 @@ namespace sinew::haptics {
 /// What the builder publishes (docs/haptics.md).
 struct LocalContactSettings {
   double margin = 0.005;          ///< tissue within this distance of the tool's surface is published [m], > 0
-  double stiffness = 0.0;         ///< every contact's [N/m], > 0; 0: each body's flat-punch estimate from E, nu
+  double stiffness = 0.0;         ///< every contact's [N/m], >= 0; 0: estimated (step 4 above)
   double touch_distance = 5e-4;   ///< planes this close to the tool may carry the frame's force [m], >= 0
   double max_normal_angle = 0.5;  ///< candidates whose normals differ less share a plane [rad], in (0, pi]
   std::uint32_t max_contacts = static_cast<std::uint32_t>(kMaxLocalContacts);  ///< 1..kMaxLocalContacts
