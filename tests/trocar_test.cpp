@@ -300,4 +300,30 @@ TEST(Trocar, SceneFilesReadIt) {
       << off.error().message();
 }
 
+TEST(Trocar, ItsPushIsPartOfASavedState) {
+  // A sideways push on the handle: the port pushes back, and a state saved
+  // then restores that reported push (into the same and a new Simulation).
+  const sinew::SceneDesc s = scene(Around::free_space, true);
+  auto sim = sinew::Simulation::create(s, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const auto push = [&](double fx) {
+    ASSERT_TRUE(sim->apply_tool_force(0, {fx, 0.0, 0.0}, {0.0, 0.0, 0.0}).ok());
+    ASSERT_TRUE(sim->step().ok());
+  };
+  push(0.5);
+  const Vec3 saved_push = sim->tool_state(0)->trocar_force;
+  ASSERT_GT(std::abs(saved_push[0]), 0.0);
+  sinew::SavedState state;
+  ASSERT_TRUE(sim->save_state(state).ok());
+  push(-2.0);
+  push(-2.0);
+  ASSERT_NE(sim->tool_state(0)->trocar_force, saved_push);
+  ASSERT_TRUE(sim->restore_state(state).ok());
+  EXPECT_EQ(sim->tool_state(0)->trocar_force, saved_push);
+  auto fresh = sinew::Simulation::create(s, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(fresh.ok());
+  ASSERT_TRUE(fresh->restore_state(state).ok());
+  EXPECT_EQ(fresh->tool_state(0)->trocar_force, saved_push);
+}
+
 }  // namespace

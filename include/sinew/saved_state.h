@@ -6,8 +6,9 @@
 // particle forces set for the next frame, the colliders' and kinematic
 // targets' poses, the rigid tools' motion and reactions, a fluid's
 // particles, grid, counts and emitters, each grasper's hold (open, or the
-// particles and surface points it holds and where in its frame), the frame
-// count and the divergence checks' history. Restoring it into the Simulation it
+// particles and surface points it holds and where in its frame), what each
+// trocar pushed over the last frame, the frame count and the divergence
+// checks' history. Restoring it into the Simulation it
 // came from, or into a new Simulation made from the same SceneDesc on the
 // same backend, and stepping gives bitwise the positions of the run that
 // was never interrupted.

@@ -235,7 +235,7 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   fb_.time_ns = start;
   fb_.force = drive.force;
   fb_.torque = drive.torque;
-  fb_.rendered_force = out.force;
+  fb_.rendered_force = device_force;
   fb_.device_position = sample_.position;
   fb_.device_rotation = sample_.rotation;
   fb_.gain = gain;
@@ -243,7 +243,7 @@ TickRecord HapticLoop::tick_at(std::int64_t scheduled_ns, bool use_scheduled) no
   feedback_.publish(fb_);
   prev_force_ = drive.force;
   prev_torque_ = drive.torque;
-  prev_rendered_force_ = out.force;
+  prev_rendered_force_ = device_force;  // with the passivity controller's damper: what the hand pushed against
   prev_start_ns_ = start;
   have_prev_tick_ = true;
   if (watchdog_.stalls() != counters_.stalls.load(std::memory_order_relaxed))

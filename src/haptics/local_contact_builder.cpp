@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 
+#include "math/proximity_math.h"
 #include "math/vec3.h"
 #include "sinew/mesh.h"
 
@@ -18,12 +19,12 @@ using V3 = math::Vec3;
 
 Error bad(const std::string& what) { return Error(ErrorCode::bad_parameter, "local contacts: " + what); }
 
-// The closest point to p on the segment a-b.
+// The closest point to p on the segment a-b (proximity_math.h's parameter).
 V3 closest_on_segment(const V3& a, const V3& b, const V3& p) {
-  const V3 ab = math::sub(b, a);
-  const double len2 = math::dot(ab, ab);
-  const double t = len2 > 0.0 ? std::clamp(math::dot(math::sub(p, a), ab) / len2, 0.0, 1.0) : 0.0;
-  return math::add(a, math::mul(ab, t));
+  using V = kernels::vec4<double>;
+  const double t = kernels::proximity::closest_on_segment(V{p[0], p[1], p[2], 0.0}, V{a[0], a[1], a[2], 0.0},
+                                                          V{b[0], b[1], b[2], 0.0});
+  return math::add(a, math::mul(math::sub(b, a), t));
 }
 
 V3 particle(const std::vector<float>& xyzw, std::uint32_t i) {

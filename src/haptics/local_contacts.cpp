@@ -11,31 +11,14 @@
 #include <cmath>
 #include <limits>
 
+#include "math/mat3.h"
 #include "math/vec3.h"
 
 namespace sinew::haptics {
 namespace {
 
 using V3 = math::Vec3;
-using M3 = std::array<double, 9>;  // row-major
-
-// The inverse of the symmetric positive definite 3x3 matrix a, by its
-// adjugate; false when a is singular (cannot happen with K > 0).
-bool invert(const M3& a, M3& inv) {
-  const double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8], c02 = a[3] * a[7] - a[4] * a[6];
-  const double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
-  if (!(std::abs(det) > 0.0)) return false;
-  const double s = 1.0 / det;
-  inv = {c00 * s, (a[2] * a[7] - a[1] * a[8]) * s, (a[1] * a[5] - a[2] * a[4]) * s,
-         c01 * s, (a[0] * a[8] - a[2] * a[6]) * s, (a[2] * a[3] - a[0] * a[5]) * s,
-         c02 * s, (a[1] * a[6] - a[0] * a[7]) * s, (a[0] * a[4] - a[1] * a[3]) * s};
-  return true;
-}
-
-V3 apply(const M3& m, const V3& v) {
-  return {m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
-          m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
-}
+using M3 = math::Mat3;
 
 bool usable(const LocalContact& c) { return c.stiffness > 0.0; }
 
@@ -56,22 +39,22 @@ LocalContactSolution solve_local_contacts(const LocalContactModel& model, const 
   std::uint32_t active_mask = 0;
   for (std::size_t i = 0; i < n; ++i)
     if (usable(model.contacts[i]) && gap_at(model.contacts[i], gap_offset, x, x0) < 0.0) active_mask |= 1u << i;
-  M3 inv{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  M3 inv{V3{1, 0, 0}, V3{0, 1, 0}, V3{0, 0, 1}};
   const std::uint32_t max_steps = 2 * kMaxLocalContacts + 2;
   out.converged = false;
   for (std::uint32_t step = 0; step < max_steps; ++step) {
     // (K I + sum_A k n n^T) x = K a - sum_A k (g - n . x0) n
-    M3 a{k_c, 0, 0, 0, k_c, 0, 0, 0, k_c};
+    M3 a{V3{k_c, 0, 0}, V3{0, k_c, 0}, V3{0, 0, k_c}};
     V3 rhs = math::mul(device, k_c);
     for (std::size_t i = 0; i < n; ++i) {
       if (!(active_mask & (1u << i))) continue;
       const LocalContact& c = model.contacts[i];
       for (int r = 0; r < 3; ++r)
-        for (int col = 0; col < 3; ++col) a[3 * r + col] += c.stiffness * c.normal[r] * c.normal[col];
+        for (int col = 0; col < 3; ++col) a[r][col] += c.stiffness * c.normal[r] * c.normal[col];
       rhs = math::sub(rhs, math::mul(c.normal, c.stiffness * (c.gap + gap_offset - math::dot(c.normal, x0))));
     }
-    if (!invert(a, inv)) break;
-    x = apply(inv, rhs);
+    if (!math::invert3(a, inv)) break;  // cannot happen with K > 0: a is positive definite
+    x = math::mul3(inv, rhs);
     out.iterations = step + 1;
     std::uint32_t next = 0;
     for (std::size_t i = 0; i < n; ++i)
@@ -97,8 +80,8 @@ LocalContactSolution solve_local_contacts(const LocalContactModel& model, const 
     ++out.active;
   }
   // dx/da = K (K I + sum_A k n n^T)^-1 on the final active set.
-  for (double& v : inv) v *= k_c;
-  out.sensitivity = inv;
+  for (int r = 0; r < 3; ++r)
+    for (int col = 0; col < 3; ++col) out.sensitivity[3 * r + col] = k_c * inv[r][col];
   return out;
 }
 

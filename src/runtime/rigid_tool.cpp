@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "compiler/device_ranges.h"
+#include "math/mat3.h"
 #include "math/vec3.h"
 #include "runtime/trocar.h"
 
@@ -17,26 +18,8 @@ namespace {
 using math::Quat;
 using V3 = math::Vec3;
 
-using M3 = std::array<V3, 3>;  // row-major
-
-double det3(const M3& a) {
-  return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-         a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-}
-
-// Solves a x = f by Cramer's rule; false (x untouched) when a is singular.
-bool solve3(const M3& a, const V3& f, V3& x) {
-  const double d = det3(a);
-  if (!(std::abs(d) > 0.0) || !std::isfinite(d)) return false;
-  V3 out;
-  for (int k = 0; k < 3; ++k) {
-    M3 m = a;
-    for (int r = 0; r < 3; ++r) m[r][k] = f[r];
-    out[k] = det3(m) / d;
-  }
-  x = out;
-  return true;
-}
+using M3 = math::Mat3;
+using math::solve3;
 
 // One Newton step of implicit Euler on I (w' - w) + dt w' x (I w') = 0 from
 // w' = w, in the body frame: w' = w - J^-1 dt w x (I w) with
@@ -75,17 +58,6 @@ double effective_mass(const ToolBody& b, double stiffness) {
   return std::max(b.mass, 0.25 * stiffness * b.touching_mass);
 }
 
-// A^-1 by columns (A symmetric positive definite); false when singular.
-bool invert(const M3& a, M3& inverse) {
-  for (int c = 0; c < 3; ++c) {
-    V3 e{0.0, 0.0, 0.0}, x{0.0, 0.0, 0.0};
-    e[c] = 1.0;
-    if (!solve3(a, e, x)) return false;
-    for (int r = 0; r < 3; ++r) inverse[r][c] = x[r];
-  }
-  return true;
-}
-
 // The trocar's impulse on the tool's velocities at its current pose, added
 // to what the port pushed over the frame.
 void apply_trocar_impulse(ToolBody& b, double mass, const M3& inverse_inertia, double dt) {
@@ -105,7 +77,7 @@ void hold_trocar(ToolBody& b, double dt, double stiffness) {
   // from the pivot to the shaft line is zero to rounding afterwards.
   b.position = math::add(b.position, trocar_offset(b.pivot, math::rotate(b.rotation, b.shaft_axis), b.position));
   M3 inverse;
-  if (invert(world_inertia(b, stiffness), inverse))
+  if (math::invert3(world_inertia(b, stiffness), inverse))
     apply_trocar_impulse(b, effective_mass(b, stiffness), inverse, dt);
 }
 
@@ -155,7 +127,7 @@ void integrate_tool(ToolBody& b, double dt, double stiffness) {
   if (b.trocar) {
     b.trocar_force = b.trocar_torque = V3{0.0, 0.0, 0.0};
     M3 inverse;
-    if (invert(a, inverse)) apply_trocar_impulse(b, mass, inverse, dt);
+    if (math::invert3(a, inverse)) apply_trocar_impulse(b, mass, inverse, dt);
   }
 
   b.position = math::add(b.position, math::mul(b.velocity, dt));

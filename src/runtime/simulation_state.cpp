@@ -8,8 +8,9 @@
 // in Impl::saved_buffers, the colliders' and targets' host copies (uploaded
 // before the frame), the rigid tools' state, the particle forces' flags,
 // the residual stepper's warm start, the mesh collision's velocities (the
-// last frame's mean, which set the next frame's reach) and the fluid's
-// counts; all are restored exactly (and the mesh collision reads the
+// last frame's mean, which set the next frame's reach), the fluid's
+// counts and the graspers' holds (the particles and points in their slots,
+// written again with the program rebuilt); all are restored exactly (and the mesh collision reads the
 // positions again), and the
 // scene's constant data (constraint data, level-set grids) is checked to be
 // unchanged through shape_generation.
@@ -36,6 +37,10 @@ void tool_fields(Tool& t, Visit visit) {
   visit(t.touching_inertia);
   visit(t.penalty_points);
   visit(t.penalty_depth);
+}
+
+bool has_trocar(const std::vector<ToolBody>& tools) {
+  return std::any_of(tools.begin(), tools.end(), [](const ToolBody& t) { return t.trocar; });
 }
 
 // What a state must not be saved with yet: each names itself.
@@ -134,6 +139,11 @@ Status Simulation::Impl::save_state(SavedState& out, const char* call) {
       w.array(std::span<const double>(offsets));
     }
   }
+  if (has_trocar(contacts.tools))  // since version 3: what each trocar pushed over the last frame (ToolState)
+    for (const ToolBody& t : contacts.tools) {
+      w.value(t.trocar_force);
+      w.value(t.trocar_torque);
+    }
   w.finish();
   return {};
 }
@@ -225,6 +235,13 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
       if (Status s = graspers->check(g, h, particles, what); !s) return s;
     }
   }
+  // Version 3 added the trocars' push (reported in ToolState; an older
+  // state restores it as zero, until the next frame measures it).
+  for (ToolBody& t : saved_tools) t.trocar_force = t.trocar_torque = {0.0, 0.0, 0.0};
+  if (has_trocar(saved_tools) && version >= 3)
+    for (ToolBody& t : saved_tools)
+      for (Status s : {r.value(t.trocar_force), r.value(t.trocar_torque)})
+        if (!s) return s;
   if (!r.done()) return Error(ErrorCode::bad_input_file, what + ": the saved state has bytes past its end");
 
   for (std::size_t i = 0; i < saved.size(); ++i)

@@ -15,10 +15,8 @@ V3 trocar_offset(const V3& pivot, const V3& world_axis, const V3& centre) {
 }
 
 TrocarImpulse hold_trocar_velocity(const V3& pivot, const V3& u, const V3& centre, double mass,
-                                   const std::array<V3, 3>& inverse_inertia, V3& velocity, V3& angular_velocity) {
-  const auto apply_inverse = [&](const V3& x) {
-    return V3{math::dot(inverse_inertia[0], x), math::dot(inverse_inertia[1], x), math::dot(inverse_inertia[2], x)};
-  };
+                                   const math::Mat3& inverse_inertia, V3& velocity, V3& angular_velocity) {
+  const auto apply_inverse = [&](const V3& x) { return math::mul3(inverse_inertia, x); };
   // The tool's point on its shaft at the pivot, from its centre.
   const V3 r = math::mul(u, math::dot(u, math::sub(pivot, centre)));
   const V3 vp = math::add(velocity, math::cross(angular_velocity, r));

@@ -16,8 +16,7 @@
 // constraints", ICRA 2003 (velocity held by an impulse, position projected).
 #pragma once
 
-#include <array>
-
+#include "math/mat3.h"
 #include "math/vec3.h"
 
 namespace sinew {
@@ -37,7 +36,7 @@ math::Vec3 trocar_offset(const math::Vec3& pivot, const math::Vec3& world_axis, 
 /// [in] mass [kg]; [in] inverse_inertia: A^-1, world frame, row-major.
 /// Returns the impulse applied (zero when K is singular: never for m, A > 0).
 TrocarImpulse hold_trocar_velocity(const math::Vec3& pivot, const math::Vec3& world_axis, const math::Vec3& centre,
-                                   double mass, const std::array<math::Vec3, 3>& inverse_inertia,
+                                   double mass, const math::Mat3& inverse_inertia,
                                    math::Vec3& velocity, math::Vec3& angular_velocity);
 
 }  // namespace sinew
