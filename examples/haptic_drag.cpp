@@ -3,7 +3,10 @@
 // loop: a 1 kHz thread (SCHED_FIFO when granted) renders the virtual
 // coupling (Colgate et al. 1995) to the device while this thread steps the
 // physics at 250 Hz, paced to the wall clock, and drives the probe with
-// minus the coupling force averaged over each frame.
+// minus the coupling force averaged over each frame. With --clock virtual
+// the same loop is ticked between the frames on a virtual clock
+// (haptics::ScriptedHands): the run is the same every time, and it is what
+// scenes/haptic_drag.json gives through `sinew run`.
 //
 // Writes into the output folder:
 //   force_trace.csv   every haptic tick: time, device and rendered tool
@@ -11,8 +14,8 @@
 //   frames.csv        every physics frame: tool position, contact force from
 //                     the tissue, force applied to the tool
 //   force_trace.png   the force trace and the positions (when gnuplot exists)
-//   haptic_drag.pvd   the VTU series of the tissue (frame_*.vtu), for ParaView
-//   probe.pvd         the probe's surface (probe_*.vtu) at the same times
+//   haptic_drag.pvd   every 25th frame (10 a second): the tissue
+//                     (tissue_<frame>.vtu) and the probe (tool0_<frame>.vtu)
 //
 //   haptic_drag --help   (the options, their defaults and units)
 #include <algorithm>
@@ -21,26 +24,32 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "command_line.h"
 #include "sinew/haptics/haptic_loop.h"
+#include "sinew/haptics/keyframe_path.h"
 #include "sinew/haptics/scripted_device.h"
+#include "sinew/haptics/scripted_hands.h"
 #include "sinew/haptics/tool_bridge.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
-#include "tool_surface.h"
+#include "sinew/vtk_output.h"
 
 namespace {
 
 using namespace sinew::haptics;
+using sinew::Result;
 
 struct Options {
   std::string out;
   std::string backend = "cpu";
   double rate = 1000.0;
   bool realtime = true;
+  std::string clock = "wall";  // or "virtual"
 };
 
 // The block: 6.4 x 2 x 6.4 cm, 4 mm cells, its top face at y = 2 cm, centred on x = z = 0.
@@ -52,20 +61,19 @@ constexpr double kPress = 0.012;  // down 12 mm: the tip 7 mm below the surface 
 constexpr double kDrag = 0.02;    // then 2 cm along x
 constexpr double kDuration = 5.0;  // [s]
 
-// Smooth 0 -> 1 over [a, b] (cosine ramp: zero velocity at both ends).
-double ramp(double t, double a, double b) {
-  if (t <= a) return 0.0;
-  if (t >= b) return 1.0;
-  return 0.5 - 0.5 * std::cos(M_PI * (t - a) / (b - a));
-}
-
-// The scripted hand: hold, press down, hold, drag sideways, hold, lift.
-ScriptedPose hand(double t) {
-  ScriptedPose p;
-  const double x = -0.01 + kDrag * ramp(t, 2.0, 3.5);
-  const double y = kStartY - kPress * (ramp(t, 0.5, 1.5) - ramp(t, 4.0, 4.6));
-  p.position = {x, y, 0.0};
-  return p;
+// The scripted hand: hold, press down (0.5-1.5 s), hold, drag sideways
+// (2-3.5 s), hold, lift (4-4.6 s); cosine ramps between the keys, so the
+// hand starts and stops at rest.
+Result<KeyframePath> hand_path() {
+  const double x0 = -0.01, x1 = x0 + kDrag, down = kStartY - kPress;
+  return KeyframePath::create({{.time = 0.0, .position = {x0, kStartY, 0.0}},
+                               {.time = 0.5, .position = {x0, kStartY, 0.0}},
+                               {.time = 1.5, .position = {x0, down, 0.0}},
+                               {.time = 2.0, .position = {x0, down, 0.0}},
+                               {.time = 3.5, .position = {x1, down, 0.0}},
+                               {.time = 4.0, .position = {x1, down, 0.0}},
+                               {.time = 4.6, .position = {x1, kStartY, 0.0}}},
+                              PathInterpolation::smooth);
 }
 
 int fail(const std::string& what) {
@@ -88,6 +96,12 @@ int main(int argc, char** argv) {
   // The rate is checked with the loop's settings below (a clear error for 0, nan, ...).
   cli.app().add_option("--rate", opt.rate, "Haptic loop rate [Hz]");
   cli.app().add_flag_callback("--no-realtime", [&opt] { opt.realtime = false; }, "Run the haptic thread without asking for SCHED_FIFO");
+  cli.app()
+      .add_option("--clock", opt.clock,
+                   "wall: the haptic loop on its own thread, the physics paced to the wall clock; virtual: the loop "
+                   "ticked between the frames on a virtual clock (the same run every time, as `sinew run "
+                   "scenes/haptic_drag.json`)")
+      ->check(CLI::IsMember({"wall", "virtual"}));
   cli.add_out(opt.out);
   if (auto exit = cli.parse(argc, argv)) return *exit;
 
@@ -101,7 +115,6 @@ int main(int argc, char** argv) {
   if (auto s = body.set_elastic(300e3, 0.4); !s) return fail(s.error().message());  // E = 300 kPa
   for (std::uint32_t v = 0; v < body.mesh.vertices.size(); ++v)
     if (body.mesh.vertices[v][1] < 1e-9) body.pinned.push_back(v);
-  const auto tets = body.mesh.tets;
 
   sinew::SceneDesc scene;
   scene.gravity = {0.0, -9.81, 0.0};
@@ -128,10 +141,8 @@ int main(int argc, char** argv) {
   if (!probe_id) return fail(probe_id.error().message());
 
   // ------------------------------------------------------------ the haptic side
-  MonotonicClock clock;
-  SnapshotChannel snapshots;
-  FeedbackChannel feedback;
-  ScriptedDevice device(hand);
+  auto path = hand_path();
+  if (!path) return fail(path.error().message());
   HapticLoopSettings settings;
   settings.rate_hz = opt.rate;
   settings.realtime = opt.realtime;
@@ -139,60 +150,84 @@ int main(int argc, char** argv) {
   // The rate sizes the telemetry below: the loop's own check first (a clear error for --rate nan, 0, ...).
   if (auto s = check(settings); !s) return fail(s.error().message());
   settings.telemetry_capacity = static_cast<std::size_t>((kDuration + 1.0) * opt.rate);
-  auto loop = HapticLoop::create(settings, device, snapshots, feedback, clock);
-  if (!loop) return fail(loop.error().message());
-  HapticToolBridge bridge(0, snapshots, feedback, clock);
   // Damps the probe's swing on the coupling spring (not felt; tool_bridge.h).
-  if (auto s = bridge.set_damping(5.0, 2e-3); !s) return fail(s.error().message());
-  if (auto s = bridge.publish(*sim); !s) return fail(s.error().message());
+  constexpr double kToolDamping = 5.0, kToolAngularDamping = 2e-3;
+  const bool virtual_clock = opt.clock == "virtual";
 
-  const std::int64_t t0 = clock.now_ns() + seconds_to_ns(0.01);
-  device.set_origin(t0);
-  if (auto s = (*loop)->start(); !s) return fail(s.error().message());
-  std::printf("haptic_drag on %s: %u particles; haptic loop at %.0f Hz, %s\n", sim->device_name().c_str(),
-              sim->info().particles, opt.rate, (*loop)->scheduling().describe().c_str());
+  // Wall clock: the loop on its own thread, a bridge on this one.
+  MonotonicClock clock;
+  SnapshotChannel snapshots;
+  FeedbackChannel feedback;
+  ScriptedDevice device(path->script());
+  std::unique_ptr<HapticLoop> loop;
+  std::optional<HapticToolBridge> bridge;
+  // Virtual clock: the same loop, ticked between the frames.
+  std::unique_ptr<ScriptedHands> hands;
+  std::int64_t t0 = 0;
+  if (virtual_clock) {
+    auto made = ScriptedHands::create({{.tool = 0, .path = *path, .loop = settings, .tool_damping = kToolDamping,
+                                        .tool_angular_damping = kToolAngularDamping}},
+                                      *sim, scene.solver.time_step);
+    if (!made) return fail(made.error().message());
+    hands = std::move(*made);
+    std::printf("haptic_drag on %s: %u particles; haptic loop at %.0f Hz on a virtual clock\n",
+                sim->device_name().c_str(), sim->info().particles, opt.rate);
+  } else {
+    auto made = HapticLoop::create(settings, device, snapshots, feedback, clock);
+    if (!made) return fail(made.error().message());
+    loop = std::move(*made);
+    bridge.emplace(0, snapshots, feedback, clock);
+    if (auto s = bridge->set_damping(kToolDamping, kToolAngularDamping); !s) return fail(s.error().message());
+    if (auto s = bridge->publish(*sim); !s) return fail(s.error().message());
+    t0 = clock.now_ns() + seconds_to_ns(0.01);
+    device.set_origin(t0);
+    if (auto s = loop->start(); !s) return fail(s.error().message());
+    std::printf("haptic_drag on %s: %u particles; haptic loop at %.0f Hz, %s\n", sim->device_name().c_str(),
+                sim->info().particles, opt.rate, loop->scheduling().describe().c_str());
+  }
+  const HapticLoop& the_loop = virtual_clock ? hands->loop(0) : *loop;
+  const HapticToolBridge& the_bridge = virtual_clock ? hands->bridge(0) : *bridge;
 
-  // ------------------------------------------------------------ physics, paced to the wall clock
+  // The tissue named as in scenes/haptic_drag.json: the runner's output of it is the same.
+  auto output = sinew::SceneOutput::create(scene, opt.out, {.bodies = {{.name = "tissue"}}, .name = "haptic_drag"});
+  if (!output) return fail(output.error().message());
+  if (auto s = output->write(*sim, 0); !s) return fail(s.error().message());
+
+  // ------------------------------------------------------------ physics, paced to the wall clock (or not)
   const double dt = scene.solver.time_step;
   const int frames = static_cast<int>(std::lround(kDuration / dt));
-  std::vector<std::vector<float>> shots;  // positions kept for the VTU series, written after the run
-  std::vector<double> shot_times;
-  std::vector<sinew::Pose> probe_poses;  // the probe at each shot
   std::FILE* frames_csv = std::fopen((opt.out + "/frames.csv").c_str(), "w");
   if (!frames_csv) return fail("cannot write " + opt.out + "/frames.csv");
   std::fprintf(frames_csv, "time,tool_x,tool_y,tool_z,contact_fx,contact_fy,contact_fz,tool_force_x,tool_force_y,"
                            "tool_force_z,step_ms\n");
-  std::vector<float> x;
   int late = 0;
   double step_ms_max = 0.0, step_ms_sum = 0.0;
   for (int f = 1; f <= frames; ++f) {
-    if (auto s = bridge.apply_feedback(*sim); !s) return fail(s.error().message());
+    if (auto s = virtual_clock ? hands->before_step(*sim) : bridge->apply_feedback(*sim); !s)
+      return fail(s.error().message());
     if (auto s = sim->step(); !s) return fail(s.error().message());
-    if (auto s = bridge.publish(*sim); !s) return fail(s.error().message());
+    if (auto s = virtual_clock ? hands->after_step(*sim) : bridge->publish(*sim); !s) return fail(s.error().message());
     step_ms_max = std::max(step_ms_max, sim->last_frame().wall_ms);
     step_ms_sum += sim->last_frame().wall_ms;
     auto tool = sim->tools().state(*probe_id);
     if (!tool) return fail(tool.error().message());
-    const Vec3& applied = bridge.last_tool_force();
+    const Vec3& applied = the_bridge.last_tool_force();
     std::fprintf(frames_csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.3f\n", f * dt, tool->position[0],
                  tool->position[1], tool->position[2], tool->contact_force[0], tool->contact_force[1],
                  tool->contact_force[2], applied[0], applied[1], applied[2], sim->last_frame().wall_ms);
-    if (f % 25 == 0) {  // 10 VTU frames per second
-      if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
-      shots.push_back(x);
-      shot_times.push_back(f * dt);
-      probe_poses.push_back({.position = tool->position, .rotation = tool->rotation});
-    }
+    if (f % 25 == 0 || f == frames)  // 10 VTU frames per second
+      if (auto s = output->write(*sim, f); !s) return fail(s.error().message());
+    if (virtual_clock) continue;
     const std::int64_t next = t0 + seconds_to_ns(f * dt);
     if (clock.now_ns() > next) ++late;
     clock.sleep_until(next);
   }
-  (*loop)->stop();
+  if (loop) loop->stop();
   std::fclose(frames_csv);
 
   // ------------------------------------------------------------ outputs
   std::vector<TickRecord> ticks;
-  if (auto s = (*loop)->copy_telemetry(ticks); !s) return fail(s.error().message());
+  if (auto s = the_loop.copy_telemetry(ticks); !s) return fail(s.error().message());
   const std::string trace = opt.out + "/force_trace.csv";
   std::FILE* csv = std::fopen(trace.c_str(), "w");
   if (!csv) return fail("cannot write " + trace);
@@ -208,17 +243,6 @@ int main(int argc, char** argv) {
                  r.gain, 1e3 * r.snapshot_age, r.flags);
   }
   std::fclose(csv);
-
-  std::vector<std::filesystem::path> files, probe_files;
-  for (std::size_t i = 0; i < shots.size(); ++i) {
-    files.push_back(opt.out + "/frame_" + std::to_string(i) + ".vtu");
-    if (auto s = sinew::write_vtu(files.back(), shots[i], 4, tets); !s) return fail(s.error().message());
-    probe_files.push_back(opt.out + "/probe_" + std::to_string(i) + ".vtu");
-    if (auto s = sinew::examples::write_capsule_vtu(probe_files.back(), kRadius, kHalfHeight, probe_poses[i]); !s)
-      return fail(s.error().message());
-  }
-  if (auto s = sinew::write_pvd(opt.out + "/haptic_drag.pvd", files, shot_times); !s) return fail(s.error().message());
-  if (auto s = sinew::write_pvd(opt.out + "/probe.pvd", probe_files, shot_times); !s) return fail(s.error().message());
 
   const std::string plot = opt.out + "/force_trace.png";
   if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
@@ -250,15 +274,17 @@ int main(int argc, char** argv) {
     std::printf("gnuplot not found (apt-get install gnuplot-nox): no plot, CSV only\n");
   }
 
-  const HapticCounters c = (*loop)->counters();
+  const HapticCounters c = the_loop.counters();
   std::printf("%llu ticks, %llu missed deadlines (> 2 periods), %llu stale ticks, %llu clamped, %llu slew-limited; "
               "peak device force %.2f N\n",
               static_cast<unsigned long long>(c.ticks), static_cast<unsigned long long>(c.missed_deadlines),
               static_cast<unsigned long long>(c.stale_ticks), static_cast<unsigned long long>(c.clamped),
               static_cast<unsigned long long>(c.slew_limited), peak);
-  std::printf("%d physics frames of %.1f ms: step %.2f ms mean, %.2f ms max, %d started late\n", frames, 1e3 * dt,
-              step_ms_sum / frames, step_ms_max, late);
-  std::printf("wrote %s, %s/frames.csv and %zu VTU files; open %s/haptic_drag.pvd and probe.pvd in ParaView\n", trace.c_str(),
-              opt.out.c_str(), files.size(), opt.out.c_str());
+  std::printf("%d physics frames of %.1f ms: step %.2f ms mean, %.2f ms max", frames, 1e3 * dt,
+              step_ms_sum / frames, step_ms_max);
+  if (virtual_clock) std::printf(" (on the virtual clock: not paced)\n");
+  else std::printf(", %d started late\n", late);
+  std::printf("wrote %s and %s/frames.csv; open %s/haptic_drag.pvd in ParaView\n", trace.c_str(), opt.out.c_str(),
+              opt.out.c_str());
   return 0;
 }

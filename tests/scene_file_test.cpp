@@ -224,5 +224,64 @@ TEST(SceneFile, ScriptMovesACollider) {
   EXPECT_LT(lowest_top, 0.0045f);
 }
 
+// "haptics": scripted hands read with their paths, loops and damping; every
+// bad value named by its JSON path.
+TEST(SceneFile, HapticsHandsReadWithTheirFieldsAndErrors) {
+  const auto with = [](const std::string& hands) {
+    std::string s = block_scene();
+    s.pop_back();  // the closing brace: add a tool and the hands
+    return s + R"(, "tools": [{"shape": "capsule", "radius": 0.004, "half_height": 0.01, "mass": 0.2,
+      "inertia": [1e-4, 1e-4, 1e-4], "position": [0.02, 0.02, 0.01], "gravity": false}],
+      "haptics": {"hands": [)" + hands + "]}}";
+  };
+  const std::string good = R"({"tool": 0, "rate_hz": 500, "path": {"interpolation": "linear",
+      "keys": [{"time": 0, "position": [0.02, 0.02, 0.01]},
+               {"time": 1, "position": [0.02, 0.015, 0.01], "rotation": [0, 0, 0, 2]}]},
+      "coupling": {"stiffness": 300, "damping": 2, "max_force": 5}, "tool_damping": 4, "tool_angular_damping": 0.001})";
+  auto file = parse_scene_json(with(good), kScenes);
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  ASSERT_EQ(file->hands.size(), 1u);
+  const haptics::ScriptedHandDesc& h = file->hands[0];
+  EXPECT_EQ(h.tool, 0u);
+  EXPECT_EQ(h.loop.rate_hz, 500.0);
+  EXPECT_EQ(h.loop.coupling.stiffness, 300.0);
+  EXPECT_EQ(h.loop.coupling.damping, 2.0);
+  EXPECT_EQ(h.loop.coupling.max_force, 5.0);
+  EXPECT_EQ(h.loop.coupling.rotational_stiffness, haptics::CouplingParams{}.rotational_stiffness);
+  EXPECT_EQ(h.tool_damping, 4.0);
+  EXPECT_EQ(h.tool_angular_damping, 0.001);
+  EXPECT_EQ(h.path.interpolation(), haptics::PathInterpolation::linear);
+  ASSERT_EQ(h.path.keys().size(), 2u);
+  EXPECT_EQ(h.path.keys()[1].rotation, (haptics::Quat{0.0, 0.0, 0.0, 1.0}));  // normalised
+  EXPECT_NEAR(h.path.at(0.5).position[1], 0.0175, 1e-15);
+
+  EXPECT_EQ(error_of(with(R"({"tool": 1, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})")),
+            "/haptics/hands/0/tool: tool 1 does not exist (the scene has 1)");
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}},
+                              {"tool": 0, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})")),
+            "/haptics/hands/1/tool: tool 0 is driven by /haptics/hands/0 already");
+  EXPECT_EQ(error_of(with(R"({"tool": 0})")), "/haptics/hands/0/path: is required");
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "path": {"keys": []}})")),
+            "/haptics/hands/0/path/keys: a path needs at least one key");
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "path": {"keys": [{"time": 1, "position": [0, 0, 0]},
+                                                           {"time": 0.5, "position": [0, 0, 0]}]}})")),
+            "/haptics/hands/0/path/keys/1/time: must be greater than the previous key's (got 0.5 after 1)");
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "path": {"keys": [{"time": 0}]}})")),
+            "/haptics/hands/0/path/keys/0/position: is required");
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "path": {"interpolation": "cubic", "keys": [{"time": 0, "position": [0, 0, 0]}]}})"))
+                .rfind("/haptics/hands/0/path/interpolation: must be one of", 0),
+            0u);
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "rate_hz": 0, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})")),
+            "/haptics/hands/0/rate_hz: must be in [1, 1e6] [Hz]");
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "coupling": {"damping": -1}, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})"))
+                .rfind("/haptics/hands/0/coupling/damping: must be finite and >= 0", 0),
+            0u);
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "tool_damping": -1, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})")),
+            "/haptics/hands/0/tool_damping: must be finite and >= 0");
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "grip": 1, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})"))
+                .rfind("/haptics/hands/0/grip", 0),
+            0u);
+}
+
 }  // namespace
 }  // namespace sinew

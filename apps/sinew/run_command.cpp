@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -158,6 +159,16 @@ int run_scene(const RunOptions& o) {
     if (Status s = vtk->write(*sim, 0); !s) return fail(s.error().message());
   }
   ScriptPlayer player(file->script);
+  // The file's scripted hands: their loops tick on a virtual clock between frames.
+  std::unique_ptr<haptics::ScriptedHands> hands;
+  if (!file->hands.empty()) {
+    auto made = haptics::ScriptedHands::create(file->hands, *sim, file->scene.solver.time_step);
+    if (!made) return fail(made.error().message());
+    hands = std::move(*made);
+    for (std::size_t i = 0; i < file->hands.size(); ++i)
+      std::printf("hand %zu drives tool %u: a scripted device over %g s, its haptic loop at %g Hz on the frames' clock\n", i,
+                  file->hands[i].tool, file->hands[i].path.duration(), file->hands[i].loop.rate_hz);
+  }
   Progress progress(frames, isatty(fileno(stdout)) != 0);
   Profile profile;
   std::vector<std::string> events;
@@ -165,7 +176,11 @@ int run_scene(const RunOptions& o) {
   for (int f = 1; f <= frames; ++f) {
     events.clear();
     if (Status s = player.before_frame(*sim, f, &events); !s) return fail("frame " + std::to_string(f) + ": " + s.error().message());
+    if (hands)
+      if (Status s = hands->before_step(*sim); !s) return fail("frame " + std::to_string(f) + ": " + s.error().message());
     if (Status s = sim->step(); !s) return fail("frame " + std::to_string(f) + ": " + s.error().message());
+    if (hands)
+      if (Status s = hands->after_step(*sim); !s) return fail("frame " + std::to_string(f) + ": " + s.error().message());
     const FrameStats& st = sim->last_frame();
     total_ms += st.wall_ms;
     profile.add(st);
@@ -185,6 +200,13 @@ int run_scene(const RunOptions& o) {
   if (!o.positions.empty()) {
     if (Status s = write_positions(*sim, o.positions); !s) return fail(s.error().message());
     std::printf("wrote %u particles' final positions to %s\n", info.particles, o.positions.c_str());
+  }
+  for (std::size_t i = 0; hands && i < hands->count(); ++i) {
+    const haptics::HapticCounters c = hands->loop(i).counters();
+    const haptics::Vec3& f = hands->device(i).last_force();
+    std::printf("hand %zu: %llu ticks, %llu clamped, %llu slew-limited; last force on the device (%.4f, %.4f, %.4f) N\n", i,
+                static_cast<unsigned long long>(c.ticks), static_cast<unsigned long long>(c.clamped),
+                static_cast<unsigned long long>(c.slew_limited), f[0], f[1], f[2]);
   }
   profile.print(frames, total_ms);
   std::fflush(stdout);

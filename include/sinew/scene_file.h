@@ -25,6 +25,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sinew/haptics/scripted_hands.h"
 #include "sinew/level_set.h"
 #include "sinew/result.h"
 #include "sinew/scene.h"
@@ -120,6 +121,9 @@ struct SceneFile {
   SceneDesc scene;
   SceneRunSettings run;
   SceneScript script;
+  /// "haptics": scripted hands driving tools through the haptic loop on a
+  /// virtual clock (haptics::ScriptedHands runs them; sinew run does).
+  std::vector<haptics::ScriptedHandDesc> hands;
   std::vector<SceneBodyName> bodies;  ///< every body: tet ones, then tri, then line
 };
 

@@ -1,55 +1,42 @@
 #!/usr/bin/env python3
 """Writes scenes/haptic_drag.json: examples/haptic_drag.cpp as a scene file.
 
-The example's probe is a tool (0.5 kg) pulled by a virtual coupling to a
-scripted haptic device, in a 1 kHz haptic loop paced to the wall clock; a
-scene file has no haptic loop, so its probe is a kinematic capsule that
-follows the device's scripted path itself (its cosine ramps, a key at every
-physics frame while it moves): no coupling spring, no lag, no force fed back.
+The probe is a tool (0.5 kg) pulled by a virtual coupling to a scripted
+haptic device whose path is the example's keys (cosine ramps between them);
+the runner ticks the device's 1 kHz haptic loop between the frames on a
+virtual clock, as `haptic_drag --clock virtual` does, so the two runs are
+the same bit for bit.
 
     scenes/generators/haptic_drag.py > scenes/haptic_drag.json
 """
-import math
 import sys
 
 import scene_json
-from motion import ramp
 
 CELL = 0.004
 TOP = 5 * CELL
 RADIUS, HALF_HEIGHT = 0.006, 0.015
 START_Y = TOP + 0.005 + RADIUS + HALF_HEIGHT
 PRESS, DRAG, DURATION, DT = 0.012, 0.02, 5.0, 1.0 / 250.0
-# The ramps' spans [s]: press, drag, lift.
-RAMPS = [(0.5, 1.5), (2.0, 3.5), (4.0, 4.6)]
+MASS = 0.5
+R2, L2 = RADIUS * RADIUS, 4 * HALF_HEIGHT * HALF_HEIGHT
 
-
-def hand(t):
-    """The example's scripted hand: hold, press down, hold, drag along x, hold, lift."""
-    x = -0.01 + DRAG * ramp(t, 2.0, 3.5)
-    y = START_Y - PRESS * (ramp(t, 0.5, 1.5) - ramp(t, 4.0, 4.6))
-    return [x, y, 0.0]
-
-
-frames = round(DURATION / DT)
-keys = []
-for f in range(frames + 1):
-    t = f * DT
-    # Holds need only their ends: a key at every frame inside a ramp and at its ends.
-    if f in (0, frames) or any(a - DT <= t <= b + DT for a, b in RAMPS):
-        keys.append({"frame": f, "position": hand(t)})
+# The example's hand: hold, press down, hold, drag along x, hold, lift.
+X0 = -0.01
+X1 = X0 + DRAG
+DOWN = START_Y - PRESS
+KEYS = [(0.0, X0, START_Y), (0.5, X0, START_Y), (1.5, X0, DOWN), (2.0, X0, DOWN), (3.5, X1, DOWN),
+        (4.0, X1, DOWN), (4.6, X1, START_Y)]
 
 scene = {
     "format": "sinew-scene",
     "version": 1,
     "description": "A rigid probe pressed 12 mm into a block of soft tissue (300 kPa) and dragged 2 cm across it "
-                   "(examples/haptic_drag.cpp; written by scenes/generators/haptic_drag.py). Differences from the "
-                   "example: the example drives a 0.5 kg tool through a virtual coupling from a scripted haptic "
-                   "device in the real 1 kHz haptic loop, paced to the wall clock; a real-time haptic loop is not "
-                   "part of a scene file, so here the device's scripted path is the probe's keyframed pose (a "
-                   "kinematic capsule collider with the tool's friction): no coupling stretch, no force rendered "
-                   "to a device, and the same result on every run.",
-    "run": {"frames": frames, "every": 25},
+                   "(examples/haptic_drag.cpp; written by scenes/generators/haptic_drag.py). The probe is a 0.5 kg "
+                   "tool driven through a virtual coupling by a scripted haptic device; the runner ticks its 1 kHz "
+                   "haptic loop between the frames on a virtual clock, as `haptic_drag --clock virtual` does (the "
+                   "example's default paces the loop's own thread to the wall clock instead).",
+    "run": {"frames": round(DURATION / DT), "every": 25},
     "gravity": [0.0, -9.81, 0.0],
     "solver": {"time_step": DT, "substeps": 5, "iterations": 2, "measure_errors": False},
     "tet_bodies": [{
@@ -60,8 +47,22 @@ scene = {
         "elastic": {"youngs_modulus": 300e3, "poisson_ratio": 0.4},
         "pinned": [{"min": [-1.0, -1.0, -1.0], "max": [1.0, 1e-9, 1.0]}],
     }],
-    "colliders": [{"shape": "capsule", "radius": RADIUS, "half_height": HALF_HEIGHT, "position": hand(0.0),
-                   "static_friction": 0.4, "dynamic_friction": 0.3}],
-    "script": {"poses": [{"collider": 0, "keys": keys}]},
+    "tools": [{
+        "shape": "capsule", "radius": RADIUS, "half_height": HALF_HEIGHT,
+        "mass": MASS,
+        "inertia": [MASS * (3 * R2 + L2) / 12, MASS * R2 / 2, MASS * (3 * R2 + L2) / 12],
+        "position": [X0, START_Y, 0.0],
+        "gravity": False,
+        "static_friction": 0.4, "dynamic_friction": 0.3,
+    }],
+    "haptics": {"hands": [{
+        "tool": 0,
+        "rate_hz": 1000.0,
+        "path": {"interpolation": "smooth",
+                 "keys": [{"time": t, "position": [x, y, 0.0]} for t, x, y in KEYS]},
+        "coupling": {"damping": 3.0},
+        "tool_damping": 5.0,
+        "tool_angular_damping": 2e-3,
+    }]},
 }
 scene_json.write(scene, sys.stdout)

@@ -77,4 +77,9 @@ void read_script(const Json& v, const std::string& path, Context& ctx, SceneScri
 /// that exists; keyed subjects of the right kind).
 void check_script(const SceneScript& script, const SceneDesc& scene, Context& ctx);
 
+// haptics_reader.cpp
+void read_haptics(const Json& v, const std::string& path, Context& ctx, std::vector<haptics::ScriptedHandDesc>& out);
+/// Each hand's tool exists and is driven by one hand only.
+void check_haptics(const std::vector<haptics::ScriptedHandDesc>& hands, const SceneDesc& scene, Context& ctx);
+
 }  // namespace sinew::scene_file

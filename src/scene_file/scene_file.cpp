@@ -114,8 +114,10 @@ Result<SceneFile> read_document(const Json& doc, const scene_file::Where& where)
     check(scene, ctx);
   }
   if (const Json* s = root.find("script")) scene_file::read_script(*s, "/script", ctx, file.script);
+  if (const Json* h = root.find("haptics")) scene_file::read_haptics(*h, "/haptics", ctx, file.hands);
   root.finish();
   scene_file::check_script(file.script, scene, ctx);
+  scene_file::check_haptics(file.hands, scene, ctx);
   if (ctx.failed()) return *ctx.error();
   name_bodies(file, BodyKind::tet, scene.tet_bodies.size(), "tet", tet_names);
   name_bodies(file, BodyKind::tri, scene.tri_bodies.size(), "tri", tri_names);
