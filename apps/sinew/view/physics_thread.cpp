@@ -27,8 +27,20 @@ PhysicsThread::PhysicsThread(SceneFile file, DeviceOptions device, MouseDevice& 
 
 PhysicsThread::~PhysicsThread() { stop(); }
 
+// Whether the file's scripted hands drive `tool` (the mouse then leaves it to them).
+bool PhysicsThread::scripted(int tool) const {
+  for (const haptics::ScriptedHandDesc& h : file_.hands)
+    if (static_cast<int>(h.tool) == tool) return true;
+  return false;
+}
+
 Status PhysicsThread::start() {
-  if (!file_.scene.tools.empty()) driven_tool_.store(0);
+  // The mouse drives the first tool no scripted hand drives.
+  for (std::size_t t = 0; t < file_.scene.tools.size(); ++t)
+    if (!scripted(static_cast<int>(t))) {
+      driven_tool_.store(static_cast<int>(t));
+      break;
+    }
   std::promise<Status> ready;
   std::future<Status> made = ready.get_future();
   thread_ = std::thread([this, p = std::move(ready)]() mutable { run(std::move(p)); });
@@ -36,8 +48,8 @@ Status PhysicsThread::start() {
     stop();
     return s;
   }
-  if (file_.scene.tools.empty()) return {};
-  const ToolDesc& tool = file_.scene.tools[0];
+  if (driven_tool_.load() < 0) return {};
+  const ToolDesc& tool = file_.scene.tools[static_cast<std::size_t>(driven_tool_.load())];
   mouse_.place(tool.position);
   haptics::HapticLoopSettings settings;
   // The viewer is no real-time haptic rig: an ordinary thread (no
@@ -69,11 +81,18 @@ void PhysicsThread::stop() {
 Status PhysicsThread::make_simulation() {
   bridge_.reset();
   player_.reset();
+  hands_.reset();
   sim_.reset();  // the old device goes first: two at once may not fit
   auto sim = Simulation::create(file_.scene, device_options_);
   if (!sim) return sim.error();
   sim_.emplace(std::move(*sim));
   player_.emplace(file_.script);
+  // The file's scripted hands, on the frames' clock (they follow simulated time, as in sinew run).
+  if (!file_.hands.empty()) {
+    auto hands = haptics::ScriptedHands::create(file_.hands, *sim_, file_.scene.solver.time_step);
+    if (!hands) return hands.error();
+    hands_ = std::move(*hands);
+  }
   bridged_tool_ = -1;
   ++generation_;
   frame_ = 0;
@@ -122,7 +141,7 @@ void PhysicsThread::refresh_shapes() {
 }
 
 Status PhysicsThread::step_frame() {
-  const int tool = driven_tool_.load();
+  const int tool = scripted(driven_tool_.load()) ? -1 : driven_tool_.load();
   if (tool != bridged_tool_) {
     bridge_.reset();
     if (tool >= 0 && static_cast<std::size_t>(tool) < file_.scene.tools.size()) {
@@ -134,6 +153,8 @@ Status PhysicsThread::step_frame() {
   }
   if (bridge_)
     if (Status s = bridge_->apply_feedback(*sim_); !s) return s;
+  if (hands_)
+    if (Status s = hands_->before_step(*sim_); !s) return s;
   results_.clear();
   const int frame = static_cast<int>(frame_ + 1);
   if (Status s = player_->before_frame(*sim_, frame, results_); !s) return s;
@@ -149,6 +170,8 @@ Status PhysicsThread::step_frame() {
     for (const TopologyEvent& e : sim_->topology().last_tears()) note_change(e);
   if (bridge_)
     if (Status s = bridge_->publish(*sim_); !s) return s;
+  if (hands_)
+    if (Status s = hands_->after_step(*sim_); !s) return s;
   return {};
 }
 

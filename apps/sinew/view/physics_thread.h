@@ -18,6 +18,7 @@
 
 #include "sinew/haptics/clock.h"
 #include "sinew/haptics/haptic_loop.h"
+#include "sinew/haptics/scripted_hands.h"
 #include "sinew/haptics/tool_bridge.h"
 #include "sinew/scene_file.h"
 #include "sinew/simulation.h"
@@ -37,8 +38,10 @@ class PhysicsThread {
   PhysicsThread& operator=(const PhysicsThread&) = delete;
 
   /// Makes the Simulation on the physics thread and starts stepping it, and
-  /// the haptic loop when the scene has a tool (the mouse's handle placed at
-  /// tool 0). Errors: the Simulation's (a backend not available, ...), the loop's.
+  /// the haptic loop when the scene has a tool no scripted hand of the file
+  /// drives (the mouse's handle placed at the first such tool; the file's
+  /// scripted hands play on theirs, on the frames' clock). Errors: the
+  /// Simulation's (a backend not available, ...), the loop's, the hands'.
   Status start();
   /// Stops the haptic loop and the physics thread. Idempotent.
   void stop();
@@ -50,7 +53,8 @@ class PhysicsThread {
   /// Remakes the Simulation from the scene (its first frame again).
   void reset() { reset_requested_.store(true); }
   /// Drives tool `tool` with the haptic loop from the next frame (the viewer
-  /// places the mouse's handle at it first).
+  /// places the mouse's handle at it first); a tool a scripted hand drives
+  /// stays the hand's (the mouse then drives nothing).
   void drive_tool(int tool) { driven_tool_.store(tool); }
   [[nodiscard]] int driven_tool() const { return driven_tool_.load(); }
 
@@ -69,6 +73,7 @@ class PhysicsThread {
   void run(std::promise<Status> ready);
   Status make_simulation();
   Status step_frame();
+  [[nodiscard]] bool scripted(int tool) const;
   void note_change(const TopologyEvent& event);
   void refresh_shapes();
   Status fill_snapshot(ViewSnapshot& out);
@@ -86,6 +91,7 @@ class PhysicsThread {
   std::optional<Simulation> sim_;
   std::optional<ScriptPlayer> player_;
   std::optional<haptics::HapticToolBridge> bridge_;
+  std::unique_ptr<haptics::ScriptedHands> hands_;  // the file's scripted hands
   int bridged_tool_ = -1;
   std::uint64_t generation_ = 0, frame_ = 0, shape_version_ = 0, surfaces_version_ = UINT64_MAX;
   std::vector<std::vector<std::array<std::uint32_t, 3>>> tet_surfaces_, tri_surfaces_;
