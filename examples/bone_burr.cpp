@@ -1,13 +1,14 @@
-// bone_burr — a burr cuts a groove across the tibia's plateau (issue 14,
-// part 5). A scripted haptic device drives the burr, a rigid tool shaped by
-// a level set, through the virtual coupling (Colgate et al. 1995); the
-// bone is a level-set collider built from the tibia's surface with its
-// whole inside stored; each tick the burr's penalty against the bone
-// (voxmap-pointshell, ToolDesc) pushes it back and the bone it presses
-// deeper than --cut-depth is removed (Simulation::cut_collider along the
-// burr's motion), so the force the hand feels while cutting is the
-// penalty at that depth. Physics and the haptic loop run in lockstep at
-// 1 kHz on a virtual clock (deterministic); the wall time of each tick's
+// bone_burr — a burr cuts a groove across the tibia's plateau. A scripted
+// haptic device drives the burr, a rigid tool shaped by a level set,
+// through the virtual coupling (Colgate et al. 1995); the bone is a
+// level-set collider built from the tibia's surface with its inside stored;
+// each tick the burr's penalty against the bone (voxmap-pointshell,
+// ToolDesc) pushes it back and the bone it presses deeper than --cut-depth
+// is removed (ToolDesc::cuts: the bone cut along the burr's motion after
+// every frame), so the force the hand feels while cutting is the penalty
+// at that depth. Physics and the haptic loop run in lockstep at 1 kHz on a
+// virtual clock (haptics::ScriptedHands: deterministic, and what
+// `sinew run scenes/bone_burr.json` gives); the wall time of each tick's
 // work is measured and reported against the 1 ms a tick has.
 //
 // Writes into the output folder:
@@ -20,6 +21,8 @@
 //   bone_burr.pvd     every --surface-every ticks, as a ParaView series
 //   burr_*.vtu,       the burr's surface at the same ticks
 //   burr.pvd
+//   scene.pvd         the whole scene (the bone's whole surface and the burr,
+//                     the runner's blocks) at the first and the last tick
 //
 //   bone_burr --help   (the options, their defaults and units)
 #include <algorithm>
@@ -36,11 +39,12 @@
 #include "command_line.h"
 #include "sinew/haptics/clock.h"
 #include "sinew/haptics/haptic_loop.h"
-#include "sinew/haptics/scripted_device.h"
-#include "sinew/haptics/tool_bridge.h"
+#include "sinew/haptics/keyframe_path.h"
+#include "sinew/haptics/scripted_hands.h"
 #include "sinew/level_set.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
+#include "sinew/vtk_output.h"
 #include "tool_surface.h"
 
 namespace {
@@ -64,6 +68,7 @@ constexpr double kRadius = 2e-3, kMass = 0.03;
 // sqrt(k_contact / M) dt = 0.5 below 2 at 1 kHz (ToolDesc).
 constexpr double kStiffness = 2.66e9, kDamping = 2e6;
 constexpr double kTick = 1e-3;  // [s]: physics and haptics at 1 kHz
+constexpr int kKeyEvery = 10;   // ticks between the hand path's keys
 
 // The script, relative to the plateau's surface under the device: from 3
 // mm above it down to 4 mm below over 1.5 s (the coupling's spring
@@ -77,6 +82,29 @@ double ramp(double t, double a, double b) {
   if (t <= a) return 0.0;
   if (t >= b) return 1.0;
   return 0.5 - 0.5 * std::cos(M_PI * (t - a) / (b - a));
+}
+
+// The surface's height at (top x, y): the highest triangle over that point
+// below top z + 5 mm (the same arithmetic as scenes/generators/bone_burr.py).
+double plateau_height(const sinew::TriMesh& mesh, const std::array<double, 3>& top, double y0, double y) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (const auto& t : mesh.triangles) {
+    const auto& a = mesh.vertices[t[0]];
+    const auto& b = mesh.vertices[t[1]];
+    const auto& c = mesh.vertices[t[2]];
+    // Only triangles near the groove (the generator's prefilter).
+    if (!(std::min({a[0], b[0], c[0]}) <= top[0] && top[0] <= std::max({a[0], b[0], c[0]}) &&
+          std::max({a[1], b[1], c[1]}) >= y0 - 1e-3 && std::min({a[1], b[1], c[1]}) <= y0 + kGroove + 1e-3))
+      continue;
+    const double d = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
+    if (d == 0.0) continue;
+    const double u = ((b[1] - c[1]) * (top[0] - c[0]) + (c[0] - b[0]) * (y - c[1])) / d;
+    const double v = ((c[1] - a[1]) * (top[0] - c[0]) + (a[0] - c[0]) * (y - c[1])) / d;
+    if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+    const double z = u * a[2] + v * b[2] + (1.0 - u - v) * c[2];
+    if (z <= top[2] + 5e-3) best = std::max(best, z);
+  }
+  return best;
 }
 
 int fail(const std::string& what) {
@@ -106,7 +134,8 @@ int main(int argc, char** argv) {
       "A burr cuts a groove across the tibia's plateau: a scripted haptic device drives the burr (a level-set\n"
       "tool) through the virtual coupling, physics and haptics in lockstep at 1 kHz on a virtual clock; the\n"
       "bone it presses deeper than --cut-depth is removed. Writes into --out: force_trace.csv (every tick),\n"
-      "force_trace.png (with gnuplot), bone_burr.pvd (the bone's surface around the groove) and burr.pvd.");
+      "force_trace.png (with gnuplot), bone_burr.pvd (the bone's surface around the groove), burr.pvd and\n"
+      "scene.pvd (the whole scene at the first and last tick, as `sinew run scenes/bone_burr.json` writes it).");
   opt.out = cli.default_out();
   cli.add_backend(opt.backend);
   cli.app().add_option("--voxel", opt.voxel, "The bone's voxel size [m]")->check(sinew::examples::greater_than(0));
@@ -135,34 +164,41 @@ int main(int argc, char** argv) {
 
   // Where to cut: the plateau (z is the bone's long axis), the highest
   // vertex moved 5 mm towards the bone's middle; the groove runs along y
-  // from there, the script following the surface's height along it
-  // (sampled before any cut, every 0.1 mm).
-  std::array<double, 3> top = mesh->vertices[0];
-  for (const auto& v : mesh->vertices)
-    if (v[2] > top[2]) top = v;
-  const auto box = bone->bounds();
-  for (int k = 0; k < 2; ++k) top[k] += top[k] < 0.5 * (box[k] + box[k + 3]) ? 5e-3 : -5e-3;
+  // from there, the path following the surface's height along it (the
+  // STL's triangles, every 0.1 mm; scenes/generators/bone_burr.py does the
+  // same arithmetic for the scene file).
+  std::array<double, 3> top = mesh->vertices[mesh->triangles[0][0]];
+  std::array<double, 3> lo = top, hi = top;
+  for (const auto& t : mesh->triangles)
+    for (std::uint32_t v : t) {
+      const auto& p = mesh->vertices[v];
+      if (p[2] > top[2]) top = p;
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    }
+  for (int k = 0; k < 2; ++k) top[k] += top[k] < 0.5 * (lo[k] + hi[k]) ? 5e-3 : -5e-3;
   const double y0 = top[1] - 0.5 * kGroove;
   std::vector<double> height;  // the surface's z at y0 + i * 0.1 mm
-  for (int i = 0; i <= 100; ++i) {
-    std::array<double, 3> p{top[0], y0 + i * kGroove / 100, top[2] + 5e-3};
-    while (bone->value(p) > 0.0 && p[2] > box[2]) p[2] -= 1e-5;
-    height.push_back(p[2]);
-  }
+  for (int i = 0; i <= 100; ++i) height.push_back(plateau_height(*mesh, top, y0, y0 + i * kGroove / 100));
   const auto surface_z = [height, y0](double y) {
     const double u = std::clamp((y - y0) / kGroove * 100, 0.0, 100.0);
     const auto i = std::min<std::size_t>(static_cast<std::size_t>(u), 99);
     return height[i] + (u - double(i)) * (height[i + 1] - height[i]);
   };
   const std::array<double, 3> surface{top[0], top[1], surface_z(top[1])};
-  auto hand = [x = top[0], y0, surface_z](double t) {
-    ScriptedPose p;
+  // The hand: down into the plateau, along the groove, out; keys every 10
+  // ms of that motion, straight lines between them.
+  const auto hand_at = [x = top[0], y0, surface_z](double t) {
     const double y = y0 + kGroove * ramp(t, 0.3 + kDown, 0.3 + kDown + kAlong);
     const double depth = kAbove - (kAbove + kBelow) * ramp(t, 0.3, 0.3 + kDown) +
                          (kBelow + kLift) * ramp(t, 0.3 + kDown + kAlong, kDuration - 0.2);
-    p.position = {x, y, surface_z(y) + depth};
-    return p;
+    return std::array<double, 3>{x, y, surface_z(y) + depth};
   };
+  const int ticks = static_cast<int>(std::lround(kDuration / kTick));
+  std::vector<PathKey> keys;
+  for (int tick = 0; tick <= ticks; tick += kKeyEvery) keys.push_back({.time = tick * kTick, .position = hand_at(tick * kTick)});
+  auto path = KeyframePath::create(std::move(keys), PathInterpolation::linear);
+  if (!path) return fail(path.error().message());
+  const ScriptedPose start = path->at(0.0);
 
   // ------------------------------------------------------------ the scene
   sinew::SceneDesc scene;
@@ -173,7 +209,7 @@ int main(int argc, char** argv) {
   collider.level_set = *bone;  // shared: cut_collider cuts this grid
   scene.colliders.push_back(collider);
   auto ball = sinew::LevelSet::sphere({0, 0, 0}, kRadius, {.voxel_size = kRadius / 8, .exterior_band = kRadius / 2,
-                                                          .interior_band = std::numeric_limits<double>::infinity()});
+                                                          .interior_band = kRadius});
   if (!ball) return fail(ball.error().message());
   sinew::ToolDesc burr;
   burr.shape = sinew::ToolShape::level_set;
@@ -182,9 +218,11 @@ int main(int argc, char** argv) {
   burr.penalty_damping = kDamping;
   burr.mass = kMass;
   burr.inertia = {2.5e-5, 2.5e-5, 2e-6};
-  const ScriptedPose start = hand(0.0);
   burr.position = start.position;
   burr.gravity = false;  // the hand carries the instrument
+  // It removes the bone its motion sweeps deeper than cut_depth, after every frame.
+  burr.cuts = sinew::ToolCutDesc{.collider = 0,
+                                 .cutter = {.kind = sinew::CutterShape::Kind::sphere, .radius = kRadius - opt.cut_depth}};
   scene.tools.push_back(burr);
   auto sim = sinew::Simulation::create(scene, {.backend = opt.backend, .quiet = true});
   if (!sim) return fail(sim.error().message());
@@ -194,25 +232,22 @@ int main(int argc, char** argv) {
   if (!burr_id || !bone_id) return fail("the scene lacks its burr or bone");
 
   // ------------------------------------------------------------ the haptic side
-  VirtualClock clock{0};
-  SnapshotChannel snapshots;
-  FeedbackChannel feedback;
-  ScriptedDevice device(hand);
-  if (auto s = device.start(0); !s) return fail(s.error().message());
-  HapticLoopSettings settings;
-  settings.realtime = false;  // ticked here, in lockstep with the physics
-  const int ticks = static_cast<int>(std::lround(kDuration / kTick));
-  settings.telemetry_capacity = static_cast<std::size_t>(ticks + 1);
-  auto loop = HapticLoop::create(settings, device, snapshots, feedback, clock);
-  if (!loop) return fail(loop.error().message());
-  HapticToolBridge bridge(0, snapshots, feedback, clock);
+  // Ticked here, in lockstep with the physics (a tick before each frame).
+  ScriptedHandDesc hand;
+  hand.path = *path;  // tool 0
   // Damps the burr's own motion (not felt; tool_bridge.h): 2 N s/m x 1 ms / 30 g = 0.07.
-  if (auto s = bridge.set_damping(2.0, 1e-4); !s) return fail(s.error().message());
-  if (auto s = bridge.publish(*sim); !s) return fail(s.error().message());
+  hand.tool_damping = 2.0;
+  hand.tool_angular_damping = 1e-4;
+  auto hands = ScriptedHands::create({hand}, *sim, kTick);
+  if (!hands) return fail(hands.error().message());
+  const HapticLoop& loop = (*hands)->loop(0);
   std::printf("bone_burr on %s: the tibia at %.2f mm voxels (%.2f M voxels, built in %.0f ms); a %.0f mm burr, %zu "
               "ticks at 1 kHz\n",
               sim->device_name().c_str(), opt.voxel * 1e3, double(bone->voxels()) * 1e-6, build_ms, 2e3 * kRadius,
               static_cast<std::size_t>(ticks));
+  auto output = sinew::SceneOutput::create(scene, opt.out);
+  if (!output) return fail(output.error().message());
+  if (auto s = output->write(*sim, 0); !s) return fail(s.error().message());
 
   // ------------------------------------------------------------ the run
   const std::string trace = opt.out + "/force_trace.csv";
@@ -220,7 +255,6 @@ int main(int argc, char** argv) {
   if (!csv) return fail("cannot write " + trace);
   std::fprintf(csv, "time,device_x,device_y,device_z,burr_x,burr_y,burr_z,force_x,force_y,force_z,force,"
                     "bone_push_x,bone_push_y,bone_push_z,points_in_bone,removed_mm3,step_ms,cut_ms,haptic_ms,surface_z\n");
-  const sinew::CutterShape cutter{.kind = sinew::CutterShape::Kind::sphere, .radius = kRadius - opt.cut_depth};
   // The region the burr works in, for the surfaces written (the whole bone
   // would be about a million triangles): the groove and 8 mm around it.
   const std::array<double, 6> region{surface[0] - 8e-3, surface[1] - 0.5 * kGroove - 8e-3, surface[2] - 8e-3,
@@ -229,39 +263,36 @@ int main(int argc, char** argv) {
   std::vector<double> times, tick_ms, step_ms, cut_ms, cutting_force;
   double removed = 0.0, peak = 0.0, surface_ms = 0.0;
   std::uint64_t changed_bytes = 0;
-  sinew::Pose from{.position = start.position};
+  std::vector<TickRecord> record;
   for (int tick = 1; tick <= ticks; ++tick) {
     const auto t0 = Wall::now();
-    if (auto s = bridge.apply_feedback(*sim); !s) return fail(s.error().message());
-    if (auto s = sim->step(); !s) return fail(s.error().message());
-    const double step = ms_since(t0);
+    if (auto s = (*hands)->before_step(*sim); !s) return fail(s.error().message());  // the tick, the coupling's force
+    const double before = ms_since(t0);
+    const auto t1 = Wall::now();
+    if (auto s = sim->step(); !s) return fail(s.error().message());  // the burr moves, then cuts
+    const double step = ms_since(t1);
+    const auto t2 = Wall::now();
+    if (auto s = (*hands)->after_step(*sim); !s) return fail(s.error().message());
+    const double haptic = before + ms_since(t2);
     auto state = tools.state(*burr_id);
     if (!state) return fail(state.error().message());
-    // The bone the burr's motion in this tick swept deeper than cut_depth.
-    const auto t1 = Wall::now();
-    const sinew::Pose to{.position = state->position, .rotation = state->rotation};
-    auto cut = tools.cut(*bone_id, cutter, from, to);
-    if (!cut) return fail(cut.error().message());
-    from = to;
-    removed += cut->removed_volume;
-    for (const auto& range : cut->changed_bytes) changed_bytes += range[1];
-    const double cutting = ms_since(t1);
-    const auto t2 = Wall::now();
-    if (auto s = bridge.publish(*sim); !s) return fail(s.error().message());
-    const TickRecord r = (*loop)->tick();
-    clock.advance(seconds_to_ns(kTick));
-    const double haptic = ms_since(t2);
-    tick_ms.push_back(step + cutting + haptic);
-    step_ms.push_back(step);
+    const double cutting = sim->last_frame().stage_ms("tool cuts");
+    removed += state->cut_volume;
+    changed_bytes += static_cast<std::uint64_t>(sim->last_frame().counter("tool cuts", "changed_bytes"));
+    if (auto s = loop.copy_telemetry(record); !s) return fail(s.error().message());
+    const TickRecord& r = record.back();
+    tick_ms.push_back(step + haptic);
+    step_ms.push_back(step - cutting);
     cut_ms.push_back(cutting);
     const double force = std::sqrt(r.force[0] * r.force[0] + r.force[1] * r.force[1] + r.force[2] * r.force[2]);
     peak = std::max(peak, force);
-    if (cut->removed_volume > 0.0) cutting_force.push_back(force);
+    if (state->cut_volume > 0.0) cutting_force.push_back(force);
     std::fprintf(csv, "%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%u,%.5f,%.4f,%.4f,%.4f,%.6f\n",
                  tick * kTick, r.device_position[0], r.device_position[1], r.device_position[2], state->position[0],
                  state->position[1], state->position[2], r.force[0], r.force[1], r.force[2], force,
                  state->penalty_force[0], state->penalty_force[1], state->penalty_force[2], state->penalty_points,
-                 removed * 1e9, step, cutting, haptic, surface_z(r.device_position[1]));
+                 removed * 1e9, step - cutting, cutting, haptic, surface_z(r.device_position[1]));
+    const sinew::Pose to{.position = state->position, .rotation = state->rotation};
     if (tick % opt.surface_every == 0 || tick == ticks) {  // the display's rate, not the haptic one
       const auto t3 = Wall::now();
       auto part = bone->surface_in(region);
@@ -278,6 +309,7 @@ int main(int argc, char** argv) {
     }
   }
   std::fclose(csv);
+  if (auto s = output->write(*sim, ticks); !s) return fail(s.error().message());
   if (auto s = sinew::write_pvd(opt.out + "/bone_burr.pvd", files, times); !s) return fail(s.error().message());
   if (auto s = sinew::write_pvd(opt.out + "/burr.pvd", burr_files, times); !s) return fail(s.error().message());
 
@@ -315,7 +347,7 @@ int main(int argc, char** argv) {
     std::printf("gnuplot not found (apt-get install gnuplot-nox): no plot, CSV only\n");
   }
 
-  const HapticCounters c = (*loop)->counters();
+  const HapticCounters c = loop.counters();
   std::printf("removed %.2f mm^3 of bone (%llu bytes re-uploaded in all); force while cutting %.3f N median over %zu "
               "ticks, peak %.3f N; %llu clamped, %llu slew-limited ticks\n",
               removed * 1e9, static_cast<unsigned long long>(changed_bytes), median(cutting_force),
@@ -324,7 +356,8 @@ int main(int argc, char** argv) {
   std::printf("per tick: %.3f ms median, %.3f ms p99 (step %.3f, cut %.3f ms median) of the 1 ms a tick has; "
               "surface of the region %.0f ms at most\n",
               median(tick_ms), quantile(tick_ms, 0.99), median(step_ms), median(cut_ms), surface_ms);
-  std::printf("wrote %s and %zu surfaces; open %s/bone_burr.pvd and burr.pvd in ParaView\n", trace.c_str(), files.size(),
-              opt.out.c_str());
+  std::printf("wrote %s and %zu surfaces; open %s/bone_burr.pvd and burr.pvd (or scene.pvd: the whole bone at the "
+              "start and the end) in ParaView\n",
+              trace.c_str(), files.size(), opt.out.c_str());
   return 0;
 }

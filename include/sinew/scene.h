@@ -401,6 +401,22 @@ inline constexpr double kTrocarPoseTolerance = 1e-5;
 /// stretches as the port holds the tool back. The initial pose must put
 /// the shaft line within kTrocarPoseTolerance of the pivot (a named
 /// error otherwise); the rest is projected when the scene is created.
+/// A tool that removes a level-set collider's material as it moves (a
+/// burr, a drill, a saw; ToolDesc::cuts): after each frame the collider is
+/// cut (Tools::cut) by `cutter`, swept from the tool's pose at the frame's
+/// start to its pose at the end, the cutter in the tool's frame (centred at
+/// its origin; a capsule along its y). A cutter a little smaller than the
+/// tool's own shape removes only what the tool presses deeper than the
+/// difference, so the tool's penalty against the bone is the force felt
+/// while cutting. The collider must be a level set with its inside stored
+/// (LevelSet::cut); the cut is done on the host and the changed leaves
+/// uploaded, as Tools::cut does (a saved state from before it no longer
+/// restores: the grid is not part of it).
+struct ToolCutDesc {
+  std::uint32_t collider = 0;  ///< the level-set collider it cuts (SceneDesc::colliders index)
+  CutterShape cutter;          ///< its shape [m], in the tool's frame
+};
+
 struct ToolDesc {
   ToolShape shape = ToolShape::capsule;  ///< a capsule, or a level set's shape
   double radius = 0.005;                                ///< capsule [m], > 0
@@ -420,6 +436,8 @@ struct ToolDesc {
   double compliance = 0.0;                              ///< of its contacts [m/N]
   /// A trocar its shaft passes through (see above); none by default.
   std::optional<TrocarDesc> trocar;
+  /// A collider it cuts as it moves (ToolCutDesc); none by default.
+  std::optional<ToolCutDesc> cuts;
 };
 
 /// How a needle moves (NeedleDesc::drive).

@@ -40,6 +40,9 @@ struct ToolState {
   std::array<double, 3> trocar_force{};
   std::array<double, 3> trocar_torque{};
   ///@}
+  /// A cutting tool's (ToolDesc::cuts) removed volume of its collider in
+  /// the last frame [m^3], measured on the grid (CutReport::removed_volume).
+  double cut_volume = 0.0;
 };
 
 /// A handle on a Simulation's tools, colliders and targets; a view of the

@@ -1,15 +1,13 @@
 #!/usr/bin/env python3
 """Writes scenes/bone_burr.json: examples/bone_burr.cpp as a scene file.
 
-The example drives a burr (a level-set tool, 30 g, its penalty against the
-bone) through a virtual coupling from a scripted haptic device, ticked in
-lockstep with the physics at 1 kHz, and removes the bone the burr's own
-motion sweeps. A scene file has no haptic loop: here the device's scripted
-path is the burr's keyframed pose (a kinematic level-set collider, a key
-every 10 ms) and the bone is cut along that path (a cut_collider action
-every 10 ms, the example's cutter). The path follows the plateau's height
-along the groove, which the example samples from its level set and this
-from the STL's triangles (within a voxel of it).
+A scripted haptic device drives the burr (a level-set tool, 30 g, its
+penalty against the bone) through a virtual coupling, its haptic loop ticked
+in lockstep with the physics at 1 kHz on a virtual clock; the burr cuts the
+bone along its own motion after every frame (the tool's "cuts"). The hand's
+path follows the plateau's height along the groove, taken from the STL's
+triangles with the example's arithmetic, as keys every 10 ms (straight
+lines between them), so `sinew run` and the example give the same run.
 
     scenes/generators/bone_burr.py DATA_DIR > scenes/bone_burr.json
 
@@ -28,7 +26,7 @@ TICK = 1e-3
 ABOVE, BELOW, LIFT, GROOVE = 3e-3, 4e-3, 8e-3, 0.01
 DOWN, ALONG, UP = 1.5, 4.0, 1.0
 DURATION = 0.3 + DOWN + ALONG + UP + 0.2
-EVERY = 10  # ticks between keys and cuts
+EVERY = 10  # ticks between the path's keys
 
 
 def read_stl(path):
@@ -90,47 +88,34 @@ def hand(t):
 
 
 ticks = round(DURATION / TICK)
-keys, actions = [], []
-last = hand(0.0)
-for tick in range(0, ticks + 1, EVERY):
-    at = hand(tick * TICK)
-    keys.append({"frame": tick, "position": at})
-    if tick > 0 and at != last:
-        actions.append({"frame": tick, "do": "cut_collider", "collider": 0,
-                        "cutter": {"kind": "sphere", "radius": RADIUS - CUT_DEPTH},
-                        "from": {"position": last}, "to": {"position": at}})
-    last = at
+keys = [{"time": tick * TICK, "position": hand(tick * TICK)} for tick in range(0, ticks + 1, EVERY)]
 
 scene = {
     "format": "sinew-scene",
     "version": 1,
     "description": "A burr cuts a 10 mm groove across the tibia's plateau (examples/bone_burr.cpp; written by "
-                   "scenes/generators/bone_burr.py). Differences from the example: the example drives a 30 g "
-                   "level-set tool through a virtual coupling from a scripted haptic device in a 1 kHz haptic loop, "
-                   "and removes the bone the tool's own motion sweeps (the bone's penalty holds it back: the "
-                   "coupling stretches and the groove is shallower than the hand's path); a haptic loop is not part "
-                   "of a scene file, so here the example's burr tool is declared but not driven (it stays at its "
-                   "start, 3 mm above the plateau), and a kinematic level-set ball (collider 1) follows the device's path (a key "
-                   "every 10 ms) and the bone is cut along that path (every 10 ms): the full 4 mm deep groove, no "
-                   "force rendered. The bone keeps its whole inside to 5 cm (the example: an unbounded band); the "
-                   "path's heights come from the STL's triangles (the example samples its level set).",
+                   "scenes/generators/bone_burr.py). A scripted haptic device drives the 30 g burr (a level-set "
+                   "tool) through a virtual coupling, its 1 kHz haptic loop ticked between the frames on a virtual "
+                   "clock, and the burr removes the bone its own motion sweeps deeper than 0.1 mm (its \"cuts\"), "
+                   "so the bone's push holds it back and the hand feels it: the same run as the example.",
     "run": {"frames": ticks, "every": 500},
     "gravity": [0.0, 0.0, -9.81],
     "solver": {"time_step": TICK, "substeps": 1, "iterations": 1, "measure_errors": False},
     "colliders": [
         {"shape": "level_set",
          "level_set": {"file": "data:" + stl, "scale": 1e-3, "voxel_size": VOXEL, "exterior_band": 3.0 * VOXEL,
-                       "interior_band": 0.05}},
-        {"shape": "level_set", "position": hand(0.0),
-         "level_set": {"sphere": {"centre": [0.0, 0.0, 0.0], "radius": RADIUS}, "voxel_size": RADIUS / 8,
-                       "exterior_band": RADIUS / 2, "interior_band": RADIUS}},
+                       "interior_band": "whole"}},
     ],
-    # The example's burr, as it declares it: with no haptic loop to pull it,
-    # it stays where it starts, 3 mm above the plateau (gravity off).
     "tools": [{"shape": "level_set", "position": hand(0.0), "gravity": False,
                "level_set": {"sphere": {"centre": [0.0, 0.0, 0.0], "radius": RADIUS}, "voxel_size": RADIUS / 8,
                              "exterior_band": RADIUS / 2, "interior_band": RADIUS},
-               "penalty_stiffness": 2.66e9, "penalty_damping": 2e6, "mass": 0.03, "inertia": [2.5e-5, 2.5e-5, 2e-6]}],
-    "script": {"poses": [{"collider": 1, "keys": keys}], "actions": actions},
+               "penalty_stiffness": 2.66e9, "penalty_damping": 2e6, "mass": 0.03, "inertia": [2.5e-5, 2.5e-5, 2e-6],
+               "cuts": {"collider": 0, "cutter": {"kind": "sphere", "radius": RADIUS - CUT_DEPTH}}}],
+    "haptics": {"hands": [{
+        "tool": 0,
+        "path": {"interpolation": "linear", "keys": keys},
+        "tool_damping": 2.0,
+        "tool_angular_damping": 1e-4,
+    }]},
 }
 scene_json.write(scene, sys.stdout)

@@ -310,6 +310,27 @@ Status check_tool(const ToolDesc& t, const std::string& name) {
   return check_trocar(*t.trocar, t.position, t.rotation, name + ".trocar");
 }
 
+// A cutting tool's collider is a level set, and its cutter has a size.
+Status check_tool_cut(const SceneDesc& scene, const ToolCutDesc& cut, const std::string& name) {
+  if (cut.collider >= scene.colliders.size())
+    return Error(ErrorCode::bad_parameter, name + ".collider: collider " + std::to_string(cut.collider) +
+                                               " does not exist (the scene has " +
+                                               std::to_string(scene.colliders.size()) + ")");
+  if (scene.colliders[cut.collider].shape != ColliderShape::level_set)
+    return Error(ErrorCode::bad_parameter, name + ".collider: collider " + std::to_string(cut.collider) +
+                                               " is not a level set (only a level set can be cut)");
+  const CutterShape& c = cut.cutter;
+  if (c.kind == CutterShape::Kind::box) {
+    for (int k = 0; k < 3; ++k)
+      if (Status s = positive(name + ".cutter.half_extents[" + std::to_string(k) + "]", c.half_extents[k]); !s)
+        return s;
+    return {};
+  }
+  if (Status s = positive(name + ".cutter.radius", c.radius); !s) return s;
+  if (c.kind == CutterShape::Kind::capsule) return non_negative(name + ".cutter.half_height", c.half_height);
+  return {};
+}
+
 Status check_needle(const SceneDesc& scene, const NeedleDesc& n, const std::string& name) {
   if (n.curve.size() < 2)
     return Error(ErrorCode::bad_parameter,
@@ -484,6 +505,9 @@ Status check_scene(const SceneDesc& scene) {
   if (Status s = check_all(scene.line_bodies, "line_bodies", check_line_body); !s) return s;
   if (Status s = check_all(scene.colliders, "colliders", check_collider); !s) return s;
   if (Status s = check_all(scene.tools, "tools", check_tool); !s) return s;
+  for (std::size_t t = 0; t < scene.tools.size(); ++t)
+    if (scene.tools[t].cuts)
+      if (Status s = check_tool_cut(scene, *scene.tools[t].cuts, "tools[" + std::to_string(t) + "].cuts"); !s) return s;
   if (Status s = check_mesh_collision(scene); !s) return s;
   if (Status s = check_scene_fluid(scene); !s) return s;
   for (std::size_t i = 0; i < scene.needles.size(); ++i)

@@ -106,6 +106,8 @@ struct ToolBody {
   V3 pivot{};                  ///< world [m]
   V3 shaft_axis{0.0, 1.0, 0.0};  ///< unit, tool frame
   V3 trocar_force{}, trocar_torque{};  ///< the port's push over the last frame [N], about its centre [N m]
+
+  double cut_volume = 0.0;  ///< a cutting tool's (ToolDesc::cuts) removed volume in the last frame [m^3]
 };
 
 /// One semi-implicit Euler step of the tool over dt [s] from the applied

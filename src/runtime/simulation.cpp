@@ -172,6 +172,7 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
   Impl& im = *impl;
   if (compiled->external_forces) im.add_stage(make_forces_stage(im));
   if (im.fluid) im.add_stage(make_fluid_stage(im));
+  if (auto cuts = make_tool_cuts_stage(im, scene.tools)) im.add_stage(std::move(cuts));
   im.add_stage(make_tools_stage(im));
   if (im.mesh_collision) im.add_stage(make_mesh_collision_stage(im));
   if (im.sutures) im.add_stage(make_sutures_stage(im));

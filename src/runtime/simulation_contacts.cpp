@@ -334,6 +334,7 @@ Result<ToolState> Simulation::tool_state(std::size_t index) const {
   state.penalty_depth = b.penalty_depth;
   state.trocar_force = b.trocar_force;
   state.trocar_torque = b.trocar_torque;
+  state.cut_volume = b.cut_volume;
   return state;
 }
 
@@ -363,8 +364,13 @@ Result<NeedleState> Simulation::needle_state(std::size_t index) const {
 
 Result<CutReport> Simulation::cut_collider(std::size_t index, const CutterShape& shape, const Pose& from,
                                            const Pose& to) {
+  return impl_->cut_collider(index, shape, from, to);
+}
+
+Result<CutReport> Simulation::Impl::cut_collider(std::size_t index, const CutterShape& shape, const Pose& from,
+                                                 const Pose& to) {
   constexpr const char* call = "cut_collider";
-  ContactState& c = impl_->contacts;
+  ContactState& c = contacts;
   if (Status s = check_index(call, "collider", index, c.shapes.size()); !s) return s.error();
   ColliderDesc& collider = c.shapes[index];
   if (collider.shape != ColliderShape::level_set || !collider.level_set)
@@ -376,9 +382,9 @@ Result<CutReport> Simulation::cut_collider(std::size_t index, const CutterShape&
   // grids buffer, before the next frame reads them.
   const std::span<const std::byte> bytes = collider.level_set->nanovdb_bytes();
   const std::uint64_t base = c.level_set_offsets[index];
-  if (!report->changed_bytes.empty()) ++impl_->shape_generation;  // a saved state does not hold the grids
+  if (!report->changed_bytes.empty()) ++shape_generation;  // a saved state does not hold the grids
   for (const auto& [offset, size] : report->changed_bytes)
-    if (Status s = impl_->device->write_buffer(impl_->buffers.level_set_grids, base + offset, bytes.data() + offset,
+    if (Status s = device->write_buffer(buffers.level_set_grids, base + offset, bytes.data() + offset,
                                                size);
         !s)
       return s.error();

@@ -159,6 +159,8 @@ struct Simulation::Impl {
   /// continuous collision detection (after before_frame).
   [[nodiscard]] std::vector<FrameCapsule> frame_capsules() const;
   Status after_frame();   ///< settles what moved, takes each tool's reaction from device_stats
+  /// Cuts level-set collider `index` (Simulation::cut_collider; the tool cuts stage).
+  Result<CutReport> cut_collider(std::size_t index, const CutterShape& shape, const Pose& from, const Pose& to);
 
   // ---- Saved state and divergence (simulation_state.cpp, divergence_check.cpp).
   /// Changes of the scene's shape a saved state does not hold: topology

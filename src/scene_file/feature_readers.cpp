@@ -3,6 +3,7 @@
 // bodies) and mesh collision. Keys are
 // the fields of the structs in sinew/scene.h, enumerators their names.
 #include <cmath>
+#include <limits>
 
 #include "scene_file/readers.h"
 #include "sinew/mesh.h"
@@ -31,14 +32,22 @@ namespace {
 
 // A level set: {"file" (closed binary STL) and "scale" | "sphere": {"centre",
 // "radius"} | "box": {"min", "max"}}, with "voxel_size", "exterior_band"
-// and "interior_band" (LevelSetSettings).
+// and "interior_band" (LevelSetSettings; "whole": the whole inside stored,
+// infinity, as a level set that is cut needs).
 void read_level_set(const Json& v, const std::string& path, const Where& where, Context& ctx,
                     std::optional<LevelSet>& out) {
   Object o(v, path, ctx);
   LevelSetSettings settings;
   o.read("voxel_size", settings.voxel_size);
   o.read("exterior_band", settings.exterior_band);
-  o.read("interior_band", settings.interior_band);
+  if (const Json* band = o.find("interior_band")) {
+    if (band->is_string() && band->get_ref<const std::string&>() == "whole")
+      settings.interior_band = std::numeric_limits<double>::infinity();
+    else if (band->is_string() && !ctx.failed())
+      ctx.fail(ErrorCode::bad_input_file, o.path("interior_band"), "must be a number [m] or \"whole\" (the whole inside)");
+    else
+      read_double(*band, o.path("interior_band"), ctx, settings.interior_band);
+  }
   const int sources = o.has("file") + o.has("sphere") + o.has("box");
   if (!ctx.failed() && sources != 1)
     return ctx.fail(ErrorCode::bad_input_file, path, "needs exactly one of \"file\", \"sphere\" or \"box\"");
@@ -148,6 +157,14 @@ void read_tool(const Json& v, const std::string& path, const Where& where, Conte
     else if (!ctx.failed()) ctx.fail(ErrorCode::bad_input_file, trocar.path("pivot"), "is required");
     trocar.read("axis", d.axis);
     trocar.finish();
+  }
+  if (const Json* c = o.find("cuts")) {
+    Object cuts(*c, o.path("cuts"), ctx);
+    ToolCutDesc& d = out.cuts.emplace();
+    cuts.read("collider", d.collider, true);
+    if (const Json* cutter = cuts.find("cutter")) read_cutter(*cutter, cuts.path("cutter"), ctx, d.cutter);
+    else if (!ctx.failed()) ctx.fail(ErrorCode::bad_input_file, cuts.path("cutter"), "is required");
+    cuts.finish();
   }
   o.finish();
 }

@@ -1,11 +1,12 @@
 // stages.h — the stages of the frame (runtime/frame_stage.h), one file
 // each, registered in Simulation::create in this order:
-//   forces, fluid, tools, mesh collision, sutures, continuous collision,
+//   forces, fluid, tool cuts, tools, mesh collision, sutures, continuous collision,
 //   solve, statistics, tearing.
 // A stage a scene does not use is not registered.
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "runtime/frame_stage.h"
 #include "runtime/simulation_impl.h"
@@ -16,6 +17,10 @@ namespace sinew {
 std::unique_ptr<FrameStage> make_forces_stage(Simulation::Impl& sim);
 /// SceneDesc::fluid: the fluid's frame on the scene's device, coupled with the tissue.
 std::unique_ptr<FrameStage> make_fluid_stage(Simulation::Impl& sim);
+/// ToolDesc::cuts: the cutting tools' poses before the frame (registered
+/// before the tools stage), their collider cut along their motion after
+/// it; nullptr when no tool cuts.
+std::unique_ptr<FrameStage> make_tool_cuts_stage(Simulation::Impl& sim, const std::vector<ToolDesc>& tools);
 /// Colliders, targets and rigid tools: integrated and uploaded before the
 /// frame, settled (and the tools' reactions taken) after its statistics.
 std::unique_ptr<FrameStage> make_tools_stage(Simulation::Impl& sim);
