@@ -124,7 +124,7 @@ void bind_simulation(py::module_& m) {
            py::arg("play_script") = true, py::arg("cpu_adaptive_team") = true,
            "Makes the Simulation of `scene` on `backend` ('cpu', 'opencl', 'vulkan', 'auto'; default: the "
            "scene's run.backend), device (index or name substring), CPU worker `threads` (0: all). With "
-           "play_script, each step() first plays the scene's script for its frame.")
+           "play_script, each step() first plays the scene's script and scripted hands for its frame.")
       .def(
           "step",
           [](PySimulation& s) {

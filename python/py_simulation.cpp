@@ -38,6 +38,8 @@ PySimulation::PySimulation(const SceneFile& file, const DeviceOptions& device, b
 PySimulation::PySimulation(Simulation&& made, const SceneFile& file, bool play_script)
     : sim(std::move(made)), scene(file.scene), bodies(file.bodies) {
   if (play_script) player_.emplace(file.script);
+  // The file's scripted hands play with its script (on the frames' clock).
+  if (play_script && !file.hands.empty()) hands_ = take(haptics::ScriptedHands::create(file.hands, sim, file.scene.solver.time_step));
   punctures_.resize(sim.needles().count());
 }
 
@@ -48,7 +50,11 @@ Status PySimulation::step(FrameStats* stats) {
   const int next = frame + 1;
   if (player_)
     if (Status s = player_->before_frame(sim, next, script_events_); !s) return s;
+  if (hands_)
+    if (Status s = hands_->before_step(sim); !s) return s;
   if (Status s = sim.step(); !s) return s;
+  if (hands_)
+    if (Status s = hands_->after_step(sim); !s) return s;
   frame = next;
   if (stats) *stats = sim.last_frame();
   return gather_events(script_events_);

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <mutex>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,6 +61,7 @@ class PySimulation {
   Status gather_events(std::vector<ScriptEvent>& script_events);
 
   std::optional<ScriptPlayer> player_;
+  std::unique_ptr<haptics::ScriptedHands> hands_;  // the file's scripted hands, played with the script
   std::vector<ScriptEvent> script_events_;          // reused each frame
   std::vector<std::vector<Puncture>> punctures_;    // each needle's punctures after the last frame
 };

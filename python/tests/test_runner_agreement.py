@@ -43,3 +43,16 @@ def test_without_the_script_the_scene_differs(scenes):
     played.run(9)
     unplayed.run(9)
     assert not np.array_equal(played.read_positions(), unplayed.read_positions())
+
+
+def test_scripted_hands_equal_the_runner(scenes, runner_positions):
+    # haptic_drag's probe is driven by a scripted hand through the haptic
+    # loop, ticked between the frames: Python plays it as the runner does.
+    scene = sinew.load_scene_file(scenes / "haptic_drag.json")
+    sim = sinew.Simulation(scene, backend="cpu")
+    sim.run(400)  # through the press (0.5-1.5 s) into the drag
+    assert sim.read_positions().tobytes() == runner_positions(scenes / "haptic_drag.json", "cpu", 400).tobytes()
+    # Without the hand the probe stays where it starts: the tissue only sags.
+    still = sinew.Simulation(scene, backend="cpu", play_script=False)
+    still.run(400)
+    assert not np.array_equal(sim.read_positions(), still.read_positions())

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <exception>
 #include <new>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@ struct sinew_simulation {
   sinew::SceneFile file;
   std::optional<sinew::Simulation> sim;  // always engaged once created (Simulation has no default)
   std::optional<sinew::ScriptPlayer> player;
+  std::unique_ptr<sinew::haptics::ScriptedHands> hands;  // the file's scripted hands, played with the script
   bool play_script = true;
   int frames_done = 0;
   // Events of calls and script actions since the last step, and of the last frame.

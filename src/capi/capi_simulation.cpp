@@ -25,6 +25,11 @@ sinew_status create(const char* call, Result<SceneFile> file, const char* backen
   if (!sim) return fail(sim.error());
   handle->sim.emplace(std::move(*sim));
   handle->player.emplace(handle->file.script);
+  if (!handle->file.hands.empty()) {
+    auto hands = sinew::haptics::ScriptedHands::create(handle->file.hands, *handle->sim, handle->file.scene.solver.time_step);
+    if (!hands) return fail(hands.error());
+    handle->hands = std::move(*hands);
+  }
   handle->punctures.resize(handle->sim->needles().count());
   // Without topology changes a tet body's surface is its whole mesh's, for good.
   if (!handle->file.scene.topology_changes)
@@ -261,9 +266,13 @@ sinew_status sinew_step(sinew_simulation* sim) {
       for (const sinew::ScriptEvent& r : done)
         if (const sinew_event e = action_event(r, frame); e.kind != 0) sim->pending_events.push_back(e);
       if (!played) return fail(played.error());
+      if (sim->hands)
+        if (const sinew::Status s = sim->hands->before_step(*sim->sim); !s) return fail(s.error());
     }
     ++sim->frames_done;
     const sinew::Status stepped = sim->sim->step();
+    if (stepped && sim->play_script && sim->hands)
+      if (const sinew::Status s = sim->hands->after_step(*sim->sim); !s) return fail(s.error());
     sim->last_events = std::move(sim->pending_events);
     sim->pending_events.clear();
     step_events(*sim, frame, sim->last_events);

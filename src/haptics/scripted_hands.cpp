@@ -50,8 +50,10 @@ Result<std::unique_ptr<ScriptedHands>> ScriptedHands::create(std::vector<Scripte
 }
 
 Status ScriptedHands::before_step(Simulation& sim) {
-  ++frames_;
-  const auto end = static_cast<std::int64_t>(std::llround(double(frames_) * frame_s_ * 1e9));
+  // The coming frame's end, from the frames the Simulation has done (so
+  // frames stepped without the hands leave no lag: their ticks run now).
+  const std::uint64_t frame = sim.last_frame().frame + 1;
+  const auto end = static_cast<std::int64_t>(std::llround(double(frame) * frame_s_ * 1e9));
   // Tick k of a hand at round(k 1e9 / rate): each loop at its own rate, as
   // its device's servo scheduler would call it over this frame, all in the
   // order of time (the clock never goes back).

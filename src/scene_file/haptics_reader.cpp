@@ -87,7 +87,7 @@ void read_hand(const Json& v, const std::string& path, Context& ctx, haptics::Sc
       if (c == '.') c = '/';
     return ctx.fail(ErrorCode::bad_parameter, path + "/" + key, m.substr(space + 1));
   }
-  if (Status s = haptics::check(out.loop); !s) return ctx.fail(ErrorCode::bad_parameter, path, s.error().message());
+  // The loop's other settings are not in the file (their defaults hold); ScriptedHands checks them all.
   if (!(out.tool_damping >= 0.0) || !(out.tool_angular_damping >= 0.0) || !std::isfinite(out.tool_damping) ||
       !std::isfinite(out.tool_angular_damping))
     ctx.fail(ErrorCode::bad_parameter, path + (out.tool_damping >= 0.0 ? "/tool_angular_damping" : "/tool_damping"),

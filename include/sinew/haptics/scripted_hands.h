@@ -54,10 +54,12 @@ class ScriptedHands {
   static Result<std::unique_ptr<ScriptedHands>> create(std::vector<ScriptedHandDesc> hands, Simulation& sim,
                                                        double frame_seconds);
 
-  /// Before Simulation::step() makes frame f (f = 1, 2, ... in order):
-  /// moves the virtual clock through frame f's interval, ticking every loop
-  /// at each of its periods in it (tick k at round(k 1e9 / rate_hz) ns),
-  /// then applies each loop's mean force over the interval to its tool.
+  /// Before Simulation::step() makes frame f (f = the frames it has done +
+  /// 1): moves the virtual clock to frame f's end, f x frame_seconds,
+  /// ticking every loop at each of its periods up to it (tick k at
+  /// round(k 1e9 / rate_hz) ns; after frames stepped without the hands,
+  /// their ticks too), then applies each loop's mean force over the
+  /// interval to its tool.
   Status before_step(Simulation& sim);
   /// After Simulation::step(): publishes each tool's state to its loop.
   Status after_step(const Simulation& sim);
@@ -85,7 +87,6 @@ class ScriptedHands {
   ScriptedHands() = default;
   VirtualClock clock_{0};
   std::vector<std::unique_ptr<Hand>> hands_;
-  std::uint64_t frames_ = 0;
   double frame_s_ = 0.0;
 };
 
