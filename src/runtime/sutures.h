@@ -134,6 +134,16 @@ class Sutures {
   // triangle and weights. Counts the triangles refused on `needle`.
   bool first_crossing(const math::Vec3& a, const math::Vec3& b, bool entering, Needle& needle, Row& row);
   Status upload(Device& device);
+  // A blunt tip (NeedleDesc::tip_radius): adds a row (kind 5) for each
+  // surface vertex of surface `surface` its flat end meets this frame.
+  // [in] tip_start, tip_end: the tip at the frame's start and end; axis: its
+  // unit direction. Errors: more rows than a needle holds.
+  Status add_blunt_rows(Needle& n, std::size_t index, std::uint32_t surface, const math::Vec3& tip_start,
+                        const math::Vec3& tip_end, const math::Vec3& axis);
+  // Sets each puncture's inserted shaft length (weights[3], [m]) and cutting
+  // flag (words[7]) for the shaft's friction. [in] curve: the needle at the
+  // frame's start.
+  void set_shaft_lengths(Needle& n, const std::vector<math::Vec3>& curve);
 
   std::vector<Surface> surfaces_;
   std::vector<Needle> needles_;
