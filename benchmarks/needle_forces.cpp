@@ -13,7 +13,7 @@
 //     prints (and with --csv writes) E, frame, depth, force, tip force,
 //     punctured, inverted tets; then per E the force and depth at puncture,
 //     the pre-puncture stiffness (least-squares slope of force over depth
-//     between 10% and 60% of the puncture force) and the most inverted tets.
+//     between 0.2 and 1.2 mm) and the most inverted tets before puncture.
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
@@ -22,6 +22,10 @@
 
 #include "command_line.h"
 #include "needle_forces_scene.h"
+
+// The depths [m] over which the stiffness is the slope of force over depth:
+// the same for every E (a rounded tip stiffens as it goes in).
+constexpr double kFrom = 2e-4, kTo = 1.2e-3;
 
 int main(int argc, char** argv) {
   sinew::test::NeedlePushSettings s;
@@ -56,7 +60,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cannot write %s\n", csv.c_str());
     return 1;
   }
-  const char* header = "E_Pa,frame,depth_mm,force_N,tip_force_N,punctured,inverted_tets\n";
+  const char* header = "E_Pa,frame,depth_mm,force_N,tip_force_N,punctured,inverted_tets,punctures,pushing\n";
   std::printf("%s", header);
   if (out) std::fprintf(out, "%s", header);
   std::stringstream list(moduli);
@@ -81,14 +85,14 @@ int main(int argc, char** argv) {
     for (std::size_t f = 0; f < trace.size(); ++f) {
       const auto& t = trace[f];
       char line[160];
-      std::snprintf(line, sizeof line, "%g,%zu,%.4f,%.5f,%.5f,%d,%u\n", s.young, f + 1, t.depth * 1e3, t.force,
-                    t.tip_force, t.punctured ? 1 : 0, t.inverted_tets);
+      std::snprintf(line, sizeof line, "%g,%zu,%.4f,%.5f,%.5f,%d,%u,%zu,%d\n", s.young, f + 1, t.depth * 1e3,
+                    t.force, t.tip_force, t.punctured ? 1 : 0, t.inverted_tets, t.punctures, t.pushing ? 1 : 0);
       std::printf("%s", line);
       if (out) std::fprintf(out, "%s", line);
       if (!punctured) inverted = std::max(inverted, t.inverted_tets);
       if (!punctured && t.punctured && f > 0) at_force = trace[f - 1].tip_force, at_depth = t.depth;
       punctured = punctured || t.punctured;
-      if (!punctured && t.force >= 0.1 * s.puncture_force && t.force <= 0.6 * s.puncture_force)
+      if (!punctured && t.depth >= kFrom && t.depth <= kTo)
         sx += t.depth, sy += t.force, sxx += t.depth * t.depth, sxy += t.depth * t.force, ++n;
     }
     const double slope = n >= 2 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 0.0;

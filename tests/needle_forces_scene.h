@@ -74,6 +74,8 @@ struct NeedlePushSample {
   double force = 0.0;   // the reaction along the needle, against the push [N]
   double tip_force = 0.0;  // NeedleState::tip_force [N]
   bool punctured = false;  // the needle holds a puncture
+  std::size_t punctures = 0;  // how many
+  bool pushing = false;    // its tip pushes a surface
   std::uint32_t inverted_tets = 0;
   std::uint32_t refused_inverted = 0;
 };
@@ -98,6 +100,8 @@ inline Status push_needle(Simulation& sim, const NeedlePushSettings& s, double d
     sample.force = state->reaction_force[1];
     sample.tip_force = state->tip_force;
     sample.punctured = !state->punctures.empty();
+    sample.punctures = state->punctures.size();
+    sample.pushing = state->pushing;
     sample.inverted_tets = sim.last_frame().inverted_tets;
     sample.refused_inverted = state->refused_inverted;
     trace.push_back(sample);

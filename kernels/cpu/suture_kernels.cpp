@@ -112,7 +112,8 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
     float4* l = b.lambda + 3 * std::size_t{i};
     if (p.reset_lambda == 2u) l[2] = zero;
     if (p.reset_lambda == 1u) l[2] = l[2] + l[1];
-    if (p.reset_lambda != 0u) l[0] = zero, l[1] = zero;
+    // (l[0].z, the shaft's slide speed at the end of the last substep, carries over.)
+    if (p.reset_lambda != 0u) l[0] = float4{0.0f, 0.0f, l[0].z, 0.0f}, l[1] = zero;
     if (r[0].x == SINEW_SUTURE_DEAD) continue;
     const std::uint32_t n = r[0].y, points = b.table[2 + 2 * n];
     const float4 needle = b.needles[3 * n];
@@ -217,7 +218,7 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
     float weight = 0.0f;
     for (std::uint32_t k = 0; k < count; ++k) weight = weight + b.x[v[k]].w * (c[k] * c[k]);
     if (!(weight > 0.0f)) continue;
-    float lambda_n = l[0].x, lambda_t = l[0].y;
+    float lambda_n = l[0].x, lambda_t = l[0].y, slip = l[0].z;
     // The impulse given this substep, summed step by step: the directions
     // turn between sweeps, so lambda times the last direction is not it.
     float4 given = l[1];
@@ -263,17 +264,27 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       float4 slide = zero;
       for (std::uint32_t k = 0; k < count; ++k) slide = slide + c[k] * (b.x[v[k]] - b.prev[v[k]]);
       const float rel = dot3(tangent, slide - moved);
-      const float speed = std::fabs(rel) / p.h;
-      const float held = lambda_t - rel / weight;
+      const float held = lambda_t - rel / weight;  // the multiplier that stops the slide
+      const float magnitude = std::fabs(held);
       // The cutting force resists the needle advancing (the tissue held
       // towards the tip: held > 0) on the row of the body the tip is in.
       const float cutting = r[1].w == 1u && held > 0.0f ? cut : 0.0f;
       const float h2 = p.h * p.h;
-      // Karnopp: within the band it sticks up to the static level; beyond,
-      // Coulomb plus viscous; either way it may stop the slide, never reverse it.
-      const float limit = speed <= shaft.w ? (shaft.y * w.w + cutting) * h2
-                                           : (shaft.x * w.w + shaft.z * w.w * speed + cutting) * h2;
-      const float next = std::fabs(held) <= limit ? held : (held > 0.0f ? limit : -limit);
+      float limit = 0.0f;
+      if (slip <= shaft.w) {
+        // Karnopp: sliding slower than the band at the last substep's end,
+        // it sticks while the static level holds it, else breaks away at it.
+        limit = (shaft.y * w.w + cutting) * h2;
+      } else {
+        // Slipping: Coulomb, plus a viscous force on the slide that remains
+        // (implicit: b L h W of it, over 1 + b L h W, so that a large b
+        // brakes the slide without reversing it).
+        const float coulomb = (shaft.x * w.w + cutting) * h2;
+        const float k = shaft.z * w.w * p.h * weight;
+        limit = magnitude <= coulomb ? magnitude : (coulomb + k * magnitude) / (1.0f + k);
+      }
+      const float next = magnitude <= limit ? held : (held > 0.0f ? limit : -limit);
+      slip = std::fabs(held - next) * weight / p.h;
       apply(b, v, c, count, tangent, next - lambda_t);
       given = given + (next - lambda_t) * tangent;
       lambda_t = next;
@@ -292,7 +303,7 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       given = given + (next - lambda_t) * tangent;
       lambda_t = next;
     }
-    l[0] = float4{lambda_n, lambda_t, 0.0f, 0.0f};
+    l[0] = float4{lambda_n, lambda_t, slip, 0.0f};
     l[1] = float4{given.x, given.y, given.z, 0.0f};
   }
 }

@@ -328,8 +328,12 @@ Status Sutures::upload(Device& device) {
   if (table[0] == 0) return {};
   if (Status s = device.write_buffer(buffers_.rows, 0, words.data(), words.size() * 4); !s) return s;
   if (Status s = device.write_buffer(buffers_.weights, 0, weights.data(), weights.size() * 4); !s) return s;
-  const std::vector<float> zeros(std::size_t{table[0]} * 12, 0.0f);
-  return device.write_buffer(buffers_.lambda, 0, zeros.data(), zeros.size() * 4);
+  // The multipliers start at zero; a puncture's slide speed carries over.
+  std::vector<float> lambda(std::size_t{table[0]} * 12, 0.0f);
+  std::size_t k = 0;
+  for (const Needle& n : needles_)
+    for (const Row& r : n.rows) lambda[12 * k++ + 2] = r.slip;
+  return device.write_buffer(buffers_.lambda, 0, lambda.data(), lambda.size() * 4);
 }
 
 Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame) {
@@ -350,6 +354,7 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
     const Vec3 tip = end.back(), d = unit(math::sub(end.back(), end[end.size() - 2]));
     n.tip_force = 0.0;
     for (std::size_t k = 0; k < n.rows.size(); ++k) {
+      n.rows[k].slip = lambda[(at + k) * 12 + 2];
       std::copy_n(&words[(at + k) * 8], 8, n.rows[k].words.begin());
       std::copy_n(&weights[(at + k) * 4], 4, n.rows[k].weights.begin());
     }

@@ -103,6 +103,7 @@ class Sutures {
     std::array<float, 4> weights{};        // (wa, wb, wc, s)
     std::uint32_t surface = kNone, triangle = 0;
     bool exit = false;
+    float slip = 0.0f;  // a puncture's slide speed along the shaft at the last frame's end [m/s] (Karnopp's band)
   };
   struct Needle {
     NeedleDesc desc;
