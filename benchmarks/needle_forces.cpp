@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
       std::printf("%s", line);
       if (out) std::fprintf(out, "%s", line);
       if (!punctured) inverted = std::max(inverted, t.inverted_tets);
-      if (!punctured && t.punctured && f > 0) at_force = trace[f - 1].tip_force, at_depth = t.depth;
+      if (!punctured && t.punctured) at_force = t.tip_force, at_depth = t.depth;  // the frame whose push punctured
       punctured = punctured || t.punctured;
       if (!punctured && t.depth >= kFrom && t.depth <= kTo)
         sx += t.depth, sy += t.force, sxx += t.depth * t.depth, sxy += t.depth * t.force, ++n;
