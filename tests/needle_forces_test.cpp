@@ -12,6 +12,7 @@
 #include <cstdio>
 
 #include "needle_forces_scene.h"
+#include "sinew/scene_file.h"
 #include "test_support.h"
 
 namespace sinew::test {
@@ -197,6 +198,31 @@ TEST(NeedleForces, BadSettingsAreNamed) {
   named([](NeedleDesc& n) { n.shaft_viscous_friction = INFINITY; }, "shaft_viscous_friction");
   named([](NeedleDesc& n) { n.shaft_stick_velocity = 0.0; }, "shaft_stick_velocity");
   named([](NeedleDesc& n) { n.cutting_force = -0.1; }, "cutting_force");
+}
+
+// A scene file sets the fields (scenes/schema/scene.schema.json lists them);
+// a bad value is named with its path in the file.
+TEST(NeedleForces, SceneFilesSetTheFields) {
+  auto file = parse_scene_json(R"({"tet_bodies": [{"mesh": {"grid": {"cells": [2, 2, 2], "cell_size": [0.002, 0.002, 0.002]}}}],
+      "needles": [{"curve": [[0, 0.01, 0], [0, 0, 0]], "tip_radius": 0.004,
+      "shaft_friction": 10, "shaft_static_friction": 15, "shaft_viscous_friction": 100,
+      "shaft_stick_velocity": 0.002, "cutting_force": 0.05}]})",
+                               ".");
+  SINEW_ASSERT_OK(file);
+  ASSERT_EQ(file->scene.needles.size(), 1u);
+  const NeedleDesc& n = file->scene.needles[0];
+  EXPECT_EQ(n.tip_radius, 0.004);
+  EXPECT_EQ(n.shaft_friction, 10.0);
+  EXPECT_EQ(n.shaft_static_friction, 15.0);
+  EXPECT_EQ(n.shaft_viscous_friction, 100.0);
+  EXPECT_EQ(n.shaft_stick_velocity, 0.002);
+  EXPECT_EQ(n.cutting_force, 0.05);
+  auto bad = parse_scene_json(R"({"tet_bodies": [{"mesh": {"grid": {"cells": [2, 2, 2], "cell_size": [0.002, 0.002, 0.002]}}}],
+      "needles": [{"curve": [[0, 0.01, 0], [0, 0, 0]], "shaft_friction": 20,
+      "shaft_static_friction": 15}]})",
+                              ".");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message().find("/needles/0/shaft_friction"), std::string::npos) << bad.error().message();
 }
 
 }  // namespace
