@@ -5,7 +5,9 @@
 // interactive medical simulation toolkit (iMSTK)", Frontiers in Virtual
 // Reality 2023, section 2.5; Macklin, Müller, Chentanez, "XPBD", MIG 2016;
 // Macklin et al., "Unified Particle Physics", SIGGRAPH 2014, eq. 24-25 for
-// the thread's friction). The GPU twin (kernels/gpu/xpbd_sutures.gpu) does
+// the thread's friction; Karnopp, J. Dyn. Sys. Meas. Control 107(1), 1985, as
+// Okamura, Simone and O'Leary, IEEE TBME 51(10), 2004, fit it to needle
+// insertion, for the shaft's friction). The GPU twin (kernels/gpu/xpbd_sutures.gpu) does
 // the same float operations in the same order.
 #include <cmath>
 

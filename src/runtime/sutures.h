@@ -28,6 +28,13 @@
 // coupling, its stability bound and its limits), the rows' particles
 // standing for the tool's touching particles.
 //
+// Needle forces (docs/needles.md; Okamura, Simone and O'Leary, IEEE TBME
+// 51(10), 2004): a blunt tip (NeedleDesc::tip_radius) adds a row (kind 5)
+// for each surface vertex its rounded end meets, made afresh each frame
+// with the tip contact and pushing with it; each entering puncture of a tet
+// body carries the length of shaft inside that body and, for the body the
+// tip is in, the cutting force, for the kernel's Karnopp friction.
+//
 // Why the detection is on the host: a needle is one polyline and its tip
 // path one segment per frame, tested against the surfaces' triangles in a
 // linear pass (60,000 triangles: a fraction of a millisecond); the read-back
