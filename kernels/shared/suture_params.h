@@ -44,27 +44,34 @@
  *                  a thread the row becomes a thread puncture on the
  *                  thread's first segment, without one it ends (kind 0);
  *                  With NeedleDesc::shaft_friction and the others set
- *                  (needle words 4-8), friction along the shaft
- *                  (Karnopp, "Computer simulation of stick-slip friction
- *                  in mechanical dynamic systems", J. Dyn. Sys. 107(1),
- *                  1985, as Okamura, Simone and O'Leary, IEEE TBME 51(10),
- *                  2004, used it for needles): v the tissue point's slide
- *                  along the needle's tangent relative to the needle's
- *                  point (segment, u) over the substep, over h; L the
- *                  row's inserted shaft length (weights.w) [m]. Within
- *                  |v| <= v_band the multiplier holding the slide at zero
- *                  is kept up to (f_s L + cut) h^2 (stick); beyond it the
- *                  slide is resisted by (f_c L + b L |v| + cut) h^2,
- *                  never reversing it (slip). cut is the cutting force
- *                  while the needle advances, on the row whose body the tip
- *                  is inside (word 7 = 1);
+ *                  (binding 3's 2nd and 3rd float4), friction along the
+ *                  shaft (Karnopp, "Computer simulation of stick-slip
+ *                  friction in mechanical dynamic systems", J. Dyn. Sys.
+ *                  Meas. Control 107(1), 1985, as Okamura, Simone and
+ *                  O'Leary, IEEE TBME 51(10), 2004, used it for needles):
+ *                  along the needle's tangent, the tissue point's slide
+ *                  relative to the needle's own point (segment, u) over the
+ *                  substep; L the row's inserted shaft length (weights.w)
+ *                  [m]; v the slide speed at the end of the last substep
+ *                  (lambda.z, carried over substeps and frames). With
+ *                  |v| <= v_band the multiplier that stops the slide is
+ *                  kept up to (f_s L + cut) h^2 (stick; beyond, it breaks
+ *                  away at that level); else Coulomb (f_c L + cut) h^2
+ *                  plus the viscous b L v h^2 taken implicitly (of the
+ *                  multiplier m that would stop it, (coulomb + k m) /
+ *                  (1 + k) with k = b L h W), never reversing the slide.
+ *                  cut is the cutting force while the needle advances
+ *                  (m > 0), on the row of the body the tip is inside
+ *                  (word 7 = 1);
  *   5 blunt        one surface vertex x_a (weights (1, 0, 0)) kept ahead
- *                  of a blunt tip's flat end: C = d_tip . (x_a - tip) >=
- *                  0, no catch (it slides across the end). The host adds
- *                  one for every surface vertex within
- *                  NeedleDesc::tip_radius of the tip's axis while a tip
- *                  contact (kind 2) pushes, sums their push with its own
- *                  for the puncture, and drops them every frame;
+ *                  of a blunt tip's rounded end (a hemisphere of radius R
+ *                  = NeedleDesc::tip_radius, binding 3's 3rd float4 .y)
+ *                  along the tip's axis: C = d_tip . (x_a - tip) + R -
+ *                  sqrt(R^2 - r^2) >= 0, r the vertex's distance from the
+ *                  axis; no catch. The host adds one for every surface
+ *                  vertex within R of the tip's axis while a tip contact
+ *                  (kind 2) pushes, sums their push with its own for the
+ *                  puncture, and drops them every frame;
  *   4 thread       the tissue point held on the thread: q = (1 - s) x_i +
  *                  s x_{i+1} on segment i (s its closest point, the
  *                  segment followed to a neighbour when s leaves [0, 1],
@@ -100,7 +107,8 @@
  *     thread slot, thread vertices, segment)
  *   7 weights float4 [in/out]: per row (wa, wb, wc, s); a puncture's w
  *     is its inserted shaft length L [m] (the host's)
- *   8 lambda float4 [in/out]: 3 per row: (lambda, lambda_t, 0, 0); the
+ *   8 lambda float4 [in/out]: 3 per row: (lambda, lambda_t, v, 0), v a
+ *     puncture's slide speed along the shaft (kept by the host); the
  *     impulse vector the row gave the tissue (or the tied thread vertex)
  *     in this substep [kg m], the sum of each sweep's steps dlambda n +
  *     dlambda_t t (n and t turn between sweeps); the sum of the frame's
