@@ -488,6 +488,32 @@ struct NeedleDesc {
   int thread = -1;
   double thread_static_friction = 0.3;   ///< of the thread sliding through a puncture, >= 0
   double thread_dynamic_friction = 0.2;  ///< >= 0, <= thread_static_friction
+  // ---- Needle forces (docs/needles.md, "Needle forces"; all off by default:
+  // a point tip and a frictionless shaft, as before they existed).
+  /// A blunt tip: its end a flat disc of this radius [m], >= 0, finite (0:
+  /// a point). While it pushes an unpunctured surface, every surface vertex
+  /// of that body within this radius of the tip's axis is kept ahead of the
+  /// disc, so the push is shared by the tissue around the tip instead of one
+  /// point (which turns its tets inside out long before a puncture force of
+  /// 0.1-2 N). Set it to at least one element's edge; the rows it adds count
+  /// towards a needle's 64 (step() fails naming the needle past that).
+  double tip_radius = 0.0;
+  /// Friction along the shaft, a Karnopp stick-slip law acting where the
+  /// shaft passes through a punctured tet body, scaled by the length of
+  /// shaft inside it (Okamura, Simone and O'Leary, IEEE TBME 51(10), 2004).
+  /// Slipping (relative speed above shaft_stick_velocity): a Coulomb force
+  /// of this [N per m of inserted shaft], >= 0, plus shaft_viscous_friction
+  /// times the speed.
+  double shaft_friction = 0.0;
+  /// Sticking (relative speed within shaft_stick_velocity): holds the
+  /// tissue on the shaft up to this [N per m of inserted shaft], >=
+  /// shaft_friction.
+  double shaft_static_friction = 0.0;
+  double shaft_viscous_friction = 0.0;  ///< [N s/m per m of inserted shaft], >= 0
+  double shaft_stick_velocity = 1e-3;   ///< Karnopp's band [m/s], > 0: below it the shaft sticks
+  /// The force [N], >= 0, the tip needs to cut its way on through a tet
+  /// body it is inside (added to the shaft's friction while it advances).
+  double cutting_force = 0.0;
   NeedleDrive drive = NeedleDrive::kinematic;  ///< posed by the caller, or moved by force
   // ---- A force-driven needle's body (drive = force; ignored otherwise).
   // The needle's frame has its origin at the centre of mass and its axes

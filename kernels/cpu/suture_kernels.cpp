@@ -5,7 +5,9 @@
 // interactive medical simulation toolkit (iMSTK)", Frontiers in Virtual
 // Reality 2023, section 2.5; Macklin, Müller, Chentanez, "XPBD", MIG 2016;
 // Macklin et al., "Unified Particle Physics", SIGGRAPH 2014, eq. 24-25 for
-// the thread's friction). The GPU twin (kernels/gpu/xpbd_sutures.gpu) does
+// the thread's friction; Karnopp, J. Dyn. Sys. Meas. Control 107(1), 1985, as
+// Okamura, Simone and O'Leary, IEEE TBME 51(10), 2004, fit it to needle
+// insertion, for the shaft's friction). The GPU twin (kernels/gpu/xpbd_sutures.gpu) does
 // the same float operations in the same order.
 #include <cmath>
 
@@ -112,10 +114,13 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
     float4* l = b.lambda + 3 * std::size_t{i};
     if (p.reset_lambda == 2u) l[2] = zero;
     if (p.reset_lambda == 1u) l[2] = l[2] + l[1];
-    if (p.reset_lambda != 0u) l[0] = zero, l[1] = zero;
+    // (l[0].z, the shaft's slide speed at the end of the last substep, carries over.)
+    if (p.reset_lambda != 0u) l[0] = float4{0.0f, 0.0f, l[0].z, 0.0f}, l[1] = zero;
     if (r[0].x == SINEW_SUTURE_DEAD) continue;
     const std::uint32_t n = r[0].y, points = b.table[2 + 2 * n];
-    const float4 needle = b.needles[n];
+    const float4 needle = b.needles[3 * n];
+    const float4 shaft = b.needles[3 * n + 1];  // (f_c, f_s, b, v_band)
+    const float cut = b.needles[3 * n + 2].x;
     const float alpha = needle.x * p.inv_h2;
     const float4 w = b.weights[i];
     std::uint32_t v[5] = {r[0].z, r[0].w, r[1].x, 0, 0};
@@ -124,6 +129,8 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
     float4 dir = zero;
     float constraint = 0.0f;
     bool unilateral = false;
+    std::uint32_t near_segment = 0;  // a puncture's closest point on the needle
+    float near_u = 0.0f;
     const float4 p_now = tissue_point(b.x, v, w);
     if (r[0].x == SINEW_SUTURE_TIE) {
       const float4 d = b.x[v[0]] - curve_point(b, n, 0, t);
@@ -140,8 +147,24 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       if (dot3(dir, d_tip) < 0.0f) dir = float4{-dir.x, -dir.y, -dir.z, 0.0f};
       constraint = dot3(dir, p_now - tip);
       unilateral = true;
+    } else if (r[0].x == SINEW_SUTURE_BLUNT) {
+      // Kept ahead of the blunt tip's rounded end along the tip's axis: the
+      // end is a hemisphere of radius R, set back from the tip by
+      // R - sqrt(R^2 - r^2) at r from the axis (a flat end's rim, a step
+      // as deep as the dent, would shear the tets there).
+      const float4 tip = curve_point(b, n, points - 1, t);
+      dir = unit(tip - curve_point(b, n, points - 2, t));
+      const float4 off = p_now - tip;
+      const float ahead = dot3(dir, off);
+      const float radius = b.needles[3 * n + 2].y;
+      const float left = radius * radius - (dot3(off, off) - ahead * ahead);
+      const float sag = radius - std::sqrt(left > 0.0f ? left : 0.0f);
+      constraint = ahead + sag;
+      unilateral = true;
     } else if (r[0].x == SINEW_SUTURE_PUNCTURE) {
       const Closest q = closest_on_needle(b, n, p_now, t);
+      near_segment = q.segment;
+      near_u = q.u;
       const float4 d_tail = unit(curve_point(b, n, 1, t) - curve_point(b, n, 0, t));
       if (q.segment == 0 && q.u == 0.0f && dot3(d_tail, p_now - q.q) < 0.0f) {
         // The needle has passed this point: onto its thread (its
@@ -197,7 +220,7 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
     float weight = 0.0f;
     for (std::uint32_t k = 0; k < count; ++k) weight = weight + b.x[v[k]].w * (c[k] * c[k]);
     if (!(weight > 0.0f)) continue;
-    float lambda_n = l[0].x, lambda_t = l[0].y;
+    float lambda_n = l[0].x, lambda_t = l[0].y, slip = l[0].z;
     // The impulse given this substep, summed step by step: the directions
     // turn between sweeps, so lambda times the last direction is not it.
     float4 given = l[1];
@@ -230,6 +253,44 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
         lambda_t = next;
       }
     }
+    if (r[0].x == SINEW_SUTURE_PUNCTURE &&
+        (shaft.x > 0.0f || shaft.y > 0.0f || shaft.z > 0.0f || cut > 0.0f)) {
+      // The shaft's Karnopp friction: the tissue point's slide along the
+      // needle relative to the needle's own point over the substep.
+      const float4 a0 = curve_point(b, n, near_segment, t), a1 = curve_point(b, n, near_segment + 1, t);
+      const float4 b0 = curve_point(b, n, near_segment, p.substep_begin);
+      const float4 b1 = curve_point(b, n, near_segment + 1, p.substep_begin);
+      tangent = unit(a1 - a0);
+      const float one_minus_u = 1.0f - near_u;
+      const float4 moved = (one_minus_u * a0 + near_u * a1) - (one_minus_u * b0 + near_u * b1);
+      float4 slide = zero;
+      for (std::uint32_t k = 0; k < count; ++k) slide = slide + c[k] * (b.x[v[k]] - b.prev[v[k]]);
+      const float rel = dot3(tangent, slide - moved);
+      const float held = lambda_t - rel / weight;  // the multiplier that stops the slide
+      const float magnitude = std::fabs(held);
+      // The cutting force resists the needle advancing (the tissue held
+      // towards the tip: held > 0) on the row of the body the tip is in.
+      const float cutting = r[1].w == 1u && held > 0.0f ? cut : 0.0f;
+      const float h2 = p.h * p.h;
+      float limit = 0.0f;
+      if (slip <= shaft.w) {
+        // Karnopp: sliding slower than the band at the last substep's end,
+        // it sticks while the static level holds it, else breaks away at it.
+        limit = (shaft.y * w.w + cutting) * h2;
+      } else {
+        // Slipping: Coulomb, plus a viscous force on the slide that remains
+        // (implicit: b L h W of it, over 1 + b L h W, so that a large b
+        // brakes the slide without reversing it).
+        const float coulomb = (shaft.x * w.w + cutting) * h2;
+        const float k = shaft.z * w.w * p.h * weight;
+        limit = magnitude <= coulomb ? magnitude : (coulomb + k * magnitude) / (1.0f + k);
+      }
+      const float next = magnitude <= limit ? held : (held > 0.0f ? limit : -limit);
+      slip = std::fabs(held - next) * weight / p.h;
+      apply(b, v, c, count, tangent, next - lambda_t);
+      given = given + (next - lambda_t) * tangent;
+      lambda_t = next;
+    }
     if (r[0].x == SINEW_SUTURE_THREAD) {
       // Friction: the tissue point's slide along the thread relative to the
       // thread's point, since the substep's start.
@@ -244,7 +305,7 @@ void xpbd_sutures(const void* params, std::byte* const* bindings, std::uint32_t 
       given = given + (next - lambda_t) * tangent;
       lambda_t = next;
     }
-    l[0] = float4{lambda_n, lambda_t, 0.0f, 0.0f};
+    l[0] = float4{lambda_n, lambda_t, slip, 0.0f};
     l[1] = float4{given.x, given.y, given.z, 0.0f};
   }
 }

@@ -43,6 +43,35 @@
  *                  it (d_tail . (p - tail) < 0) the needle has passed: with
  *                  a thread the row becomes a thread puncture on the
  *                  thread's first segment, without one it ends (kind 0);
+ *                  With NeedleDesc::shaft_friction and the others set
+ *                  (binding 3's 2nd and 3rd float4), friction along the
+ *                  shaft (Karnopp, "Computer simulation of stick-slip
+ *                  friction in mechanical dynamic systems", J. Dyn. Sys.
+ *                  Meas. Control 107(1), 1985, as Okamura, Simone and
+ *                  O'Leary, IEEE TBME 51(10), 2004, used it for needles):
+ *                  along the needle's tangent, the tissue point's slide
+ *                  relative to the needle's own point (segment, u) over the
+ *                  substep; L the row's inserted shaft length (weights.w)
+ *                  [m]; v the slide speed at the end of the last substep
+ *                  (lambda.z, carried over substeps and frames). With
+ *                  |v| <= v_band the multiplier that stops the slide is
+ *                  kept up to (f_s L + cut) h^2 (stick; beyond, it breaks
+ *                  away at that level); else Coulomb (f_c L + cut) h^2
+ *                  plus the viscous b L v h^2 taken implicitly (of the
+ *                  multiplier m that would stop it, (coulomb + k m) /
+ *                  (1 + k) with k = b L h W), never reversing the slide.
+ *                  cut is the cutting force while the needle advances
+ *                  (m > 0), on the row of the body the tip is inside
+ *                  (word 7 = 1);
+ *   5 blunt        one surface vertex x_a (weights (1, 0, 0)) kept ahead
+ *                  of a blunt tip's rounded end (a hemisphere of radius R
+ *                  = NeedleDesc::tip_radius, binding 3's 3rd float4 .y)
+ *                  along the tip's axis: C = d_tip . (x_a - tip) + R -
+ *                  sqrt(R^2 - r^2) >= 0, r the vertex's distance from the
+ *                  axis; no catch. The host adds one for every surface
+ *                  vertex within R of the tip's axis while a tip contact
+ *                  (kind 2) pushes, sums their push with its own for the
+ *                  puncture, and drops them every frame;
  *   4 thread       the tissue point held on the thread: q = (1 - s) x_i +
  *                  s x_{i+1} on segment i (s its closest point, the
  *                  segment followed to a neighbour when s leaves [0, 1],
@@ -68,15 +97,18 @@
  *   0 position float4 (xyz, w = inverse mass) [in/out]
  *   1 previous position float4 (the substep's start) [in]
  *   2 table uint [in]: word 0 the rows; then per needle (first point, points)
- *   3 needles float4 [in]: per needle (compliance, mu_s, mu_k,
- *     tan(max_puncture_angle), at most 1e6)
+ *   3 needles float4 [in]: 3 per needle: (compliance, mu_s, mu_k,
+ *     tan(max_puncture_angle), at most 1e6), the shaft's (f_c [N/m], f_s
+ *     [N/m], b [N s/m^2], v_band [m/s]), (cut [N], 0, 0, 0)
  *   4 curve float4 [in]: per needle point, its world position at the
  *     frame's start and at its end (2 per point)
  *   5 thread slots uint [in]: the device slots of the threads' vertices
  *   6 rows uint4 [in/out]: 2 per row, (kind, needle, a, b), (c, first
  *     thread slot, thread vertices, segment)
- *   7 weights float4 [in/out]: per row (wa, wb, wc, s)
- *   8 lambda float4 [in/out]: 3 per row: (lambda, lambda_t, 0, 0); the
+ *   7 weights float4 [in/out]: per row (wa, wb, wc, s); a puncture's w
+ *     is its inserted shaft length L [m] (the host's)
+ *   8 lambda float4 [in/out]: 3 per row: (lambda, lambda_t, v, 0), v a
+ *     puncture's slide speed along the shaft (kept by the host); the
  *     impulse vector the row gave the tissue (or the tied thread vertex)
  *     in this substep [kg m], the sum of each sweep's steps dlambda n +
  *     dlambda_t t (n and t turn between sweeps); the sum of the frame's
@@ -93,6 +125,7 @@
 #define SINEW_SUTURE_TIP 2u
 #define SINEW_SUTURE_PUNCTURE 3u
 #define SINEW_SUTURE_THREAD 4u
+#define SINEW_SUTURE_BLUNT 5u
 /* How many segments a thread puncture may move along its thread per solve. */
 #define SINEW_SUTURE_MAX_MOVES 4u
 
@@ -104,7 +137,9 @@ SINEW_STRUCT_BEGIN(SutureParams)
   float inv_h2;       /* 1 / h^2 [1/s^2] */
   uint reset_lambda;  /* a substep's first sweep: 1, the frame's first: 2; else 0 */
   float substep_end;  /* fraction of the frame done at the end of this substep, in (0, 1] */
-  uint pad0;          /* 16-byte size */
+  float substep_begin; /* ... and at its start, in [0, 1) (the shaft's friction) */
+  float h;            /* the substep [s] (the shaft's friction) */
+  uint pad0, pad1, pad2;  /* 16-byte size */
 SINEW_STRUCT_END(SutureParams)
 
 #ifdef __cplusplus

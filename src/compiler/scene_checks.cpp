@@ -331,6 +331,20 @@ Status check_tool_cut(const SceneDesc& scene, const ToolCutDesc& cut, const std:
   return {};
 }
 
+// The blunt tip, the shaft's Karnopp friction and the cutting force (docs/needles.md).
+Status check_needle_forces(const NeedleDesc& n, const std::string& name) {
+  if (Status s = non_negative(name + ".tip_radius", n.tip_radius); !s) return s;
+  if (Status s = non_negative(name + ".shaft_friction", n.shaft_friction); !s) return s;
+  if (Status s = non_negative(name + ".shaft_static_friction", n.shaft_static_friction); !s) return s;
+  if (n.shaft_friction > n.shaft_static_friction)
+    return Error(ErrorCode::bad_parameter, name + ".shaft_friction (" + str(n.shaft_friction) +
+                                               " N/m) must not exceed shaft_static_friction (" +
+                                               str(n.shaft_static_friction) + " N/m)");
+  if (Status s = non_negative(name + ".shaft_viscous_friction", n.shaft_viscous_friction); !s) return s;
+  if (Status s = positive(name + ".shaft_stick_velocity", n.shaft_stick_velocity); !s) return s;
+  return non_negative(name + ".cutting_force", n.cutting_force);
+}
+
 Status check_needle(const SceneDesc& scene, const NeedleDesc& n, const std::string& name) {
   if (n.curve.size() < 2)
     return Error(ErrorCode::bad_parameter,
@@ -349,6 +363,7 @@ Status check_needle(const SceneDesc& scene, const NeedleDesc& n, const std::stri
                  name + ".max_puncture_angle must be in (0, pi/2] radians (got " + str(n.max_puncture_angle) + ")");
   if (Status s = non_negative(name + ".compliance", n.compliance); !s) return s;
   if (Status s = check_friction(name + ".thread", n.thread_static_friction, n.thread_dynamic_friction); !s) return s;
+  if (Status s = check_needle_forces(n, name); !s) return s;
   if (n.thread < -1 || n.thread >= static_cast<int>(scene.line_bodies.size()))
     return Error(ErrorCode::bad_parameter, name + ".thread = " + std::to_string(n.thread) +
                                                " is not a line body (the scene has " +

@@ -256,6 +256,8 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
         q.inv_h2 = inv_h2;
         q.reset_lambda = p.reset_lambda == 0u ? 0u : s == 0 ? 2u : 1u;  // 2: the frame's first sweep
         q.substep_end = p.substep_end;
+        q.substep_begin = static_cast<float>(double(s) / solver.substeps);
+        q.h = p.h;
         program.dispatch(Kernel::xpbd_sutures, 1,
                          {buffers.position, buffers.previous, sutures->table, sutures->needles, sutures->curve,
                           sutures->slots, sutures->rows, sutures->weights, sutures->lambda},

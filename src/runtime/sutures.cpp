@@ -105,7 +105,7 @@ Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const C
   SutureBuffers& b = out->buffers_;
   const std::size_t needles = out->needles_.size();
   for (auto [handle, bytes, label] :
-       {std::tuple{&b.table, (1 + 2 * needles) * 4, "suture table"}, std::tuple{&b.needles, needles * 16, "needles"},
+       {std::tuple{&b.table, (1 + 2 * needles) * 4, "suture table"}, std::tuple{&b.needles, needles * 48, "needles"},
         std::tuple{&b.curve, std::size_t{out->curve_points_} * 32, "needle curves"},
         std::tuple{&b.slots, std::max<std::size_t>(out->slots_.size(), 1) * 4, "thread slots"},
         std::tuple{&b.rows, std::size_t{out->rows_capacity_} * 32, "suture rows"},
@@ -121,7 +121,10 @@ Result<std::unique_ptr<Sutures>> Sutures::create(const SceneDesc& scene, const C
   for (const Needle& n : out->needles_)
     params.insert(params.end(), {float(n.desc.compliance), float(n.desc.thread_static_friction),
                                  float(n.desc.thread_dynamic_friction),
-                                 float(std::min(std::tan(n.desc.max_puncture_angle), 1e6))});
+                                 float(std::min(std::tan(n.desc.max_puncture_angle), 1e6)),
+                                 float(n.desc.shaft_friction), float(n.desc.shaft_static_friction),
+                                 float(n.desc.shaft_viscous_friction), float(n.desc.shaft_stick_velocity),
+                                 float(n.desc.cutting_force), float(n.desc.tip_radius), 0.0f, 0.0f});
   if (Status s = device.write_buffer(b.needles, 0, params.data(), params.size() * 4); !s) return s.error();
   return out;
 }
@@ -279,7 +282,7 @@ Status Sutures::before_frame(Device& device, const XpbdBuffers& scene_buffers) {
       n.position_end = n.body.position;
       n.rotation_end = n.body.rotation;
     }
-    std::erase_if(n.rows, [](const Row& r) { return r.words[0] == SINEW_SUTURE_TIP; });
+    std::erase_if(n.rows, [](const Row& r) { return r.words[0] == SINEW_SUTURE_TIP || r.words[0] == SINEW_SUTURE_BLUNT; });
     const std::vector<Vec3> start = curve_at(n, false), end = curve_at(n, true);
     const Vec3 d0 = unit(math::sub(start.back(), start[start.size() - 2]));
     const Vec3 d1 = unit(math::sub(end.back(), end[end.size() - 2]));
@@ -292,7 +295,12 @@ Status Sutures::before_frame(Device& device, const XpbdBuffers& scene_buffers) {
         return Error(ErrorCode::capacity_exceeded, "needle " + std::to_string(i) + " holds more than " +
                                                        std::to_string(kRowsPerNeedle) + " punctures");
       n.rows.push_back(tip);
+      if (n.desc.tip_radius > 0.0)
+        if (Status s = add_blunt_rows(n, i, tip.surface, start.back(), end.back(), d0); !s) return s;
     }
+    if (n.desc.shaft_friction > 0.0 || n.desc.shaft_static_friction > 0.0 || n.desc.shaft_viscous_friction > 0.0 ||
+        n.desc.cutting_force > 0.0)
+      set_shaft_lengths(n, start);
   }
   return upload(device);
 }
@@ -320,8 +328,12 @@ Status Sutures::upload(Device& device) {
   if (table[0] == 0) return {};
   if (Status s = device.write_buffer(buffers_.rows, 0, words.data(), words.size() * 4); !s) return s;
   if (Status s = device.write_buffer(buffers_.weights, 0, weights.data(), weights.size() * 4); !s) return s;
-  const std::vector<float> zeros(std::size_t{table[0]} * 12, 0.0f);
-  return device.write_buffer(buffers_.lambda, 0, zeros.data(), zeros.size() * 4);
+  // The multipliers start at zero; a puncture's slide speed carries over.
+  std::vector<float> lambda(std::size_t{table[0]} * 12, 0.0f);
+  std::size_t k = 0;
+  for (const Needle& n : needles_)
+    for (const Row& r : n.rows) lambda[12 * k++ + 2] = r.slip;
+  return device.write_buffer(buffers_.lambda, 0, lambda.data(), lambda.size() * 4);
 }
 
 Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, double h, double frame) {
@@ -342,6 +354,7 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
     const Vec3 tip = end.back(), d = unit(math::sub(end.back(), end[end.size() - 2]));
     n.tip_force = 0.0;
     for (std::size_t k = 0; k < n.rows.size(); ++k) {
+      n.rows[k].slip = lambda[(at + k) * 12 + 2];
       std::copy_n(&words[(at + k) * 8], 8, n.rows[k].words.begin());
       std::copy_n(&weights[(at + k) * 4], 4, n.rows[k].weights.begin());
     }
@@ -351,6 +364,15 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
       n.body.angular_velocity = math::angular_velocity(n.rotation_start, n.rotation_end, frame);
       n.body.position = n.position_end;
       n.body.rotation = n.rotation_end;
+    }
+    // A blunt tip's rows push with the tip contact (their impulse counts
+    // towards the puncture) and are made afresh every frame.
+    Vec3 blunt{0.0, 0.0, 0.0};
+    for (std::size_t k = 0; k < n.rows.size(); ++k) {
+      if (n.rows[k].words[0] != SINEW_SUTURE_BLUNT) continue;
+      const float* l = &lambda[(at + k) * 12];
+      blunt = math::add(blunt, Vec3{double(l[8]) + l[4], double(l[9]) + l[5], double(l[10]) + l[6]});
+      n.rows[k].words[0] = SINEW_SUTURE_DEAD;
     }
     for (Row& r : n.rows) {
       const float* l = &lambda[at * 12];
@@ -362,7 +384,8 @@ Status Sutures::after_frame(Device& device, const XpbdBuffers& scene_buffers, do
         // The frame's impulse on the tissue, (sum + last) / h [N s], averaged
         // over the frame, into the surface (the kernel pushes along the
         // normal turned the way the tip goes).
-        const Vec3 impulse{double(l[8]) + l[4], double(l[9]) + l[5], double(l[10]) + l[6]};
+        const Vec3 own{double(l[8]) + l[4], double(l[9]) + l[5], double(l[10]) + l[6]};
+        const Vec3 impulse = n.desc.tip_radius > 0.0 ? math::add(own, blunt) : own;
         n.tip_force = std::abs(math::dot(impulse, normal)) / (h * frame);
         if (n.tip_force < n.desc.puncture_force) continue;
         // The angle to the inward normal (a membrane's: the side the tip is on).
@@ -412,7 +435,9 @@ void Sutures::add_reactions(Needle& n, const std::vector<Vec3>& end, const float
   for (std::size_t k = 0; k < n.rows.size(); ++k) {
     const Row& r = n.rows[k];
     const std::uint32_t kind = r.words[0];
-    if (kind != SINEW_SUTURE_TIE && kind != SINEW_SUTURE_TIP && kind != SINEW_SUTURE_PUNCTURE) continue;
+    if (kind != SINEW_SUTURE_TIE && kind != SINEW_SUTURE_TIP && kind != SINEW_SUTURE_PUNCTURE &&
+        kind != SINEW_SUTURE_BLUNT)
+      continue;
     const float* l = lambda + 12 * k;  // (lambda, lambda_t), the last substep's impulse, the earlier ones'
     // Where the row pulls the needle: its tail (the tie), its tip, or the
     // curve's closest point to the tissue point (a puncture).
@@ -428,6 +453,11 @@ void Sutures::add_reactions(Needle& n, const std::vector<Vec3>& end, const float
         if (d < best) best = d, point = q;
       }
     }
+    if (kind == SINEW_SUTURE_BLUNT) {  // on the flat end, across the axis from the tip
+      const Vec3 axis = unit(math::sub(end.back(), end[end.size() - 2]));
+      const Vec3 off = math::sub(position_of(r.words[2]), end.back());
+      point = math::add(end.back(), math::sub(off, math::mul(axis, math::dot(axis, off))));
+    }
     const Vec3 arm = math::sub(point, origin);
     // The tissue (or thread vertex) was moved by the impulse lambda; the
     // needle takes the opposite: per substep lambda / h [N s].
@@ -438,7 +468,8 @@ void Sutures::add_reactions(Needle& n, const std::vector<Vec3>& end, const float
     n.reaction_torque = math::add(n.reaction_torque, math::mul(math::cross(arm, frame_impulse), 1.0 / frame));
     b.coupling_force = math::add(b.coupling_force, math::mul(last_impulse, 1.0 / h));
     b.coupling_torque = math::add(b.coupling_torque, math::mul(math::cross(arm, last_impulse), 1.0 / h));
-    if (kind == SINEW_SUTURE_TIP && !(l[0] > 0.0f)) continue;  // not pushing at the frame's end
+    if ((kind == SINEW_SUTURE_TIP || kind == SINEW_SUTURE_BLUNT) && !(l[0] > 0.0f))
+      continue;  // not pushing at the frame's end
     // The particles it holds stand in for a tool's touching particles
     // (their mass c / w and its inertia about the needle's origin).
     const std::uint32_t count = kind == SINEW_SUTURE_TIE ? 1 : 3;
@@ -457,6 +488,90 @@ void Sutures::add_reactions(Needle& n, const std::vector<Vec3>& end, const float
   }
   b.contact_force = n.reaction_force;
   b.contact_torque = n.reaction_torque;
+}
+
+Status Sutures::add_blunt_rows(Needle& n, std::size_t index, std::uint32_t surface_index, const Vec3& tip_start,
+                               const Vec3& tip_end, const Vec3& axis) {
+  // Every surface vertex of the pushed body within tip_radius of the tip's
+  // axis, on a triangle facing the tip (a tet body's outward normal against
+  // the axis; a membrane either way), from just behind the rounded end at
+  // the frame's start to a radius past the tip at its end: the tissue the
+  // end may meet in this frame. A
+  // vertex it does not reach keeps an idle row (a unilateral C > 0).
+  const Surface& surface = surfaces_[surface_index];
+  const double radius = n.desc.tip_radius;
+  const double reach = math::dot(axis, math::sub(tip_end, tip_start)) + radius;
+  std::vector<std::uint32_t> vertices;
+  for (const auto& tri : surface.triangles) {
+    const Vec3 A = position_of(tri[0]);
+    const Vec3 outward = math::cross(math::sub(position_of(tri[1]), A), math::sub(position_of(tri[2]), A));
+    if (surface.kind == BodyKind::tet && !(math::dot(outward, axis) < 0.0)) continue;
+    for (std::uint32_t v : tri) {
+      const Vec3 off = math::sub(position_of(v), tip_start);
+      const double along = math::dot(axis, off);
+      const double across = math::norm(math::sub(off, math::mul(axis, along)));
+      if (across > n.desc.tip_radius) continue;
+      // The rounded end at `across` from the axis is this far behind the tip.
+      const double setback = radius - std::sqrt(radius * radius - across * across);
+      if (along < -setback - kTipReach || along > reach) continue;
+      vertices.push_back(v);
+    }
+  }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  if (n.rows.size() + vertices.size() > kRowsPerNeedle)
+    return Error(ErrorCode::capacity_exceeded,
+                 "needle " + std::to_string(index) + ": its blunt tip (tip_radius " + std::to_string(n.desc.tip_radius) +
+                     " m) meets " + std::to_string(vertices.size()) + " surface vertices, more than its " +
+                     std::to_string(kRowsPerNeedle) + " rows hold with its punctures (a smaller radius, or a "
+                     "coarser surface)");
+  for (std::uint32_t v : vertices) {
+    Row row;
+    row.words = {SINEW_SUTURE_BLUNT, static_cast<std::uint32_t>(index), v, v, v, 0, 0, 0};
+    row.weights = {1.0f, 0.0f, 0.0f, 0.0f};
+    row.surface = surface_index;
+    n.rows.push_back(row);
+  }
+  return {};
+}
+
+void Sutures::set_shaft_lengths(Needle& n, const std::vector<Vec3>& curve) {
+  // Each puncture's place along the needle (arc length from the tail [m]).
+  std::vector<double> arc(n.rows.size(), 0.0);
+  double total = 0.0;
+  for (std::size_t j = 0; j + 1 < curve.size(); ++j) total += math::norm(math::sub(curve[j + 1], curve[j]));
+  for (std::size_t k = 0; k < n.rows.size(); ++k) {
+    if (n.rows[k].words[0] != SINEW_SUTURE_PUNCTURE) continue;
+    const Vec3 p = point_of(n.rows[k]);
+    double best = INFINITY, before = 0.0;
+    for (std::size_t j = 0; j + 1 < curve.size(); ++j) {
+      const Vec3 e = math::sub(curve[j + 1], curve[j]);
+      const double length = math::norm(e);
+      const double u = std::clamp(math::dot(math::sub(p, curve[j]), e) / (length * length), 0.0, 1.0);
+      const double d = math::norm(math::sub(p, math::add(curve[j], math::mul(e, u))));
+      if (d < best) best = d, arc[k] = before + u * length;
+      before += length;
+    }
+  }
+  // An entering puncture of a tet body grips the shaft from its point to
+  // the body's next exit along the needle, or to the tip: the length the
+  // shaft's friction scales with. The tip is inside the body whose entry
+  // has no exit beyond it: that row also carries the cutting force. Exit
+  // punctures and membranes (no inside) grip nothing.
+  for (std::size_t k = 0; k < n.rows.size(); ++k) {
+    Row& r = n.rows[k];
+    if (r.words[0] != SINEW_SUTURE_PUNCTURE) continue;
+    r.words[7] = 0;
+    r.weights[3] = 0.0f;
+    if (r.exit || surfaces_[r.surface].kind != BodyKind::tet) continue;
+    double out = total;
+    for (std::size_t j = 0; j < n.rows.size(); ++j)
+      if (n.rows[j].words[0] == SINEW_SUTURE_PUNCTURE && n.rows[j].exit && n.rows[j].surface == r.surface &&
+          arc[j] > arc[k])
+        out = std::min(out, arc[j]);
+    r.weights[3] = float(std::max(0.0, out - arc[k]));
+    r.words[7] = out == total ? 1u : 0u;
+  }
 }
 
 void Sutures::mark_exemption() {
@@ -504,8 +619,9 @@ NeedleState Sutures::state(std::size_t index) const {
     p.weights = {r.weights[0], r.weights[1], r.weights[2]};
     p.exit = r.exit;
     p.on_thread = r.words[0] == SINEW_SUTURE_THREAD;
-    p.thread_segment = r.words[7];
-    p.thread_s = r.weights[3];
+    // (A puncture on the needle keeps its cutting flag and shaft length there.)
+    p.thread_segment = p.on_thread ? r.words[7] : 0;
+    p.thread_s = p.on_thread ? r.weights[3] : 0.0;
     out.punctures.push_back(p);
   }
   return out;

@@ -28,6 +28,13 @@
 // coupling, its stability bound and its limits), the rows' particles
 // standing for the tool's touching particles.
 //
+// Needle forces (docs/needles.md; Okamura, Simone and O'Leary, IEEE TBME
+// 51(10), 2004): a blunt tip (NeedleDesc::tip_radius) adds a row (kind 5)
+// for each surface vertex its rounded end meets, made afresh each frame
+// with the tip contact and pushing with it; each entering puncture of a tet
+// body carries the length of shaft inside that body and, for the body the
+// tip is in, the cutting force, for the kernel's Karnopp friction.
+//
 // Why the detection is on the host: a needle is one polyline and its tip
 // path one segment per frame, tested against the surfaces' triangles in a
 // linear pass (60,000 triangles: a fraction of a millisecond); the read-back
@@ -103,6 +110,7 @@ class Sutures {
     std::array<float, 4> weights{};        // (wa, wb, wc, s)
     std::uint32_t surface = kNone, triangle = 0;
     bool exit = false;
+    float slip = 0.0f;  // a puncture's slide speed along the shaft at the last frame's end [m/s] (Karnopp's band)
   };
   struct Needle {
     NeedleDesc desc;
@@ -134,6 +142,16 @@ class Sutures {
   // triangle and weights. Counts the triangles refused on `needle`.
   bool first_crossing(const math::Vec3& a, const math::Vec3& b, bool entering, Needle& needle, Row& row);
   Status upload(Device& device);
+  // A blunt tip (NeedleDesc::tip_radius): adds a row (kind 5) for each
+  // surface vertex of surface `surface` its flat end meets this frame.
+  // [in] tip_start, tip_end: the tip at the frame's start and end; axis: its
+  // unit direction. Errors: more rows than a needle holds.
+  Status add_blunt_rows(Needle& n, std::size_t index, std::uint32_t surface, const math::Vec3& tip_start,
+                        const math::Vec3& tip_end, const math::Vec3& axis);
+  // Sets each puncture's inserted shaft length (weights[3], [m]) and cutting
+  // flag (words[7]) for the shaft's friction. [in] curve: the needle at the
+  // frame's start.
+  void set_shaft_lengths(Needle& n, const std::vector<math::Vec3>& curve);
 
   std::vector<Surface> surfaces_;
   std::vector<Needle> needles_;

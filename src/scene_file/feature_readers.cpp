@@ -185,6 +185,12 @@ void read_needle(const Json& v, const std::string& path, Context& ctx, NeedleDes
   o.read("thread", out.thread);
   o.read("thread_static_friction", out.thread_static_friction);
   o.read("thread_dynamic_friction", out.thread_dynamic_friction);
+  o.read("tip_radius", out.tip_radius);
+  o.read("shaft_friction", out.shaft_friction);
+  o.read("shaft_static_friction", out.shaft_static_friction);
+  o.read("shaft_viscous_friction", out.shaft_viscous_friction);
+  o.read("shaft_stick_velocity", out.shaft_stick_velocity);
+  o.read("cutting_force", out.cutting_force);
   if (const Json* d = o.find("drive"))
     read_enum(*d, o.path("drive"), ctx, {{"kinematic", NeedleDrive::kinematic}, {"force", NeedleDrive::force}},
               out.drive);
