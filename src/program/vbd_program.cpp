@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <string>
+#include <tuple>
 
 #include "accelerator_params.h"
 #include "coloring/vertex_coloring.h"
@@ -36,9 +37,46 @@ Result<BufferHandle> upload_words(Device& device, const std::vector<std::uint32_
 
 }  // namespace
 
+VbdTopology make_vbd_topology(const ConstraintBlock& block, const std::vector<kernels::float4>& positions) {
+  VbdTopology t;
+  const auto particles = static_cast<std::uint32_t>(positions.size());
+  // The movable particles of the block's tets, in device order.
+  std::vector<std::uint8_t> listed(particles, 0);
+  for (std::uint32_t q : block.particles)
+    if (positions[q].w > 0.0f) listed[q] = 1;
+  std::vector<std::uint32_t> vertices;
+  for (std::uint32_t i = 0; i < particles; ++i)
+    if (listed[i]) vertices.push_back(i);
+  const Coloring coloring = color_tet_vertices(block.particles, vertices, particles);
+  t.color_offsets.assign(coloring.color_count() + 1, 0);
+  for (std::uint32_t c = 0; c < coloring.color_count(); ++c)
+    t.color_offsets[c + 1] = t.color_offsets[c] + coloring.color_sizes[c];
+  t.vertices.resize(vertices.size());
+  std::vector<std::uint32_t> entry_of(particles, UINT32_MAX);
+  {
+    std::vector<std::uint32_t> fill(t.color_offsets.begin(), t.color_offsets.end() - 1);
+    for (std::size_t e = 0; e < vertices.size(); ++e) {
+      const std::uint32_t at = fill[coloring.color_of[e]]++;
+      t.vertices[at] = vertices[e];
+      entry_of[vertices[e]] = at;
+    }
+  }
+  t.offsets.assign(t.vertices.size() + 1, 0);
+  for (std::uint32_t q : block.particles)
+    if (entry_of[q] != UINT32_MAX) ++t.offsets[entry_of[q] + 1];
+  for (std::size_t e = 0; e < t.vertices.size(); ++e) t.offsets[e + 1] += t.offsets[e];
+  t.incidences.resize(t.offsets.back());
+  std::vector<std::uint32_t> fill(t.offsets.begin(), t.offsets.end() - 1);
+  for (std::size_t slot = 0; slot < block.size(); ++slot)
+    for (std::uint32_t corner = 0; corner < 4; ++corner) {
+      const std::uint32_t e = entry_of[block.particles[slot * 4 + corner]];
+      if (e != UINT32_MAX) t.incidences[fill[e]++] = static_cast<std::uint32_t>(slot) * 4 + corner;
+    }
+  return t;
+}
+
 Result<VbdBuffers> upload_vbd(Device& device, const CompiledScene& scene) {
   VbdBuffers out;
-  const auto particles = static_cast<std::uint32_t>(scene.positions.size());
   for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
     const ConstraintBlock& block = scene.blocks[k];
     VbdBlock b;
@@ -56,42 +94,12 @@ Result<VbdBuffers> upload_vbd(Device& device, const CompiledScene& scene) {
                    "solver.method vbd supports tet bodies with a corotational or neo_hookean material only; "
                    "the scene has " + what);
     }
-    // The movable particles of the block's tets, in device order.
-    std::vector<std::uint8_t> listed(particles, 0);
-    for (std::uint32_t q : block.particles)
-      if (scene.positions[q].w > 0.0f) listed[q] = 1;
-    std::vector<std::uint32_t> vertices;
-    for (std::uint32_t i = 0; i < particles; ++i)
-      if (listed[i]) vertices.push_back(i);
-    const Coloring coloring = color_tet_vertices(block.particles, vertices, particles);
-    // Entries colour by colour (in device order within a colour), and each
-    // entry's incidences (tet slot * 4 + corner), tets in slot order.
-    b.color_offsets.assign(coloring.color_count() + 1, 0);
-    for (std::uint32_t c = 0; c < coloring.color_count(); ++c)
-      b.color_offsets[c + 1] = b.color_offsets[c] + coloring.color_sizes[c];
-    std::vector<std::uint32_t> ordered(vertices.size()), entry_of(particles, UINT32_MAX);
-    {
-      std::vector<std::uint32_t> fill(b.color_offsets.begin(), b.color_offsets.end() - 1);
-      for (std::size_t e = 0; e < vertices.size(); ++e) {
-        const std::uint32_t at = fill[coloring.color_of[e]]++;
-        ordered[at] = vertices[e];
-        entry_of[vertices[e]] = at;
-      }
-    }
-    std::vector<std::uint32_t> offsets(ordered.size() + 1, 0);
-    for (std::uint32_t q : block.particles)
-      if (entry_of[q] != UINT32_MAX) ++offsets[entry_of[q] + 1];
-    for (std::size_t e = 0; e < ordered.size(); ++e) offsets[e + 1] += offsets[e];
-    std::vector<std::uint32_t> incidences(offsets.back()), fill(offsets.begin(), offsets.end() - 1);
-    for (std::size_t slot = 0; slot < block.size(); ++slot)
-      for (std::uint32_t corner = 0; corner < 4; ++corner) {
-        const std::uint32_t e = entry_of[block.particles[slot * 4 + corner]];
-        if (e != UINT32_MAX) incidences[fill[e]++] = static_cast<std::uint32_t>(slot) * 4 + corner;
-      }
+    VbdTopology topology = make_vbd_topology(block, scene.positions);
+    b.color_offsets = std::move(topology.color_offsets);
     const std::string name = "vbd " + std::string(kernel_name(block.kernel));
-    for (auto [handle, words, label] : {std::tuple{&b.vertices, &ordered, " vertices"},
-                                        std::tuple{&b.offsets, &offsets, " offsets"},
-                                        std::tuple{&b.incidences, &incidences, " incidences"}}) {
+    for (auto [handle, words, label] : {std::tuple{&b.vertices, &topology.vertices, " vertices"},
+                                        std::tuple{&b.offsets, &topology.offsets, " offsets"},
+                                        std::tuple{&b.incidences, &topology.incidences, " incidences"}}) {
       auto made = upload_words(device, *words, name + label);
       if (!made) return made.error();
       *handle = *made;

@@ -24,6 +24,19 @@ struct VbdBlock {
   std::vector<std::uint32_t> color_offsets;    ///< colour k: entries [color_offsets[k], color_offsets[k + 1])
 };
 
+/// The host side of one FEM block's VBD data (the words of VbdBlock's
+/// buffers): its movable vertices coloured by color_tet_vertices, listed
+/// colour by colour (device order within a colour), and per entry its
+/// incidences, tet slot * 4 + corner, in slot order.
+struct VbdTopology {
+  std::vector<std::uint32_t> vertices, offsets, incidences;
+  std::vector<std::uint32_t> color_offsets;  ///< colours + 1 entries
+};
+
+/// [in] block: an FEM block (arity 4); positions: every particle (w = 0:
+/// pinned, not listed).
+VbdTopology make_vbd_topology(const ConstraintBlock& block, const std::vector<kernels::float4>& positions);
+
 /// The buffers VBD adds to the scene's (upload_scene).
 struct VbdBuffers {
   BufferHandle inertia;        ///< y per particle, float4
