@@ -491,8 +491,9 @@ struct NeedleDesc {
 ///    colour's vertices share no tet. The stiffness is the material's at any
 ///    sweep count (no compliance is softened by unconverged sweeps); too few
 ///    sweeps show as extra damping instead. For tet bodies with
-///    TetMaterial::corotational or neo_hookean only, pinned vertices, the
-///    CPU backend; every other feature is an error naming it
+///    TetMaterial::corotational or neo_hookean only, pinned vertices, on
+///    every backend (the GPU kernels agree bitwise with the CPU reference);
+///    every other feature is an error naming it
 ///    (docs/materials.md, "Vertex Block Descent").
 enum class SolverMethod { xpbd, vbd };
 

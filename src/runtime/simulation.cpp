@@ -64,11 +64,6 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
   if (scene.solver.method == SolverMethod::vbd) {
-    // The GPU kernels exist (kernels/gpu/vbd_*.gpu) but are not yet checked
-    // against the CPU reference in the agreement tests: not run there.
-    if (impl->device->backend_name() != "cpu")
-      return Error(ErrorCode::bad_parameter, "solver.method vbd: available on the cpu backend only (this device is " +
-                                                 impl->device->backend_name() + ")");
     auto vbd = upload_vbd(*impl->device, *compiled);
     if (!vbd) return vbd.error();
     impl->vbd = std::move(*vbd);
