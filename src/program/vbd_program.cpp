@@ -122,21 +122,13 @@ FrameProgram build_vbd_program(const CompiledScene& scene, const XpbdBuffers& bu
   const double h = solver.time_step / solver.substeps;
   const auto particles = static_cast<std::uint32_t>(scene.positions.size());
 
-  kernels::PredictParams predict{};
-  predict.h = static_cast<float>(h);
-  predict.gravity_x = static_cast<float>(gravity[0]);
-  predict.gravity_y = static_cast<float>(gravity[1]);
-  predict.gravity_z = static_cast<float>(gravity[2]);
-  predict.count = particles;
+  const kernels::PredictParams predict = predict_params(h, gravity, particles);
   kernels::VbdInitParams init{};
   init.h2g_x = static_cast<float>(h * h * gravity[0]);
   init.h2g_y = static_cast<float>(h * h * gravity[1]);
   init.h2g_z = static_cast<float>(h * h * gravity[2]);
   init.count = particles;
-  kernels::UpdateVelocityParams update{};
-  update.inv_h = static_cast<float>(1.0 / h);
-  update.h = predict.h;  // the very float xpbd_predict moves by
-  update.count = particles;
+  const kernels::UpdateVelocityParams update = update_params(h, particles);
   kernels::VbdSolveParams solve{};
   solve.inv_h2 = static_cast<float>(1.0 / (h * h));
 
