@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "command_line.h"
+#include "kidney_case.h"
 #include "linear_elastic_oracle.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
@@ -72,21 +73,13 @@ Body beam() {
 
 Body kidney() {
   Body b;
-  auto mesh = sinew::read_tet_mesh(std::string(SINEW_DATA_DIR) + "/meshes/tet/kidney_57k.node");
-  if (!mesh) {
-    std::fprintf(stderr, "%s\n", mesh.error().message().c_str());
-    return b;
-  }
-  sinew::scale_mesh(*mesh, 1e-3);
-  b.mesh = std::move(*mesh);
+  sinew::test::Kidney k = sinew::test::kidney_case();
+  if (!k.error.empty()) std::fprintf(stderr, "%s\n", k.error.c_str());
+  b.mesh = std::move(k.mesh);
+  b.pinned = std::move(k.pinned);
+  b.measured = std::move(k.free_end);
   b.density = 1060.0;
   b.poisson = 0.45;
-  double lo = 1e30, hi = -1e30;
-  for (const auto& v : b.mesh.vertices) lo = std::min(lo, v[0]), hi = std::max(hi, v[0]);
-  for (std::uint32_t v = 0; v < b.mesh.vertices.size(); ++v) {
-    if (b.mesh.vertices[v][0] < lo + 0.005) b.pinned.push_back(v);
-    if (b.mesh.vertices[v][0] > hi - 0.005) b.measured.push_back(v);
-  }
   return b;
 }
 

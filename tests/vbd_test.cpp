@@ -76,6 +76,19 @@ std::vector<Vec3d> run(const SceneDesc& scene, int frames, std::vector<FrameStat
   return u;
 }
 
+// The oracle's mean displacement [m] along y of the vertices whose rest
+// coordinate `along` is `at` [m], under `gravity_y` [m/s^2] with b's pins.
+double oracle_y(const Box& b, double young, double gravity_y, int along, double at) {
+  test::StaticLoads loads;
+  loads.density = kDensity;
+  loads.gravity = {0.0, gravity_y, 0.0};
+  loads.pinned = b.pinned;
+  std::string error;
+  const std::vector<Vec3d> u = test::solve_linear_elastic(b.mesh, young, 0.3, loads, &error);
+  EXPECT_FALSE(u.empty()) << error;
+  return u.empty() ? 0.0 : test::mean_displacement(b.mesh, u, 1, along, at);
+}
+
 bool all_finite(const std::vector<Vec3d>& u) {
   for (const Vec3d& d : u)
     for (double c : d)
@@ -88,14 +101,7 @@ bool all_finite(const std::vector<Vec3d>& u) {
 // under gravity; the tip is the mean vertical displacement of its x = L face.
 TEST(Vbd, StiffBeamSagsAsLinearElasticityWithinFivePercent) {
   const Box b = box(16, 2, 2, 0.01, 0);
-  test::StaticLoads loads;
-  loads.density = kDensity;
-  loads.gravity = {0.0, -9.81, 0.0};
-  loads.pinned = b.pinned;
-  std::string error;
-  const std::vector<Vec3d> oracle = test::solve_linear_elastic(b.mesh, 3e7, 0.3, loads, &error);
-  ASSERT_FALSE(oracle.empty()) << error;
-  const double tip_oracle = test::mean_displacement(b.mesh, oracle, 1, 0, 0.16);
+  const double tip_oracle = oracle_y(b, 3e7, -9.81, 0, 0.16);
   ASSERT_LT(tip_oracle, 0.0);
 
   // Few sweeps make a stiff body lag, not soften: undamped, its tip swings
@@ -117,14 +123,7 @@ TEST(Vbd, StiffBeamSagsAsLinearElasticityWithinFivePercent) {
 // Neo-Hookean and corotational, top face against the oracle.
 TEST(Vbd, BlockInCompressionWithinFivePercent) {
   const Box b = box(4, 4, 4, 0.01, 1);
-  test::StaticLoads loads;
-  loads.density = kDensity;
-  loads.gravity = {0.0, -100.0, 0.0};
-  loads.pinned = b.pinned;
-  std::string error;
-  const std::vector<Vec3d> oracle = test::solve_linear_elastic(b.mesh, 1e6, 0.3, loads, &error);
-  ASSERT_FALSE(oracle.empty()) << error;
-  const double top_oracle = test::mean_displacement(b.mesh, oracle, 1, 1, 0.04);
+  const double top_oracle = oracle_y(b, 1e6, -100.0, 1, 0.04);
   ASSERT_LT(top_oracle, 0.0);
   for (TetMaterial material : {TetMaterial::corotational, TetMaterial::neo_hookean}) {
     SceneDesc scene = vbd_scene(b, material, 1e6, 0.3, 20, 0.0);
