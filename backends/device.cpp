@@ -33,6 +33,7 @@
 #include "sph_tension_params.h"
 #include "stats_params.h"
 #include "suture_params.h"
+#include "vbd_params.h"
 #include "xpbd_params.h"
 
 namespace sinew {

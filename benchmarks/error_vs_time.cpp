@@ -20,6 +20,11 @@
 //           the same scenes damped (scene.h): the chain with stiffness
 //           damping tau = 5 ms and velocity damping 2 1/s, the kidney with
 //           velocity damping 4 1/s (the flagship example's value).
+// --method vbd runs the FEM cases (nh_bar, nh_cube) with Vertex Block Descent
+// (SolverSettings::method; Chen et al., SIGGRAPH 2024), the reference too, so
+// each error is against the converged run of the same method; the other cases
+// (a line body, the edge network) are xPBD's only and are skipped. Its rows
+// are named CASE_vbd (nh_bar_vbd, nh_cube_vbd).
 // The error is the RMS distance of the particles from the reference run's
 // after `seconds` of simulated time, divided by the body's size. The
 // reference is 16 substeps of 32 iterations per 1/60 s frame. Why not more
@@ -130,7 +135,9 @@ struct Run {
   std::string error;
 };
 
-Run run(sinew::SceneDesc scene, int substeps, int iterations, double seconds, const std::string& backend) {
+Run run(sinew::SceneDesc scene, int substeps, int iterations, double seconds, const std::string& backend,
+        sinew::SolverMethod method) {
+  scene.solver.method = method;
   scene.solver.time_step = 1.0 / 60.0;
   scene.solver.substeps = substeps;
   scene.solver.iterations = iterations;
@@ -198,8 +205,12 @@ int main(int argc, char** argv) {
         if (std::sscanf(v.c_str(), "%dx%d%c", &a, &b, &end) == 2 && a >= 1 && b >= 1) return std::string();
         return "must be SUBSTEPSxITERATIONS, both >= 1 (got " + v + ")";
       });
+  std::string method_name = "xpbd";
+  cli.app().add_option("--method", method_name, "The solver: xpbd, or vbd (the FEM cases only)")
+      ->check(CLI::IsMember({"xpbd", "vbd"}));
   cli.add_out(out);
   if (auto exit = cli.parse(argc, argv)) return *exit;
+  const sinew::SolverMethod method = method_name == "vbd" ? sinew::SolverMethod::vbd : sinew::SolverMethod::xpbd;
   std::sscanf(reference_text.c_str(), "%dx%d", &ref_substeps, &ref_iterations);
   const std::vector<Case> cases = {
       {"chain", 1.0, chain_scene},
@@ -230,21 +241,22 @@ int main(int argc, char** argv) {
               "residual");
   for (const Case& c : cases) {
     if (!only.empty() && ("," + only + ",").find("," + c.name + ",") == std::string::npos) continue;
-    const Run reference = run(c.scene(), ref_substeps, ref_iterations, seconds, backend);
+    if (method == sinew::SolverMethod::vbd && !c.name.starts_with("nh_")) continue;  // xPBD-only bodies
+    const Run reference = run(c.scene(), ref_substeps, ref_iterations, seconds, backend, method);
     if (!reference.error.empty()) {
       std::fprintf(stderr, "%s: %s\n", c.name.c_str(), reference.error.c_str());
       return 1;
     }
     std::map<int, std::pair<double, double>> one_step, one_iteration;  // sweeps -> (error, ms)
     for (auto [s, n] : configs) {
-      const Run r = run(c.scene(), s, n, seconds, backend);
+      const Run r = run(c.scene(), s, n, seconds, backend, method);
       if (!r.error.empty()) {
         std::fprintf(stderr, "%s: %s\n", c.name.c_str(), r.error.c_str());
         return 1;
       }
       const double error = rms_distance(r.x, reference.x) / c.size;
       const double static_error = c.name.starts_with("chain") ? chain_static_error(r.x) : std::nan("");
-      csv << c.name << ',' << s << ',' << n << ',' << s * n << ',' << r.ms_per_frame << ',' << error << ','
+      csv << c.name << (method == sinew::SolverMethod::vbd ? "_vbd" : "") << ',' << s << ',' << n << ',' << s * n << ',' << r.ms_per_frame << ',' << error << ','
           << r.residual << ',' << static_error << '\n';
       std::printf("%-8s %8d %10d %7d %12.4f %12.3e %12.3e\n", c.name.c_str(), s, n, s * n, r.ms_per_frame, error,
                   r.residual);

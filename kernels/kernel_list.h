@@ -71,6 +71,9 @@
   /* the sweeps' accelerators (kernels/shared/accelerator_params.h) */           \
   SINEW_KERNEL(xpbd_chebyshev, 3, ChebyshevParams, 0)                            \
   SINEW_KERNEL(xpbd_warm_start, 4, WarmStartParams, 0)                          \
+  /* Vertex Block Descent (kernels/shared/vbd_params.h) */                       \
+  SINEW_KERNEL(vbd_initial_guess, 2, VbdInitParams, 0)                           \
+  SINEW_KERNEL(vbd_solve_vertices, 8, VbdSolveParams, 0)                         \
   /* the device BVH (kernels/shared/bvh_params.h) */                             \
   SINEW_KERNEL(bvh_morton_codes, 3, MortonParams, 0)                             \
   SINEW_KERNEL(bvh_karras_nodes, 3, KarrasParams, 0)                             \

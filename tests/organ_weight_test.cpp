@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "kidney_case.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
 
@@ -20,24 +21,11 @@ namespace {
 constexpr double kDensity = 1060.0;  // [kg/m^3]
 constexpr double kPoisson = 0.45;
 
-struct Kidney {
-  TetMesh mesh;
-  std::vector<std::uint32_t> pinned, free_end;  // within 5 mm of the lowest / highest x
-};
+using test::Kidney;
 
 Kidney kidney() {
-  Kidney k;
-  auto mesh = read_tet_mesh(std::string(SINEW_DATA_DIR) + "/meshes/tet/kidney_57k.node");
-  EXPECT_TRUE(mesh.ok());
-  if (!mesh) return k;
-  scale_mesh(*mesh, 1e-3);
-  k.mesh = std::move(*mesh);
-  double lo = 1e30, hi = -1e30;
-  for (const auto& v : k.mesh.vertices) lo = std::min(lo, v[0]), hi = std::max(hi, v[0]);
-  for (std::uint32_t v = 0; v < k.mesh.vertices.size(); ++v) {
-    if (k.mesh.vertices[v][0] < lo + 0.005) k.pinned.push_back(v);
-    if (k.mesh.vertices[v][0] > hi - 0.005) k.free_end.push_back(v);
-  }
+  Kidney k = test::kidney_case();
+  EXPECT_TRUE(k.error.empty()) << k.error;
   return k;
 }
 

@@ -524,11 +524,39 @@ struct NeedleDesc {
   bool gravity = true;                               ///< whether gravity acts on it
 };
 
+/// Which solver integrates the tissue (SolverSettings::method).
+///  - xpbd: constraints solved by xPBD (Macklin et al., 2016, 2019), every
+///    feature of the scene description.
+///  - vbd: Vertex Block Descent (Chen, Liu, Yang, Yuksel, "Vertex Block
+///    Descent", ACM TOG 43(4), SIGGRAPH 2024): each substep minimises the
+///    implicit-Euler energy  sum_i m_i / (2 h^2) |x_i - y_i|^2 + E_elastic(x)
+///    (y = x + h v + h^2 g, the inertia target) by sweeps of one 3x3 Newton
+///    step per vertex over its tets' energy, vertices coloured so that a
+///    colour's vertices share no tet. The stiffness is the material's at any
+///    sweep count (no compliance is softened by unconverged sweeps); too few
+///    sweeps show as extra damping instead. For tet bodies with
+///    TetMaterial::corotational or neo_hookean only, pinned vertices, on
+///    every backend (the GPU kernels agree bitwise with the CPU reference);
+///    every other feature is an error naming it
+///    (docs/materials.md, "Vertex Block Descent").
+enum class SolverMethod { xpbd, vbd };
+
 /// How each frame is solved: a frame of length time_step is split into
 /// `substeps` substeps of h = time_step / substeps; each substep predicts,
 /// runs `iterations` Gauss-Seidel sweeps over all constraints (colour by
 /// colour) and updates velocities (Macklin et al., "Small Steps", 2019).
+/// With method = vbd a sweep is one pass of Vertex Block Descent over the
+/// vertex colours instead (SolverMethod).
 struct SolverSettings {
+  /// The solver (SolverMethod): xpbd (the default) or vbd. With vbd,
+  /// `iterations` counts VBD sweeps per substep, chebyshev_rho/gamma/delay
+  /// accelerate them (the paper's Chebyshev acceleration, positions only), and the
+  /// residual mode, warm_start and every constraint other than a tet
+  /// body's corotational or neo_hookean material are errors. FrameStats::
+  /// residual_rms and max_residual are 0 with vbd (it has no constraint
+  /// multipliers whose residual they measure); the kinetic energy, volume
+  /// change and inverted tets are measured as with xpbd.
+  SolverMethod method = SolverMethod::xpbd;
   /// Frame length [s], > 0. The device computes in float32: h =
   /// time_step / substeps, 1/h and 1/h^2 must be finite, non-zero floats
   /// (e.g. 1e300 or 1e-300 is an error naming solver.time_step), and so

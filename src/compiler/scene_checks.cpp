@@ -470,6 +470,9 @@ Status TetBodyDesc::set_material(TetMaterial model, double young, double poisson
 
 // The residual-driven mode and the Chebyshev accelerator (scene.h).
 static Status check_solve_modes(const SolverSettings& solver) {
+  if (solver.method != SolverMethod::xpbd && solver.method != SolverMethod::vbd)
+    return Error(ErrorCode::bad_parameter, "solver.method must be xpbd or vbd (got " +
+                                               std::to_string(static_cast<int>(solver.method)) + ")");
   if (Status s = non_negative("solver.residual_tolerance", solver.residual_tolerance); !s) return s;
   if (solver.residual_tolerance > 0.0) {
     if (solver.max_iterations < solver.iterations)
@@ -576,6 +579,7 @@ Status check_scene(const SceneDesc& scene) {
     if (Status s = check_attachment(scene, scene.attachments[i], "attachments[" + std::to_string(i) + "]"); !s)
       return s;
   if (Status s = check_body_attachments(scene); !s) return s;
+  if (Status s = check_vbd_scene(scene); !s) return s;
   // Last, on values known finite: what the device makes of them in float,
   // and the caps on a frame's work (device_ranges.h).
   return check_device_ranges(scene);

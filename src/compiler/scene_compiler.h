@@ -168,6 +168,10 @@ std::size_t vertex_count(const SceneDesc& scene, const VertexRef& ref);
 /// check_scene (body_attachment_checks.cpp).
 Status check_body_attachments(const SceneDesc& scene);
 
+/// What a scene may hold with SolverSettings::method = vbd; part of
+/// check_scene (vbd_checks.cpp). Errors name the unsupported feature.
+Status check_vbd_scene(const SceneDesc& scene);
+
 /// Checks (check_scene) and compiles a scene. Errors name the parameter.
 Result<CompiledScene> compile_scene(const SceneDesc& scene);
 

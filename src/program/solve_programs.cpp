@@ -138,11 +138,15 @@ SolvePrograms::SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buff
     const int more = std::max(0, solver.max_iterations - solver.iterations);
     most += (more + solver.check_interval - 1) / solver.check_interval * solver.check_interval;
   }
-  omega_.assign(std::size_t(most) + 2, 1.0);
-  const double rho2 = solver.chebyshev_rho * solver.chebyshev_rho;
-  const int s = solver.chebyshev_delay;
-  for (int n = s + 1; n < int(omega_.size()); ++n)
-    omega_[n] = n == s + 1 ? 2.0 / (2.0 - rho2) : 4.0 / (4.0 - rho2 * omega_[n - 1]);
+  omega_ = chebyshev_omegas(solver.chebyshev_rho, solver.chebyshev_delay, std::size_t(most) + 2);
+}
+
+std::vector<double> chebyshev_omegas(double rho, int delay, std::size_t count) {
+  std::vector<double> omega(count, 1.0);
+  const double rho2 = rho * rho;
+  for (int n = delay + 1; n < int(omega.size()); ++n)
+    omega[n] = n == delay + 1 ? 2.0 / (2.0 - rho2) : 4.0 / (4.0 - rho2 * omega[n - 1]);
+  return omega;
 }
 
 SolvePrograms::ChebyshevStep SolvePrograms::chebyshev_step(int n) const {

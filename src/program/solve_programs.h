@@ -107,6 +107,12 @@ class SolvePrograms {
   std::vector<double> omega_;  ///< omega_n for n = 0 .. (grown on demand, see chebyshev_step)
 };
 
+/// omega_n of Wang's recurrence (eq. 11) for sweeps n = 0 .. count - 1
+/// (1-based sweep numbers; omega_0 unused): 1 up to sweep `delay`, then
+/// 2 / (2 - rho^2) and 4 / (4 - rho^2 omega_{n-1}). Shared by the xPBD
+/// sweeps and Vertex Block Descent's (vbd_program.h).
+std::vector<double> chebyshev_omegas(double rho, int delay, std::size_t count);
+
 /// The accelerator's buffers (zero-filled).
 Result<ChebyshevBuffers> make_chebyshev_buffers(Device& device, const CompiledScene& scene);
 

@@ -161,6 +161,24 @@ void append_serial_contact_color(FrameProgram& program, const XpbdBuffers& buffe
   program.barrier();
 }
 
+kernels::PredictParams predict_params(double h, const std::array<double, 3>& gravity, std::uint32_t particles) {
+  kernels::PredictParams predict{};
+  predict.h = static_cast<float>(h);
+  predict.gravity_x = static_cast<float>(gravity[0]);
+  predict.gravity_y = static_cast<float>(gravity[1]);
+  predict.gravity_z = static_cast<float>(gravity[2]);
+  predict.count = particles;
+  return predict;
+}
+
+kernels::UpdateVelocityParams update_params(double h, std::uint32_t particles) {
+  kernels::UpdateVelocityParams update{};
+  update.inv_h = static_cast<float>(1.0 / h);
+  update.h = static_cast<float>(h);  // the very float xpbd_predict moves by
+  update.count = particles;
+  return update;
+}
+
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
                                 const std::array<double, 3>& gravity, SweepExtras extras) {
   const MeshContactBuffers* mesh_contacts = extras.mesh_contacts;
@@ -169,19 +187,11 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   const auto particles = static_cast<std::uint32_t>(scene.positions.size());
   const auto inv_h2 = static_cast<float>(1.0 / (h * h));
 
-  kernels::PredictParams predict{};
-  predict.h = static_cast<float>(h);
-  predict.gravity_x = static_cast<float>(gravity[0]);
-  predict.gravity_y = static_cast<float>(gravity[1]);
-  predict.gravity_z = static_cast<float>(gravity[2]);
-  predict.count = particles;
+  const kernels::PredictParams predict = predict_params(h, gravity, particles);
   kernels::ExternalForceParams force{};
   force.h = predict.h;  // the very float xpbd_predict moves by
   force.count = particles;
-  kernels::UpdateVelocityParams update{};
-  update.inv_h = static_cast<float>(1.0 / h);
-  update.h = predict.h;  // the very float xpbd_predict moves by
-  update.count = particles;
+  const kernels::UpdateVelocityParams update = update_params(h, particles);
 
   FrameProgram program;
   // Mesh contacts: colour k's count is word k of the table, which the host

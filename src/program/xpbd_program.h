@@ -7,7 +7,9 @@
 #include "backends/backend.h"
 #include "coloring/device_contact_coloring.h"
 #include "mesh_contact_params.h"
+#include "xpbd_params.h"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -107,6 +109,14 @@ std::vector<std::uint32_t> declare_device_color_counters(FrameProgram& program, 
 void append_device_colored_sweep(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
                                  const DeviceColorTable& colored, std::span<const std::uint32_t> counters,
                                  kernels::MeshContactParams m);
+
+/// xpbd_predict's parameters for substeps of h [s] under `gravity`
+/// [m/s^2] over `particles` particles (shared by the VBD program).
+kernels::PredictParams predict_params(double h, const std::array<double, 3>& gravity, std::uint32_t particles);
+
+/// xpbd_update_velocity's parameters, with the very float h predict_params
+/// moves by.
+kernels::UpdateVelocityParams update_params(double h, std::uint32_t particles);
 
 /// Creates the buffers on `device` and uploads the compiled scene.
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);

@@ -63,6 +63,11 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
   auto buffers = upload_scene(*impl->device, *compiled);
   if (!buffers) return buffers.error();
   impl->buffers = *buffers;
+  if (scene.solver.method == SolverMethod::vbd) {
+    auto vbd = upload_vbd(*impl->device, *compiled);
+    if (!vbd) return vbd.error();
+    impl->vbd = std::move(*vbd);
+  }
   if (compiled->external_forces) {
     impl->force_scratch.resize(compiled->positions.size());
     for (const kernels::float4& p : compiled->positions) impl->force_inverse_mass.push_back(p.w);
@@ -156,7 +161,7 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
     if (impl->mesh_collision) impl->mesh_collision->set_suture_exemption(impl->sutures->exemption());
     if (impl->continuous) impl->continuous->set_suture_exemption(impl->sutures->exemption());
   }
-  if (SolveStepper::needed(scene.solver, continuous)) {
+  if (!impl->vbd && SolveStepper::needed(scene.solver, continuous)) {
     impl->program = build_xpbd_program(*compiled, impl->buffers, scene.solver, scene.gravity);
     append_stats(impl->program, impl->stats_plan, impl->buffers);
     auto stepper = SolveStepper::create(*impl->device, *compiled, impl->buffers, scene.solver, scene.gravity,
@@ -207,7 +212,8 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
 }
 
 Status Simulation::Impl::prepare_program(const CompiledScene& compiled) {
-  program = build_xpbd_program(compiled, buffers, solver, gravity, sweep_extras());
+  program = vbd ? build_vbd_program(compiled, buffers, *vbd, solver, gravity)
+               : build_xpbd_program(compiled, buffers, solver, gravity, sweep_extras());
   append_stats(program, stats_plan, buffers);
   auto made = device->create_program(program);  // made before the old one goes: a failure leaves it whole
   if (!made) return made.error();

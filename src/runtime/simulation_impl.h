@@ -6,11 +6,13 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "compiler/scene_compiler.h"
 #include "program/stats_program.h"
 #include "program/xpbd_program.h"
+#include "program/vbd_program.h"
 #include "runtime/contact_state.h"
 #include "runtime/frame_stage.h"
 #include "runtime/positions_mirror.h"
@@ -48,6 +50,9 @@ struct Simulation::Impl {
   // Residual-driven mode or the accelerator (SolverSettings): the frame as
   // several programs the host sequences; null in the fixed mode.
   std::unique_ptr<SolveStepper> stepper;
+  // SolverSettings::method = vbd: Vertex Block Descent's buffers (the
+  // vertex colours and incidences); its frame program replaces xPBD's.
+  std::optional<VbdBuffers> vbd;
   SceneInfo info;
   FrameStats stats;
   double time_step = 0.0;

@@ -12,6 +12,8 @@ namespace sinew::scene_file {
 
 void read_solver(const Json& v, const std::string& path, Context& ctx, SolverSettings& out) {
   Object o(v, path, ctx);
+  if (const Json* m = o.find("method"))
+    read_enum(*m, o.path("method"), ctx, {{"xpbd", SolverMethod::xpbd}, {"vbd", SolverMethod::vbd}}, out.method);
   o.read("time_step", out.time_step);
   o.read("substeps", out.substeps);
   o.read("iterations", out.iterations);
