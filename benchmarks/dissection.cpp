@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   cli.app().add_option("--iterations", s.iterations, "Iterations per substep")->check(sinew::examples::at_least(1));
   cli.app().add_option("--threads", s.threads, "cpu backend worker threads (0: all)")->check(sinew::examples::at_least(0));
   cli.app().add_option("--topology-every", s.topology_every, "A burn and a cut every N frames")->check(sinew::examples::at_least(1));
+  cli.add_switch("--mesh-collision", s.mesh_collision, "Contacts between the bodies' meshes");
   if (auto exit = cli.parse(argc, argv)) return *exit;
 
   auto scene = sinew::examples::DissectionScene::create(s);

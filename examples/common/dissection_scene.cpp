@@ -225,6 +225,7 @@ Result<std::unique_ptr<DissectionScene>> DissectionScene::create(const Dissectio
   scene.solver.substeps = settings.substeps;
   scene.solver.iterations = settings.iterations;
   scene.topology_changes = true;
+  scene.mesh_collision.enabled = settings.mesh_collision;
   scene.tet_bodies.push_back(organ);
   scene.tet_bodies.push_back(liver);
   scene.tri_bodies.push_back(sheet);

@@ -43,6 +43,7 @@ struct DissectionSettings {
   double gallbladder_young = 20e3; ///< the gallbladder's Young's modulus [Pa] (corotational, nu 0.45)
   double attachment_compliance = 1e-4;  ///< of each body attachment [m/N]
   int topology_every = 2;          ///< a burn and a cut every this many frames (>= 1)
+  bool mesh_collision = true;      ///< contacts between the bodies' meshes (MeshCollisionDesc)
   double script_speed = 1.0;       ///< the hands' script runs this many times faster (> 0; the ctest's short run)
 };
 
