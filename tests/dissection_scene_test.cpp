@@ -1,5 +1,5 @@
 // The reference scene S2 (examples/common/dissection_scene.h), shortened: the
-// whole script (128 frames) at 2 topology changes a frame (the lift, then the cautery and the blade).
+// lift (62 frames), then 0.4 s of the cautery and the blade (28 frames) (the lift, then the cautery and the blade).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +15,6 @@ using sinew::examples::DissectionScene;
 TEST(DissectionScene, MembranePullsTheGallbladderUpThenIsCutWithTheSceneValid) {
   sinew::examples::DissectionSettings s{.gallbladder = std::string(SINEW_DATA_DIR) + "/meshes/tet/gallbladder_volumetric.vtk"};
   s.threads = 2;
-  s.topology_every = 1;
   auto made = DissectionScene::create(s);
   ASSERT_TRUE(made.ok()) << made.error().message();
   DissectionScene& r = **made;
@@ -26,8 +25,8 @@ TEST(DissectionScene, MembranePullsTheGallbladderUpThenIsCutWithTheSceneValid) {
   auto start_colors = sinew::SimulationInternals::check_colors(r.sim());
   ASSERT_TRUE(start_colors.ok());
   std::printf("colour conflicts at the start: %llu\n", static_cast<unsigned long long>(start_colors->conflicts));
-  const int lift_end = static_cast<int>(std::lround(sinew::examples::kLiftEnd / s.script_speed / r.frame_time())) + 2;
-  const int frames = static_cast<int>(std::lround(sinew::examples::kDissectEnd / s.script_speed / r.frame_time())) + 2;
+  const int lift_end = static_cast<int>(std::lround(sinew::examples::kLiftEnd / r.frame_time())) + 2;
+  const int frames = static_cast<int>(std::lround((sinew::examples::kDissectStart + 0.4) / r.frame_time()));
   for (int f = 1; f <= lift_end; ++f) ASSERT_TRUE(r.frame().ok()) << "frame " << f;
   auto lifted = r.check();
   ASSERT_TRUE(lifted.ok());
@@ -47,7 +46,7 @@ TEST(DissectionScene, MembranePullsTheGallbladderUpThenIsCutWithTheSceneValid) {
   ASSERT_TRUE(end.ok());
   std::printf("dissection: %zu topology changes, %zu triangles removed, %zu left; deepest inside %.3f mm\n",
               r.topology_events(), r.triangles_removed(), end->membrane_triangles, 1e3 * end->deepest_inside);
-  EXPECT_GE(r.topology_events(), 10u);
+  EXPECT_GE(r.topology_events(), 5u);
   EXPECT_GT(r.triangles_removed(), 0u);
   EXPECT_TRUE(end->finite);
   auto colors = sinew::SimulationInternals::check_colors(r.sim());
