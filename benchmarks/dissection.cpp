@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
   cli.app().add_option("--iterations", s.iterations, "Iterations per substep")->check(sinew::examples::at_least(1));
   cli.app().add_option("--threads", s.threads, "cpu backend worker threads (0: all)")->check(sinew::examples::at_least(0));
   cli.app().add_option("--topology-every", s.topology_every, "A burn and a cut every N frames")->check(sinew::examples::at_least(1));
+  std::string trace;
+  cli.app().add_option("--trace", trace, "Write each frame's wall time and stages [ms] as CSV to this file");
   cli.add_switch("--mesh-collision", s.mesh_collision, "Contacts between the bodies' meshes");
   if (auto exit = cli.parse(argc, argv)) return *exit;
 
@@ -64,6 +66,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> stage_order;
   double lift = 0.0, membrane_lift = 0.0;  // at the lift's end (before the dissection)
   const int lift_end = static_cast<int>(std::lround(sinew::examples::kLiftEnd / r.frame_time()));
+  std::FILE* trace_file = trace.empty() ? nullptr : std::fopen(trace.c_str(), "w");
+  if (!trace.empty() && !trace_file) return fail("cannot write " + trace);
+  if (trace_file) std::fprintf(trace_file, "frame,wall_ms,dissecting,stage,stage_ms\n");
   for (int f = 1; f <= frames; ++f) {
     const double c0 = cpu_now_ms();
     const auto a = std::chrono::steady_clock::now();
@@ -75,6 +80,7 @@ int main(int argc, char** argv) {
     for (const auto& p : r.sim().last_frame().stages) {
       if (!stage_ms.count(p.name)) stage_order.push_back(p.name);
       stage_ms[p.name].push_back(p.ms);
+      if (trace_file) std::fprintf(trace_file, "%d,%.3f,%d,%s,%.3f\n", f, frame_ms.back(), r.dissecting() ? 1 : 0, p.name.c_str(), p.ms);
     }
     if (f == lift_end) {
       auto c = r.check();
@@ -82,6 +88,7 @@ int main(int argc, char** argv) {
       lift = c->gallbladder_lift, membrane_lift = c->membrane_lift;
     }
   }
+  if (trace_file) std::fclose(trace_file);
   auto c = r.check();
   if (!c) return fail(c.error().message());
   double load[1] = {0.0};
