@@ -12,17 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "command_line.h"
 #include "dissection_scene.h"
 
 namespace {
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t k = static_cast<std::size_t>(std::ceil(q * double(v.size())));
-  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
-}
+using sinew::bench::percentile;
 
 int fail(const std::string& what) {
   std::fprintf(stderr, "bench_dissection: %s\n", what.c_str());
