@@ -1,8 +1,9 @@
 // bench_support.h — what the scene benchmarks share: the backend they run
-// on and the median they report.
+// on and the median and percentiles they report.
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -20,6 +21,15 @@ inline double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
+}
+
+/// The q-quantile of `v` (q in [0, 1]; nearest rank: the smallest value
+/// with at least q of the values at or below it; 0 when empty).
+inline double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t k = static_cast<std::size_t>(std::ceil(q * double(v.size())));
+  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
 }
 
 }  // namespace sinew::bench

@@ -29,18 +29,14 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "command_line.h"
 #include "retraction_scene.h"
 
 namespace {
 
 // Nearest-rank percentile q in [0, 1] of v (0 when empty).
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t k = static_cast<std::size_t>(std::ceil(q * double(v.size())));
-  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
-}
+using sinew::bench::percentile;
 
 int fail(const std::string& what) {
   std::fprintf(stderr, "bench_retraction: %s\n", what.c_str());

@@ -237,8 +237,14 @@ Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const 
         }
         std::sort(users.begin(), users.end());
         out.in_use.emplace_back(block.kernel, std::move(users));
-        for (std::uint32_t a = 0; a < block.arity; ++a) {
-          const std::uint32_t p = particles[std::size_t{i} * block.arity + a];
+        // Each particle once per constraint: a body attachment repeats its
+        // side's first particle in its unused slots (weight 0), which is no
+        // conflict with another constraint.
+        std::vector<std::uint32_t> own(particles.begin() + std::size_t{i} * block.arity,
+                                       particles.begin() + (std::size_t{i} + 1) * block.arity);
+        std::sort(own.begin(), own.end());
+        own.erase(std::unique(own.begin(), own.end()), own.end());
+        for (const std::uint32_t p : own) {
           if (!(x[p].w > 0.0f)) continue;  // immovable particles may be shared
           if (owner[p] == colour_id) ++out.conflicts;
           owner[p] = colour_id;
