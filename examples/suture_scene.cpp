@@ -23,10 +23,12 @@ int main(int argc, char** argv) {
       "suture_scene", std::string(sinew::examples::kSutureAbout) + "Writes suture_scene.pvd (pad, thread, needle) into --out.");
   sinew::examples::SutureSettings s;
   std::string out = cli.default_out();
-  int every = 20;
+  int every = 20, frames = 0;
   cli.add_backend(s.backend);
   cli.app().add_option("--every", every, "Report and write every N-th frame (and the last)")
       ->check(sinew::examples::at_least(1));
+  cli.app().add_option("--frames", frames, "Stop after N frames of 1/60 s (0: the whole script, ~710 frames)")
+      ->check(sinew::examples::at_least(0));
   cli.app().add_option("--substeps", s.substeps, "Substeps per frame")->check(sinew::examples::at_least(1));
   cli.app().add_option("--threads", s.threads, "cpu backend worker threads (0: all)")->check(sinew::examples::at_least(0));
   cli.add_switch("--continuous", s.continuous, "The thread's continuous collision");
@@ -52,10 +54,10 @@ int main(int argc, char** argv) {
               r.sim().device_name().c_str(), r.scene().tet_bodies[0].mesh.tets.size(), s.thread_segments,
               sinew::examples::SutureScene::stitch_frames());
   std::vector<double> ms;
-  while (!r.done()) {
+  while (!r.done() && (frames == 0 || r.frames() < frames)) {
     if (auto st = r.frame(); !st) return fail("frame " + std::to_string(r.frames()) + ": " + st.error().message());
     ms.push_back(r.sim().last_frame().wall_ms);
-    if (r.frames() % every != 0 && !r.done()) continue;
+    if (r.frames() % every != 0 && !r.done() && r.frames() != frames) continue;
     auto c = r.check();
     if (!c) return fail(c.error().message());
     std::printf("frame %4d  %7.2f ms  slit %.2f mm  %zu punctures (%zu left lip, %zu right, %zu on the thread)%s\n",

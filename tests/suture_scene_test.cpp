@@ -10,6 +10,7 @@
 // first, and the slit at the stitches is narrower than before the pull.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -33,7 +34,9 @@ TEST(SutureScene, StitchedThreadClosesTheSlitWithoutCrossing) {
   ASSERT_TRUE(before) << before.error().message();
   EXPECT_NEAR(*before, 2e-3, 1e-9) << "the slit starts 2 mm wide";
   std::uint64_t forced = 0, touches = 0;
-  double least = INFINITY;
+  double least = INFINITY;  // the least distance between non-adjacent thread segments, its frame and pair
+  int least_frame = -1;
+  std::array<int, 2> pair{};
   sinew::examples::SutureCheck c;
   while (!scene.done()) {
     ASSERT_TRUE(scene.frame()) << "frame " << scene.frames();
@@ -44,7 +47,7 @@ TEST(SutureScene, StitchedThreadClosesTheSlitWithoutCrossing) {
     ASSERT_TRUE(checked) << checked.error().message();
     c = *checked;
     ASSERT_TRUE(c.finite) << "frame " << scene.frames();
-    least = std::min(least, c.thread_min_distance);
+    if (c.thread_min_distance < least) least = c.thread_min_distance, least_frame = scene.frames(), pair = c.thread_closest;
     ASSERT_GT(c.thread_min_distance, 1e-6) << "frame " << scene.frames() << ": the thread crossed itself";
   }
   EXPECT_EQ(forced, 0u) << "a crossing continuous collision could not prevent";
@@ -54,9 +57,9 @@ TEST(SutureScene, StitchedThreadClosesTheSlitWithoutCrossing) {
   EXPECT_EQ(c.on_thread, c.punctures) << "every puncture holds the thread";
   EXPECT_TRUE(c.knot_holds);
   EXPECT_LT(c.gap, *before - 1e-4) << "the stitches must close the slit by more than 0.1 mm";
-  std::printf("%d frames, knot at frame %d; slit %.3f -> %.3f mm; least thread distance %.3f mm; %llu CCD touches, "
-              "%llu forced\n",
-              scene.frames(), scene.knot_frame(), 1e3 * *before, 1e3 * c.gap, 1e3 * least,
+  std::printf("%d frames, knot at frame %d; slit %.3f -> %.3f mm; least thread distance %.4f mm (frame %d, segments "
+              "%d and %d); %llu CCD touches, %llu forced\n",
+              scene.frames(), scene.knot_frame(), 1e3 * *before, 1e3 * c.gap, 1e3 * least, least_frame, pair[0], pair[1],
               static_cast<unsigned long long>(touches), static_cast<unsigned long long>(forced));
 }
 

@@ -210,7 +210,8 @@ Result<SutureCheck> SutureScene::check() {
     for (int j = i + 2; j < n; ++j) {
       const float* a = &x_[4 * (t0 + i)];
       const float* b = &x_[4 * (t0 + j)];
-      c.thread_min_distance = std::min(c.thread_min_distance, segment_distance(a, a + 4, b, b + 4));
+      const double d = segment_distance(a, a + 4, b, b + 4);
+      if (d < c.thread_min_distance) c.thread_min_distance = d, c.thread_closest = {i, j};
     }
   return c;
 }

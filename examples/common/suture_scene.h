@@ -64,6 +64,7 @@ struct SutureCheck {
   bool knot_holds = false;          ///< the thread's last segment sits in the first puncture
   double gap = 0.0;                 ///< the slit's width at the stitches [m] (SutureScene::gap)
   double thread_min_distance = 0.0;  ///< the least distance between two non-adjacent thread segments [m]
+  std::array<int, 2> thread_closest{-1, -1};  ///< those two segments
   bool finite = true;               ///< every particle's position is finite
 };
 
