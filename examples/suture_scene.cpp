@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   if (!before) return fail(before.error().message());
   std::printf("suture_scene on %s: %zu tets, a %d-segment thread; %d frames of stitching, then the pull\n",
               r.sim().device_name().c_str(), r.scene().tet_bodies[0].mesh.tets.size(), s.thread_segments,
-              sinew::examples::SutureScene::stitch_frames());
+              sinew::examples::kSutureStitchFrames);
   std::vector<double> ms;
   while (!r.done() && (frames == 0 || r.frames() < frames)) {
     if (auto st = r.frame(); !st) return fail("frame " + std::to_string(r.frames()) + ": " + st.error().message());

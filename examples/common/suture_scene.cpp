@@ -16,44 +16,35 @@ namespace sinew::examples {
 
 namespace {
 
-constexpr double kRadius = 0.008, kAbove = 0.002;  // the needle's radius; its centre over the pad [m]
-constexpr double kSlit = 0.002;                    // the slit's width [m]
-constexpr double kStitchZ[2] = {-0.003, 0.003};    // the stitches along the cut [m]
-constexpr double kThreadLength = 0.1;              // [m]
-constexpr double kThreadMass = 1e-3;               // the whole thread [kg]
-constexpr int kTurn = 110, kShift = 40;            // frames of each turn, and of the move between them
+constexpr double kRadius = kSutureNeedleRadius, kAbove = kSutureNeedleAbove;
+constexpr double kSlit = 0.002;              // the slit's width [m]
+constexpr double kThreadLength = 0.1;        // [m]
+constexpr double kThreadMass = 1e-3;         // the whole thread [kg]
+constexpr const double (&kStitchZ)[2] = kSutureStitchZ;
 // The pull: up and away from the cut at this speed [m per frame] until the
 // knot holds at the first puncture, then kTighten frames more, then held for
 // kHold frames; at most kMostPull frames to reach the knot.
 constexpr double kPullSpeed = 4.25e-4;
 constexpr int kTighten = 10, kHold = 30, kMostPull = 500;
-constexpr double kLastAngle = 2.0 * M_PI - 0.2;
-constexpr int kStitched = 2 * kTurn + kShift;
+constexpr int kStitched = kSutureStitchFrames;
 
 Error bad(const std::string& what) { return Error(ErrorCode::bad_parameter, "suture scene: " + what); }
-
-// The needle's pose in frame f: turned about z by `angle` around its centre,
-// kAbove over the cut at a stitch's z; in the pull, `pulled` [m] up and away.
-struct NeedlePose {
-  std::array<double, 3> position;
-  double angle;
-};
-NeedlePose script(int f, double pulled) {
-  const int second = kTurn + kShift;
-  if (f < kTurn) return {{0.0, kAbove, kStitchZ[0]}, kLastAngle * (f + 1) / kTurn};
-  if (f < second) {  // over to the second stitch, the tip above the left lip
-    const double u = double(f - kTurn + 1) / kShift;
-    return {{0.0, kAbove, kStitchZ[0] + u * (kStitchZ[1] - kStitchZ[0])}, kLastAngle};
-  }
-  if (f < kStitched) return {{0.0, kAbove, kStitchZ[1]}, kLastAngle + kLastAngle * (f - second + 1) / kTurn};
-  return {{0.5 * pulled, kAbove + pulled, kStitchZ[1]}, 2.0 * kLastAngle};
-}
 
 double segment_distance(const float* p0, const float* p1, const float* q0, const float* q1);
 
 }  // namespace
 
-int SutureScene::stitch_frames() { return kStitched; }
+SutureNeedlePose suture_script(int f, double pulled) {
+  constexpr int turn = kSutureTurnFrames, second = kSutureTurnFrames + kSutureShiftFrames;
+  constexpr double last_angle = 2.0 * M_PI - 0.2;  // a turn short of the whole circle: the tip stays outside
+  if (f < turn) return {{0.0, kAbove, kStitchZ[0]}, last_angle * (f + 1) / turn};
+  if (f < second) {  // over to the second stitch, the tip above the left lip
+    const double u = double(f - turn + 1) / kSutureShiftFrames;
+    return {{0.0, kAbove, kStitchZ[0] + u * (kStitchZ[1] - kStitchZ[0])}, last_angle};
+  }
+  if (f < kStitched) return {{0.0, kAbove, kStitchZ[1]}, last_angle + last_angle * (f - second + 1) / turn};
+  return {{0.5 * pulled, kAbove + pulled, kStitchZ[1]}, 2.0 * last_angle};  // up and away from the cut
+}
 
 Result<SutureScene> SutureScene::create(const SutureSettings& settings) {
   const SutureSettings& s = settings;
@@ -154,7 +145,7 @@ Status SutureScene::frame() {
   auto needles = sim_->needles();
   auto id = needles.needle(0);
   if (!id) return id.error();
-  const NeedlePose p = script(frames_, pulled_);
+  const SutureNeedlePose p = suture_script(frames_, pulled_);
   const std::array<double, 4> q{std::cos(p.angle / 2), 0.0, 0.0, std::sin(p.angle / 2)};
   if (auto st = needles.set_pose(*id, p.position, q); !st) return st;
   if (auto st = sim_->step(); !st) return st;

@@ -55,6 +55,26 @@ inline constexpr const char* kSutureAbout =
     "twice, then pulled until the thread's knot holds and the stitches close the slit; mesh collision and\n"
     "continuous collision of the thread on; 60 Hz frames.\n";
 
+/// The running suture's script, shared with examples/suturing.cpp: a
+/// curved needle (a half circle of kSutureNeedleRadius, its centre
+/// kSutureNeedleAbove over the cut at y = 0) turned about the z axis through
+/// both lips at kSutureStitchZ[0] (kSutureTurnFrames frames), moved along
+/// the cut to kSutureStitchZ[1] (kSutureShiftFrames), turned again, then
+/// pulled up and away.
+inline constexpr double kSutureNeedleRadius = 0.008, kSutureNeedleAbove = 0.002;  // [m]
+inline constexpr double kSutureStitchZ[2] = {-0.003, 0.003};                    // [m]
+inline constexpr int kSutureTurnFrames = 110, kSutureShiftFrames = 40;
+inline constexpr int kSutureStitchFrames = 2 * kSutureTurnFrames + kSutureShiftFrames;
+/// The needle's pose: its centre [m] and its turn about z [rad].
+struct SutureNeedlePose {
+  std::array<double, 3> position;
+  double angle;
+};
+/// [in] frame: from 0; [in] pulled: how far [m] the pull has gone (used
+/// from frame kSutureStitchFrames on: pulled up, and half as far away from
+/// the cut along +x).
+SutureNeedlePose suture_script(int frame, double pulled);
+
 /// What the scene's checks measure (SutureScene::check).
 struct SutureCheck {
   std::size_t punctures = 0;        ///< the needle's punctures (entering and leaving)
@@ -86,9 +106,6 @@ class SutureScene {
   [[nodiscard]] int frames() const { return frames_; }
   /// The frame whose step first held the knot at the first puncture (-1: not yet).
   [[nodiscard]] int knot_frame() const { return knot_frame_; }
-  /// Frames of the stitching (both turns) before the pull starts.
-  [[nodiscard]] static int stitch_frames();
-
   /// [out] the slit's width [m] at the stitches' depth and positions along
   /// the cut: the mean x distance between its two faces' vertices there.
   Result<double> gap();
