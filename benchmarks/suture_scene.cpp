@@ -1,5 +1,5 @@
 // bench_suture_scene — the reference scene S3 (examples/common/suture_scene.h):
-// a 20,328-tet pad with a slit, a needle and its 200-segment thread stitched
+// a 20,064-tet pad with a slit, a needle and its 200-segment thread stitched
 // through both lips and pulled to the knot, mesh collision and the thread's
 // continuous collision on; 60 Hz frames. Times whole frames (the needle's
 // pose and step()) over the whole script, or its first FRAMES frames.

@@ -1,5 +1,5 @@
 // suture_scene — the reference scene S3 (examples/common/suture_scene.h): a
-// tissue pad of 20,328 tets with a 2 mm slit, a curved needle and its
+// tissue pad of 20,064 tets with a 2 mm slit, a curved needle and its
 // 200-segment thread turned through both lips twice, then pulled until the
 // thread's knot holds and the stitches close the slit; the thread's mesh
 // collision and continuous collision on.

@@ -1,5 +1,5 @@
 // The reference scene S3 (examples/common/suture_scene.h), shortened: the
-// pad at 2 mm cells (13 x 5 x 8 cells, 3,012 tets instead of 20,328), the
+// pad at 2 mm cells (13 x 5 x 8 cells, 3,012 tets instead of 20,064), the
 // same 200-segment thread and the whole script (both stitches, the pull to
 // the knot, the hold). Every frame: every position finite; the continuous
 // collision forced no crossing (FrameStats::ccd_forced: a thread segment
