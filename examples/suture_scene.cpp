@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   cli.add_backend(s.backend);
   cli.app().add_option("--every", every, "Report and write every N-th frame (and the last)")
       ->check(sinew::examples::at_least(1));
-  cli.app().add_option("--frames", frames, "Stop after N frames of 1/60 s (0: the whole script, ~710 frames)")
+  cli.app().add_option("--frames", frames, "Stop after N frames of 1/60 s (0: the whole script, ~600 frames)")
       ->check(sinew::examples::at_least(0));
   cli.app().add_option("--substeps", s.substeps, "Substeps per frame")->check(sinew::examples::at_least(1));
   cli.app().add_option("--threads", s.threads, "cpu backend worker threads (0: all)")->check(sinew::examples::at_least(0));
