@@ -31,11 +31,11 @@
 
 #include "bench_support.h"
 #include "command_line.h"
+#include "frame_profile.h"
 #include "retraction_scene.h"
 
 namespace {
 
-// Nearest-rank percentile q in [0, 1] of v (0 when empty).
 using sinew::bench::percentile;
 
 int fail(const std::string& what) {
@@ -136,27 +136,11 @@ int main(int argc, char** argv) {
   sinew::examples::RetractionScene& r = **scene;
   if (haptics)
     if (auto st = r.start_haptics(); !st) return fail(st.error().message());
-  // Wall time, and the process's CPU time (every thread's): on a shared
-  // machine the latter is the frame's work without the time other jobs took
-  // (spinning barriers included).
-  auto cpu_now_ms = [] {
-    timespec ts{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-  };
-  std::vector<double> frame_ms, cpu_ms;
-  std::map<std::string, std::vector<double>> stage_ms;
-  std::vector<std::string> stage_order;
+  sinew::bench::FrameProfile profile;
   for (int f = 0; f < frames; ++f) {
-    const double c0 = cpu_now_ms();
-    const auto a = std::chrono::steady_clock::now();
+    profile.start();
     if (auto st = r.frame(); !st) return fail(st.error().message());
-    frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
-    cpu_ms.push_back(cpu_now_ms() - c0);
-    for (const auto& p : r.sim().last_frame().stages) {
-      if (!stage_ms.count(p.name)) stage_order.push_back(p.name);
-      stage_ms[p.name].push_back(p.ms);
-    }
+    profile.stop(r.sim().last_frame());
   }
   r.stop_haptics();
   auto c = r.check();
@@ -165,17 +149,12 @@ int main(int argc, char** argv) {
   std::printf("backend,particles,held,substeps,iterations,frames,median_ms,p95_ms,worst_ms,cpu_median_ms,"
               "load_1min,mesh_contacts,contact_violation_m,max_slip_m,pole_lift_m,grasp_force_y_n,device_force_y_n,"
               "inverted_tets\n");
-  double load[1] = {0.0};
-  if (getloadavg(load, 1) != 1) load[0] = -1.0;
   std::printf("%s,%u,%zu,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.2f,%u,%.3e,%.3e,%.3e,%.4f,%.4f,%zu\n", s.backend.c_str(),
-              r.sim().info().particles, r.held().size(), s.substeps, s.iterations, frames, percentile(frame_ms, 0.5),
-              percentile(frame_ms, 0.95), percentile(frame_ms, 1.0), percentile(cpu_ms, 0.5), load[0], st.mesh_contacts,
+              r.sim().info().particles, r.held().size(), s.substeps, s.iterations, frames, profile.wall(0.5),
+              profile.wall(0.95), profile.wall(1.0), profile.cpu(0.5), sinew::bench::load_average(), st.mesh_contacts,
               c->contact_violation, c->max_slip, c->pole_lift, c->grasp_force[1], c->device_force[1],
               c->inverted_tets);
-  std::printf("stage,median_ms,p95_ms,worst_ms\n");
-  for (const auto& name : stage_order)
-    std::printf("%s,%.3f,%.3f,%.3f\n", name.c_str(), percentile(stage_ms[name], 0.5), percentile(stage_ms[name], 0.95),
-                percentile(stage_ms[name], 1.0));
+  profile.print_stages();
   // Each stage's own figures of the last frame (StageProfile::counters).
   std::printf("stage,counter,last_frame\n");
   for (const auto& p : st.stages)

@@ -27,23 +27,23 @@
 #include <vector>
 
 #include "command_line.h"
+#include "suture_scene.h"
 #include "sinew/mesh.h"
 #include "sinew/simulation.h"
 #include "sinew/vtk_output.h"
 
 namespace {
 
-constexpr double kCell = 0.002, kRadius = 0.008, kAbove = 0.002;  // [m]
+constexpr double kCell = 0.002;  // [m]
+constexpr double kRadius = sinew::examples::kSutureNeedleRadius, kAbove = sinew::examples::kSutureNeedleAbove;
 constexpr int kNx = 13, kNy = 5, kNz = 6, kSlit = 6;               // cells; the slit is column kSlit
 constexpr int kThreadSegments = 100;
-constexpr double kStitchZ[2] = {-0.003, 0.003};
-constexpr int kTurn = 110, kShift = 40;  // frames of each phase
+constexpr const double (&kStitchZ)[2] = sinew::examples::kSutureStitchZ;
 // The pull: up and away from the cut at this speed [m per frame] until the
 // knot holds at the first puncture, then kTighten frames more, then held
 // for kHold frames; at most kMostPull frames to reach the knot.
 constexpr double kPullSpeed = 4.25e-4;
 constexpr int kTighten = 10, kHold = 60, kMostPull = 400;
-constexpr double kLastAngle = 2.0 * M_PI - 0.2;
 
 int fail(const std::string& message) {
   std::fprintf(stderr, "suturing: %s\n", message.c_str());
@@ -67,25 +67,8 @@ sinew::TetMesh slit_pad() {
   return pad;
 }
 
-// The needle's pose in the script: turned about the z axis by `angle`
-// around its centre, which sits kAbove over the cut at depth z.
-struct Pose {
-  std::array<double, 3> position;
-  double angle;
-};
-// The stitches' frames: both turns, then the pull.
-constexpr int kStitched = 2 * kTurn + kShift;
-// The needle's pose in frame f < kStitched, or `pulled` [m] into the pull.
-Pose script(int f, double pulled) {
-  const int second = kTurn + kShift;
-  if (f < kTurn) return {{0.0, kAbove, kStitchZ[0]}, kLastAngle * (f + 1) / kTurn};
-  if (f < second) {  // over to the second stitch, the tip above the left lip
-    const double u = double(f - kTurn + 1) / kShift;
-    return {{0.0, kAbove, kStitchZ[0] + u * (kStitchZ[1] - kStitchZ[0])}, kLastAngle};
-  }
-  if (f < kStitched) return {{0.0, kAbove, kStitchZ[1]}, kLastAngle + kLastAngle * (f - second + 1) / kTurn};
-  return {{0.5 * pulled, kAbove + pulled, kStitchZ[1]}, 2.0 * kLastAngle};  // up and away from the cut
-}
+// The stitches' frames (both turns; the script is suture_scene.h's), then the pull.
+constexpr int kStitched = sinew::examples::kSutureStitchFrames;
 
 }  // namespace
 
@@ -171,7 +154,7 @@ int main(int argc, char** argv) {
   double width_before = 0.0, pulled = 0.0;
   int knot_frame = -1, last = -1;  // when the knot first held; the last frame
   for (int f = 0; last < 0 || f <= last; ++f) {
-    const Pose p = script(f, pulled);
+    const sinew::examples::SutureNeedlePose p = sinew::examples::suture_script(f, pulled);
     const std::array<double, 4> q{std::cos(p.angle / 2), 0.0, 0.0, std::sin(p.angle / 2)};
     if (auto s = needles.set_pose(*needle_id, p.position, q); !s) return fail(s.error().message());
     if (auto s = sim->step(); !s) return fail("frame " + std::to_string(f) + ": " + s.error().message());
