@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <string>
 
+#include "math/vec3.h"
+
 namespace sinew::haptics {
 namespace {
 
@@ -57,17 +59,8 @@ ScriptedPose KeyframePath::at(double t) const noexcept {
   const double s = (t - a.time) / (b.time - a.time);
   const double w = interpolation_ == PathInterpolation::smooth ? 0.5 - 0.5 * std::cos(M_PI * s) : s;
   for (int i = 0; i < 3; ++i) p.position[i] = a.position[i] + (b.position[i] - a.position[i]) * w;
-  // Along the shorter arc: q and -q are the same rotation.
-  const double dot = a.rotation[0] * b.rotation[0] + a.rotation[1] * b.rotation[1] + a.rotation[2] * b.rotation[2] +
-                     a.rotation[3] * b.rotation[3];
-  const double sign = dot < 0.0 ? -1.0 : 1.0;
-  double n = 0.0;
-  for (int i = 0; i < 4; ++i) {
-    p.rotation[i] = a.rotation[i] + (sign * b.rotation[i] - a.rotation[i]) * w;
-    n += p.rotation[i] * p.rotation[i];
-  }
-  n = std::sqrt(n);
-  for (double& c : p.rotation) c /= n;
+  // Along the shorter arc (q and -q are the same rotation), normalised.
+  p.rotation = math::nlerp(a.rotation, b.rotation, w);
   return p;
 }
 
