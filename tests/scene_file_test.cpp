@@ -278,6 +278,9 @@ TEST(SceneFile, HapticsHandsReadWithTheirFieldsAndErrors) {
             0u);
   EXPECT_EQ(error_of(with(R"({"tool": 0, "tool_damping": -1, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})")),
             "/haptics/hands/0/tool_damping: must be finite and >= 0");
+  // Each damping is named by its own key.
+  EXPECT_EQ(error_of(with(R"({"tool": 0, "tool_angular_damping": -0.5, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})")),
+            "/haptics/hands/0/tool_angular_damping: must be finite and >= 0");
   EXPECT_EQ(error_of(with(R"({"tool": 0, "grip": 1, "path": {"keys": [{"time": 0, "position": [0, 0, 0]}]}})"))
                 .rfind("/haptics/hands/0/grip", 0),
             0u);

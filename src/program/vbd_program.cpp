@@ -25,18 +25,6 @@
 #include "xpbd_params.h"
 
 namespace sinew {
-namespace {
-
-Result<BufferHandle> upload_words(Device& device, const std::vector<std::uint32_t>& words, std::string_view label) {
-  auto buffer = device.create_buffer(std::max<std::size_t>(words.size() * 4, 16), label);
-  if (!buffer) return buffer;
-  if (!words.empty())
-    if (Status s = device.write_buffer(*buffer, 0, words.data(), words.size() * 4); !s) return s.error();
-  return buffer;
-}
-
-}  // namespace
-
 VbdTopology make_vbd_topology(const ConstraintBlock& block, const std::vector<kernels::float4>& positions) {
   VbdTopology t;
   const auto particles = static_cast<std::uint32_t>(positions.size());
@@ -100,7 +88,7 @@ Result<VbdBuffers> upload_vbd(Device& device, const CompiledScene& scene) {
     for (auto [handle, words, label] : {std::tuple{&b.vertices, &topology.vertices, " vertices"},
                                         std::tuple{&b.offsets, &topology.offsets, " offsets"},
                                         std::tuple{&b.incidences, &topology.incidences, " incidences"}}) {
-      auto made = upload_words(device, *words, name + label);
+      auto made = make_buffer(device, *words, name + label);
       if (!made) return made.error();
       *handle = *made;
     }

@@ -20,16 +20,6 @@
 namespace sinew {
 namespace {
 
-template <class T>
-Result<BufferHandle> make_buffer(Device& device, const std::vector<T>& data, std::string_view label) {
-  // Empty blocks still get a (small) buffer so every handle is valid.
-  auto buffer = device.create_buffer(std::max<std::size_t>(data.size() * sizeof(T), 16), label);
-  if (!buffer) return buffer;
-  if (!data.empty())
-    if (Status s = device.write_buffer(*buffer, 0, data.data(), data.size() * sizeof(T)); !s) return s.error();
-  return buffer;
-}
-
 // A range of one block's slots that one dispatch solves.
 struct SlotRange {
   std::uint32_t first, count;

@@ -9,9 +9,11 @@
 #include "mesh_contact_params.h"
 #include "xpbd_params.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace sinew {
@@ -119,6 +121,17 @@ kernels::PredictParams predict_params(double h, const std::array<double, 3>& gra
 kernels::UpdateVelocityParams update_params(double h, std::uint32_t particles);
 
 /// Creates the buffers on `device` and uploads the compiled scene.
+/// A device buffer holding `data`; an empty vector still gets a small
+/// (16-byte) buffer so that every handle is valid.
+template <class T>
+Result<BufferHandle> make_buffer(Device& device, const std::vector<T>& data, std::string_view label) {
+  auto buffer = device.create_buffer(std::max<std::size_t>(data.size() * sizeof(T), 16), label);
+  if (!buffer) return buffer;
+  if (!data.empty())
+    if (Status s = device.write_buffer(*buffer, 0, data.data(), data.size() * sizeof(T)); !s) return s.error();
+  return buffer;
+}
+
 Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
 
 /// The dispatches of one frame of `solver`, with `gravity` [m/s^2].

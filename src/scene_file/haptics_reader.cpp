@@ -3,6 +3,7 @@
 // virtual clock (docs/scene_files.md, "Haptics"; sinew/haptics/scripted_hands.h).
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "scene_file/readers.h"
 
@@ -88,10 +89,10 @@ void read_hand(const Json& v, const std::string& path, Context& ctx, haptics::Sc
     return ctx.fail(ErrorCode::bad_parameter, path + "/" + key, m.substr(space + 1));
   }
   // The loop's other settings are not in the file (their defaults hold); ScriptedHands checks them all.
-  if (!(out.tool_damping >= 0.0) || !(out.tool_angular_damping >= 0.0) || !std::isfinite(out.tool_damping) ||
-      !std::isfinite(out.tool_angular_damping))
-    ctx.fail(ErrorCode::bad_parameter, path + (out.tool_damping >= 0.0 ? "/tool_angular_damping" : "/tool_damping"),
-             "must be finite and >= 0");
+  for (const auto& [key, value] : {std::pair<const char*, double>{"tool_damping", out.tool_damping},
+                                    {"tool_angular_damping", out.tool_angular_damping}})
+    if (!(value >= 0.0 && std::isfinite(value)))
+      return ctx.fail(ErrorCode::bad_parameter, path + "/" + key, "must be finite and >= 0");
 }
 
 }  // namespace

@@ -71,8 +71,6 @@ class ScriptedHands {
   [[nodiscard]] const ScriptedDevice& device(std::size_t i) const { return *hands_[i]->device; }
   /// Hand i's bridge: the force applied to its tool last frame.
   [[nodiscard]] const HapticToolBridge& bridge(std::size_t i) const { return *hands_[i]->bridge; }
-  /// The virtual clock's time [ns] (the end of the last frame stepped).
-  [[nodiscard]] std::int64_t now_ns() { return clock_.now_ns(); }
 
  private:
   struct Hand {
