@@ -12,13 +12,19 @@
 //     cells, 1,600 triangles), 50 kPa, with bending, lying under the
 //     gallbladder. Its far edge is fastened to the
 //     liver bed (pinned); its near edge to the gallbladder: each of those
-//     vertices is attached to a target that follows the nearest gallbladder
-//     vertex every frame (one-way: the membrane follows the organ, and does
-//     not pull on it);
-//   - at 0.5 s a grasper closes on the middle of the membrane and lifts it
-//     15 mm over a second; from 0.8 s a cautery tip of 3 mm radius (dwell
-//     0.1 s) burns a strand near the liver edge; from 1.5 s a blade sweeps
-//     along the gallbladder edge, cutting the membrane free of it.
+//     vertices is attached, two ways, to the nearest gallbladder vertex at
+//     their rest distance (BodyAttachmentDesc: the membrane pulls on the
+//     organ as the organ pulls on it);
+//   - at 0.5 s a grasper closes on the middle of the membrane where it
+//     hangs then, and lifts it 15 mm over a second; from 0.8 s a cautery
+//     tip of 3 mm radius (dwell 0.1 s) burns a strand near the liver edge,
+//     where that strand is each frame; from 1.5 s a blade sweeps along the
+//     gallbladder edge, following the membrane, cutting it free.
+//
+// scenes/cholecystectomy.json is this scene as a file (its script's
+// landmarks find the membrane's middle and the strand in the running
+// scene, a relative track lifts the grasper): `sinew run` on it writes
+// the same files, byte for byte.
 //
 // Prints each topology event (what it removed and what it took) and the wall
 // time per frame; writes cholecystectomy.pvd (sinew/vtk_output.h, from
@@ -125,49 +131,43 @@ int main(int argc, char** argv) {
   // No bending constraints: a membrane this thin drapes (and each hinge
   // costs about as much as its two triangles' area and edges together).
   sheet.velocity_damping = 2.0;
-  // The near edge follows the gallbladder: each vertex there attached to a
-  // target at its nearest gallbladder vertex (plus their rest offset).
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> fastened;  // (membrane vertex, gallbladder vertex)
-  std::vector<V3> offset;
+  // The near edge is attached to the gallbladder, two ways: each vertex
+  // there to its three nearest gallbladder vertices (the first of equals),
+  // each at their rest distance. One strut would let the vertex swing
+  // about its organ vertex like a pendulum; three hold it where it lies.
+  std::size_t fastened = 0;
   for (std::uint32_t v = 0; v < sheet.mesh.vertices.size(); ++v) {
     const V3& p = sheet.mesh.vertices[v];
     if (p[2] < far_z + 1e-9) sheet.pinned.push_back(v);  // the liver bed
     if (p[2] < near_z - 1e-9) continue;
-    std::uint32_t nearest = 0;
-    double best = std::numeric_limits<double>::infinity();
+    std::vector<std::pair<double, std::uint32_t>> by_distance;  // (squared distance, gallbladder vertex)
     for (std::uint32_t u = 0; u < organ.mesh.vertices.size(); ++u) {
       double d2 = 0.0;
       for (int a = 0; a < 3; ++a) d2 += (organ.mesh.vertices[u][a] - p[a]) * (organ.mesh.vertices[u][a] - p[a]);
-      if (d2 < best) best = d2, nearest = u;
+      by_distance.emplace_back(d2, u);
     }
-    scene.attachments.push_back({.vertex = {sinew::BodyKind::tri, 0, v},
-                                 .target = static_cast<std::uint32_t>(scene.targets.size()), .compliance = 0.0});
-    scene.targets.push_back(p);
-    fastened.emplace_back(v, nearest);
-    offset.push_back({p[0] - organ.mesh.vertices[nearest][0], p[1] - organ.mesh.vertices[nearest][1],
-                      p[2] - organ.mesh.vertices[nearest][2]});
+    std::partial_sort(by_distance.begin(), by_distance.begin() + 3, by_distance.end());
+    for (int k = 0; k < 3; ++k)
+      scene.body_attachments.push_back(
+          {.a = {.body_kind = sinew::BodyKind::tri, .body = 0, .vertices = {v}, .weights = {1.0}},
+           .b = {.body_kind = sinew::BodyKind::tet, .body = 0, .vertices = {by_distance[k].second}, .weights = {1.0}},
+           .compliance = 0.0,
+           .rest_length = std::sqrt(by_distance[k].first)});
+    ++fastened;
   }
   scene.tri_bodies.push_back(sheet);
   auto sim = sinew::Simulation::create(scene, {.backend = backend});
   if (!sim) return fail(sim.error().message());
-  const std::uint32_t organ_first = sim->info().tet_body_first_particle[0];
   const std::uint32_t sheet_first = sim->info().tri_body_first_particle[0];
   // The features' handles and the ids of what the script drives.
-  sinew::Tools tools = sim->tools();
   sinew::Topology topology = sim->topology();
   const auto grasper = sim->graspers().grasper(0);
   const auto gallbladder_id = topology.tet_body(0);
   const auto membrane_id = topology.tri_body(0);
   if (!grasper || !gallbladder_id || !membrane_id) return fail("the scene lacks its grasper or bodies");
-  std::vector<sinew::TargetId> edge_targets;
-  for (std::size_t i = 0; i < fastened.size(); ++i) {
-    auto id = tools.target(i);
-    if (!id) return fail(id.error().message());
-    edge_targets.push_back(*id);
-  }
   std::printf("cholecystectomy: %s; gallbladder %zu tets, membrane %zu triangles (%zu vertices fastened to the "
               "gallbladder)\n",
-              sim->device_name().c_str(), organ.mesh.tets.size(), sheet.mesh.triangles.size(), fastened.size());
+              sim->device_name().c_str(), organ.mesh.tets.size(), sheet.mesh.triangles.size(), fastened);
 
   std::printf("  %u colours a sweep, %u dispatches and %u barriers a frame\n", sim->info().colors,
               sim->info().dispatches_per_frame, sim->info().barriers_per_frame);
@@ -198,6 +198,7 @@ int main(int argc, char** argv) {
   std::vector<float> x;
   std::vector<double> frame_ms;
   sinew::Pose jaws;
+  V3 grasped_at{};  // where the jaws closed
   std::size_t held = 0;
   auto output = sinew::SceneOutput::create(
       scene, out,
@@ -210,13 +211,8 @@ int main(int argc, char** argv) {
     const double t = frame * kFrame;
     const auto t0 = std::chrono::steady_clock::now();
     if (auto s = sim->read_positions(x); !s) return fail(s.error().message());
-    // The near edge's targets: where their gallbladder vertices are now.
-    for (std::size_t i = 0; i < fastened.size(); ++i) {
-      const float* q = &x[4 * (std::size_t{organ_first} + fastened[i].second)];
-      if (auto s = tools.set_position(edge_targets[i], {q[0] + offset[i][0], q[1] + offset[i][1], q[2] + offset[i][2]}); !s)
-        return fail(s.error().message());
-    }
-    // The grasper: closes on the membrane's middle at 0.5 s, lifts 15 mm by 1.5 s.
+    // The grasper: closes on the membrane's middle at 0.5 s, lifts 15 mm by
+    // 1.5 s (linearly in the frame number) and holds it there.
     if (frame == 30) {
       // Where the membrane's middle hangs now (the mean of its vertices
       // within 1.5 mm of the middle at rest).
@@ -230,12 +226,13 @@ int main(int argc, char** argv) {
       }
       for (double& c : middle) c /= n;
       jaws.position = middle;
+      grasped_at = middle;
       auto h = sim->graspers().close(*grasper, jaws, jaws_half_extents);
       if (!h) return fail(h.error().message());
       held = h->size();
       std::printf("  %5.3f s  grasp    %zu particles held\n", t, held);
-    } else if (frame > 30 && frame <= 90) {
-      jaws.position[1] += 0.015 / 60.0;
+    } else if (frame > 30) {
+      jaws.position[1] = grasped_at[1] + 0.015 * std::min(double(frame - 30) / 60.0, 1.0);
       if (auto s = sim->graspers().move(*grasper, jaws); !s) return fail(s.error().message());
     }
     // Cautery: a 3 mm tip held on a strand near the liver edge, 0.8 to
@@ -249,17 +246,23 @@ int main(int argc, char** argv) {
       if (!e) return fail(e.error().message());
       record(t, "cautery", *e);
     }
-    // The blade: from 1.5 s it sweeps along the gallbladder edge, 2 mm from
-    // it, across the membrane, 2 mm a frame. Each stroke starts
-    // 2 mm back: a stroke cuts what it touches where the tissue is now, and
-    // the membrane moves between frames (strokes that only met end to end
-    // left uncut tissue that had swung back across the line).
+    // The blade: from 1.5 s it sweeps along the gallbladder edge across the
+    // membrane, 2 mm a frame, following the tissue: each stroke is placed on
+    // the membrane vertex that lay 2 mm from the edge at rest, where that
+    // vertex is now (the membrane pulls the gallbladder's bottom towards
+    // the liver as the grasper lifts it, so a fixed line would miss). A
+    // stroke runs from 3 mm behind that vertex to 1 mm past it, 6 mm above
+    // to 9 mm below it: each starts 2 mm back of the last one's end, since a
+    // stroke cuts what it touches where the tissue is now and the membrane
+    // moves between frames (strokes that only met end to end left uncut
+    // tissue that had swung back across the line).
     std::optional<sinew::Blade> blade;  // the blade's edge at the end of this frame's stroke
-    if (t >= 1.5 && t < 2.3) {
-      const int k = frame - 90;
-      const double bx = centre[0] - 0.021 + 2e-3 * k, bz = near_z - 2e-3;
-      const sinew::Blade from{{bx - 2e-3, centre[1] + 5e-3, bz}, {bx - 2e-3, centre[1] - 1e-2, bz}};
-      const sinew::Blade to{{bx + 2e-3, centre[1] + 5e-3, bz}, {bx + 2e-3, centre[1] - 1e-2, bz}};
+    if (frame >= 90 && frame <= 110) {
+      const std::uint32_t on_line = static_cast<std::uint32_t>(2 * (frame - 90)) * (kNz + 1) + (kNz - 2);
+      const float* q = &x[4 * (std::size_t{sheet_first} + on_line)];
+      const auto at = [&](double dx, double dy) { return V3{q[0] + dx, q[1] + dy, q[2] + 0.0}; };
+      const sinew::Blade from{at(-3e-3, 6e-3), at(-3e-3, -9e-3)};
+      const sinew::Blade to{at(1e-3, 6e-3), at(1e-3, -9e-3)};
       blade = to;
       auto e = topology.cut(*membrane_id, from, to);
       if (!e) return fail(e.error().message());

@@ -224,6 +224,86 @@ TEST(SceneFile, ScriptMovesACollider) {
   EXPECT_LT(lowest_top, 0.0045f);
 }
 
+// A landmark finds where the tissue is when the action runs, and a relative
+// grasper track moves the jaws from where they closed: the script plays
+// bitwise as the same done by hand in C++ (read the positions, close on
+// their mean, lift from there).
+TEST(SceneFile, LandmarksAndRelativeTracksFollowTheRunningScene) {
+  const std::string far_end = "[4, 9, 14, 19, 24, 29]";  // x = 0.04 of the 5 x 2 x 3 grid's vertices
+  auto file = parse_scene_json(block_scene().substr(0, block_scene().size() - 1) + R"(,
+    "graspers": [{"capacity": 64, "compliance": 0.0}],
+    "script": {"poses": [{"grasper": 0, "relative": true,
+                          "keys": [{"frame": 5, "position": [0, 0, 0]}, {"frame": 15, "position": [0, 0.01, 0]}]}],
+               "actions": [{"frame": 5, "do": "close_grasper", "grasper": 0, "half_extents": [0.003, 0.008, 0.012],
+                            "at": {"body": 0, "vertices": )" + far_end + R"(}}]}})",
+                               kScenes);
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  ASSERT_TRUE(file->script.actions.at(0).at.has_value());
+  const std::vector<std::uint32_t> end = file->script.actions[0].at->vertices;
+  for (std::uint32_t v : end) ASSERT_EQ(file->scene.tet_bodies[0].mesh.vertices.at(v)[0], 0.04);
+
+  auto played = Simulation::create(file->scene, {.backend = "cpu", .threads = 1});
+  auto by_hand = Simulation::create(file->scene, {.backend = "cpu", .threads = 1});
+  ASSERT_TRUE(played.ok() && by_hand.ok());
+  ScriptPlayer player(file->script);
+  std::vector<ScriptEvent> events;
+  std::vector<float> x;
+  const auto mean_of_end = [&](Simulation& sim) {
+    EXPECT_TRUE(sim.read_positions(x).ok());
+    std::array<double, 3> m{0.0, 0.0, 0.0};
+    for (std::uint32_t v : end)
+      for (int c = 0; c < 3; ++c) m[c] += x[4 * v + c];
+    for (double& c : m) c /= static_cast<double>(end.size());
+    return m;
+  };
+  auto grasper = by_hand->graspers().grasper(0);
+  ASSERT_TRUE(grasper.ok());
+  Pose jaws;
+  std::array<double, 3> closed_at{};
+  std::size_t held_by_hand = 0;
+  for (int f = 1; f <= 20; ++f) {
+    ASSERT_TRUE(player.before_frame(*played, f, events).ok());
+    if (f == 5) {
+      closed_at = jaws.position = mean_of_end(*by_hand);
+      auto held = by_hand->graspers().close(*grasper, jaws, {0.003, 0.008, 0.012});
+      ASSERT_TRUE(held.ok());
+      held_by_hand = held->size();
+    } else if (f > 5) {
+      jaws.position[1] = closed_at[1] + 0.01 * std::min(double(f - 5) / 10.0, 1.0);
+      ASSERT_TRUE(by_hand->graspers().move(*grasper, jaws).ok());
+    }
+    ASSERT_TRUE(played->step().ok() && by_hand->step().ok());
+  }
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].particles.size(), held_by_hand);
+  EXPECT_EQ(held_by_hand, end.size());  // the jaws closed on the sagged end, not where it was at rest
+  std::vector<float> a, b;
+  ASSERT_TRUE(played->read_positions(a).ok() && by_hand->read_positions(b).ok());
+  EXPECT_EQ(a, b);
+  // The end was lifted 10 mm from where it was grasped (held rigidly: within a tenth of a millimetre).
+  EXPECT_NEAR(mean_of_end(*played)[1] - closed_at[1], 0.01, 1e-4);
+}
+
+TEST(SceneFile, LandmarkAndRelativeTrackErrors) {
+  const std::string scene = block_scene().substr(0, block_scene().size() - 1) +
+                            R"(, "graspers": [{"capacity": 8}], "colliders": [{"shape": "sphere", "radius": 0.01}],
+                            "script": )";
+  EXPECT_EQ(error_of(scene + R"({"actions": [{"frame": 1, "do": "close_grasper", "grasper": 0, "half_extents": [1, 1, 1],
+                                  "at": {"body": 0, "vertices": [30]}}]}})"),
+            "/script/actions (frame 1)/at: vertex 30 is out of range (the body has 30)");
+  EXPECT_EQ(error_of(scene + R"({"actions": [{"frame": 1, "do": "close_grasper", "grasper": 0, "half_extents": [1, 1, 1],
+                                  "at": {"body_kind": "tri", "body": 0, "vertices": [0]}}]}})"),
+            "/script/actions (frame 1)/at: body 0 does not exist (the scene has 0)");
+  EXPECT_EQ(error_of(scene + R"({"actions": [{"frame": 1, "do": "close_grasper", "grasper": 0, "half_extents": [1, 1, 1],
+                                  "position": [0, 0, 0], "at": {"body": 0, "vertices": [0]}}]}})"),
+            "/script/actions/0/position: give \"position\" or \"at\" (a landmark), not both");
+  EXPECT_EQ(error_of(scene + R"({"actions": [{"frame": 1, "do": "close_grasper", "grasper": 0, "half_extents": [1, 1, 1],
+                                  "at": {"body": 0, "vertices": []}}]}})"),
+            "/script/actions/0/at/vertices: must not be empty");
+  EXPECT_EQ(error_of(scene + R"({"poses": [{"collider": 0, "relative": true, "keys": [{"frame": 0, "position": [0, 0, 0]}]}]}})"),
+            "/script/poses/0/relative: only a grasper's track can be relative (to the pose its jaws closed at)");
+}
+
 // "haptics": scripted hands read with their paths, loops and damping; every
 // bad value named by its JSON path.
 TEST(SceneFile, HapticsHandsReadWithTheirFieldsAndErrors) {

@@ -21,6 +21,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -70,10 +71,31 @@ struct ScriptKey {
 /// target (Tools::set_position; the rotation is ignored), grasper
 /// (Graspers::move, only while it is closed), needle (Needles::set_pose).
 /// Forces: tool (Tools::apply_force), needle (Needles::apply_force).
+///
+/// A grasper's track may be `relative`: its keys are then offsets from the
+/// pose the jaws closed at (ScriptAction::at finds that pose in the running
+/// scene): position = closed position + key position [m], rotation = key
+/// rotation * closed rotation (the key's rotation applied after the
+/// closed pose's, in the world frame). "Lift 15 mm from wherever it took
+/// hold" is then two keys, {0, 0, 0} and {0, 0.015, 0}.
 struct ScriptTrack {
   ScriptSubject subject = ScriptSubject::collider;
   std::uint32_t index = 0;  ///< among the scene's objects of that kind
   std::vector<ScriptKey> keys;  ///< at least one
+  bool relative = false;    ///< grasper tracks only: keys relative to the pose the jaws closed at
+};
+
+/// A point of the running scene: the mean of some vertices of one body
+/// where they are when the action runs (after the frame's poses are set,
+/// before its step), plus an offset. The vertices are summed in the order
+/// given, in double, from the float positions Simulation::read_positions
+/// returns; then divided by their count. Grasping "where the membrane's
+/// middle hangs now" or burning "where this strand is now" is a landmark.
+struct ScriptLandmark {
+  BodyKind body_kind = BodyKind::tet;   ///< tet, tri or line body
+  std::uint32_t body = 0;               ///< among the scene's bodies of that kind
+  std::vector<std::uint32_t> vertices;  ///< at least one, each a vertex of that body's mesh
+  std::array<double, 3> offset{0.0, 0.0, 0.0};  ///< [m], added to the mean
 };
 
 /// What a ScriptAction does at its frame.
@@ -97,6 +119,12 @@ struct ScriptAction {
   BodyKind body_kind = BodyKind::tet;    ///< cut, cauterize, remove
   Pose pose;                             ///< close_grasper: the jaws' pose
   std::array<double, 3> half_extents{};  ///< close_grasper: the jaws' box [m]
+  /// close_grasper, cauterize: when set, the jaws' position (pose.rotation
+  /// still applies) or the tip's centre is this landmark, found when the
+  /// action runs, instead of pose.position or centre. cut: the blade's
+  /// points are then offsets from the landmark [m] (a stroke that follows
+  /// the tissue).
+  std::optional<ScriptLandmark> at;
   std::array<double, 3> a_from{}, b_from{}, a_to{}, b_to{};  ///< cut: the blade's ends, from and to [m]
   std::array<double, 3> centre{};        ///< cauterize [m]
   double radius = 0.0;                   ///< cauterize [m]
@@ -173,6 +201,7 @@ class ScriptPlayer {
   SceneScript script_;
   std::size_t next_action_ = 0;
   std::vector<bool> grasper_closed_;
+  std::vector<Pose> grasper_closed_at_;  ///< the pose each grasper last closed at (relative tracks)
 };
 
 /// A key's interpolated value at `frame` (ScriptKey's rule): position,

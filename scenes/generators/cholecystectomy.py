@@ -5,20 +5,16 @@ The gallbladder's bounds place the membrane, its pins and the tools; this
 computes them from the same mesh (data/meshes/tet/gallbladder_volumetric.vtk,
 big-endian float32 points: Python's floats are the same doubles the reader
 makes of them) and writes them out: the membrane inline, its liver-bed pins,
-its near edge's attachments, the grasper's path, a cautery at each frame of
-0.8 to 1.2 s and the blade's strokes at each frame of 1.5 to 2.3 s (the
-example's own numbers). What the example reads from the running scene a
-script cannot: the description says what stands in for it.
+its near edge's two-way attachments to the gallbladder, the grasper's lift,
+a cautery at each frame of 0.8 to 1.2 s and the blade's strokes at each
+frame of 1.5 to 1.83 s (the example's own numbers). What the example reads
+from the running scene (where the membrane's middle hangs when the grasper
+closes, where the strand is while it burns, where the blade's line is) the
+script's landmarks find.
 
     scenes/generators/cholecystectomy.py DATA_DIR > scenes/cholecystectomy.json
-    sinew run scenes/cholecystectomy.json --backend cpu --frames 29 --quiet --positions hang.f32
-    scenes/generators/cholecystectomy.py DATA_DIR hang.f32 > scenes/cholecystectomy.json
 
-DATA_DIR: the data folder (data/ or a build's data folder). The grasper
-closes at frame 30 on the membrane's middle where it hangs then: the first
-pass closes it at rest (on nothing, the membrane has sagged), the second
-where the first pass's membrane hangs after 29 frames (HANG, the runner's
-positions, float32 xyzw per particle, the gallbladder's first).
+DATA_DIR: the data folder (data/ or a build's data folder).
 """
 import math
 import os
@@ -41,20 +37,24 @@ def section(data, name, fmt):
 
 
 def read_vtk_points(path):
-    """The points of a legacy binary VTK file that its tets use (the reader
-    drops the others), as doubles."""
+    """The points of a legacy binary VTK file that its tets use, as doubles,
+    in the reader's order: the others dropped, the rest numbered in the
+    order the tets first use them (drop_unused_vertices)."""
     with open(path, "rb") as f:
         data = f.read()
     header, values = section(data, b"POINTS", "f")
     assert header[1] == b"float", header
     _, cells = section(data, b"CELLS", "i")
     _, types = section(data, b"CELL_TYPES", "i")
-    used, at = set(), 0
+    used, order, at = set(), [], 0
     for kind in types:
         if kind == 10:  # VTK_TETRA
-            used.update(cells[at + 1:at + 5])
+            for i in cells[at + 1:at + 5]:
+                if i not in used:
+                    used.add(i)
+                    order.append(i)
         at += 1 + cells[at]
-    return [list(values[3 * i:3 * i + 3]) for i in sorted(used)]
+    return [list(values[3 * i:3 * i + 3]) for i in order]
 
 
 data = sys.argv[1] if len(sys.argv) > 1 else "data"
@@ -79,47 +79,55 @@ pin_above = hi[1] - 0.2 * (hi[1] - lo[1])
 pin_bottom = math.nextafter(pin_above, math.inf)
 assert sum(v[1] > pin_above for v in organ) == sum(v[1] >= pin_bottom for v in organ)
 
-# The grasper closes at frame 30 on the membrane's middle: the mean of the
-# vertices within 1.5 mm of it at rest, where they hang after 29 frames.
+# The near edge's attachments: each vertex to its three nearest gallbladder
+# vertices (the first of equals), at their distances (summed as the example
+# sums them).
+attached = []
+for v in edge:
+    p = vertices[v]
+    by_distance = []
+    for u, q in enumerate(organ):
+        d2 = 0.0
+        for k in range(3):
+            d2 += (q[k] - p[k]) * (q[k] - p[k])
+        by_distance.append((d2, u))
+    for d2, u in sorted(by_distance)[:3]:
+        attached.append({"a": {"body_kind": "tri", "body": 0, "vertices": [v], "weights": [1.0]},
+                         "b": {"body_kind": "tet", "body": 0, "vertices": [u], "weights": [1.0]},
+                         "compliance": 0.0, "rest_length": math.sqrt(d2)})
+
+# The grasper closes at frame 30 on the membrane's middle where it hangs
+# then: the mean of the vertices within 1.5 mm of it at rest (a landmark).
 near_middle = [v for v, p in enumerate(vertices)
                if abs(p[0] - centre[0]) <= 1.5e-3 and abs(p[2] - (near_z - 0.01)) <= 1.5e-3]
-hang = vertices
-if len(sys.argv) > 2:
-    with open(sys.argv[2], "rb") as f:
-        xyzw = f.read()
-    first = len(organ)  # the membrane's particles follow the gallbladder's
-    assert len(xyzw) == 16 * (first + len(vertices)), "not this scene's positions"
-    hang = [list(struct.unpack_from("<3f", xyzw, 16 * (first + v))) for v in range(len(vertices))]
-middle = [sum(hang[v][k] for v in near_middle) / len(near_middle) for k in range(3)]
-lifted = [middle[0], middle[1] + 0.015, middle[2]]
-strand = [p for p in vertices
+strand = [v for v, p in enumerate(vertices)
           if abs(p[0] - (centre[0] + 0.012)) < 0.5 * CELL and abs(p[2] - (far_z + 4e-3)) < 0.5 * CELL][-1]
 
-actions = [{"frame": 30, "do": "close_grasper", "grasper": 0, "position": middle,
+actions = [{"frame": 30, "do": "close_grasper", "grasper": 0,
+            "at": {"body_kind": "tri", "body": 0, "vertices": near_middle},
             "half_extents": [1.5e-3, 2e-3, 1.5e-3]}]
 for frame in range(1, 151):
     t = frame * FRAME
-    if 0.8 <= t < 1.2:  # the example burns where the strand is now; this where it was at rest
-        actions.append({"frame": frame, "do": "cauterize", "body_kind": "tri", "body": 0, "centre": strand,
+    if 0.8 <= t < 1.2:  # where the strand is now
+        actions.append({"frame": frame, "do": "cauterize", "body_kind": "tri", "body": 0,
+                        "at": {"body_kind": "tri", "body": 0, "vertices": [strand]},
                         "radius": 3e-3, "seconds": FRAME, "dwell_time": 0.1})
-    if 1.5 <= t < 2.3:
-        bx, bz = centre[0] - 0.021 + 2e-3 * (frame - 90), near_z - 2e-3
+    if 90 <= frame <= 110:  # on the vertex 2 mm from the edge at rest, where it is now
+        on_line = 2 * (frame - 90) * (NZ + 1) + (NZ - 2)
         actions.append({"frame": frame, "do": "cut", "body_kind": "tri", "body": 0,
-                        "from": {"a": [bx - 2e-3, centre[1] + 5e-3, bz], "b": [bx - 2e-3, centre[1] - 1e-2, bz]},
-                        "to": {"a": [bx + 2e-3, centre[1] + 5e-3, bz], "b": [bx + 2e-3, centre[1] - 1e-2, bz]}})
+                        "at": {"body_kind": "tri", "body": 0, "vertices": [on_line]},
+                        "from": {"a": [-3e-3, 6e-3, 0.0], "b": [-3e-3, -9e-3, 0.0]},
+                        "to": {"a": [1e-3, 6e-3, 0.0], "b": [1e-3, -9e-3, 0.0]}})
 
 scene = {
     "format": "sinew-scene",
     "version": 1,
     "description": "A cholecystectomy-like sequence: a grasper lifts the membrane joining the gallbladder to the "
                    "liver bed, a cautery tip burns a strand, a blade cuts the membrane free "
-                   "(examples/cholecystectomy.cpp; written by scenes/generators/cholecystectomy.py). Differences "
-                   "from the example, which reads the running scene: its membrane's near edge follows the "
-                   "gallbladder's vertices every frame (targets moved to them), here that edge is attached to "
-                   "targets fixed where it lies at rest; its grasper closes where the membrane's middle hangs at "
-                   "0.5 s, here where it hung at 0.5 s in a run of this scene (written in as numbers); its cautery burns where the strand is now, here where it "
-                   "was at rest. The bodies, materials, solver settings, the grasper's lift and the blade's "
-                   "strokes are the example's.",
+                   "(examples/cholecystectomy.cpp; written by scenes/generators/cholecystectomy.py). The "
+                   "membrane's near edge is attached two ways to the gallbladder; the grasper closes where the "
+                   "membrane's middle hangs at 0.5 s, the cautery burns where the strand is and the blade's strokes "
+                   "follow the membrane (landmarks); the grasper's lift is relative to where it closed.",
     "run": {"frames": 150, "every": 5},
     "solver": {"time_step": FRAME, "substeps": 10, "iterations": 2},
     "topology_changes": True,
@@ -141,12 +149,11 @@ scene = {
         "velocity_damping": 2.0,
         "pinned": liver_bed,
     }],
-    "targets": [vertices[v] for v in edge],
-    "attachments": [{"vertex": {"body_kind": "tri", "body": 0, "vertex": v}, "target": i, "compliance": 0.0}
-                    for i, v in enumerate(edge)],
+    "body_attachments": attached,
     "graspers": [{"capacity": 64, "compliance": 0.0}],
     "script": {
-        "poses": [{"grasper": 0, "keys": [{"frame": 30, "position": middle}, {"frame": 90, "position": lifted}]}],
+        "poses": [{"grasper": 0, "relative": True,
+                   "keys": [{"frame": 30, "position": [0.0, 0.0, 0.0]}, {"frame": 90, "position": [0.0, 0.015, 0.0]}]}],
         "actions": actions,
     },
 }

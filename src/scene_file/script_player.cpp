@@ -49,7 +49,44 @@ std::string describe(const char* what, const TopologyEvent& e) {
          " constraints removed";
 }
 
-Status pose_track(Simulation& sim, const ScriptTrack& track, const ScriptKey& k, const std::vector<bool>& closed) {
+// Where landmark `l` is now: the mean of its vertices (summed in order, in
+// double) plus its offset.
+Result<std::array<double, 3>> landmark_position(Simulation& sim, const ScriptLandmark& l) {
+  const SceneInfo& info = sim.info();
+  const auto& firsts = l.body_kind == BodyKind::tet   ? info.tet_body_first_particle
+                       : l.body_kind == BodyKind::tri ? info.tri_body_first_particle
+                                                      : info.line_body_first_particle;
+  if (l.body >= firsts.size() || l.vertices.empty())
+    return Error(ErrorCode::bad_parameter, "a landmark names body " + std::to_string(l.body) +
+                                               " of a kind the scene has " + std::to_string(firsts.size()) +
+                                               " of, or no vertex");
+  std::vector<float> x;
+  if (Status s = sim.read_positions(x); !s) return s.error();
+  std::array<double, 3> mean{0.0, 0.0, 0.0};
+  for (std::uint32_t v : l.vertices) {
+    const std::size_t at = 4 * (std::size_t{firsts[l.body]} + v);
+    if (at + 3 > x.size()) return Error(ErrorCode::bad_parameter, "a landmark's vertex " + std::to_string(v) + " is past the scene's particles");
+    for (int c = 0; c < 3; ++c) mean[c] += x[at + c];
+  }
+  for (int c = 0; c < 3; ++c) mean[c] = mean[c] / static_cast<double>(l.vertices.size()) + l.offset[c];
+  return mean;
+}
+
+// A relative grasper key on the pose the jaws closed at (ScriptTrack::relative).
+Pose relative_pose(const Pose& closed, const ScriptKey& k) {
+  Pose p;
+  for (int c = 0; c < 3; ++c) p.position[c] = closed.position[c] + k.position[c];
+  const auto& a = k.rotation;
+  const auto& b = closed.rotation;
+  p.rotation = {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+                a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+                a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+                a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+  return p;
+}
+
+Status pose_track(Simulation& sim, const ScriptTrack& track, const ScriptKey& k, const std::vector<bool>& closed,
+                  const std::vector<Pose>& closed_at) {
   switch (track.subject) {
     case ScriptSubject::collider: {
       auto id = sim.tools().collider(track.index);
@@ -66,7 +103,8 @@ Status pose_track(Simulation& sim, const ScriptTrack& track, const ScriptKey& k,
       if (track.index >= closed.size() || !closed[track.index]) return {};
       auto id = sim.graspers().grasper(track.index);
       if (!id) return id.error();
-      return sim.graspers().move(*id, {k.position, k.rotation});
+      return sim.graspers().move(*id, track.relative ? relative_pose(closed_at[track.index], k)
+                                                     : Pose{k.position, k.rotation});
     }
     case ScriptSubject::needle: {
       auto id = sim.needles().needle(track.index);
@@ -106,17 +144,25 @@ Result<TopologyEvent> topology_action(Simulation& sim, const ScriptAction& a) {
     if (!id) return id.error();
     return topology.remove_segments(*id, a.elements);
   }
-  const Blade from{a.a_from, a.b_from}, to{a.a_to, a.b_to};
+  Blade from{a.a_from, a.b_from}, to{a.a_to, a.b_to};
+  std::array<double, 3> centre = a.centre;
+  if (a.at) {
+    auto p = landmark_position(sim, *a.at);
+    if (!p) return p.error();
+    if (a.kind == ScriptActionKind::cauterize) centre = *p;
+    for (auto* point : {&from.a, &from.b, &to.a, &to.b})  // a cut's blade is relative to the landmark
+      for (int c = 0; c < 3; ++c) (*point)[c] = (*p)[c] + (*point)[c];
+  }
   if (a.body_kind == BodyKind::tet) {
     auto id = topology.tet_body(a.index);
     if (!id) return id.error();
     if (a.kind == ScriptActionKind::cut) return topology.cut(*id, from, to);
-    return topology.cauterize(*id, a.centre, a.radius, a.seconds, a.dwell_time);
+    return topology.cauterize(*id, centre, a.radius, a.seconds, a.dwell_time);
   }
   auto id = topology.tri_body(a.index);
   if (!id) return id.error();
   if (a.kind == ScriptActionKind::cut) return topology.cut(*id, from, to);
-  return topology.cauterize(*id, a.centre, a.radius, a.seconds, a.dwell_time);
+  return topology.cauterize(*id, centre, a.radius, a.seconds, a.dwell_time);
 }
 
 }  // namespace
@@ -131,9 +177,13 @@ Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<std::s
 }
 
 Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<ScriptEvent>& events) {
-  if (grasper_closed_.size() < sim.graspers().count()) grasper_closed_.resize(sim.graspers().count(), false);
+  if (grasper_closed_.size() < sim.graspers().count()) {
+    grasper_closed_.resize(sim.graspers().count(), false);
+    grasper_closed_at_.resize(sim.graspers().count());
+  }
   for (const ScriptTrack& t : script_.poses)
-    if (Status s = pose_track(sim, t, interpolate_keys(t.keys, frame), grasper_closed_); !s) return s;
+    if (Status s = pose_track(sim, t, interpolate_keys(t.keys, frame), grasper_closed_, grasper_closed_at_); !s)
+      return s;
   for (const ScriptTrack& t : script_.forces)
     if (Status s = force_track(sim, t, interpolate_keys(t.keys, frame)); !s) return s;
   while (next_action_ < script_.actions.size() && script_.actions[next_action_].frame <= frame) {
@@ -147,10 +197,17 @@ Status ScriptPlayer::before_frame(Simulation& sim, int frame, std::vector<Script
       case ScriptActionKind::open_grasper: {
         auto id = sim.graspers().grasper(a.index);
         if (!id) return id.error();
-        auto held = a.kind == ScriptActionKind::close_grasper ? sim.graspers().close(*id, a.pose, a.half_extents)
+        Pose jaws = a.pose;
+        if (a.kind == ScriptActionKind::close_grasper && a.at) {
+          auto p = landmark_position(sim, *a.at);
+          if (!p) return p.error();
+          jaws.position = *p;
+        }
+        auto held = a.kind == ScriptActionKind::close_grasper ? sim.graspers().close(*id, jaws, a.half_extents)
                                                               : sim.graspers().open(*id);
         if (!held) return held.error();
         grasper_closed_[a.index] = a.kind == ScriptActionKind::close_grasper;
+        if (a.kind == ScriptActionKind::close_grasper) grasper_closed_at_[a.index] = jaws;
         event.text = at + (a.kind == ScriptActionKind::close_grasper ? "grasper closed on " : "grasper released ") +
                      std::to_string(held->size()) + " vertices";
         event.particles = std::move(*held);

@@ -50,7 +50,43 @@ void read_track(const Json& v, const std::string& path, Context& ctx, bool force
   } else if (!ctx.failed()) {
     ctx.fail(ErrorCode::bad_input_file, o.path("keys"), "is required");
   }
+  if (!forces && o.has("relative")) {
+    o.read("relative", out.relative);
+    if (!ctx.failed() && out.relative && out.subject != ScriptSubject::grasper)
+      ctx.fail(ErrorCode::bad_parameter, o.path("relative"),
+               "only a grasper's track can be relative (to the pose its jaws closed at)");
+  }
   o.finish();
+}
+
+// A landmark: {"body_kind", "body", "vertices": [...], "offset"}.
+void read_landmark(Object& o, const std::string& key, ScriptLandmark& out) {
+  Context& ctx = o.ctx();
+  Object lo(*o.find(key), o.path(key), ctx);
+  if (const Json* k = lo.find("body_kind")) read_body_kind(*k, lo.path("body_kind"), ctx, out.body_kind);
+  lo.read("body", out.body, true);
+  if (const Json* vs = lo.find("vertices")) {
+    read_array(*vs, lo.path("vertices"), ctx, [&](const Json& x, const std::string& p) {
+      std::uint32_t i = 0;
+      if (read_uint32(x, p, ctx, i)) out.vertices.push_back(i);
+    });
+    if (!ctx.failed() && out.vertices.empty()) ctx.fail(ErrorCode::bad_parameter, lo.path("vertices"), "must not be empty");
+  } else if (!ctx.failed()) {
+    ctx.fail(ErrorCode::bad_input_file, lo.path("vertices"), "is required");
+  }
+  lo.read("offset", out.offset);
+  lo.finish();
+}
+
+// An action's point: a landmark under "at", or the numbers under `key`
+// (required unless `optional`), not both.
+void read_point_or_landmark(Object& o, const char* key, bool optional, std::array<double, 3>& point,
+                            std::optional<ScriptLandmark>& at) {
+  if (!o.has("at")) return o.read(key, point, !optional);
+  if (o.has(key) && !o.ctx().failed())
+    return o.ctx().fail(ErrorCode::bad_input_file, o.path(key),
+                        std::string("give \"") + key + "\" or \"at\" (a landmark), not both");
+  read_landmark(o, "at", at.emplace());
 }
 
 void read_blade(Object& o, const std::string& key, std::array<double, 3>& a, std::array<double, 3>& b) {
@@ -83,7 +119,8 @@ void read_action(const Json& v, const std::string& path, Context& ctx, ScriptAct
   switch (out.kind) {
     case ScriptActionKind::close_grasper:
       o.read("grasper", out.index, true);
-      read_pose(o, out.pose);
+      read_point_or_landmark(o, "position", true, out.pose.position, out.at);
+      o.read("rotation", out.pose.rotation);
       o.read("half_extents", out.half_extents, true);
       break;
     case ScriptActionKind::open_grasper: o.read("grasper", out.index, true); break;
@@ -95,8 +132,9 @@ void read_action(const Json& v, const std::string& path, Context& ctx, ScriptAct
       if (out.kind == ScriptActionKind::cut) {
         read_blade(o, "from", out.a_from, out.b_from);
         read_blade(o, "to", out.a_to, out.b_to);
+        if (o.has("at")) read_landmark(o, "at", out.at.emplace());  // the blade's points relative to it
       } else if (out.kind == ScriptActionKind::cauterize) {
-        o.read("centre", out.centre, true);
+        read_point_or_landmark(o, "centre", false, out.centre, out.at);
         o.read("radius", out.radius, true);
         o.read("seconds", out.seconds, true);
         o.read("dwell_time", out.dwell_time, true);
@@ -163,6 +201,22 @@ void check_index(Context& ctx, const std::string& path, const char* what, std::s
                  std::to_string(count) + ")");
 }
 
+// The landmark's body exists and every vertex is one of its mesh's.
+void check_landmark(Context& ctx, const std::string& path, const ScriptLandmark& l, const SceneDesc& scene) {
+  const std::size_t bodies = l.body_kind == BodyKind::tet   ? scene.tet_bodies.size()
+                             : l.body_kind == BodyKind::tri ? scene.tri_bodies.size()
+                                                            : scene.line_bodies.size();
+  check_index(ctx, path, "body", l.body, bodies);
+  if (ctx.failed()) return;
+  const std::size_t vertices = l.body_kind == BodyKind::tet   ? scene.tet_bodies[l.body].mesh.vertices.size()
+                               : l.body_kind == BodyKind::tri ? scene.tri_bodies[l.body].mesh.vertices.size()
+                                                              : scene.line_bodies[l.body].vertices.size();
+  for (std::uint32_t v : l.vertices)
+    if (v >= vertices)
+      return ctx.fail(ErrorCode::bad_parameter, path,
+                      "vertex " + std::to_string(v) + " is out of range (the body has " + std::to_string(vertices) + ")");
+}
+
 }  // namespace
 
 void read_script(const Json& v, const std::string& path, Context& ctx, SceneScript& out) {
@@ -221,6 +275,7 @@ void check_script(const SceneScript& script, const SceneDesc& scene, Context& ct
       case ScriptActionKind::set_emitter: check_index(ctx, at, "emitter", a.index, emitters); break;
       case ScriptActionKind::set_sink: check_index(ctx, at, "sink", a.index, sinks); break;
     }
+    if (a.at) check_landmark(ctx, at + "/at", *a.at, scene);
   }
 }
 
