@@ -5,6 +5,7 @@
 // pose and step()) over the whole script, or its first FRAMES frames.
 //
 //   bench_suture_scene BACKEND [FRAMES] [--threads N] [--substeps N] [--iterations N] [--continuous on|off]
+//                      [--positions FILE]
 //   e.g. bench_suture_scene cpu --threads 2
 //
 // Prints CSV: a header and one line of the frame times (median, p95, worst
@@ -12,8 +13,12 @@
 // end)
 // and the scene's figures at the last frame; then the per-stage profile
 // (FrameStats::stages), one line per stage with its median, p95 and worst
-// [ms] over the frames.
+// [ms] over the frames. --positions writes the particles' positions at the
+// last frame (float32 x, y, z, w per particle, as read_positions gives
+// them), for comparing settings against a converged run
+// (benchmarks/compare_positions.py).
 #include <cstdio>
+#include <vector>
 #include <string>
 
 #include "command_line.h"
@@ -37,6 +42,8 @@ int main(int argc, char** argv) {
   cli.app().add_option("--iterations", s.iterations, "Iterations per substep")->check(sinew::examples::at_least(1));
   cli.app().add_option("--threads", s.threads, "cpu backend worker threads (0: all)")->check(sinew::examples::at_least(0));
   cli.add_switch("--continuous", s.continuous, "The thread's continuous collision");
+  std::string positions;
+  cli.app().add_option("--positions", positions, "Write the last frame's positions here (float32 xyzw per particle)");
   if (auto exit = cli.parse(argc, argv)) return *exit;
   auto fail = [](const std::string& what) {
     std::fprintf(stderr, "bench_suture_scene: %s\n", what.c_str());
@@ -69,5 +76,12 @@ int main(int argc, char** argv) {
               1e3 * c->gap, static_cast<unsigned long long>(touches), static_cast<unsigned long long>(forced), 1e3 * c->thread_min_distance,
               c->finite ? 1 : 0);
   profile.print_stages();
+  if (!positions.empty()) {
+    std::vector<float> x;
+    if (auto st = r.sim().read_positions(x); !st) return fail(st.error().message());
+    std::FILE* f = std::fopen(positions.c_str(), "wb");
+    if (!f || std::fwrite(x.data(), sizeof(float), x.size(), f) != x.size()) return fail("cannot write " + positions);
+    std::fclose(f);
+  }
   return 0;
 }

@@ -9,8 +9,7 @@ namespace {
 
 using V3 = std::array<double, 3>;
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kDrainBall = 1.0;
-const double kWoundAt[2] = {std::getenv("WX") ? std::atof(std::getenv("WX")) : 69e-3, std::getenv("WZ") ? std::atof(std::getenv("WZ")) : -48e-3};  // the drain's radius [m]: its top is nearly flat under the kidney
+constexpr double kDrainBall = 1.0;  // the drain's radius [m]: its top is nearly flat under the kidney
 
 }  // namespace
 
