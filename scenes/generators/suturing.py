@@ -14,44 +14,18 @@ math.sin the same C library's), so the scene runs bitwise as the example.
     scenes/generators/suturing.py > scenes/suturing.json
 """
 import json
-import math
 import sys
 
-CELL, RADIUS, ABOVE = 0.002, 0.008, 0.002
+from suture_path import ABOVE, RADIUS, STITCH_Z, keys as needle_keys, needle
+
+CELL = 0.002
 NX, NY, NZ, SLIT = 13, 5, 6, 6
 THREAD_SEGMENTS = 100
-STITCH_Z = [-0.003, 0.003]
-TURN, SHIFT = 110, 40
-PULL_SPEED = 4.25e-4
 TIGHTEN, HOLD = 10, 60
-LAST_ANGLE = 2.0 * math.pi - 0.2
-STITCHED = 2 * TURN + SHIFT
 KNOT_FRAME = 538  # measured: the example's "frame 538  the knot holds at the first puncture"
 
-
-def script(f, pulled):
-    """The needle's position and angle about z in the example's frame f (from 0)."""
-    second = TURN + SHIFT
-    if f < TURN:
-        return [0.0, ABOVE, STITCH_Z[0]], LAST_ANGLE * (f + 1) / TURN
-    if f < second:
-        u = float(f - TURN + 1) / SHIFT
-        return [0.0, ABOVE, STITCH_Z[0] + u * (STITCH_Z[1] - STITCH_Z[0])], LAST_ANGLE
-    if f < STITCHED:
-        return [0.0, ABOVE, STITCH_Z[1]], LAST_ANGLE + LAST_ANGLE * (f - second + 1) / TURN
-    return [0.5 * pulled, ABOVE + pulled, STITCH_Z[1]], 2.0 * LAST_ANGLE
-
-
+keys = needle_keys(KNOT_FRAME, TIGHTEN, HOLD)
 last = KNOT_FRAME + TIGHTEN + HOLD
-keys, pulled = [], 0.0
-for f in range(last + 1):
-    position, angle = script(f, pulled)
-    # The example's frame f is the runner's frame f + 1 (it counts from 0).
-    keys.append({"frame": f + 1, "position": position,
-                 "rotation": [math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)]})
-    if f >= STITCHED and f < KNOT_FRAME + TIGHTEN:
-        pulled += PULL_SPEED
-
 half_x = NX * CELL / 2
 slit_lo = -half_x + SLIT * CELL
 scene = {
@@ -83,12 +57,7 @@ scene = {
         "bending_compliance": 10.0,
         "velocity_damping": 5.0,
     }],
-    "needles": [{
-        "curve": [[RADIUS * math.cos(math.pi * i / 16), RADIUS * math.sin(math.pi * i / 16), 0.0] for i in range(17)],
-        "position": [0.0, ABOVE, STITCH_Z[0]],
-        "puncture_force": 0.01,
-        "thread": 0,
-    }],
+    "needles": [needle(0.01)],
     "script": {"poses": [{"needle": 0, "keys": "KEYS"}]},
 }
 one_line = ",\n   ".join(json.dumps(k) for k in keys)
