@@ -46,3 +46,23 @@ def needle(puncture_force):
             "position": [0.0, ABOVE, STITCH_Z[0]],
             "puncture_force": puncture_force,
             "thread": 0}
+
+
+def pad(nx, ny, nz, cell, slit_column):
+    """The pad both suture scenes stitch: a grid of nx x ny x nz cells centred
+    on x = 0 and z = 0 with its top at y = 0, the cells of column slit_column
+    above the bottom layer removed (the slit), edge network of 30 kPa and nu
+    0.45, damped 5/s, pinned at its two ends in x and its base."""
+    half_x = nx * cell / 2
+    slit_lo = -half_x + slit_column * cell
+    return {
+        "name": "pad",
+        "mesh": {"grid": {"cells": [nx, ny, nz], "origin": [-half_x, -ny * cell, -nz * cell / 2],
+                          "cell_size": [cell, cell, cell]},
+                 "remove": [{"min": [slit_lo, -(ny - 1) * cell, -1.0], "max": [slit_lo + cell, 1.0, 1.0]}]},
+        "elastic": {"youngs_modulus": 3e4, "poisson_ratio": 0.45},
+        "velocity_damping": 5.0,
+        "pinned": [{"min": [-1.0, -1.0, -1.0], "max": [-half_x + 1e-9, 1.0, 1.0]},
+                   {"min": [half_x - 1e-9, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
+                   {"min": [-1.0, -1.0, -1.0], "max": [1.0, -ny * cell + 1e-9, 1.0]}],
+    }

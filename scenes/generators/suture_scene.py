@@ -18,7 +18,7 @@ the example.
 import sys
 
 import scene_json
-from suture_path import ABOVE, RADIUS, STITCH_Z, keys as needle_keys, needle
+from suture_path import ABOVE, RADIUS, STITCH_Z, keys as needle_keys, needle, pad
 
 CELL = 0.002
 NX, NY, NZ = 27, 8, 16
@@ -27,8 +27,6 @@ THREAD_SEGMENTS, THREAD_LENGTH, THREAD_MASS = 200, 0.1, 1e-3
 TIGHTEN, HOLD = 10, 30
 KNOT_FRAME = 561  # measured: the example's "the knot held from frame 561"
 
-half_x = NX * CELL / 2
-slit_lo = -half_x + SLIT_COLUMN * CELL
 piece = THREAD_LENGTH / THREAD_SEGMENTS
 keys = needle_keys(KNOT_FRAME, TIGHTEN, HOLD)
 scene = {
@@ -41,19 +39,7 @@ scene = {
     "run": {"frames": len(keys), "every": 20},
     "gravity": [0.0, 0.0, 0.0],
     "solver": {"time_step": 1.0 / 60.0, "substeps": 16, "iterations": 2},
-    "tet_bodies": [{
-        "name": "pad",
-        # The slit: the cells of the middle column above the bottom layer removed.
-        "mesh": {"grid": {"cells": [NX, NY, NZ], "origin": [-NX * CELL / 2, -NY * CELL, -NZ * CELL / 2],
-                          "cell_size": [CELL, CELL, CELL]},
-                 "remove": [{"min": [slit_lo, -(NY - 1) * CELL, -1.0], "max": [slit_lo + CELL, 1.0, 1.0]}]},
-        "elastic": {"youngs_modulus": 3e4, "poisson_ratio": 0.45},
-        "velocity_damping": 5.0,
-        # Its two ends in x and its base.
-        "pinned": [{"min": [-1.0, -1.0, -1.0], "max": [-half_x + 1e-9, 1.0, 1.0]},
-                   {"min": [half_x - 1e-9, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
-                   {"min": [-1.0, -1.0, -1.0], "max": [1.0, -NY * CELL + 1e-9, 1.0]}],
-    }],
+    "tet_bodies": [pad(NX, NY, NZ, CELL, SLIT_COLUMN)],
     "line_bodies": [{
         "name": "thread",
         "vertices": [[RADIUS, ABOVE + piece * i, STITCH_Z[0]] for i in range(THREAD_SEGMENTS + 1)],

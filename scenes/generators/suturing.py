@@ -16,7 +16,7 @@ math.sin the same C library's), so the scene runs bitwise as the example.
 import json
 import sys
 
-from suture_path import ABOVE, RADIUS, STITCH_Z, keys as needle_keys, needle
+from suture_path import ABOVE, RADIUS, STITCH_Z, keys as needle_keys, needle, pad
 
 CELL = 0.002
 NX, NY, NZ, SLIT = 13, 5, 6, 6
@@ -26,8 +26,6 @@ KNOT_FRAME = 538  # measured: the example's "frame 538  the knot holds at the fi
 
 keys = needle_keys(KNOT_FRAME, TIGHTEN, HOLD)
 last = KNOT_FRAME + TIGHTEN + HOLD
-half_x = NX * CELL / 2
-slit_lo = -half_x + SLIT * CELL
 scene = {
     "format": "sinew-scene",
     "version": 1,
@@ -37,19 +35,7 @@ scene = {
     "run": {"frames": last + 1, "every": 10, "backend": "auto"},
     "gravity": [0.0, 0.0, 0.0],
     "solver": {"time_step": 1.0 / 60.0, "substeps": 8, "iterations": 10},
-    "tet_bodies": [{
-        "name": "pad",
-        # The slit: the cells of column SLIT above the bottom layer removed.
-        "mesh": {"grid": {"cells": [NX, NY, NZ], "origin": [-half_x, -NY * CELL, -NZ * CELL / 2],
-                          "cell_size": [CELL, CELL, CELL]},
-                 "remove": [{"min": [slit_lo, -(NY - 1) * CELL, -1.0], "max": [slit_lo + CELL, 1.0, 1.0]}]},
-        "elastic": {"youngs_modulus": 3e4, "poisson_ratio": 0.45},
-        "velocity_damping": 5.0,
-        # Its two ends in x and its base.
-        "pinned": [{"min": [-1.0, -1.0, -1.0], "max": [-half_x + 1e-9, 1.0, 1.0]},
-                   {"min": [half_x - 1e-9, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
-                   {"min": [-1.0, -1.0, -1.0], "max": [1.0, -NY * CELL + 1e-9, 1.0]}],
-    }],
+    "tet_bodies": [pad(NX, NY, NZ, CELL, SLIT)],
     "line_bodies": [{
         "name": "thread",
         "vertices": [[RADIUS, ABOVE + 0.001 * i, STITCH_Z[0]] for i in range(THREAD_SEGMENTS + 1)],
