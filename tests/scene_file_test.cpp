@@ -284,6 +284,31 @@ TEST(SceneFile, LandmarksAndRelativeTracksFollowTheRunningScene) {
   EXPECT_NEAR(mean_of_end(*played)[1] - closed_at[1], 0.01, 1e-4);
 }
 
+// "axes" turns a mesh by quarter turns, exactly; a reflection is refused.
+TEST(SceneFile, MeshAxesTurnExactlyAndRefuseReflections) {
+  const std::string tet = R"({"vertices": [[0.001, 0.002, 0.003], [0.011, 0.002, 0.003], [0.001, 0.012, 0.003],
+                                           [0.001, 0.002, 0.013]], "tets": [[0, 1, 2, 3]])";
+  auto file = parse_scene_json(R"({"tet_bodies": [{"mesh": )" + tet + R"(, "axes": ["x", "z", "-y"]},
+                                                  "elastic": {"youngs_modulus": 1e4, "poisson_ratio": 0.3}}]})",
+                               kScenes);
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  const auto& v = file->scene.tet_bodies[0].mesh.vertices;
+  EXPECT_EQ(v[0], (Vec3d{0.001, 0.003, -0.002}));
+  EXPECT_EQ(v[3], (Vec3d{0.001, 0.013, -0.002}));
+  const auto error_with = [&](const std::string& axes) {
+    return error_of(R"({"tet_bodies": [{"mesh": )" + tet + R"(, "axes": )" + axes +
+                    R"(}, "elastic": {"youngs_modulus": 1e4, "poisson_ratio": 0.3}}]})");
+  };
+  EXPECT_EQ(error_with(R"(["x", "z", "y"])"),
+            "/tet_bodies/0/mesh/axes: is a reflection, which turns every tet inside out (flip one sign)");
+  EXPECT_EQ(error_with(R"(["x", "x", "y"])"), "/tet_bodies/0/mesh/axes: must name each of x, y and z once");
+  EXPECT_EQ(error_with(R"(["x", "w", "y"])"),
+            "/tet_bodies/0/mesh/axes/1: must be one of \"x\", \"y\", \"z\", \"-x\", \"-y\", \"-z\"");
+  EXPECT_EQ(error_of(R"({"tet_bodies": [{"mesh": )" + tet + R"(, "axes": ["-x", "-y", "z"]},
+                         "elastic": {"youngs_modulus": 1e4, "poisson_ratio": 0.3}}]})"),
+            "(no error)");  // a half turn about z
+}
+
 TEST(SceneFile, LandmarkAndRelativeTrackErrors) {
   const std::string scene = block_scene().substr(0, block_scene().size() - 1) +
                             R"(, "graspers": [{"capacity": 8}], "colliders": [{"shape": "sphere", "radius": 0.01}],

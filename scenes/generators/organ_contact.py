@@ -20,17 +20,9 @@ import os
 import sys
 
 import scene_json
+from mesh_files import read_node
 
 FRAMES = 60
-
-
-def read_node(path):
-    """A TetGen .node file's vertices, in millimetres as written."""
-    with open(path) as f:
-        rows = [line.split("#")[0].split() for line in f]
-    rows = [r for r in rows if r]
-    count = int(rows[0][0])
-    return [[float(c) for c in r[1:4]] for r in rows[1:1 + count]]
 
 
 def bounds(vertices):

@@ -118,7 +118,38 @@ void check_indices(const std::vector<std::array<std::uint32_t, N>>& elements, st
                             std::to_string(vertices) + ")");
 }
 
-// A tet body's "mesh": {"file", "scale", "translate"} | {"grid", "remove"} | {"vertices", "tets"}.
+// "axes": where each of the mesh's axes goes, e.g. ["x", "z", "-y"] (new x =
+// old x, new y = old z, new z = -old y): an exact turn by quarter turns (a
+// mesh modelled lying on another side). A reflection would turn every tet
+// inside out, so it is refused.
+void read_axes(Object& o, std::array<int, 3>& from, std::array<double, 3>& sign) {
+  const Json* a = o.find("axes");
+  if (!a) return;
+  Context& ctx = o.ctx();
+  const std::string path = o.path("axes");
+  if (!a->is_array() || a->size() != 3)
+    return ctx.fail(ErrorCode::bad_input_file, path, "must be three of \"x\", \"y\", \"z\", each maybe with a \"-\"");
+  int used = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Json& e = (*a)[static_cast<std::size_t>(k)];
+    const std::string name = e.is_string() ? e.get<std::string>() : "";
+    const bool minus = !name.empty() && name[0] == '-';
+    const std::string axis = minus ? name.substr(1) : name;
+    if (axis != "x" && axis != "y" && axis != "z")
+      return ctx.fail(ErrorCode::bad_input_file, path + "/" + std::to_string(k),
+                      "must be one of \"x\", \"y\", \"z\", \"-x\", \"-y\", \"-z\"");
+    from[k] = axis[0] - 'x';
+    sign[k] = minus ? -1.0 : 1.0;
+    used |= 1 << from[k];
+  }
+  if (used != 7) return ctx.fail(ErrorCode::bad_parameter, path, "must name each of x, y and z once");
+  // The permutation's parity times the signs: +1 for a rotation.
+  const bool odd = (from[0] == 0) + (from[1] == 1) + (from[2] == 2) == 1;
+  if ((odd ? -1.0 : 1.0) * sign[0] * sign[1] * sign[2] < 0.0)
+    ctx.fail(ErrorCode::bad_parameter, path, "is a reflection, which turns every tet inside out (flip one sign)");
+}
+
+// A tet body's "mesh": {"file", "scale", "axes", "translate"} | {"grid", "remove"} | {"vertices", "tets"}.
 void read_tet_mesh_source(const Json& v, const std::string& path, const Where& where, Context& ctx, TetMesh& out) {
   Object o(v, path, ctx);
   const int sources = o.has("file") + o.has("grid") + o.has("vertices");
@@ -130,6 +161,9 @@ void read_tet_mesh_source(const Json& v, const std::string& path, const Where& w
   // are): added after the scale, as a C++ scene adds it to scaled vertices.
   Vec3d translate{0.0, 0.0, 0.0};
   o.read("translate", translate);
+  std::array<int, 3> from{0, 1, 2};
+  std::array<double, 3> sign{1.0, 1.0, 1.0};
+  read_axes(o, from, sign);
   if (o.has("file")) {
     const std::filesystem::path p = read_file_member(o, where, ctx);
     if (ctx.failed()) return;
@@ -155,6 +189,12 @@ void read_tet_mesh_source(const Json& v, const std::string& path, const Where& w
   }
   o.finish();
   if (!ctx.failed() && scale != 1.0) scale_mesh(out, scale);
+  // After the scale, before the translation; exact (a copy and a sign).
+  if (!ctx.failed() && (from != std::array<int, 3>{0, 1, 2} || sign != std::array<double, 3>{1.0, 1.0, 1.0}))
+    for (auto& vertex : out.vertices) {
+      const Vec3d old = vertex;
+      for (int k = 0; k < 3; ++k) vertex[k] = sign[k] * old[from[k]];
+    }
   if (!ctx.failed() && translate != Vec3d{0.0, 0.0, 0.0})
     for (auto& vertex : out.vertices)
       for (int k = 0; k < 3; ++k) vertex[k] += translate[k];
@@ -348,18 +388,25 @@ void read_line_body(const Json& v, const std::string& path, Context& ctx, LineBo
 
 void select_triangles(const Json& v, const std::string& path, Context& ctx, const std::vector<Vec3d>& vertices,
                       const std::vector<std::array<std::uint32_t, 3>>& triangles,
-                      std::vector<std::array<std::uint32_t, 3>>& out) {
+                      std::vector<std::array<std::uint32_t, 3>>& out, TriangleTest test) {
   std::vector<Box> boxes;
   read_array(v, path, ctx, [&](const Json& b, const std::string& p) {
     Box box;
     if (read_box(b, p, ctx, box)) boxes.push_back(box);
   });
   if (ctx.failed()) return;
+  const auto in_a_box = [&](const Vec3d& p) {
+    return std::any_of(boxes.begin(), boxes.end(), [&](const Box& b) { return b.holds(p); });
+  };
   for (const auto& t : triangles) {
+    if (test == TriangleTest::any_vertex) {
+      if (in_a_box(vertices[t[0]]) || in_a_box(vertices[t[1]]) || in_a_box(vertices[t[2]])) out.push_back(t);
+      continue;
+    }
     Vec3d c{};
     for (std::uint32_t i : t)
       for (int a = 0; a < 3; ++a) c[a] += vertices[i][a] / 3.0;
-    if (std::any_of(boxes.begin(), boxes.end(), [&](const Box& b) { return b.holds(c); })) out.push_back(t);
+    if (in_a_box(c)) out.push_back(t);
   }
 }
 

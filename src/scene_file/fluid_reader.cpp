@@ -84,15 +84,22 @@ void read_surface(const Json& v, const std::string& path, const SceneDesc& scene
       std::array<std::uint32_t, 3> tri{};
       if (read_uint32s(e, p, ctx, tri)) out.triangles.push_back(tri);
     });
-  } else if (const Json* s = o.find("centroid_in")) {
+  } else {
     // The surface's triangles (a tet body's boundary, a tri body's own)
-    // whose centroid lies in one of the boxes.
-    if (out.body_kind == BodyKind::tet) {
-      const TriMesh surface = extract_boundary_surface(scene.tet_bodies[body].mesh);
-      select_triangles(*s, o.path("centroid_in"), ctx, surface.vertices, surface.triangles, out.triangles);
-    } else {
-      const TriMesh& mesh = scene.tri_bodies[body].mesh;
-      select_triangles(*s, o.path("centroid_in"), ctx, mesh.vertices, mesh.triangles, out.triangles);
+    // whose centroid, or any of whose vertices, lies in one of the boxes.
+    const bool by_centroid = o.has("centroid_in");
+    const char* key = by_centroid ? "centroid_in" : "any_vertex_in";
+    if (const Json* s = o.find(key)) {
+      const TriangleTest test = by_centroid ? TriangleTest::centroid : TriangleTest::any_vertex;
+      if (by_centroid && o.has("any_vertex_in") && !ctx.failed())
+        return ctx.fail(ErrorCode::bad_input_file, path, "give one of \"triangles\", \"centroid_in\", \"any_vertex_in\"");
+      if (out.body_kind == BodyKind::tet) {
+        const TriMesh surface = extract_boundary_surface(scene.tet_bodies[body].mesh);
+        select_triangles(*s, o.path(key), ctx, surface.vertices, surface.triangles, out.triangles, test);
+      } else {
+        const TriMesh& mesh = scene.tri_bodies[body].mesh;
+        select_triangles(*s, o.path(key), ctx, mesh.vertices, mesh.triangles, out.triangles, test);
+      }
     }
   }
   o.finish();

@@ -47,11 +47,13 @@ void read_tet_body(const Json& v, const std::string& path, const Where& where, C
 void read_tri_body(const Json& v, const std::string& path, const Where& where, Context& ctx, TriBodyDesc& out,
                    std::string& name);
 void read_line_body(const Json& v, const std::string& path, Context& ctx, LineBodyDesc& out, std::string& name);
-/// Triangles whose centroid lies in one of the boxes at `v` (an array of
-/// {"min", "max"} objects, bounds included).
+/// Which point of a triangle select_triangles tests against the boxes.
+enum class TriangleTest { centroid, any_vertex };
+/// Triangles whose centroid (or any of whose vertices) lies in one of the
+/// boxes at `v` (an array of {"min", "max"} objects, bounds included).
 void select_triangles(const Json& v, const std::string& path, Context& ctx, const std::vector<Vec3d>& vertices,
                       const std::vector<std::array<std::uint32_t, 3>>& triangles,
-                      std::vector<std::array<std::uint32_t, 3>>& out);
+                      std::vector<std::array<std::uint32_t, 3>>& out, TriangleTest test = TriangleTest::centroid);
 
 // feature_readers.cpp
 void read_solver(const Json& v, const std::string& path, Context& ctx, SolverSettings& out);
