@@ -1,0 +1,330 @@
+// saved_topology_test.cpp — saved states across topology changes, level-set
+// cuts and needles: a state saved before or after removals, cuts, cautery,
+// tears or a level-set cut, restored into the same Simulation (which has
+// made more changes since, or other ones) or into a new one, and stepped
+// with the same inputs, gives bitwise the run that was never interrupted,
+// with the same constraint slots; so does a needle and its thread saved
+// mid-insertion. On every backend (a missing device skips). Damaged logs
+// are named errors.
+#include <algorithm>
+#include <cstring>
+#include <map>
+
+#include "robustness_scenes.h"
+#include "runtime/simulation_internals.h"
+#include "runtime/state_format.h"
+#include "mesh_contact_support.h"
+#include "sinew/level_set.h"
+
+namespace sinew {
+namespace {
+
+using test::same_bits;
+using test::snapshot;
+using test::Snapshot;
+
+class SavedTopologyTest : public test::BackendTest {};
+
+std::vector<std::uint32_t> slots(const Simulation& sim) {
+  auto words = SimulationInternals::constraint_words(sim);
+  EXPECT_TRUE(words.ok()) << words.error().message();
+  return words.ok() ? *words : std::vector<std::uint32_t>{};
+}
+
+// The block of the robustness tests with topology changes, driven as there
+// (test::drive), and changed between frames as a function of the frame
+// alone: after frame 3 a hole removed from its middle, after frame 6 a cut
+// down through its free end, from frame 8 to 10 a cautery tip on its top
+// (its dwell time reached on the second touch: the heat carries between
+// frames).
+void change(Simulation& sim, int frame) {
+  auto body = sim.topology().tet_body(0);
+  ASSERT_TRUE(body.ok());
+  if (frame == 3) {
+    const std::vector<std::uint32_t> hole{40, 41, 42, 43, 44, 45};
+    auto removed = sim.topology().remove_tets(*body, hole);
+    ASSERT_TRUE(removed.ok()) << removed.error().message();
+  }
+  if (frame == 6) {
+    auto cut = sim.topology().cut(*body, {{0.033, 0.03, -0.01}, {0.033, 0.03, 0.03}},
+                                  {{0.033, 0.005, -0.01}, {0.033, 0.005, 0.03}});
+    ASSERT_TRUE(cut.ok()) << cut.error().message();
+    EXPECT_FALSE(cut->tets_removed.empty());
+  }
+  if (frame >= 8 && frame <= 10) {
+    auto burned = sim.topology().cauterize(*body, {0.015, 0.02, 0.01}, 0.006, 1.0 / 60.0, 1.5 / 60.0);
+    ASSERT_TRUE(burned.ok()) << burned.error().message();
+    if (frame < 10) EXPECT_EQ(burned->tets_removed.empty(), frame == 8) << "frame " << frame;
+  }
+}
+
+// Frames [from, to], each with its inputs and its changes after it.
+void run(Simulation& sim, int from, int to) {
+  for (int f = from; f <= to; ++f) {
+    test::drive(sim, f);
+    SINEW_ASSERT_OK(sim.step());
+    change(sim, f);
+  }
+}
+
+TEST_P(SavedTopologyTest, RemovalsCutsAndCauteryRestoreBitwiseEitherWay) {
+  const SceneDesc scene = test::robustness_block(/*topology=*/true);
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  // States after frames 2 (no change yet), 7 (hole and cut) and 9 (cautery heat
+  // and a first burn), each with the constraint slots then.
+  std::map<int, SavedState> state;
+  std::map<int, std::vector<std::uint32_t>> slots_at;
+  for (int f = 1; f <= 14; ++f) {
+    run(*sim, f, f);
+    if (f == 2 || f == 7 || f == 9) {
+      SINEW_ASSERT_OK(sim->save_state(state[f]));
+      slots_at[f] = slots(*sim);
+    }
+  }
+  const Snapshot uninterrupted = snapshot(*sim);
+  const std::vector<std::uint32_t> slots14 = slots(*sim);
+  ASSERT_NE(slots_at[2], slots14);  // the changes changed the slots
+
+  // The same Simulation, which has made every change since: back before
+  // all of them (it is made again), then forward across some (replayed).
+  SINEW_ASSERT_OK(sim->restore_state(state[2]));
+  EXPECT_EQ(slots(*sim), slots_at[2]);
+  SINEW_ASSERT_OK(sim->restore_state(state[9]));
+  EXPECT_EQ(slots(*sim), slots_at[9]);
+  SINEW_ASSERT_OK(sim->restore_state(state[7]));  // fewer changes than it has made
+  EXPECT_EQ(slots(*sim), slots_at[7]);
+  run(*sim, 8, 14);
+  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored back across the changes, on " << GetParam();
+  EXPECT_EQ(slots(*sim), slots14);
+  // Its ids still name it.
+  EXPECT_TRUE(sim->tools().state(*sim->tools().tool(0)).ok());
+
+  // A new Simulation, from the state after the hole and the cut (replayed).
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok()) << fresh.error().message();
+  SINEW_ASSERT_OK(fresh->restore_state(state[9]));
+  EXPECT_EQ(slots(*fresh), slots_at[9]);
+  run(*fresh, 10, 14);
+  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored in a new Simulation, on " << GetParam();
+  EXPECT_EQ(slots(*fresh), slots14);
+}
+
+// A strip of 10 x 1 x 1 cells pinned at both ends and held 30% beyond its
+// length: it tears within the first frames (topology_test.cpp's).
+SceneDesc torn_strip() {
+  SceneDesc scene;
+  TetBodyDesc strip;
+  strip.mesh = test::box_mesh(10, 1, 1, 0.002);
+  (void)strip.set_elastic(3e5, 0.3);
+  strip.density = 1000.0;
+  for (std::uint32_t v = 0; v < strip.mesh.vertices.size(); ++v) {
+    const Vec3d& p = strip.mesh.vertices[v];
+    if (p[0] < 1e-9 || p[0] > 0.02 - 1e-9) strip.pinned.push_back(v);
+    strip.initial_vertices.push_back({p[0] * 1.3, p[1], p[2]});
+  }
+  strip.tear_strain = 0.2;
+  scene.tet_bodies.push_back(strip);
+  scene.gravity = {0.0, 0.0, 0.0};
+  scene.solver.time_step = 1.0 / 60.0;
+  scene.solver.substeps = 40;
+  scene.topology_changes = true;
+  return scene;
+}
+
+TEST_P(SavedTopologyTest, TearsRestoreBitwiseEitherWay) {
+  const SceneDesc scene = torn_strip();
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SavedState start, torn;
+  SINEW_ASSERT_OK(sim->save_state(start));
+  std::size_t tears = 0;
+  for (int f = 1; f <= 20; ++f) {
+    SINEW_ASSERT_OK(sim->step());
+    tears += sim->topology().last_tears().size();
+    if (f == 10) SINEW_ASSERT_OK(sim->save_state(torn));
+  }
+  ASSERT_GT(tears, 0u);
+  const Snapshot uninterrupted = snapshot(*sim);
+  // Back before the tears in the same Simulation: they happen again.
+  SINEW_ASSERT_OK(sim->restore_state(start));
+  for (int f = 1; f <= 20; ++f) SINEW_ASSERT_OK(sim->step());
+  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored before the tears, on " << GetParam();
+  // After them, in a new Simulation: replayed.
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok());
+  SINEW_ASSERT_OK(fresh->restore_state(torn));
+  for (int f = 11; f <= 20; ++f) SINEW_ASSERT_OK(fresh->step());
+  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored after the tears, on " << GetParam();
+}
+
+#if SINEW_HAS_OPENVDB
+// A cloth resting on a solid level-set block (its inside stored, so it can be
+// cut) with a burr drilling through it under the cloth after frame 8.
+SceneDesc cloth_on_block() {
+  SceneDesc scene;
+  scene.solver.substeps = 8;
+  scene.solver.iterations = 10;
+  TriBodyDesc cloth;
+  cloth.mesh = test::membrane(10, 10, 0.002, 0.0);
+  for (auto& v : cloth.mesh.vertices) v = {v[0] - 0.01, 0.003, v[2] - 0.01};
+  cloth.velocity_damping = 2.0;
+  scene.tri_bodies.push_back(cloth);
+  auto block = LevelSet::box({-0.015, -0.01, -0.015}, {0.015, 0.0, 0.015},
+                             {.voxel_size = 5e-4, .exterior_band = 2e-3, .interior_band = INFINITY});
+  EXPECT_TRUE(block.ok()) << block.error().message();
+  ColliderDesc collider;
+  collider.shape = ColliderShape::level_set;
+  if (block.ok()) collider.level_set = *block;
+  scene.colliders.push_back(collider);
+  return scene;
+}
+
+void run_cloth(Simulation& sim, int from, int to) {
+  for (int f = from; f <= to; ++f) {
+    SINEW_ASSERT_OK(sim.step());
+    if (f != 8) continue;
+    auto cut = sim.tools().cut(*sim.tools().collider(0), {.radius = 0.006}, {.position = {0.0, 0.002, 0.0}},
+                               {.position = {0.0, -0.02, 0.0}});
+    ASSERT_TRUE(cut.ok()) << cut.error().message();
+    EXPECT_GT(cut->removed_volume, 0.0);
+  }
+}
+
+TEST_P(SavedTopologyTest, ALevelSetCutRestoresBitwiseEitherWay) {
+  const SceneDesc scene = cloth_on_block();
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SavedState before, after;
+  run_cloth(*sim, 1, 5);
+  SINEW_ASSERT_OK(sim->save_state(before));
+  run_cloth(*sim, 6, 12);
+  SINEW_ASSERT_OK(sim->save_state(after));
+  run_cloth(*sim, 13, 30);
+  const Snapshot uninterrupted = snapshot(*sim);
+  // Before the cut, in the same Simulation: the block whole again, then cut again.
+  SINEW_ASSERT_OK(sim->restore_state(before));
+  run_cloth(*sim, 6, 30);
+  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored before the cut, on " << GetParam();
+  // After it, in a new Simulation.
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok());
+  SINEW_ASSERT_OK(fresh->restore_state(after));
+  run_cloth(*fresh, 13, 30);
+  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored after the cut, on " << GetParam();
+}
+#endif
+
+// A pinned pad (12 x 10 x 12 mm of 2 mm cells) and a straight needle with a
+// thread tied to its tail, driven down into the pad 0.5 mm a frame.
+SceneDesc needle_and_thread() {
+  SceneDesc scene;
+  scene.gravity = {0.0, -9.81, 0.0};
+  scene.solver.substeps = 8;
+  scene.solver.iterations = 10;
+  auto mesh = make_tet_grid({.nx = 6, .ny = 5, .nz = 6, .origin = {-0.006, -0.01, -0.006},
+                             .cell_size = {0.002, 0.002, 0.002}});
+  EXPECT_TRUE(mesh.ok());
+  TetBodyDesc pad;
+  if (mesh.ok()) pad.mesh = *mesh;
+  (void)pad.set_elastic(3e4, 0.45);
+  pad.velocity_damping = 5.0;
+  for (std::uint32_t v = 0; v < pad.mesh.vertices.size(); ++v)
+    if (pad.mesh.vertices[v][1] < -0.01 + 1e-9) pad.pinned.push_back(v);
+  scene.tet_bodies.push_back(pad);
+  LineBodyDesc thread;
+  for (std::uint32_t i = 0; i <= 20; ++i) {
+    thread.vertices.push_back({0.0007 + 0.001 * i, 0.0102, 0.0009});  // from the needle's tail, sideways
+    thread.masses.push_back(1e-5);
+    if (i < 20) thread.segments.push_back({i, i + 1});
+  }
+  thread.velocity_damping = 5.0;
+  scene.line_bodies.push_back(thread);
+  NeedleDesc needle;
+  needle.curve = {{0.0, 0.01, 0.0}, {0.0, 0.0, 0.0}};  // tail up, tip at its origin
+  needle.position = {0.0007, 0.0002, 0.0009};
+  needle.puncture_force = 0.01;
+  needle.thread = 0;
+  scene.needles.push_back(needle);
+  return scene;
+}
+
+void push(Simulation& sim, int from, int to) {
+  auto id = sim.needles().needle(0);
+  ASSERT_TRUE(id.ok());
+  for (int f = from; f <= to; ++f) {
+    SINEW_ASSERT_OK(sim.needles().set_pose(*id, {0.0007, 0.0002 - 0.0005 * f, 0.0009}, {1.0, 0.0, 0.0, 0.0}));
+    SINEW_ASSERT_OK(sim.step());
+  }
+}
+
+TEST_P(SavedTopologyTest, ANeedleAndThreadSavedMidInsertionRestoreBitwise) {
+  const SceneDesc scene = needle_and_thread();
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  auto id = sim->needles().needle(0);
+  ASSERT_TRUE(id.ok());
+  push(*sim, 1, 10);
+  auto at10 = sim->needles().state(*id);
+  ASSERT_TRUE(at10.ok());
+  ASSERT_FALSE(at10->punctures.empty()) << "the needle should be in the pad by now";
+  SavedState state;
+  SINEW_ASSERT_OK(sim->save_state(state));
+  push(*sim, 11, 20);
+  const Snapshot uninterrupted = snapshot(*sim);
+  const auto end = sim->needles().state(*id);
+  ASSERT_TRUE(end.ok());
+  const auto expect_same_needle = [&](Simulation& s, const char* how) {
+    EXPECT_TRUE(same_bits(snapshot(s), uninterrupted)) << how << ", on " << GetParam();
+    auto got = s.needles().state(*s.needles().needle(0));
+    ASSERT_TRUE(got.ok());
+    EXPECT_EQ(got->punctures.size(), end->punctures.size()) << how;
+    EXPECT_EQ(std::memcmp(got->reaction_force.data(), end->reaction_force.data(), sizeof end->reaction_force), 0)
+        << how;
+  };
+  SINEW_ASSERT_OK(sim->restore_state(state));
+  push(*sim, 11, 20);
+  expect_same_needle(*sim, "restored in the same Simulation");
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok());
+  SINEW_ASSERT_OK(fresh->restore_state(state));
+  push(*fresh, 11, 20);
+  expect_same_needle(*fresh, "restored in a new Simulation");
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, SavedTopologyTest, ::testing::ValuesIn(test::backends()), test::backend_name);
+
+// A log that removes an element twice, or one that does not exist, is a
+// named error that leaves the Simulation as it was (CPU: the format is the
+// same on every backend).
+TEST(SavedTopologyLog, ADamagedLogIsANamedError) {
+  const SceneDesc scene = test::robustness_block(/*topology=*/true);
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 1, 4);  // the hole after frame 3
+  SavedState good;
+  SINEW_ASSERT_OK(sim->save_state(good));
+  const Snapshot at4 = snapshot(*sim);
+  // The hole's elements as the log holds them, then made 40, 40 or 40, 999999.
+  const std::uint32_t hole[6] = {40, 41, 42, 43, 44, 45};
+  const auto at = std::search(good.bytes.begin(), good.bytes.end(), reinterpret_cast<const std::byte*>(hole),
+                              reinterpret_cast<const std::byte*>(hole) + sizeof hole);
+  ASSERT_NE(at, good.bytes.end());
+  const std::size_t offset = static_cast<std::size_t>(at - good.bytes.begin());
+  for (const auto& [element, says] : {std::pair<std::uint32_t, const char*>{40, "a second time"}, {999999, "does not exist"}}) {
+    std::vector<std::byte> bytes;
+    state_format::Writer w(bytes);
+    w.begin();
+    bytes.insert(bytes.end(), good.bytes.begin() + state_format::kHeaderBytes, good.bytes.end());
+    std::memcpy(bytes.data() + offset + 4, &element, 4);
+    w.finish();
+    const Status s = sim->restore_state(SavedState{bytes});
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
+    EXPECT_NE(s.error().message().find(says), std::string::npos) << s.error().message();
+    EXPECT_TRUE(same_bits(snapshot(*sim), at4));
+  }
+}
+
+}  // namespace
+}  // namespace sinew
