@@ -52,9 +52,11 @@ void change(Simulation& sim, int frame) {
     EXPECT_FALSE(cut->tets_removed.empty());
   }
   if (frame >= 8 && frame <= 10) {
-    auto burned = sim.topology().cauterize(*body, {0.015, 0.02, 0.01}, 0.006, 1.0 / 60.0, 1.5 / 60.0);
+    auto burned = sim.topology().cauterize(*body, {0.015, 0.018, 0.01}, 0.009, 1.0 / 60.0, 1.5 / 60.0);
     ASSERT_TRUE(burned.ok()) << burned.error().message();
-    if (frame < 10) EXPECT_EQ(burned->tets_removed.empty(), frame == 8) << "frame " << frame;
+    if (frame < 10) {  // at 10 the tip may reach tets the burn at 9 uncovered, or none
+      EXPECT_EQ(burned->tets_removed.empty(), frame == 8) << "frame " << frame;
+    }
   }
 }
 
@@ -324,6 +326,43 @@ TEST(SavedTopologyLog, ADamagedLogIsANamedError) {
     EXPECT_NE(s.error().message().find(says), std::string::npos) << s.error().message();
     EXPECT_TRUE(same_bits(snapshot(*sim), at4));
   }
+}
+
+// `state` as format version 3 wrote it: without the last `drop` bytes (the
+// topology log and heat version 4 appends), the header made again.
+SavedState as_version_3(const SavedState& state, std::size_t drop) {
+  std::vector<std::byte> bytes;
+  state_format::Writer w(bytes);
+  w.begin();
+  bytes.insert(bytes.end(), state.bytes.begin() + state_format::kHeaderBytes, state.bytes.end() - drop);
+  w.finish();
+  const std::uint32_t version = 3;
+  std::memcpy(bytes.data() + 8, &version, 4);
+  return SavedState{bytes};
+}
+
+TEST(SavedTopologyLog, VersionThreeStatesRestoreOnlyWithoutChanges) {
+  const SceneDesc scene = test::robustness_block(/*topology=*/true);
+  auto sim = Simulation::create(scene, {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const std::size_t tets = scene.tet_bodies[0].mesh.tets.size();
+  const std::size_t heat = 8 + 8 * tets;  // its length, then a double per tet
+  run(*sim, 1, 2);
+  SavedState at2;
+  SINEW_ASSERT_OK(sim->save_state(at2));
+  run(*sim, 3, 5);  // the hole after frame 3
+  const Snapshot at5 = snapshot(*sim);
+  SavedState at5_state;
+  SINEW_ASSERT_OK(sim->save_state(at5_state));
+  // Saved before any change: read, with no log (the Simulation made again: it has made one since).
+  SINEW_ASSERT_OK(sim->restore_state(as_version_3(at2, 8 + heat)));
+  run(*sim, 3, 5);
+  EXPECT_TRUE(same_bits(snapshot(*sim), at5));
+  // Saved after one: that version did not hold it.
+  const std::size_t log = 8 + 2 + 8 + 8 + 4 * 6;  // one record: kind and burn, body, the hole's 6 tets
+  const Status s = sim->restore_state(as_version_3(at5_state, log + heat));
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message().find("format version 3"), std::string::npos) << s.error().message();
 }
 
 }  // namespace
