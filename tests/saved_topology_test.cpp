@@ -8,6 +8,7 @@
 // are named errors.
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <map>
 
 #include "robustness_scenes.h"
@@ -158,6 +159,41 @@ TEST_P(SavedTopologyTest, TearsRestoreBitwiseEitherWay) {
   SINEW_ASSERT_OK(fresh->restore_state(torn));
   for (int f = 11; f <= 20; ++f) SINEW_ASSERT_OK(fresh->step());
   EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored after the tears, on " << GetParam();
+}
+
+// A stage that reports the frame's kinetic energy as NaN, after the tears
+// (it runs after the scene's stages): the frame that tore diverges.
+class DivergeAfterTears final : public FrameStage {
+ public:
+  std::string_view name() const override { return "diverge after tears"; }
+  Status after_frame(FrameContext& frame) override {
+    frame.stats.kinetic_energy = std::numeric_limits<double>::quiet_NaN();
+    return {};
+  }
+};
+
+TEST_P(SavedTopologyTest, AFrameThatToreAndDivergedRollsBackBeforeTheTears) {
+  const SceneDesc scene = torn_strip();
+  auto plain = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(plain.ok()) << plain.error().message();
+  SINEW_ASSERT_OK(plain->step());
+  ASSERT_FALSE(plain->topology().last_tears().empty());  // the first frame tears
+  const Snapshot frame1 = snapshot(*plain);
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok());
+  SINEW_ASSERT_OK(sim->set_divergence_settings({.on_divergence = OnDivergence::roll_back}));
+  const Snapshot frame0 = snapshot(*sim);
+  SimulationInternals::add_stage(*sim, std::make_unique<DivergeAfterTears>());
+  SINEW_ASSERT_OK(sim->step());  // tears, diverges, rolls back (the Simulation made again, without the stage)
+  EXPECT_TRUE(sim->last_frame().divergence.rolled_back);
+  EXPECT_EQ(sim->last_frame().frame, 0u);
+  EXPECT_TRUE(same_bits(snapshot(*sim), frame0));
+  auto tets = sim->topology().current_tets(*sim->topology().tet_body(0));
+  ASSERT_TRUE(tets.ok());
+  EXPECT_EQ(tets->size(), scene.tet_bodies[0].mesh.tets.size());  // whole again
+  SINEW_ASSERT_OK(sim->step());
+  EXPECT_FALSE(sim->last_frame().divergence.rolled_back);
+  EXPECT_TRUE(same_bits(snapshot(*sim), frame1)) << "the frame again, on " << GetParam();
 }
 
 #if SINEW_HAS_OPENVDB
@@ -363,6 +399,49 @@ TEST(SavedTopologyLog, VersionThreeStatesRestoreOnlyWithoutChanges) {
   const Status s = sim->restore_state(as_version_3(at5_state, log + heat));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message().find("format version 3"), std::string::npos) << s.error().message();
+}
+
+// A needle's row that is not of the scene (its kind, here) is a named error.
+TEST(SavedTopologyLog, ADamagedNeedleRowIsANamedError) {
+  auto sim = Simulation::create(needle_and_thread(), {.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  push(*sim, 1, 10);
+  SavedState good;
+  SINEW_ASSERT_OK(sim->save_state(good));
+  // The needles end the payload (no topology changes, no level set): the
+  // last row is its 8 words, 4 weights, surface, triangle, exit and slip.
+  const std::size_t row = 8 * 4 + 4 * 4 + 4 + 4 + 1 + 4;
+  std::vector<std::byte> bytes;
+  state_format::Writer w(bytes);
+  w.begin();
+  bytes.insert(bytes.end(), good.bytes.begin() + state_format::kHeaderBytes, good.bytes.end());
+  const std::uint32_t kind = 99;
+  std::memcpy(bytes.data() + bytes.size() - row, &kind, 4);
+  w.finish();
+  const Status s = sim->restore_state(SavedState{bytes});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
+  EXPECT_NE(s.error().message().find("its kind"), std::string::npos) << s.error().message();
+  SINEW_ASSERT_OK(sim->restore_state(good));
+}
+
+// A Simulation made on a device given to it cannot be made again: a state
+// whose changes do not continue its own is a named error, nothing changed.
+TEST(SavedTopologyLog, AGivenDeviceCannotBeMadeAgain) {
+  const SceneDesc scene = test::robustness_block(/*topology=*/true);
+  auto device = create_device({.backend = "cpu", .quiet = true});
+  ASSERT_TRUE(device.ok());
+  auto sim = SimulationInternals::create(scene, std::move(*device));
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  run(*sim, 1, 2);
+  SavedState before;
+  SINEW_ASSERT_OK(sim->save_state(before));
+  run(*sim, 3, 4);  // the hole after frame 3
+  const Snapshot at4 = snapshot(*sim);
+  const Status s = sim->restore_state(before);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message().find("device given"), std::string::npos) << s.error().message();
+  EXPECT_TRUE(same_bits(snapshot(*sim), at4));
 }
 
 }  // namespace

@@ -243,7 +243,7 @@ class Simulation {
   /// step() on. With OnDivergence::roll_back the current state is saved at
   /// once (the first frame to roll back to). Errors (bad_parameter, nothing
   /// changed): energy_growth not > 1, floor_speed < 0, max_volume_change
-  /// not > 0 or checkpoint_every 0 (each named), a scene save_state refuses.
+  /// not > 0 or checkpoint_every 0 (each named); a device error saving the first checkpoint.
   Status set_divergence_settings(const DivergenceSettings& settings);
   [[nodiscard]] const DivergenceSettings& divergence_settings() const;
   /// [in] settings: the per-frame warnings' thresholds (sinew/warnings.h),

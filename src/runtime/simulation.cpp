@@ -301,6 +301,13 @@ Status Simulation::step() {
   im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
   im.warnings.after_frame(im.stats);
   if (Status s = im.check_divergence(); !s) return s;
+  if (im.pending_roll_back) {  // back before this frame's tears: the Simulation made again
+    const Impl::PendingRollBack pending = std::move(*im.pending_roll_back);
+    im.pending_roll_back.reset();
+    const SavedState good = im.last_good;
+    if (Status s = SimulationInternals::restore(*this, good, "step (rolling back)"); !s) return s;
+    impl_->report_roll_back(pending.diverged, pending.message);  // im is gone
+  }
   return frame.deferred;
 }
 

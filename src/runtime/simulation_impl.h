@@ -223,6 +223,16 @@ struct Simulation::Impl {
   void checkpoint();
   /// After a frame: the checks, the log and the policy (divergence_check.cpp).
   Status check_divergence();
+  /// A roll-back back before a tear of the diverged frame: only a Simulation
+  /// made again can take the checkpoint, which step() does
+  /// (SimulationInternals::restore), then reports it as check_divergence would.
+  struct PendingRollBack {
+    DivergenceReport diverged;
+    std::string message;
+  };
+  std::optional<PendingRollBack> pending_roll_back;
+  /// The report and the warning of a roll-back to the frame now restored.
+  void report_roll_back(const DivergenceReport& diverged, const std::string& message);
   /// A frame a stage failed (a device error): with OnDivergence::roll_back
   /// the scene goes back to the last good frame; the error is returned either way.
   Status after_failed_frame(const Error& error);

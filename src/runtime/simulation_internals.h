@@ -56,7 +56,8 @@ struct SimulationInternals {
   /// when the state's topology changes do not continue the Simulation's
   /// (it has made others, or more), into a Simulation made again from its
   /// SceneDesc and device options that then takes its place (its ids stay
-  /// valid). `what` names the state in errors; on an error `sim` is as it was.
+  /// valid; stages added by add_stage are not). `what` names the state in
+  /// errors; on an error `sim` is as it was.
   static Status restore(Simulation& sim, const SavedState& state, const std::string& what);
 };
 
