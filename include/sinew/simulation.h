@@ -265,7 +265,9 @@ class Simulation {
   /// made before or after the save: the state's changes this Simulation has
   /// not made are replayed, and a Simulation that has made others (or more)
   /// is made again from its SceneDesc first (a new device; its ids and
-  /// handles stay valid; sinew/saved_state.h). Errors, leaving the
+  /// handles stay valid, references returned before by info(),
+  /// last_frame(), last_tears() and the settings' getters do not;
+  /// sinew/saved_state.h). Errors, leaving the
   /// Simulation unchanged: bad_input_file for a damaged or foreign state,
   /// bad_parameter for another scene's state (naming what differs), a state
   /// of format version 3 or older saved after a topology change, or one
