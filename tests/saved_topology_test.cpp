@@ -113,6 +113,76 @@ TEST_P(SavedTopologyTest, RemovalsCutsAndCauteryRestoreBitwiseEitherWay) {
   EXPECT_EQ(slots(*fresh), slots14);
 }
 
+// A membrane hanging from its edge z = 0 and a thread hanging beside it,
+// changed between frames: after frame 2 four triangles removed, after frame 3
+// two of the thread's segments broken, after frames 4 to 6 a cautery tip on
+// the membrane's pinned edge (its dwell time reached on the second touch).
+SceneDesc sheet_and_thread() {
+  SceneDesc scene;
+  scene.solver.substeps = 8;
+  scene.solver.iterations = 4;
+  TriBodyDesc sheet;
+  sheet.mesh = test::membrane(8, 8, 0.005, 0.0);
+  for (std::uint32_t v = 0; v <= 8; ++v) sheet.pinned.push_back(v * 9);  // k = 0
+  scene.tri_bodies.push_back(sheet);
+  LineBodyDesc thread;
+  for (std::uint32_t i = 0; i <= 10; ++i) {
+    thread.vertices.push_back({0.05, 0.0, 0.004 * i});
+    thread.masses.push_back(1e-4);
+    if (i < 10) thread.segments.push_back({i, i + 1});
+  }
+  thread.pinned = {0};
+  scene.line_bodies.push_back(thread);
+  scene.topology_changes = true;
+  return scene;
+}
+
+void run_sheet(Simulation& sim, int from, int to) {
+  Topology t = sim.topology();
+  for (int f = from; f <= to; ++f) {
+    SINEW_ASSERT_OK(sim.step());
+    if (f == 2) {
+      const std::vector<std::uint32_t> triangles{60, 61, 62, 63};
+      ASSERT_TRUE(t.remove_triangles(*t.tri_body(0), triangles).ok());
+    }
+    if (f == 3) {
+      const std::vector<std::uint32_t> segments{7, 3};
+      ASSERT_TRUE(t.remove_segments(*t.line_body(0), segments).ok());
+    }
+    if (f >= 4 && f <= 6) {
+      // At the pinned edge, where the sheet swinging down moves least.
+      auto burned = t.cauterize(*t.tri_body(0), {0.02, 0.0, 0.003}, 0.008, 1.0 / 60.0, 1.5 / 60.0);
+      ASSERT_TRUE(burned.ok()) << burned.error().message();
+      if (f < 6) {
+        EXPECT_EQ(burned->triangles_removed.empty(), f == 4) << "frame " << f;
+      }
+    }
+  }
+}
+
+TEST_P(SavedTopologyTest, TrianglesSegmentsAndTheirCauteryRestoreBitwiseEitherWay) {
+  const SceneDesc scene = sheet_and_thread();
+  auto sim = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SavedState at1, at4;
+  run_sheet(*sim, 1, 1);
+  SINEW_ASSERT_OK(sim->save_state(at1));
+  run_sheet(*sim, 2, 4);
+  SINEW_ASSERT_OK(sim->save_state(at4));
+  const std::vector<std::uint32_t> slots4 = slots(*sim);
+  run_sheet(*sim, 5, 12);
+  const Snapshot uninterrupted = snapshot(*sim);
+  SINEW_ASSERT_OK(sim->restore_state(at1));
+  run_sheet(*sim, 2, 12);
+  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored before the changes, on " << GetParam();
+  auto fresh = test::create_or_skip(scene, GetParam());
+  ASSERT_TRUE(fresh.ok());
+  SINEW_ASSERT_OK(fresh->restore_state(at4));
+  EXPECT_EQ(slots(*fresh), slots4);
+  run_sheet(*fresh, 5, 12);
+  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored after them, on " << GetParam();
+}
+
 // A strip of 10 x 1 x 1 cells pinned at both ends and held 30% beyond its
 // length: it tears within the first frames (topology_test.cpp's).
 SceneDesc torn_strip() {
