@@ -12,6 +12,7 @@
 #include "mesh_contact_support.h"
 #include "robustness_scenes.h"
 #include "runtime/state_format.h"
+#include "saved_state_support.h"
 #include "thread_scenes.h"
 
 namespace sinew {
@@ -290,17 +291,9 @@ TEST_F(SavedStateFile, NewerVersionIsANamedError) {
   expect_refused(bytes, ErrorCode::bad_input_file, "version");
 }
 
-// `state` as version 1 wrote it: the payload less its last `drop` bytes,
-// the header's size and hash made again, the version set to 1.
+// `state` as version 1 wrote it: the payload less its last `drop` bytes.
 std::vector<std::byte> as_version_1(const SavedState& state, std::size_t drop) {
-  std::vector<std::byte> bytes;
-  state_format::Writer w(bytes);
-  w.begin();
-  bytes.insert(bytes.end(), state.bytes.begin() + state_format::kHeaderBytes, state.bytes.end() - drop);
-  w.finish();
-  const std::uint32_t version = 1;
-  std::memcpy(bytes.data() + 8, &version, 4);
-  return bytes;
+  return test::rewritten(state, drop, 1).bytes;
 }
 
 TEST_F(SavedStateFile, VersionOneStatesAreRead) {

@@ -14,6 +14,7 @@
 #include "robustness_scenes.h"
 #include "runtime/simulation_internals.h"
 #include "runtime/state_format.h"
+#include "saved_state_support.h"
 #include "mesh_contact_support.h"
 #include "sinew/level_set.h"
 
@@ -30,6 +31,39 @@ std::vector<std::uint32_t> slots(const Simulation& sim) {
   auto words = SimulationInternals::constraint_words(sim);
   EXPECT_TRUE(words.ok()) << words.error().message();
   return words.ok() ? *words : std::vector<std::uint32_t>{};
+}
+
+// A run of `scene` on `backend` whose frames [from, to] run(sim, from, to)
+// steps with their inputs and changes: saved after frame `early` and after
+// `late`, run to `end`; then `early` restored into the same Simulation (which
+// has made every later change) and `late` into a new one (which has made
+// none), each run on to `end`, must end bitwise where the uninterrupted run
+// did, the new one with the slots the state was saved with.
+template <class Run>
+void expect_restores_either_way(const SceneDesc& scene, const std::string& backend, Run run, int early, int late,
+                                int end) {
+  auto sim = test::create_or_skip(scene, backend);
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  SavedState first, second;
+  run(*sim, 1, early);
+  SINEW_ASSERT_OK(sim->save_state(first));
+  run(*sim, early + 1, late);
+  SINEW_ASSERT_OK(sim->save_state(second));
+  const std::vector<std::uint32_t> slots_then = slots(*sim);
+  const Snapshot at_late = snapshot(*sim);
+  run(*sim, late + 1, end);
+  const Snapshot uninterrupted = snapshot(*sim);
+  ASSERT_FALSE(same_bits(at_late, uninterrupted));  // the scene moves: the comparisons below can fail
+  SINEW_ASSERT_OK(sim->restore_state(first));
+  run(*sim, early + 1, end);
+  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored after frame " << early << ", on " << backend;
+  auto fresh = test::create_or_skip(scene, backend);
+  ASSERT_TRUE(fresh.ok()) << fresh.error().message();
+  SINEW_ASSERT_OK(fresh->restore_state(second));
+  EXPECT_EQ(slots(*fresh), slots_then);
+  run(*fresh, late + 1, end);
+  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted))
+      << "restored after frame " << late << " in a new Simulation, on " << backend;
 }
 
 // The block of the robustness tests with topology changes, driven as there
@@ -161,26 +195,7 @@ void run_sheet(Simulation& sim, int from, int to) {
 }
 
 TEST_P(SavedTopologyTest, TrianglesSegmentsAndTheirCauteryRestoreBitwiseEitherWay) {
-  const SceneDesc scene = sheet_and_thread();
-  auto sim = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(sim.ok()) << sim.error().message();
-  SavedState at1, at4;
-  run_sheet(*sim, 1, 1);
-  SINEW_ASSERT_OK(sim->save_state(at1));
-  run_sheet(*sim, 2, 4);
-  SINEW_ASSERT_OK(sim->save_state(at4));
-  const std::vector<std::uint32_t> slots4 = slots(*sim);
-  run_sheet(*sim, 5, 12);
-  const Snapshot uninterrupted = snapshot(*sim);
-  SINEW_ASSERT_OK(sim->restore_state(at1));
-  run_sheet(*sim, 2, 12);
-  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored before the changes, on " << GetParam();
-  auto fresh = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(fresh.ok());
-  SINEW_ASSERT_OK(fresh->restore_state(at4));
-  EXPECT_EQ(slots(*fresh), slots4);
-  run_sheet(*fresh, 5, 12);
-  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored after them, on " << GetParam();
+  expect_restores_either_way(sheet_and_thread(), GetParam(), run_sheet, 1, 4, 12);
 }
 
 // A strip of 10 x 1 x 1 cells pinned at both ends and held 30% beyond its
@@ -206,29 +221,16 @@ SceneDesc torn_strip() {
 }
 
 TEST_P(SavedTopologyTest, TearsRestoreBitwiseEitherWay) {
-  const SceneDesc scene = torn_strip();
-  auto sim = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(sim.ok()) << sim.error().message();
-  SavedState start, torn;
-  SINEW_ASSERT_OK(sim->save_state(start));
   std::size_t tears = 0;
-  for (int f = 1; f <= 20; ++f) {
-    SINEW_ASSERT_OK(sim->step());
-    tears += sim->topology().last_tears().size();
-    if (f == 10) SINEW_ASSERT_OK(sim->save_state(torn));
-  }
-  ASSERT_GT(tears, 0u);
-  const Snapshot uninterrupted = snapshot(*sim);
-  // Back before the tears in the same Simulation: they happen again.
-  SINEW_ASSERT_OK(sim->restore_state(start));
-  for (int f = 1; f <= 20; ++f) SINEW_ASSERT_OK(sim->step());
-  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored before the tears, on " << GetParam();
-  // After them, in a new Simulation: replayed.
-  auto fresh = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(fresh.ok());
-  SINEW_ASSERT_OK(fresh->restore_state(torn));
-  for (int f = 11; f <= 20; ++f) SINEW_ASSERT_OK(fresh->step());
-  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored after the tears, on " << GetParam();
+  const auto run_strip = [&](Simulation& sim, int from, int to) {
+    for (int f = from; f <= to; ++f) {
+      SINEW_ASSERT_OK(sim.step());
+      tears += sim.topology().last_tears().size();
+    }
+  };
+  // Saved before the first frame (which tears) and after the tenth.
+  expect_restores_either_way(torn_strip(), GetParam(), run_strip, 0, 10, 20);
+  EXPECT_GT(tears, 0u);
 }
 
 // A stage that reports the frame's kinetic energy as NaN, after the tears
@@ -300,26 +302,8 @@ void run_cloth(Simulation& sim, int from, int to) {
 }
 
 TEST_P(SavedTopologyTest, ALevelSetCutRestoresBitwiseEitherWay) {
-  const SceneDesc scene = cloth_on_block();
-  auto sim = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(sim.ok()) << sim.error().message();
-  SavedState before, after;
-  run_cloth(*sim, 1, 5);
-  SINEW_ASSERT_OK(sim->save_state(before));
-  run_cloth(*sim, 6, 12);
-  SINEW_ASSERT_OK(sim->save_state(after));
-  run_cloth(*sim, 13, 30);
-  const Snapshot uninterrupted = snapshot(*sim);
-  // Before the cut, in the same Simulation: the block whole again, then cut again.
-  SINEW_ASSERT_OK(sim->restore_state(before));
-  run_cloth(*sim, 6, 30);
-  EXPECT_TRUE(same_bits(snapshot(*sim), uninterrupted)) << "restored before the cut, on " << GetParam();
-  // After it, in a new Simulation.
-  auto fresh = test::create_or_skip(scene, GetParam());
-  ASSERT_TRUE(fresh.ok());
-  SINEW_ASSERT_OK(fresh->restore_state(after));
-  run_cloth(*fresh, 13, 30);
-  EXPECT_TRUE(same_bits(snapshot(*fresh), uninterrupted)) << "restored after the cut, on " << GetParam();
+  // Saved before the cut (the block whole again, then cut again) and after it.
+  expect_restores_either_way(cloth_on_block(), GetParam(), run_cloth, 5, 12, 30);
 }
 #endif
 
@@ -420,31 +404,15 @@ TEST(SavedTopologyLog, ADamagedLogIsANamedError) {
   ASSERT_NE(at, good.bytes.end());
   const std::size_t offset = static_cast<std::size_t>(at - good.bytes.begin());
   for (const auto& [element, says] : {std::pair<std::uint32_t, const char*>{40, "a second time"}, {999999, "does not exist"}}) {
-    std::vector<std::byte> bytes;
-    state_format::Writer w(bytes);
-    w.begin();
-    bytes.insert(bytes.end(), good.bytes.begin() + state_format::kHeaderBytes, good.bytes.end());
-    std::memcpy(bytes.data() + offset + 4, &element, 4);
-    w.finish();
-    const Status s = sim->restore_state(SavedState{bytes});
+    const SavedState bad = test::rewritten(good, 0, kSavedStateVersion, [&](std::vector<std::byte>& payload) {
+      std::memcpy(payload.data() + offset - state_format::kHeaderBytes + 4, &element, 4);
+    });
+    const Status s = sim->restore_state(bad);
     ASSERT_FALSE(s.ok());
     EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
     EXPECT_NE(s.error().message().find(says), std::string::npos) << s.error().message();
     EXPECT_TRUE(same_bits(snapshot(*sim), at4));
   }
-}
-
-// `state` as format version 3 wrote it: without the last `drop` bytes (the
-// topology log and heat version 4 appends), the header made again.
-SavedState as_version_3(const SavedState& state, std::size_t drop) {
-  std::vector<std::byte> bytes;
-  state_format::Writer w(bytes);
-  w.begin();
-  bytes.insert(bytes.end(), state.bytes.begin() + state_format::kHeaderBytes, state.bytes.end() - drop);
-  w.finish();
-  const std::uint32_t version = 3;
-  std::memcpy(bytes.data() + 8, &version, 4);
-  return SavedState{bytes};
 }
 
 TEST(SavedTopologyLog, VersionThreeStatesRestoreOnlyWithoutChanges) {
@@ -461,12 +429,12 @@ TEST(SavedTopologyLog, VersionThreeStatesRestoreOnlyWithoutChanges) {
   SavedState at5_state;
   SINEW_ASSERT_OK(sim->save_state(at5_state));
   // Saved before any change: read, with no log (the Simulation made again: it has made one since).
-  SINEW_ASSERT_OK(sim->restore_state(as_version_3(at2, 8 + heat)));
+  SINEW_ASSERT_OK(sim->restore_state(test::rewritten(at2, 8 + heat, 3)));
   run(*sim, 3, 5);
   EXPECT_TRUE(same_bits(snapshot(*sim), at5));
   // Saved after one: that version did not hold it.
   const std::size_t log = 8 + 2 + 8 + 8 + 4 * 6;  // one record: kind and burn, body, the hole's 6 tets
-  const Status s = sim->restore_state(as_version_3(at5_state, log + heat));
+  const Status s = sim->restore_state(test::rewritten(at5_state, log + heat, 3));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message().find("format version 3"), std::string::npos) << s.error().message();
 }
@@ -481,14 +449,11 @@ TEST(SavedTopologyLog, ADamagedNeedleRowIsANamedError) {
   // The needles end the payload (no topology changes, no level set): the
   // last row is its 8 words, 4 weights, surface, triangle, exit and slip.
   const std::size_t row = 8 * 4 + 4 * 4 + 4 + 4 + 1 + 4;
-  std::vector<std::byte> bytes;
-  state_format::Writer w(bytes);
-  w.begin();
-  bytes.insert(bytes.end(), good.bytes.begin() + state_format::kHeaderBytes, good.bytes.end());
   const std::uint32_t kind = 99;
-  std::memcpy(bytes.data() + bytes.size() - row, &kind, 4);
-  w.finish();
-  const Status s = sim->restore_state(SavedState{bytes});
+  const SavedState bad = test::rewritten(good, 0, kSavedStateVersion, [&](std::vector<std::byte>& payload) {
+    std::memcpy(payload.data() + payload.size() - row, &kind, 4);
+  });
+  const Status s = sim->restore_state(bad);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code(), ErrorCode::bad_parameter);
   EXPECT_NE(s.error().message().find("its kind"), std::string::npos) << s.error().message();
