@@ -138,7 +138,7 @@ struct Simulation::Impl {
   /// device given to it, which cannot be made again).
   std::shared_ptr<const SceneDesc> source_scene;
   std::optional<DeviceOptions> device_options;
-  bool replaying = false;  ///< inside a restore's replay: no roll-back checkpoint per change
+  bool replaying = false;  ///< inside a restore's replay: no roll-back checkpoint and no program rebuilt per change
   /// Applies one change (the editor, then finish_change) and logs it.
   Result<TopologyEvent> edit(TopologyRecord record, std::chrono::steady_clock::time_point start);
   /// After a frame: removes the tets, triangles and segments stretched

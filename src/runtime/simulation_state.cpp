@@ -306,6 +306,8 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
       return event.error();
     }
   replaying = false;
+  if (replay)  // the program of the last shape (finish_change rebuilds none while replaying)
+    if (Status s = rebuild_program(); !s) return s;
 
   for (std::size_t i = 0; i < saved.size(); ++i)
     if (Status s = device->write_buffer(saved[i].buffer, 0, contents[i].data(), contents[i].size()); !s) return s;

@@ -66,7 +66,11 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
     for (const auto& stage : stages)  // each feature follows (FrameStage::topology_changed)
       if (Status s = stage->topology_changed(*device, change); !s) return s.error();
     const auto rebuild = std::chrono::steady_clock::now();
-    if (Status s = rebuild_program(); !s) return s.error();
+    if (replaying) {
+      program_ready = false;  // a restore's replay rebuilds once, after its last change
+    } else if (Status s = rebuild_program(); !s) {
+      return s.error();
+    }
     event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
   }
   // Between frames the changed scene is the one to roll back to; a tear,
