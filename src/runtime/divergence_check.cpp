@@ -42,7 +42,7 @@ Divergence diagnose(const FrameStats& f, double bound, const DivergenceSettings&
 // is no reason to fail the frame: the last one stays, and the first
 // failure in a row is logged.
 void Simulation::Impl::checkpoint() {
-  const Status saved = save_state(last_good, "roll-back checkpoint");
+  const Status saved = save_state(last_good);
   if (!saved && !checkpoint_failed)
     log_message(LogLevel::warning, saved.error().message() + "; a roll-back goes to frame " +
                                        std::to_string(last_good.frame()) + " until a checkpoint succeeds");
@@ -137,7 +137,7 @@ Status Simulation::set_divergence_settings(const DivergenceSettings& settings) {
   if (settings.checkpoint_every == 0) return bad("checkpoint_every", "must be >= 1", 0.0);
   Impl& im = *impl_;
   if (settings.on_divergence == OnDivergence::roll_back)
-    if (Status s = im.save_state(im.last_good, call); !s) return s;
+    if (Status s = im.save_state(im.last_good); !s) return s;
   im.divergence = settings;
   return {};
 }

@@ -197,7 +197,7 @@ struct Simulation::Impl {
   [[nodiscard]] std::vector<StateBuffer> saved_buffers() const;
   /// Fills state_buffers and the divergence checks' scene figures (history) from the compiled scene.
   void init_state_buffers(const CompiledScene& compiled);
-  Status save_state(SavedState& out, const char* call);
+  Status save_state(SavedState& out);
   /// [out] rebuild (may be null): set when the state's topology log does
   /// not continue this Simulation's, so that only a Simulation made again
   /// from its SceneDesc can take it (SimulationInternals::restore); the

@@ -87,7 +87,7 @@ std::vector<Simulation::Impl::StateBuffer> Simulation::Impl::saved_buffers() con
   return all;
 }
 
-Status Simulation::Impl::save_state(SavedState& out, const char* /*call*/) {
+Status Simulation::Impl::save_state(SavedState& out) {
   const std::vector<StateBuffer> saved = saved_buffers();
   state_format::Writer w(out.bytes);
   w.begin();
@@ -383,7 +383,7 @@ Status SimulationInternals::restore(Simulation& sim, const SavedState& state, co
   return {};
 }
 
-Status Simulation::save_state(SavedState& out) { return impl_->save_state(out, "save_state"); }
+Status Simulation::save_state(SavedState& out) { return impl_->save_state(out); }
 
 Status Simulation::restore_state(const SavedState& state) {
   return SimulationInternals::restore(*this, state, "restore_state");
@@ -391,7 +391,7 @@ Status Simulation::restore_state(const SavedState& state) {
 
 Status Simulation::save_state(const std::string& path) {
   SavedState state;
-  if (Status s = impl_->save_state(state, "save_state"); !s) return s;
+  if (Status s = impl_->save_state(state); !s) return s;
   return state.write_file(path);
 }
 

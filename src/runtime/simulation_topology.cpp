@@ -59,8 +59,8 @@ Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> even
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
-  if (changed) ++shape_generation;
   if (changed) {
+    ++shape_generation;
     positions_mirror.changed();  // a removal hands mass on: the positions' w
     TopologyChange change{*event};
     for (const auto& stage : stages)  // each feature follows (FrameStage::topology_changed)
@@ -130,8 +130,7 @@ Result<TopologyEvent> Simulation::remove_segments(std::size_t body,
                                                               std::span<const std::uint32_t> segments) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_segments"); !s) return s.error();
-  return impl_->edit({BodyKind::line, body, false, {segments.begin(), segments.end()}},
-                     start);
+  return impl_->edit({BodyKind::line, body, false, {segments.begin(), segments.end()}}, start);
 }
 
 Result<TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
