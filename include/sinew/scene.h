@@ -410,8 +410,8 @@ inline constexpr double kTrocarPoseTolerance = 1e-5;
 /// difference, so the tool's penalty against the bone is the force felt
 /// while cutting. The collider must be a level set with its inside stored
 /// (LevelSet::cut); the cut is done on the host and the changed leaves
-/// uploaded, as Tools::cut does (a saved state from before it no longer
-/// restores: the grid is not part of it).
+/// uploaded, as Tools::cut does (a saved state holds the grid's values:
+/// restoring one from before the cut puts the grid back).
 struct ToolCutDesc {
   std::uint32_t collider = 0;  ///< the level-set collider it cuts (SceneDesc::colliders index)
   CutterShape cutter;          ///< its shape [m], in the tool's frame

@@ -243,7 +243,7 @@ class Simulation {
   /// step() on. With OnDivergence::roll_back the current state is saved at
   /// once (the first frame to roll back to). Errors (bad_parameter, nothing
   /// changed): energy_growth not > 1, floor_speed < 0, max_volume_change
-  /// not > 0 or checkpoint_every 0 (each named), a scene save_state refuses.
+  /// not > 0 or checkpoint_every 0 (each named); a device error saving the first checkpoint.
   Status set_divergence_settings(const DivergenceSettings& settings);
   [[nodiscard]] const DivergenceSettings& divergence_settings() const;
   /// [in] settings: the per-frame warnings' thresholds (sinew/warnings.h),
@@ -256,15 +256,23 @@ class Simulation {
   /// [out] out: the state after the last frame (sinew/saved_state.h), its
   /// bytes replaced (their capacity reused: saving every frame allocates
   /// nothing after the first). Reads the particles' buffers and multipliers
-  /// back from the device (and a fluid's particles and grid). Errors: a scene with what a state
-  /// cannot hold yet (needles; bad_parameter naming it), a device error.
+  /// back from the device (and a fluid's particles and grid, and the level
+  /// sets a cut can change). Errors: a device error.
   Status save_state(SavedState& out);
   /// [in] state: from save_state of this scene (this Simulation, or one made
   /// from the same SceneDesc); the next step() continues from it bitwise as
-  /// the run it was saved from. Errors, leaving the Simulation unchanged:
-  /// bad_input_file for a damaged or foreign state (sinew/saved_state.h),
-  /// bad_parameter for another scene's state (naming what differs) or one
-  /// saved before or after a topology change or level-set cut.
+  /// the run it was saved from, across topology changes and level-set cuts
+  /// made before or after the save: the state's changes this Simulation has
+  /// not made are replayed, and a Simulation that has made others (or more)
+  /// is made again from its SceneDesc first (a new device; its ids and
+  /// handles stay valid, references returned before by info(),
+  /// last_frame(), last_tears() and the settings' getters do not;
+  /// sinew/saved_state.h). Errors, leaving the
+  /// Simulation unchanged: bad_input_file for a damaged or foreign state,
+  /// bad_parameter for another scene's state (naming what differs), a state
+  /// of format version 3 or older saved after a topology change, or one
+  /// that needs the Simulation made again when it was made on a device
+  /// given to it; the errors of Simulation::create when it is made again.
   Status restore_state(const SavedState& state);
   /// save_state to a file [in] path (replaced). Errors as save_state's and SavedState::write_file's.
   Status save_state(const std::string& path);

@@ -3,6 +3,8 @@
 // make one fails, naming the option, so nothing else can be called.
 #include "sinew/level_set.h"
 
+#include "level_set/level_set_values.h"
+
 namespace sinew {
 namespace {
 
@@ -37,5 +39,10 @@ std::span<const std::byte> LevelSet::nanovdb_bytes() const { return {}; }
 Result<CutReport> LevelSet::cut(const CutterShape&, const Pose&, const Pose&) { return unavailable("LevelSet::cut"); }
 TriMesh LevelSet::surface() const { return {}; }
 Result<TriMesh> LevelSet::surface_in(const std::array<double, 6>&) const { return unavailable("LevelSet::surface_in"); }
+
+Status set_level_set_values(const LevelSet&, std::span<const std::byte>, const std::string&,
+                            std::vector<std::array<std::uint64_t, 2>>&) {
+  return unavailable("set_level_set_values");
+}
 
 }  // namespace sinew

@@ -38,11 +38,11 @@ Divergence diagnose(const FrameStats& f, double bound, const DivergenceSettings&
 
 }  // namespace
 
-// A checkpoint that cannot be saved (a scene with needles; a device error)
+// A checkpoint that cannot be saved (a device error)
 // is no reason to fail the frame: the last one stays, and the first
 // failure in a row is logged.
 void Simulation::Impl::checkpoint() {
-  const Status saved = save_state(last_good, "roll-back checkpoint");
+  const Status saved = save_state(last_good);
   if (!saved && !checkpoint_failed)
     log_message(LogLevel::warning, saved.error().message() + "; a roll-back goes to frame " +
                                        std::to_string(last_good.frame()) + " until a checkpoint succeeds");
@@ -85,15 +85,25 @@ Status Simulation::Impl::check_divergence() {
                                             " (DivergenceSettings::on_divergence = stop; restore_state can go back)");
     case OnDivergence::roll_back: {
       const DivergenceReport diverged = report;
-      if (Status s = restore_state(last_good, "step (rolling back)"); !s) return s;
-      stats.divergence = diverged;
-      stats.divergence.rolled_back = true;
-      stats.divergence.rolled_back_to = stats.frame;
-      log_message(LogLevel::warning, message.str() + "; rolled back to frame " + std::to_string(stats.frame));
+      bool made_again = false;
+      if (Status s = restore_state(last_good, "step (rolling back)", &made_again); !s) {
+        if (!made_again) return s;
+        // Back before a tear of this frame: step() makes the Simulation again.
+        pending_roll_back = PendingRollBack{diverged, message.str()};
+        return {};
+      }
+      report_roll_back(diverged, message.str());
       return {};
     }
   }
   return {};
+}
+
+void Simulation::Impl::report_roll_back(const DivergenceReport& diverged, const std::string& message) {
+  stats.divergence = diverged;
+  stats.divergence.rolled_back = true;
+  stats.divergence.rolled_back_to = stats.frame;
+  log_message(LogLevel::warning, message + "; rolled back to frame " + std::to_string(stats.frame));
 }
 
 Status Simulation::Impl::after_failed_frame(const Error& error) {
@@ -127,7 +137,7 @@ Status Simulation::set_divergence_settings(const DivergenceSettings& settings) {
   if (settings.checkpoint_every == 0) return bad("checkpoint_every", "must be >= 1", 0.0);
   Impl& im = *impl_;
   if (settings.on_divergence == OnDivergence::roll_back)
-    if (Status s = im.save_state(im.last_good, call); !s) return s;
+    if (Status s = im.save_state(im.last_good); !s) return s;
   im.divergence = settings;
   return {};
 }

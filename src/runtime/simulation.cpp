@@ -41,7 +41,9 @@ Result<Simulation> Simulation::create(const SceneDesc& scene, const DeviceOption
   if (!compiled) return compiled.error();
   auto device = create_device(device_options);
   if (!device) return device.error();
-  return SimulationInternals::assemble(scene, *compiled, std::move(*device));
+  auto sim = SimulationInternals::assemble(scene, *compiled, std::move(*device));
+  if (sim) sim->impl_->device_options = device_options;  // to make it again (SimulationInternals::restore)
+  return sim;
 }
 
 Result<Simulation> SimulationInternals::create(const SceneDesc& scene, std::unique_ptr<Device> device) {
@@ -134,6 +136,7 @@ Result<Simulation> SimulationInternals::assemble(const SceneDesc& scene, Compile
     if (!editor) return editor.error();
     impl->topology = std::move(*editor);
     if (impl->measure_errors) impl->topology->track_boundaries();  // volume_change after cuts (refresh_volume)
+    impl->source_scene = std::make_shared<const SceneDesc>(scene);  // a restore may make it again
   }
   if (impl->topology && impl->mesh_collision) {
     impl->collision_scene = std::make_unique<SceneDesc>(scene);
@@ -298,6 +301,13 @@ Status Simulation::step() {
   im.stats.wall_ms = std::chrono::duration<double, std::milli>(end - start).count();
   im.warnings.after_frame(im.stats);
   if (Status s = im.check_divergence(); !s) return s;
+  if (im.pending_roll_back) {  // back before this frame's tears: the Simulation made again
+    const Impl::PendingRollBack pending = std::move(*im.pending_roll_back);
+    im.pending_roll_back.reset();
+    const SavedState good = im.last_good;
+    if (Status s = SimulationInternals::restore(*this, good, "step (rolling back)"); !s) return s;
+    impl_->report_roll_back(pending.diverged, pending.message);  // im is gone
+  }
   return frame.deferred;
 }
 

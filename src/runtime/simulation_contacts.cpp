@@ -382,7 +382,7 @@ Result<CutReport> Simulation::Impl::cut_collider(std::size_t index, const Cutter
   // grids buffer, before the next frame reads them.
   const std::span<const std::byte> bytes = collider.level_set->nanovdb_bytes();
   const std::uint64_t base = c.level_set_offsets[index];
-  if (!report->changed_bytes.empty()) ++shape_generation;  // a saved state does not hold the grids
+  if (!report->changed_bytes.empty()) ++shape_generation;
   for (const auto& [offset, size] : report->changed_bytes)
     if (Status s = device->write_buffer(buffers.level_set_grids, base + offset, bytes.data() + offset,
                                                size);

@@ -23,6 +23,7 @@
 #include "runtime/graspers.h"
 #include "runtime/sutures.h"
 #include "runtime/topology_editor.h"
+#include "runtime/topology_log.h"
 #include "runtime/scene_fluid.h"
 #include "sinew/divergence.h"
 #include "runtime/frame_warnings.h"
@@ -128,6 +129,18 @@ struct Simulation::Impl {
   // removals patch (null without), and the last step's tears.
   std::unique_ptr<TopologyEditor> topology;
   std::vector<TopologyEvent> tears;
+  /// Every change the editor applied, in order (topology_log.h): a saved
+  /// state holds it, a restore replays it.
+  TopologyLog topology_log;
+  /// With topology changes: the scene and the device options it was made
+  /// with, to make it again for a restore whose log does not continue this
+  /// Simulation's (SimulationInternals::restore; no options: made on a
+  /// device given to it, which cannot be made again).
+  std::shared_ptr<const SceneDesc> source_scene;
+  std::optional<DeviceOptions> device_options;
+  bool replaying = false;  ///< inside a restore's replay: no roll-back checkpoint and no program rebuilt per change
+  /// Applies one change (the editor, then finish_change) and logs it.
+  Result<TopologyEvent> edit(TopologyRecord record, std::chrono::steady_clock::time_point start);
   /// After a frame: removes the tets, triangles and segments stretched
   /// past their body's tear_strain.
   Status tear();
@@ -168,9 +181,9 @@ struct Simulation::Impl {
   Result<CutReport> cut_collider(std::size_t index, const CutterShape& shape, const Pose& from, const Pose& to);
 
   // ---- Saved state and divergence (simulation_state.cpp, divergence_check.cpp).
-  /// Changes of the scene's shape a saved state does not hold: topology
-  /// changes (finish_change) and level-set cuts (cut_collider). A state
-  /// restores only at the generation it was saved at.
+  /// Changes of the scene's shape: topology changes (finish_change) and
+  /// level-set cuts (cut_collider), counted (a state saved by format
+  /// version 3 or older restores only where none was made).
   std::uint64_t shape_generation = 0;
   /// The device buffers whose contents carry from one frame to the next,
   /// with their sizes (set in create; save_state reads them in this order).
@@ -184,8 +197,12 @@ struct Simulation::Impl {
   [[nodiscard]] std::vector<StateBuffer> saved_buffers() const;
   /// Fills state_buffers and the divergence checks' scene figures (history) from the compiled scene.
   void init_state_buffers(const CompiledScene& compiled);
-  Status save_state(SavedState& out, const char* call);
-  Status restore_state(const SavedState& state, const std::string& what);
+  Status save_state(SavedState& out);
+  /// [out] rebuild (may be null): set when the state's topology log does
+  /// not continue this Simulation's, so that only a Simulation made again
+  /// from its SceneDesc can take it (SimulationInternals::restore); the
+  /// error returned then says so, and nothing changed.
+  Status restore_state(const SavedState& state, const std::string& what, bool* rebuild = nullptr);
 
   DivergenceSettings divergence;
   FrameWarnings warnings;  ///< sinew/warnings.h (frame_warnings.cpp)
@@ -206,6 +223,16 @@ struct Simulation::Impl {
   void checkpoint();
   /// After a frame: the checks, the log and the policy (divergence_check.cpp).
   Status check_divergence();
+  /// A roll-back back before a tear of the diverged frame: only a Simulation
+  /// made again can take the checkpoint, which step() does
+  /// (SimulationInternals::restore), then reports it as check_divergence would.
+  struct PendingRollBack {
+    DivergenceReport diverged;
+    std::string message;
+  };
+  std::optional<PendingRollBack> pending_roll_back;
+  /// The report and the warning of a roll-back to the frame now restored.
+  void report_roll_back(const DivergenceReport& diverged, const std::string& message);
   /// A frame a stage failed (a device error): with OnDivergence::roll_back
   /// the scene goes back to the last good frame; the error is returned either way.
   Status after_failed_frame(const Error& error);

@@ -48,6 +48,17 @@ struct SimulationInternals {
     std::vector<std::pair<Kernel, std::vector<std::uint32_t>>> in_use;
   };
   static Result<ColorCheck> check_colors(const Simulation& sim);
+  /// Every block's constraint slots as the device holds them (each slot's
+  /// particles and data words, in slot order) and each colour's count in
+  /// use: what replaying a topology log must give bit for bit.
+  static Result<std::vector<std::uint32_t>> constraint_words(const Simulation& sim);
+  /// Simulation::restore_state's work: restores `state` into `sim`, or,
+  /// when the state's topology changes do not continue the Simulation's
+  /// (it has made others, or more), into a Simulation made again from its
+  /// SceneDesc and device options that then takes its place (its ids stay
+  /// valid; stages added by add_stage are not). `what` names the state in
+  /// errors; on an error `sim` is as it was.
+  static Status restore(Simulation& sim, const SavedState& state, const std::string& what);
 };
 
 }  // namespace sinew

@@ -9,48 +9,44 @@
 // before the frame), the rigid tools' state, the particle forces' flags,
 // the residual stepper's warm start, the mesh collision's velocities (the
 // last frame's mean, which set the next frame's reach), the fluid's
-// counts and the graspers' holds (the particles and points in their slots,
-// written again with the program rebuilt); all are restored exactly (and the mesh collision reads the
-// positions again), and the
-// scene's constant data (constraint data, level-set grids) is checked to be
-// unchanged through shape_generation.
+// counts, the graspers' holds (the particles and points in their slots,
+// written again with the program rebuilt), the needles' state (their rows
+// are written to the device before every frame) and the level-set
+// colliders' values; all are restored exactly (and the mesh collision and
+// the needles read the positions again). The scene's constant data
+// (constraint slots, colours, masses) is the compiled scene's changed by
+// the topology log, which a restore replays where this Simulation's log is
+// the first part of the state's (topology_log.h), or replays whole in a
+// Simulation made again (SimulationInternals::restore). The continuous
+// collision carries nothing between frames: it fits its trees and takes
+// its reference positions at every frame's start.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
 #include "fluid/sph_solver.h"
+#include "level_set/level_set_values.h"
+#include "runtime/simulation_internals.h"
 #include "runtime/simulation_impl.h"
 #include "runtime/state_format.h"
+#include "runtime/tool_fields.h"
 
 namespace sinew {
 namespace {
-
-// The rigid tools' state that changes while the scene runs, visited field by
-// field in the format's order (the same visit writes and reads).
-template <class Tool, class Visit>
-void tool_fields(Tool& t, Visit visit) {
-  for (auto* v : {&t.position, &t.velocity, &t.angular_velocity, &t.force, &t.torque, &t.contact_force,
-                  &t.contact_torque, &t.coupling_force, &t.coupling_torque, &t.penalty_force, &t.penalty_torque})
-    visit(*v);
-  visit(t.rotation);
-  visit(t.touching_mass);
-  visit(t.touching_inertia);
-  visit(t.penalty_points);
-  visit(t.penalty_depth);
-}
 
 bool has_trocar(const std::vector<ToolBody>& tools) {
   return std::any_of(tools.begin(), tools.end(), [](const ToolBody& t) { return t.trocar; });
 }
 
-// What a state must not be saved with yet: each names itself.
-Status check_saveable(const Simulation::Impl& im, const char* call) {
-  const auto unsupported = [&](const std::string& what) {
-    return Error(ErrorCode::bad_parameter,
-                 std::string(call) + ": " + what + " is not part of a saved state yet, so this scene cannot be saved");
-  };
-  if (im.sutures) return unsupported("a needle (SceneDesc::needles)");
-  return {};
+// The level-set colliders a cut can change (LevelSet::cut needs the whole
+// inside stored): their values are part of the state.
+std::vector<std::size_t> cuttable_level_sets(const ContactState& c) {
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < c.shapes.size(); ++k)
+    if (c.shapes[k].shape == ColliderShape::level_set && c.shapes[k].level_set &&
+        std::isinf(c.shapes[k].level_set->interior_band()))
+      out.push_back(k);
+  return out;
 }
 
 }  // namespace
@@ -91,8 +87,7 @@ std::vector<Simulation::Impl::StateBuffer> Simulation::Impl::saved_buffers() con
   return all;
 }
 
-Status Simulation::Impl::save_state(SavedState& out, const char* call) {
-  if (Status s = check_saveable(*this, call); !s) return s;
+Status Simulation::Impl::save_state(SavedState& out) {
   const std::vector<StateBuffer> saved = saved_buffers();
   state_format::Writer w(out.bytes);
   w.begin();
@@ -144,15 +139,24 @@ Status Simulation::Impl::save_state(SavedState& out, const char* call) {
       w.value(t.trocar_force);
       w.value(t.trocar_torque);
     }
+  // Since version 4: the topology changes made, in order, and the cautery's
+  // heat; the needles; the values of the level sets a cut can change.
+  if (topology) {
+    write_log(w, topology_log);
+    for (BodyKind kind : {BodyKind::tet, BodyKind::tri})
+      for (std::size_t b = 0; b < topology->bodies(kind); ++b)
+        w.array(std::span<const double>(topology->heat(kind, b)));
+  }
+  if (sutures) sutures->save(w);
+  for (std::size_t k : cuttable_level_sets(contacts)) w.array(contacts.shapes[k].level_set->nanovdb_bytes());
   w.finish();
   return {};
 }
 
-Status Simulation::Impl::restore_state(const SavedState& state, const std::string& what) {
+Status Simulation::Impl::restore_state(const SavedState& state, const std::string& what, bool* rebuild) {
   std::span<const std::byte> payload;
   std::uint32_t version = 0;
   if (Status s = state_format::open(state.bytes, what, payload, &version); !s) return s;
-  if (Status s = check_saveable(*this, what.c_str()); !s) return s;
   state_format::Reader r(payload, what);
   const std::vector<StateBuffer> saved = saved_buffers();
   // Read and checked whole before anything changes: a bad state leaves the Simulation as it was.
@@ -162,12 +166,11 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
   for (Status s : {r.value(frame), r.value(generation), r.value(flags), r.value(last_energy),
                    r.value(next_force_speed), r.value(diverged), r.value(buffer_count)})
     if (!s) return s;
-  if (generation != shape_generation)
+  if (version < 4 && generation != 0)
     return Error(ErrorCode::bad_parameter,
                  what + ": the state was saved after " + std::to_string(generation) +
-                     " changes of the scene's shape (topology changes and level-set cuts), this Simulation has had " +
-                     std::to_string(shape_generation) +
-                     "; a saved state does not hold the topology, so it cannot be restored across such a change");
+                     " changes of the scene's shape (topology changes and level-set cuts) in format version " +
+                     std::to_string(version) + ", which does not hold the topology; it cannot be restored");
   if (buffer_count != saved.size()) return r.mismatch("device buffers", buffer_count, saved.size());
   std::vector<std::vector<std::byte>> contents(saved.size());
   for (std::size_t i = 0; i < saved.size(); ++i) {
@@ -242,7 +245,69 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
     for (ToolBody& t : saved_tools)
       for (Status s : {r.value(t.trocar_force), r.value(t.trocar_torque)})
         if (!s) return s;
+  // Version 4 added the topology log and the cautery's heat, the needles
+  // and the level sets' values; an older state holds none (it was saved
+  // with no topology change, no needle, and restores no level set).
+  TopologyLog saved_log;
+  std::vector<std::vector<double>> heat;
+  std::vector<Sutures::Needle> needles;
+  std::vector<std::vector<std::byte>> grids;
+  if (sutures && version < 4)
+    return Error(ErrorCode::bad_parameter, what + ": the saved state (format version " + std::to_string(version) +
+                                               ") holds no needles' state; this scene has needles");
+  if (version >= 4) {
+    if (topology) {
+      if (Status s = read_log(r, topology.get(), what, saved_log); !s) return s;
+      for (BodyKind kind : {BodyKind::tet, BodyKind::tri})
+        for (std::size_t b = 0; b < topology->bodies(kind); ++b) {
+          const std::size_t n = topology->heat(kind, b).size();
+          if (Status s = r.array(heat.emplace_back(), n, "cautery heat (elements)"); !s) return s;
+          if (heat.back().size() != n) return r.mismatch("cautery heat (elements)", heat.back().size(), n);
+        }
+    }
+    if (sutures)
+      if (Status s = sutures->read(r, what, needles); !s) return s;
+    for (std::size_t k : cuttable_level_sets(contacts)) {
+      const std::size_t n = contacts.shapes[k].level_set->nanovdb_bytes().size();
+      if (Status s = r.array(grids.emplace_back(), n, "level set (bytes)"); !s) return s;
+      if (grids.back().size() != n) return r.mismatch("level set (bytes)", grids.back().size(), n);
+    }
+  }
   if (!r.done()) return Error(ErrorCode::bad_input_file, what + ": the saved state has bytes past its end");
+  // The topology: the state's log must continue this Simulation's.
+  if (!is_prefix(topology_log, saved_log)) {
+    if (rebuild) *rebuild = true;
+    return Error(ErrorCode::bad_parameter,
+                 what + ": the state was saved after " + std::to_string(saved_log.size()) +
+                     " topology changes that do not continue this Simulation's " +
+                     std::to_string(topology_log.size()) +
+                     "; only a Simulation made again from the SceneDesc can take it");
+  }
+
+  // The level sets first: a layout that is not this scene's is found before anything changes.
+  const std::vector<std::size_t> level_sets = cuttable_level_sets(contacts);
+  for (std::size_t i = 0; i < grids.size(); ++i) {
+    std::vector<std::array<std::uint64_t, 2>> changed;
+    const std::size_t k = level_sets[i];
+    if (Status s = set_level_set_values(*contacts.shapes[k].level_set, grids[i], what, changed); !s) return s;
+    const std::span<const std::byte> bytes = contacts.shapes[k].level_set->nanovdb_bytes();
+    for (const auto& [offset, size] : changed)
+      if (Status s = device->write_buffer(buffers.level_set_grids, contacts.level_set_offsets[k] + offset,
+                                          bytes.data() + offset, size);
+          !s)
+        return s;
+  }
+  // The changes this Simulation has not made yet, in the order they were made.
+  const bool replay = saved_log.size() > topology_log.size();
+  replaying = true;
+  for (std::size_t i = topology_log.size(); i < saved_log.size(); ++i)
+    if (auto event = edit(saved_log[i], std::chrono::steady_clock::now()); !event) {
+      replaying = false;
+      return event.error();
+    }
+  replaying = false;
+  if (replay)  // the program of the last shape (finish_change rebuilds none while replaying)
+    if (Status s = rebuild_program(); !s) return s;
 
   for (std::size_t i = 0; i < saved.size(); ++i)
     if (Status s = device->write_buffer(saved[i].buffer, 0, contents[i].data(), contents[i].size()); !s) return s;
@@ -273,28 +338,67 @@ Status Simulation::Impl::restore_state(const SavedState& state, const std::strin
   if (mesh_collision)
     if (Status s = mesh_collision->restore_velocities(std::move(mesh_velocities)); !s) return s;
   tears.clear();
+  if (!heat.empty()) {
+    std::size_t i = 0;
+    for (BodyKind kind : {BodyKind::tet, BodyKind::tri})
+      for (std::size_t b = 0; b < topology->bodies(kind); ++b) topology->heat(kind, b) = std::move(heat[i++]);
+  }
+  if (sutures) sutures->restore_needles(std::move(needles));
+  shape_generation = generation;
   if (graspers) {  // what each grasper held when saved, and the program that solves it
     for (std::size_t g = 0; g < holds.size(); ++g)
       if (Status s = graspers->restore(*device, buffers, program_shape, order, g, holds[g]); !s) return s;
     if (Status s = rebuild_program(); !s) return s;
   }
+  // After a replay the restored state is the one to roll back to.
+  if (replay && divergence.on_divergence == OnDivergence::roll_back && &state != &last_good) last_good = state;
   return {};
 }
 
-Status Simulation::save_state(SavedState& out) { return impl_->save_state(out, "save_state"); }
+Status SimulationInternals::restore(Simulation& sim, const SavedState& state, const std::string& what) {
+  Simulation::Impl& old = *sim.impl_;
+  bool rebuild = false;
+  const Status restored = old.restore_state(state, what, &rebuild);
+  if (!rebuild) return restored;
+  if (!old.source_scene || !old.device_options)
+    return Error(restored.error().code(), restored.error().message() +
+                                              " (this one was made on a device given to it, which cannot be made again)");
+  // Made again as Simulation::create makes it, with this one's ids and
+  // settings; it takes this one's place only once the state is in it.
+  auto compiled = compile_scene(*old.source_scene);
+  if (!compiled) return compiled.error();
+  auto device = create_device(*old.device_options);
+  if (!device) return device.error();
+  auto made = assemble(*old.source_scene, *compiled, std::move(*device));
+  if (!made) return made.error();
+  Simulation::Impl& im = *made->impl_;
+  im.serial = old.serial;
+  im.source_scene = old.source_scene;
+  im.device_options = old.device_options;
+  im.warnings = old.warnings;
+  im.divergence = old.divergence;
+  if (Status s = im.restore_state(state, what); !s) return s;
+  if (im.divergence.on_divergence == OnDivergence::roll_back) im.last_good = state;
+  sim.impl_ = std::move(made->impl_);
+  return {};
+}
 
-Status Simulation::restore_state(const SavedState& state) { return impl_->restore_state(state, "restore_state"); }
+Status Simulation::save_state(SavedState& out) { return impl_->save_state(out); }
+
+Status Simulation::restore_state(const SavedState& state) {
+  return SimulationInternals::restore(*this, state, "restore_state");
+}
 
 Status Simulation::save_state(const std::string& path) {
   SavedState state;
-  if (Status s = impl_->save_state(state, "save_state"); !s) return s;
+  if (Status s = impl_->save_state(state); !s) return s;
   return state.write_file(path);
 }
 
 Status Simulation::restore_state(const std::string& path) {
   auto state = SavedState::read_file(path);
   if (!state) return state.error();
-  return impl_->restore_state(*state, path);
+  return SimulationInternals::restore(*this, *state, path);
 }
 
 }  // namespace sinew

@@ -42,27 +42,41 @@ Status check_body(const TopologyEditor& editor, BodyKind kind, std::size_t body)
 Result<TopologyEvent> Simulation::Impl::apply_removal(BodyKind kind, std::size_t body,
                                                                  std::span<const std::uint32_t> elements, bool burn,
                                                                  std::chrono::steady_clock::time_point start) {
-  return finish_change(topology->remove(*device, buffers, program_shape, kind, body, elements, burn),
-                       !elements.empty(), start);
+  return edit({kind, body, burn, {elements.begin(), elements.end()}}, start);
+}
+
+Result<TopologyEvent> Simulation::Impl::edit(TopologyRecord record, std::chrono::steady_clock::time_point start) {
+  auto event = record.kind == BodyKind::line
+                   ? topology->remove_segments(*device, buffers, program_shape, record.body, record.elements)
+                   : topology->remove(*device, buffers, program_shape, record.kind, record.body, record.elements,
+                                      record.burn);
+  const bool changed = event.ok() && !record.elements.empty();
+  if (changed) topology_log.push_back(std::move(record));
+  return finish_change(std::move(event), changed, start);
 }
 
 Result<TopologyEvent> Simulation::Impl::finish_change(Result<TopologyEvent> event,
                                                                   bool changed,
                                                                   std::chrono::steady_clock::time_point start) {
   if (!event) return event.error();
-  if (changed) ++shape_generation;  // a saved state does not hold the topology (simulation_state.cpp)
   if (changed) {
+    ++shape_generation;
     positions_mirror.changed();  // a removal hands mass on: the positions' w
     TopologyChange change{*event};
     for (const auto& stage : stages)  // each feature follows (FrameStage::topology_changed)
       if (Status s = stage->topology_changed(*device, change); !s) return s.error();
     const auto rebuild = std::chrono::steady_clock::now();
-    if (Status s = rebuild_program(); !s) return s.error();
+    if (replaying) {
+      program_ready = false;  // a restore's replay rebuilds once, after its last change
+    } else if (Status s = rebuild_program(); !s) {
+      return s.error();
+    }
     event->rebuild_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - rebuild).count();
   }
-  // Between frames the changed scene is the one to roll back to (a saved
-  // state holds no topology); a tear, inside a frame, waits for the frame's verdict.
-  if (changed && !stepping && divergence.on_divergence == OnDivergence::roll_back) checkpoint();
+  // Between frames the changed scene is the one to roll back to; a tear,
+  // inside a frame, waits for the frame's verdict; a restore's replay is
+  // followed by the restored state.
+  if (changed && !stepping && !replaying && divergence.on_divergence == OnDivergence::roll_back) checkpoint();
   event->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return event;
 }
@@ -116,9 +130,7 @@ Result<TopologyEvent> Simulation::remove_segments(std::size_t body,
                                                               std::span<const std::uint32_t> segments) {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = need_topology(impl_->topology, "remove_segments"); !s) return s.error();
-  return impl_->finish_change(impl_->topology->remove_segments(*impl_->device, impl_->buffers, impl_->program_shape,
-                                                               body, segments),
-                              !segments.empty(), start);
+  return impl_->edit({BodyKind::line, body, false, {segments.begin(), segments.end()}}, start);
 }
 
 Result<TopologyEvent> Simulation::cut_body(std::size_t body, const Blade& from, const Blade& to) {
@@ -190,7 +202,7 @@ Status Simulation::Impl::tear() {
     if (!(strain > 0.0)) continue;
     const auto torn = segments_torn(topology->line(b), topology->whole(b), {x, topology->line_first_particle(b)}, strain);
     if (torn.empty()) continue;
-    auto event = finish_change(topology->remove_segments(*device, buffers, program_shape, b, torn), true, start);
+    auto event = edit({BodyKind::line, b, false, torn}, start);
     if (!event) return event.error();
     tears.push_back(std::move(*event));
     start = std::chrono::steady_clock::now();
@@ -254,6 +266,24 @@ Result<SimulationInternals::ColorCheck> SimulationInternals::check_colors(const 
   }
   for (const auto& p : x) out.total_mass += p.w > 0.0f ? 1.0 / double(p.w) : 0.0;
   std::sort(out.in_use.begin(), out.in_use.end());
+  return out;
+}
+
+Result<std::vector<std::uint32_t>> SimulationInternals::constraint_words(const Simulation& sim) {
+  const Simulation::Impl& impl = *sim.impl_;
+  std::vector<std::uint32_t> out;
+  for (std::size_t k = 0; k < impl.program_shape.blocks.size(); ++k) {
+    const ConstraintBlock& block = impl.program_shape.blocks[k];
+    std::vector<std::uint32_t> particles(std::size_t{block.size()} * block.arity),
+        data(std::size_t{block.size()} * block.data_stride);
+    if (Status s = impl.device->read_buffer(impl.buffers.blocks[k].particles, 0, particles.data(), particles.size() * 4); !s)
+      return s.error();
+    if (Status s = impl.device->read_buffer(impl.buffers.blocks[k].data, 0, data.data(), data.size() * 4); !s)
+      return s.error();
+    out.insert(out.end(), block.color_counts.begin(), block.color_counts.end());
+    out.insert(out.end(), particles.begin(), particles.end());
+    out.insert(out.end(), data.begin(), data.end());
+  }
   return out;
 }
 

@@ -44,6 +44,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "compiler/scene_compiler.h"
@@ -54,6 +55,11 @@
 #include "sinew/simulation.h"
 
 namespace sinew {
+
+namespace state_format {
+class Writer;
+class Reader;
+}  // namespace state_format
 
 class Sutures {
  public:
@@ -94,17 +100,7 @@ class Sutures {
   [[nodiscard]] const std::vector<std::uint8_t>* exemption() const { return &exempt_; }
   [[nodiscard]] std::size_t needles() const { return needles_.size(); }
 
- private:
-  // A surface a tip can puncture: its triangles (device slots), the
-  // opposite vertex of each one's tet (tet bodies; kNone for tri bodies,
-  // which are two-sided).
-  struct Surface {
-    BodyKind kind = BodyKind::tet;
-    std::uint32_t body = 0;
-    std::vector<std::array<std::uint32_t, 3>> triangles;
-    std::vector<std::uint32_t> opposite;
-  };
-  static constexpr std::uint32_t kNone = UINT32_MAX;
+  // What a needle keeps between frames (all of it saved in a state: sutures_state.cpp).
   struct Row {
     std::array<std::uint32_t, 8> words{};  // rows binding: (kind, needle, a, b), (c, first slot, vertices, segment)
     std::array<float, 4> weights{};        // (wa, wb, wc, s)
@@ -125,6 +121,26 @@ class Sutures {
     math::Vec3 reaction_force{}, reaction_torque{};  // the last frame's average [N], [N m]
     double tip_force = 0.0;
     std::uint32_t refused_degenerate = 0, refused_inverted = 0, refused_angle = 0;
+  };
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+  /// Appends each needle's state, its rows with it, to a saved state's payload.
+  void save(state_format::Writer& w) const;
+  /// [out] out: each needle's state read back from a payload (save's
+  /// order), checked against this scene: the rows' kinds, needles,
+  /// particles, thread slots, surfaces and triangles. Errors name `what`
+  /// and the bad field (bad_parameter; bad_input_file when truncated).
+  Status read(state_format::Reader& r, const std::string& what, std::vector<Needle>& out) const;
+  void restore_needles(std::vector<Needle> needles);
+
+ private:
+  // A surface a tip can puncture: its triangles (device slots), the
+  // opposite vertex of each one's tet (tet bodies; kNone for tri bodies,
+  // which are two-sided).
+  struct Surface {
+    BodyKind kind = BodyKind::tet;
+    std::uint32_t body = 0;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::uint32_t> opposite;
   };
   // The needle's points in the world at its start (end = false) or end pose.
   std::vector<math::Vec3> curve_at(const Needle& n, bool end) const;
