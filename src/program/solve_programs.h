@@ -79,7 +79,8 @@ class SolvePrograms {
   void append_sweeps(FrameProgram& program, int s, int first, int count, bool warm) const;
   /// The measuring pass at the end of substep s (read-only).
   void append_measure(FrameProgram& program, int s) const;
-  /// The velocity update of substep s.
+  /// The end of substep s: its SolverSettings::contact_sweeps (as
+  /// build_xpbd_program emits them), then its velocity update.
   void append_update(FrameProgram& program, int s) const;
   /// Measure, then reduce the residuals into check.results, declared as
   /// the program's last end read (FrameProgram::read_at_end).
@@ -94,6 +95,7 @@ class SolvePrograms {
  private:
   struct Parts {
     Commands predict, first_sweep, sweep, measure, update;
+    Commands contacts;  ///< one contact-only sweep (append_contact_sweep)
   };
   void append_chebyshev(FrameProgram& program, const ChebyshevStep& step) const;
   void append_warm_start(FrameProgram& program) const;
