@@ -10,6 +10,9 @@
 // Cutting build_xpbd_program's own output, not re-emitting its dispatches,
 // keeps one definition of what a sweep is: with the accelerator off and
 // the same sweep count the re-assembled frame is bitwise the fixed one.
+// The contact-only sweeps (SolverSettings::contact_sweeps) are the one
+// exception: cut out they would read as later sweeps, so both programs
+// emit them with append_contact_sweep (xpbd_program.h).
 #pragma once
 
 #include <array>
