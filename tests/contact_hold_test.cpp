@@ -121,7 +121,9 @@ TEST(ContactHoldSettings, BadContactSweepsAreErrorsNamingTheSetting) {
 // presses its front and the grasper lifts its pole, every frame the
 // kidney's self-contacts, its faces' contacts with the tools and its
 // vertices inside the probe end within half the 1 mm thickness (measured
-// 0.19, 0.015 and 0.14 mm; without the sweeps 0.83, 0.086 and 0.68 mm).
+// 0.22, 0.030 and 0.084 mm; without the sweeps 0.013, 0.054 and 0.050 mm,
+// and with the face manifold on 0.83, 0.086 and 0.68 mm: the sweeps keep
+// the contacts within the bound, they do not improve on S1's light press).
 // A 5 N press is beyond this kidney: it pushes back at most ~0.35 N at S1's
 // 16 substeps x 1 iteration before the probe pierces it (docs/collision.md,
 // "Contacts that hold").

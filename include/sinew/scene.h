@@ -750,8 +750,10 @@ struct MeshCollisionDesc {
   /// where within reach, facing as the deepest point's contact does and a
   /// tenth of the triangle's longest edge apart. With one point a face
   /// pivots about it under a long tool (docs/collision.md, "Contacts that
-  /// hold"). Off: the deepest point only.
-  bool face_manifold = true;
+  /// hold"). Off (the default): the deepest point only. (On, a probe
+  /// pushed up under a free membrane with continuous collision needed more
+  /// than 12 repair rounds: tests/continuous_collision_test.cpp.)
+  bool face_manifold = false;
   double compliance = 0.0;        ///< of each contact [m/N], >= 0
   double static_friction = 0.3;   ///< >= 0
   double dynamic_friction = 0.2;  ///< >= 0, <= static_friction
