@@ -6,11 +6,16 @@
 //
 //   bench_retraction BACKEND FRAMES [--mesh M] [--substeps N] [--iterations N] [--threads N] [--haptics]
 //                    [--haptic-cpus C0 C1] [--local-contacts] [--probe-trace FILE]
+//                    [--probe-force N] [--contact-sweeps N]
 //   e.g. bench_retraction cpu 180
+//        bench_retraction cpu 60 --probe-force 5 --contact-sweeps 4   (contacts under a 5 N press)
 //
 // Prints CSV: a header and one line of the frame times (median, p95, worst
 // [ms]; the median process CPU time; the 1-minute load average at the end)
-// and the scene's figures at the last frame; then the per-stage
+// and the scene's figures at the last frame; the contacts' worst over the
+// frames (RetractionCheck: the kidney's self-contacts, its faces against
+// the tools, its vertices inside the probe, each [m] against the
+// thickness) and the probe's push and depth at the end; then the per-stage
 // profile (FrameStats::stages), one line per stage with its median and p95
 // [ms] over the frames. --haptics runs both haptic loops on their own threads
 // at 1 kHz of wall time while the frames run back to back (the solver using
@@ -126,6 +131,12 @@ int main(int argc, char** argv) {
       .add_option("--haptic-cpus", haptic_cpus, "--haptics: pin the grasper's and the probe's loops to these two CPUs")
       ->expected(2);
   cli.app().add_option("--probe-trace", probe_trace, "Write the probe loop's ticks (force against time) as CSV");
+  cli.app()
+      .add_option("--probe-force", s.probe_force, "Press the probe with this force [N] instead of its hand (0: the hand)")
+      ->check(CLI::NonNegativeNumber);
+  cli.app()
+      .add_option("--contact-sweeps", s.contact_sweeps, "SolverSettings::contact_sweeps")
+      ->check(sinew::examples::at_least(0));
   if (auto exit = cli.parse(argc, argv)) return *exit;
   s.self_collision = self_collision;
   s.realtime_haptics = haptics;
@@ -137,10 +148,16 @@ int main(int argc, char** argv) {
   if (haptics)
     if (auto st = r.start_haptics(); !st) return fail(st.error().message());
   sinew::bench::FrameProfile profile;
+  sinew::examples::RetractionCheck worst;  // the contacts' worst over the frames
   for (int f = 0; f < frames; ++f) {
     profile.start();
     if (auto st = r.frame(); !st) return fail(st.error().message());
     profile.stop(r.sim().last_frame());
+    auto c = r.check();
+    if (!c) return fail(c.error().message());
+    worst.self_violation = std::max(worst.self_violation, c->self_violation);
+    worst.tool_violation = std::max(worst.tool_violation, c->tool_violation);
+    worst.probe_penetration = std::max(worst.probe_penetration, c->probe_penetration);
   }
   r.stop_haptics();
   auto c = r.check();
@@ -154,6 +171,11 @@ int main(int argc, char** argv) {
               profile.wall(0.95), profile.wall(1.0), profile.cpu(0.5), sinew::bench::load_average(), st.mesh_contacts,
               c->contact_violation, c->max_slip, c->pole_lift, c->grasp_force[1], c->device_force[1],
               c->inverted_tets);
+  std::printf("contacts,contact_sweeps,probe_force_set_n,thickness_m,worst_self_violation_m,worst_tool_violation_m,"
+              "worst_probe_penetration_m,probe_push_n,probe_depth_m\n");
+  std::printf("contacts,%d,%.3f,%.3e,%.4e,%.4e,%.4e,%.4f,%.4e\n", s.contact_sweeps, s.probe_force,
+              r.scene().mesh_collision.thickness, worst.self_violation, worst.tool_violation, worst.probe_penetration,
+              c->probe_force, c->probe_depth);
   profile.print_stages();
   // Each stage's own figures of the last frame (StageProfile::counters).
   std::printf("stage,counter,last_frame\n");

@@ -105,6 +105,21 @@ inline TriMesh membrane(int nx, int nz, double cell, double height) {
   return m;
 }
 
+/// membrane(cells, cells, cell, 0) as a tri body pinned along its border,
+/// its distance and area compliance `compliance` [1/Pa], velocity damping 5 / s.
+inline TriBodyDesc pinned_membrane(int cells, double cell, double compliance) {
+  TriBodyDesc sheet;
+  sheet.mesh = membrane(cells, cells, cell, 0.0);
+  sheet.distance_compliance = compliance;
+  sheet.area_compliance = compliance;
+  sheet.velocity_damping = 5.0;
+  for (int i = 0; i <= cells; ++i)
+    for (int k = 0; k <= cells; ++k)
+      if (i == 0 || k == 0 || i == cells || k == cells)
+        sheet.pinned.push_back(static_cast<std::uint32_t>(i * (cells + 1) + k));
+  return sheet;
+}
+
 /// Whether segment (p, q) crosses triangle (a, b, c) (touching counts), in double.
 inline bool segment_crosses_triangle(const P3& p, const P3& q, const P3& a, const P3& b, const P3& c) {
   const P3 n = cross(sub(b, a), sub(c, a));
@@ -407,17 +422,7 @@ struct ThinProbe {
     scene.solver.substeps = 10;
     scene.solver.iterations = 2;
     scene.gravity = {0.0, 0.0, 0.0};
-    TriBodyDesc sheet;
-    constexpr int cells = 4;
-    sheet.mesh = membrane(cells, cells, 0.02, 0.0);
-    sheet.distance_compliance = 1e-5;
-    sheet.area_compliance = 1e-5;
-    sheet.velocity_damping = 5.0;
-    for (int i = 0; i <= cells; ++i)
-      for (int k = 0; k <= cells; ++k)
-        if (i == 0 || k == 0 || i == cells || k == cells)
-          sheet.pinned.push_back(static_cast<std::uint32_t>(i * (cells + 1) + k));
-    scene.tri_bodies.push_back(sheet);
+    scene.tri_bodies.push_back(pinned_membrane(4, 0.02, 1e-5));
     ColliderDesc probe;
     probe.shape = ColliderShape::capsule;
     probe.radius = 0.002;

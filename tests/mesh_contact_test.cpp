@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "contact_hold_support.h"
 #include "mesh_contact_support.h"
 #include "test_support.h"
 
@@ -539,8 +540,11 @@ TEST_P(MeshContact, AToolHeldByACouplingPressesACoarseMembraneBetweenItsVertices
 // Every backend against the CPU reference after 100 frames: the dropped
 // blocks with either schedule (contacts from the third frame on), the
 // folded membrane (self-contacts from about the 40th) and the thin probe
-// (triangle-shape contacts) with either schedule, and the coupled tool on
-// the membrane (its faces' reaction moves the tool): positions within
+// (triangle-shape contacts) with either schedule, the coupled tool on
+// the membrane (its faces' reaction moves the tool), and with
+// SolverSettings::contact_sweeps the 500 g tool lying on a membrane
+// (tests/contact_hold_support.h) and the blocks with the Jacobi schedule:
+// positions within
 // 1e-5 m (the kernels follow the CPU's operation order without fused
 // multiply-adds, so they are expected to agree bitwise; the test prints how
 // many coordinates do). The contacts are found on the host from each
@@ -556,12 +560,16 @@ TEST_P(MeshContact, BackendsAgreeWithTheCpuReference) {
   };
   SceneDesc probe_jacobi = ThinProbe::scene();
   probe_jacobi.mesh_collision.schedule = ContactSchedule::jacobi;
+  SceneDesc blocks_jacobi_swept = dropped_blocks_scene(ContactSchedule::jacobi);
+  blocks_jacobi_swept.solver.contact_sweeps = 2;
   const Case cases[] = {{"blocks, colored", dropped_blocks_scene(ContactSchedule::colored), false, false},
                         {"blocks, jacobi", dropped_blocks_scene(ContactSchedule::jacobi), false, false},
                         {"fold, colored", FoldedStrip::scene(ContactSchedule::colored), true, false},
                         {"thin probe, colored", ThinProbe::scene(), false, true},
                         {"thin probe, jacobi", probe_jacobi, false, true},
-                        {"coupled tool on the membrane", ThinProbe::tool_scene(0.02), false, false, true}};
+                        {"coupled tool on the membrane", ThinProbe::tool_scene(0.02), false, false, true},
+                        {"heavy tool on the membrane, contact sweeps", ToolOnMembrane::scene(0.5, 4), false, false},
+                        {"blocks, jacobi, contact sweeps", blocks_jacobi_swept, false, false}};
   for (const Case& c : cases) {
     auto reference = create_or_skip(c.scene, "cpu");
     auto sim = create_or_skip(c.scene, GetParam());

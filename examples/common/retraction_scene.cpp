@@ -100,6 +100,9 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
   std::unique_ptr<RetractionScene> self(new RetractionScene());
   RetractionScene& s = *self;
   s.settings_ = settings;
+  if (!(settings.probe_force >= 0.0 && std::isfinite(settings.probe_force)))
+    return Error(ErrorCode::bad_parameter,
+                 "retraction: probe_force must be finite and >= 0 (got " + std::to_string(settings.probe_force) + ")");
   if (!(settings.script_speed > 0.0 && std::isfinite(settings.script_speed)))
     return Error(ErrorCode::bad_parameter,
                  "retraction: script_speed must be finite and > 0 (got " + std::to_string(settings.script_speed) + ")");
@@ -175,6 +178,7 @@ Result<std::unique_ptr<RetractionScene>> RetractionScene::create(const Retractio
   scene.solver.substeps = settings.substeps;
   scene.solver.iterations = settings.iterations;
   scene.solver.measure_errors = settings.measure_errors;
+  scene.solver.contact_sweeps = settings.contact_sweeps;
   scene.tet_bodies.push_back(std::move(body));
   // Tool 0: the grasper's shaft, straight above the upper pole (y up), the
   // jaws' box centred on the pole's top vertex.
@@ -305,8 +309,11 @@ Status RetractionScene::frame() {
   auto grasper = sim_->graspers().grasper(0);
   if (!tool) return tool.error();
   if (!grasper) return grasper.error();
-  for (auto& b : bridges_)
-    if (auto st = b->apply_feedback(*sim_); !st) return st;
+  for (std::size_t i = 0; i < bridges_.size(); ++i)
+    if (i != 1 || settings_.probe_force <= 0.0)
+      if (auto st = bridges_[i]->apply_feedback(*sim_); !st) return st;
+  if (settings_.probe_force > 0.0)
+    if (auto st = press_probe(); !st) return st;
   // The tissue's pull on the jaws acts on the shaft (at its centre: the hand
   // holds the instrument's orientation, the coupling's torque keeps it).
   if (auto st = sim_->tools().apply_force(*tool, pull_, {0.0, 0.0, 0.0}); !st) return st;
@@ -318,6 +325,35 @@ Status RetractionScene::frame() {
   for (auto& b : bridges_)
     if (auto st = b->publish(*sim_); !st) return st;
   return measure_pull();
+}
+
+// The probe pressed by a force (RetractionSettings::probe_force) over the
+// coming frame, ramped in with the script's press from the frame's start,
+// held on its axis and in its orientation by ProbeHold's spring-dampers.
+Status RetractionScene::press_probe() {
+  auto probe = sim_->tools().tool(1);
+  if (!probe) return probe.error();
+  auto state = sim_->tools().state(*probe);
+  if (!state) return state.error();
+  const ToolDesc& start = scene_.tools[1];
+  const double t = double(frames_ - 1) * frame_time() * settings_.script_speed;
+  V3 force{}, torque{};
+  for (int k = 0; k < 3; ++k)
+    force[k] = (k == 2 ? 0.0 : -ProbeHold::stiffness * (state->position[k] - start.position[k])) -
+               ProbeHold::damping * state->velocity[k];
+  force[2] -= settings_.probe_force * ramp(t, kPressStart, kPressEnd);
+  // The rotation from the start's orientation, q q0^-1, as a small rotation vector.
+  const Q4 q{state->rotation[0], state->rotation[1], state->rotation[2], state->rotation[3]};
+  const Q4 q0 = conjugate({start.rotation[0], start.rotation[1], start.rotation[2], start.rotation[3]});
+  const Q4 e{q[0] * q0[0] - q[1] * q0[1] - q[2] * q0[2] - q[3] * q0[3],
+             q[0] * q0[1] + q[1] * q0[0] + q[2] * q0[3] - q[3] * q0[2],
+             q[0] * q0[2] - q[1] * q0[3] + q[2] * q0[0] + q[3] * q0[1],
+             q[0] * q0[3] + q[1] * q0[2] - q[2] * q0[1] + q[3] * q0[0]};
+  const double sign = e[0] < 0.0 ? -1.0 : 1.0;
+  for (int k = 0; k < 3; ++k)
+    torque[k] = -ProbeHold::angular_stiffness * 2.0 * sign * e[k + 1] -
+                ProbeHold::angular_damping * state->angular_velocity[k];
+  return sim_->tools().apply_force(*probe, force, torque);
 }
 
 Status RetractionScene::measure_pull() {
@@ -344,6 +380,27 @@ Result<RetractionCheck> RetractionScene::check() {
     for (int i = 0; i < 3; ++i) mean[i] += p[i] / double(held_.size());
   }
   c.pole_lift = mean[1] - grasp_centre_[1];
+  const FrameStats& stats = sim_->last_frame();
+  c.self_violation = stats.counter("mesh collision", "self_violation_m");
+  c.tool_violation = stats.counter("mesh collision", "tool_violation_m");
+  // The probe's capsule: its axis is its frame's y, +-half_height.
+  auto probe = sim_->tools().tool(1);
+  if (!probe) return probe.error();
+  auto state = sim_->tools().state(*probe);
+  if (!state) return state.error();
+  const ToolDesc& tool = scene_.tools[1];
+  const Q4 q{state->rotation[0], state->rotation[1], state->rotation[2], state->rotation[3]};
+  const V3 axis = rotate(q, {0.0, tool.half_height, 0.0});
+  const V3 end0 = sub(state->position, axis), span{2 * axis[0], 2 * axis[1], 2 * axis[2]};
+  const double span2 = span[0] * span[0] + span[1] * span[1] + span[2] * span[2];
+  for (std::size_t i = 0; i < x_.size() / 4; ++i) {
+    const V3 d = sub(particle(x_, static_cast<std::uint32_t>(i)), end0);
+    const double u = std::clamp((d[0] * span[0] + d[1] * span[1] + d[2] * span[2]) / span2, 0.0, 1.0);
+    const V3 r{d[0] - u * span[0], d[1] - u * span[1], d[2] - u * span[2]};
+    c.probe_penetration = std::max(c.probe_penetration, tool.radius - std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
+  }
+  c.probe_force = state->contact_force[2];
+  c.probe_depth = tool.position[2] - state->position[2];
   for (std::size_t t = 0; t < tets_.size(); ++t) {
     const auto& e = tets_[t];
     const V3 o = particle(x_, e[0]);

@@ -60,6 +60,12 @@ struct RetractionSettings {
   bool local_contacts = false;
   /// Real time: pin the grasper's and the probe's loop threads to these CPUs (-1: not pinned).
   std::array<int, 2> haptic_cpus{-1, -1};
+  /// > 0: the probe presses with this force [N] along -z, ramped in as the
+  /// script's press is (kPressStart, kPressEnd) and then held, instead of
+  /// following its hand's coupling; a spring-damper (kProbeHold) keeps it on
+  /// its axis and its orientation. 0: the hand's coupling (the scene S1).
+  double probe_force = 0.0;
+  int contact_sweeps = 0;  ///< SolverSettings::contact_sweeps
 };
 
 /// The scene in a few lines, for the programs' --help.
@@ -79,10 +85,27 @@ inline constexpr double kToolGap = 0.002;
 /// press ramp 0.5 - 0.5 cos(pi u) has covered kToolGap.
 double probe_contact_time();
 
+/// RetractionSettings::probe_force: the spring-damper that holds the probe
+/// on its axis (across it) and in its orientation: stiffness [N/m] and
+/// damping [N s/m] across the axis (damping along it too), and angular
+/// stiffness [N m/rad] and damping [N m s/rad]; all explicit, inside
+/// their bounds at 60 Hz for the tool's 0.3 kg and 1e-4 kg m^2
+/// (k dt^2 / M = 0.46, b dt / M = 1.1; 1.4 and 0.67 for the rotation).
+struct ProbeHold {
+  static constexpr double stiffness = 500.0, damping = 20.0;
+  static constexpr double angular_stiffness = 0.5, angular_damping = 0.004;
+};
+
 /// What one frame's physics checks measure (RetractionScene::check).
 struct RetractionCheck {
   double max_slip = 0.0;           ///< the held vertex furthest from where the jaws hold it [m]
   double contact_violation = 0.0;  ///< FrameStats::contact_violation [m]
+  double self_violation = 0.0;     ///< the same over the kidney's contacts with itself [m]
+  double tool_violation = 0.0;     ///< the same over its faces' contacts with the tools [m]
+  /// The deepest kidney vertex inside the probe's capsule [m] (0: none inside).
+  double probe_penetration = 0.0;
+  double probe_force = 0.0;        ///< the tissue's push on the probe along +z, the frame's average [N]
+  double probe_depth = 0.0;        ///< how far the probe's tip moved along -z since the start [m]
   std::size_t inverted_tets = 0;   ///< tets whose signed volume changed sign from the rest shape
   std::array<double, 3> grasp_force{};   ///< the tissue's pull on the jaws [N]
   std::array<double, 3> device_force{};  ///< last force commanded to the grasper's device [N]
@@ -125,6 +148,7 @@ class RetractionScene {
   RetractionScene() = default;
   Status grasp();
   Status measure_pull();  // pull_ from the positions after a frame
+  Status press_probe();   // RetractionSettings::probe_force: the probe's force for the coming frame
 
   RetractionSettings settings_;
   SceneDesc scene_;

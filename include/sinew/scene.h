@@ -568,6 +568,19 @@ struct SolverSettings {
   double time_step = 1.0 / 60.0;
   int substeps = 1;               ///< >= 1, <= 10,000 (a bound on a frame's work)
   int iterations = 5;             ///< >= 1, <= 10,000; substeps x iterations <= 1,000,000 sweeps a frame
+  /// Contact-only sweeps at the end of every substep, >= 0, <= 10,000
+  /// (default 0: none). After the substep's `iterations` sweeps (and, in
+  /// the residual-driven mode, its checks), each runs the colliders' and
+  /// tools' contacts with the particles and then the mesh contacts
+  /// (MeshCollisionDesc), their multipliers carried on, and no other
+  /// constraint; then the velocities are updated. Contacts solved last in
+  /// a sweep share particles across colours and with each other (a folded
+  /// or pressed surface, a heavy tool's faces), so one sweep leaves them
+  /// unconverged: these end the substep with the contacts held, the
+  /// elastic constraints answering in the next substep. Costs one contact
+  /// pass each (the bodies' constraints are not swept). Measured
+  /// (docs/collision.md, "Contacts that hold"). With method vbd: an error.
+  int contact_sweeps = 0;
   /// Measure the frame's errors (FrameStats): costs one store per
   /// constraint in the last sweep and a read-back of the residuals,
   /// velocities and positions after each frame.
@@ -729,6 +742,18 @@ struct MeshCollisionDesc {
   /// soft 5 mm block at 20 substeps rests without faces but bounces and
   /// falls through with them (the tool's coupling is explicit, rigid_tool.h).
   bool tool_faces = true;
+  /// A capsule (a tool's or a collider's) lying along a triangle meets it
+  /// at up to 3 points instead of 1 (a contact manifold): the triangle's
+  /// deepest point in it, and the two ends of the part of its axis over
+  /// the triangle (the axis projected onto the triangle's plane, clipped
+  /// to it), each against the capsule's surface nearest to that point,
+  /// where within reach, facing as the deepest point's contact does and a
+  /// tenth of the triangle's longest edge apart. With one point a face
+  /// pivots about it under a long tool (docs/collision.md, "Contacts that
+  /// hold"). Off (the default): the deepest point only. (On, a probe
+  /// pushed up under a free membrane with continuous collision needed more
+  /// than 12 repair rounds: tests/continuous_collision_test.cpp.)
+  bool face_manifold = false;
   double compliance = 0.0;        ///< of each contact [m/N], >= 0
   double static_friction = 0.3;   ///< >= 0
   double dynamic_friction = 0.2;  ///< >= 0, <= static_friction

@@ -78,7 +78,10 @@ struct StageProfile {
   /// name: "margin_m"); FrameStats::counter reads one. A counter
   /// "X_capacity" is the capacity of counter "X" (warned near it:
   /// sinew/warnings.h). Mesh collision: contacts, colors, pairs,
-  /// pairs_capacity, margin_m, violation_m; continuous collision: hits,
+  /// pairs_capacity, margin_m, violation_m (FrameStats::contact_violation),
+  /// self_violation_m and tool_violation_m (the same over a body's contacts
+  /// with itself, and over faces' and segments' contacts with the rigid
+  /// tools); continuous collision: hits,
   /// repairs, reverted, carried, forced; sutures: host_ms; fluid:
   /// particles, particles_capacity, steps.
   struct Counter {

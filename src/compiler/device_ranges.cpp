@@ -23,14 +23,19 @@ Status check_work(const SolverSettings& solver) {
   if (solver.iterations > kMaxIterations)
     return Error(ErrorCode::bad_parameter, "solver.iterations must be <= " + std::to_string(kMaxIterations) +
                                                " (got " + std::to_string(solver.iterations) + ")");
+  if (solver.contact_sweeps > kMaxIterations)
+    return Error(ErrorCode::bad_parameter, "solver.contact_sweeps must be <= " + std::to_string(kMaxIterations) +
+                                               " (got " + std::to_string(solver.contact_sweeps) + ")");
   const bool residual_mode = solver.residual_tolerance > 0.0;
   if (residual_mode && solver.max_iterations > kMaxResidualIterations)
     return Error(ErrorCode::bad_parameter, "solver.max_iterations must be <= " + std::to_string(kMaxResidualIterations) +
                                                " (got " + std::to_string(solver.max_iterations) + ")");
-  const double sweeps = double(solver.substeps) * (residual_mode ? solver.max_iterations : solver.iterations);
+  const double sweeps =
+      double(solver.substeps) * ((residual_mode ? solver.max_iterations : solver.iterations) + solver.contact_sweeps);
   if (sweeps > kMaxSweepsPerFrame)
     return Error(ErrorCode::bad_parameter,
-                 std::string("solver.substeps x solver.") + (residual_mode ? "max_iterations" : "iterations") + " = " +
+                 std::string("solver.substeps x (solver.") + (residual_mode ? "max_iterations" : "iterations") +
+                     " + solver.contact_sweeps) = " +
                      str(sweeps) + " sweeps per frame, more than " + str(kMaxSweepsPerFrame));
   return {};
 }

@@ -29,7 +29,7 @@ std::string number_text(double v);
 constexpr int kMaxSubsteps = 10000;
 constexpr int kMaxIterations = 10000;           ///< iterations per substep
 constexpr int kMaxResidualIterations = 100000;  ///< max_iterations per substep (residual mode)
-constexpr double kMaxSweepsPerFrame = 1000000;  ///< substeps x (max_)iterations
+constexpr double kMaxSweepsPerFrame = 1000000;  ///< substeps x ((max_)iterations + contact_sweeps)
 
 /// The most a constant acceleration (gravity, a particle's force over its
 /// mass) may move a particle in one frame, a dt^2 [m]: the constraint math

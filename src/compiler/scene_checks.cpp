@@ -516,6 +516,13 @@ Status check_scene(const SceneDesc& scene) {
     return Error(ErrorCode::bad_parameter,
                  "solver.iterations must be >= 1 (got " + std::to_string(scene.solver.iterations) + ")");
   if (Status s = check_solve_modes(scene.solver); !s) return s;
+  if (scene.solver.contact_sweeps < 0)
+    return Error(ErrorCode::bad_parameter,
+                 "solver.contact_sweeps must be >= 0 (got " + std::to_string(scene.solver.contact_sweeps) + ")");
+  if (scene.solver.contact_sweeps > 0 && scene.solver.method == SolverMethod::vbd)
+    return Error(ErrorCode::bad_parameter, "solver.contact_sweeps must be 0 with solver.method vbd (got " +
+                                               std::to_string(scene.solver.contact_sweeps) +
+                                               "): its sweeps have no separate contact pass");
   if (scene.tet_bodies.empty() && scene.tri_bodies.empty() && scene.line_bodies.empty() && scene.tools.empty())
     return Error(ErrorCode::bad_parameter, "the scene has no bodies");
   if (Status s = check_all(scene.tet_bodies, "tet_bodies", check_tet_body); !s) return s;

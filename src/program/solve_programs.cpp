@@ -92,6 +92,7 @@ SolvePrograms::SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buff
   SolverSettings cut = solver;
   cut.iterations = 2;
   cut.measure_errors = true;
+  cut.contact_sweeps = 0;  // emitted by append_update (below): they would read as later sweeps here
   const FrameProgram whole = build_xpbd_program(scene, buffers, cut, gravity, extras);
   counters_ = whole.counters();
   enum class Phase { predict, first_sweep, sweep, measure, update } phase = Phase::predict;
@@ -131,6 +132,18 @@ SolvePrograms::SolvePrograms(const CompiledScene& scene, const XpbdBuffers& buff
         break;
       }
     part.measure = with_substep_end(measure, substep_end);
+  }
+  // Each substep's contact-only sweep, its dispatches naming the counters
+  // the whole frame declares (begin_contacts declares them first, in the
+  // same order, on a scratch program).
+  if (solver.contact_sweeps > 0) {
+    for (int s = 0; s < static_cast<int>(parts_.size()); ++s) {
+      FrameProgram scratch;
+      const ContactCounters contact_counters = begin_contacts(scratch, buffers, extras.mesh_contacts);
+      const std::size_t before = scratch.commands().size();
+      append_contact_sweep(scratch, scene, buffers, solver, s, extras.mesh_contacts, contact_counters);
+      parts_[s].contacts.assign(scratch.commands().begin() + std::ptrdiff_t(before), scratch.commands().end());
+    }
   }
   // omega_n of the sweeps this solver may run (Wang's eq. 11, sweep n = k + 1).
   int most = solver.iterations;
@@ -220,7 +233,10 @@ void SolvePrograms::append_sweeps(FrameProgram& program, int s, int first, int c
 
 void SolvePrograms::append_measure(FrameProgram& program, int s) const { append_commands(program, parts_[s].measure); }
 
-void SolvePrograms::append_update(FrameProgram& program, int s) const { append_commands(program, parts_[s].update); }
+void SolvePrograms::append_update(FrameProgram& program, int s) const {
+  for (int c = 0; c < solver_.contact_sweeps; ++c) append_commands(program, parts_[s].contacts);
+  append_commands(program, parts_[s].update);
+}
 
 void SolvePrograms::append_check(FrameProgram& program, int s, const ResidualCheck& check) const {
   append_measure(program, s);

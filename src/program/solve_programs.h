@@ -10,6 +10,9 @@
 // Cutting build_xpbd_program's own output, not re-emitting its dispatches,
 // keeps one definition of what a sweep is: with the accelerator off and
 // the same sweep count the re-assembled frame is bitwise the fixed one.
+// The contact-only sweeps (SolverSettings::contact_sweeps) are the one
+// exception: cut out they would read as later sweeps, so both programs
+// emit them with append_contact_sweep (xpbd_program.h).
 #pragma once
 
 #include <array>
@@ -79,7 +82,8 @@ class SolvePrograms {
   void append_sweeps(FrameProgram& program, int s, int first, int count, bool warm) const;
   /// The measuring pass at the end of substep s (read-only).
   void append_measure(FrameProgram& program, int s) const;
-  /// The velocity update of substep s.
+  /// The end of substep s: its SolverSettings::contact_sweeps (as
+  /// build_xpbd_program emits them), then its velocity update.
   void append_update(FrameProgram& program, int s) const;
   /// Measure, then reduce the residuals into check.results, declared as
   /// the program's last end read (FrameProgram::read_at_end).
@@ -94,6 +98,7 @@ class SolvePrograms {
  private:
   struct Parts {
     Commands predict, first_sweep, sweep, measure, update;
+    Commands contacts;  ///< one contact-only sweep (append_contact_sweep)
   };
   void append_chebyshev(FrameProgram& program, const ChebyshevStep& step) const;
   void append_warm_start(FrameProgram& program) const;

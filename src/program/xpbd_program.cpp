@@ -151,6 +151,80 @@ void append_serial_contact_color(FrameProgram& program, const XpbdBuffers& buffe
   program.barrier();
 }
 
+ContactCounters begin_contacts(FrameProgram& program, const XpbdBuffers& buffers,
+                               const MeshContactBuffers* mesh_contacts) {
+  // Mesh contacts: colour k's count is word k of the table, which the host
+  // writes before each frame (at most the capacity, checked after the run).
+  ContactCounters out;
+  if (mesh_contacts && mesh_contacts->device_colored) {
+    // Once per frame, before anything moves the particles (the colouring
+    // reads only their inverse masses): its counters come first
+    // (DeviceColoringCounters), then the colours'.
+    const DeviceContactColoring& c = mesh_contacts->coloring;
+    append_device_contact_coloring(program, c, mesh_contacts->particles, buffers.position);
+    out.device_colors = {c.table, c.order, c.colors, c.capacity};
+    out.counters = declare_device_color_counters(program, out.device_colors);
+  } else if (mesh_contacts && mesh_contacts->jacobi) {
+    out.counters.push_back(program.counter("mesh contacts", mesh_contacts->table, 0, mesh_contacts->capacity));
+    out.counters.push_back(program.counter("particles touched by mesh contacts", mesh_contacts->table, 1,
+                                           mesh_contacts->touched_capacity));
+  } else if (mesh_contacts) {
+    for (std::uint32_t k = 0; k < mesh_contacts->colors; ++k)
+      out.counters.push_back(program.counter("mesh contacts of colour " + std::to_string(k), mesh_contacts->table, k,
+                                             mesh_contacts->capacity));
+  }
+  return out;
+}
+
+kernels::MeshContactParams mesh_contact_params(const MeshContactBuffers& contacts, float inv_h2, float substep_end) {
+  kernels::MeshContactParams m = contacts.params;
+  m.colors = contacts.colors;
+  m.inv_h2 = inv_h2;
+  m.reset_lambda = 0u;
+  m.substep_end = substep_end;
+  return m;
+}
+
+void append_mesh_contact_sweep(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                               const ContactCounters& counters, kernels::MeshContactParams m) {
+  if (contacts.jacobi) {
+    program.dispatch_indirect(Kernel::xpbd_mesh_contacts_jacobi, counters.counters[0],
+                              {buffers.position, buffers.previous, contacts.table, contacts.particles,
+                               contacts.coefficients, contacts.normals, contacts.lambda, contacts.delta,
+                               contacts.lambda_sum, contacts.motion},
+                              m);
+    program.barrier();
+    program.dispatch_indirect(Kernel::xpbd_mesh_contacts_gather, counters.counters[1],
+                              {buffers.position, contacts.table, contacts.touched, contacts.offsets, contacts.slots,
+                               contacts.delta},
+                              m);
+    program.barrier();
+  } else if (contacts.device_colored) {
+    append_device_colored_sweep(program, buffers, contacts, counters.device_colors, counters.counters, m);
+  } else {
+    append_contact_colors(program, buffers, contacts, contacts.table, contacts.table, counters.counters, m);
+  }
+}
+
+void append_contact_sweep(FrameProgram& program, const CompiledScene& scene, const XpbdBuffers& buffers,
+                          const SolverSettings& solver, int s, const MeshContactBuffers* mesh_contacts,
+                          const ContactCounters& counters) {
+  const double h = solver.time_step / solver.substeps;
+  kernels::SolveParams p{};
+  p.inv_h2 = static_cast<float>(1.0 / (h * h));
+  p.reset_lambda = 0u;  // the multipliers carry on from the substep's sweeps
+  p.h = static_cast<float>(h);
+  p.substep_end = static_cast<float>(double(s + 1) / solver.substeps);
+  for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
+    if (scene.blocks[k].kernel != Kernel::xpbd_solve_contacts) continue;
+    p.damping = static_cast<float>(scene.blocks[k].damping_time / h);
+    sweep(program, scene.blocks[k], color_ranges(scene.blocks[k]), buffers.blocks[k], buffers, p);
+  }
+  if (mesh_contacts)
+    append_mesh_contact_sweep(program, buffers, *mesh_contacts, counters,
+                              mesh_contact_params(*mesh_contacts, p.inv_h2, p.substep_end));
+}
+
 kernels::PredictParams predict_params(double h, const std::array<double, 3>& gravity, std::uint32_t particles) {
   kernels::PredictParams predict{};
   predict.h = static_cast<float>(h);
@@ -184,27 +258,7 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
   const kernels::UpdateVelocityParams update = update_params(h, particles);
 
   FrameProgram program;
-  // Mesh contacts: colour k's count is word k of the table, which the host
-  // writes before each frame (at most the capacity, checked after the run).
-  std::vector<std::uint32_t> contact_counters;
-  DeviceColorTable device_colors;
-  if (mesh_contacts && mesh_contacts->device_colored) {
-    // Once per frame, before anything moves the particles (the colouring
-    // reads only their inverse masses): its counters come first
-    // (DeviceColoringCounters), then the colours'.
-    const DeviceContactColoring& c = mesh_contacts->coloring;
-    append_device_contact_coloring(program, c, mesh_contacts->particles, buffers.position);
-    device_colors = {c.table, c.order, c.colors, c.capacity};
-    contact_counters = declare_device_color_counters(program, device_colors);
-  } else if (mesh_contacts && mesh_contacts->jacobi) {
-    contact_counters.push_back(program.counter("mesh contacts", mesh_contacts->table, 0, mesh_contacts->capacity));
-    contact_counters.push_back(program.counter("particles touched by mesh contacts", mesh_contacts->table, 1,
-                                               mesh_contacts->touched_capacity));
-  } else if (mesh_contacts) {
-    for (std::uint32_t k = 0; k < mesh_contacts->colors; ++k)
-      contact_counters.push_back(program.counter("mesh contacts of colour " + std::to_string(k),
-                                                 mesh_contacts->table, k, mesh_contacts->capacity));
-  }
+  const ContactCounters contact_counters = begin_contacts(program, buffers, mesh_contacts);
   for (int s = 0; s < solver.substeps; ++s) {
     if (scene.external_forces) {
       // Into the velocity before predict, so the force acts in every
@@ -226,30 +280,9 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
         sweep(program, scene.blocks[k], color_ranges(scene.blocks[k]), buffers.blocks[k], buffers, p);
       }
       if (mesh_contacts) {  // after the bodies' constraints, colour by colour
-        kernels::MeshContactParams m = mesh_contacts->params;
-        m.colors = mesh_contacts->colors;
-        m.inv_h2 = inv_h2;
+        kernels::MeshContactParams m = mesh_contact_params(*mesh_contacts, inv_h2, p.substep_end);
         m.reset_lambda = p.reset_lambda == 0u ? 0u : s == 0 ? 2u : 1u;  // 2: the frame's first sweep
-        m.substep_end = p.substep_end;
-        if (mesh_contacts->jacobi) {
-          program.dispatch_indirect(Kernel::xpbd_mesh_contacts_jacobi, contact_counters[0],
-                                    {buffers.position, buffers.previous, mesh_contacts->table,
-                                     mesh_contacts->particles, mesh_contacts->coefficients, mesh_contacts->normals,
-                                     mesh_contacts->lambda, mesh_contacts->delta, mesh_contacts->lambda_sum,
-                                     mesh_contacts->motion},
-                                    m);
-          program.barrier();
-          program.dispatch_indirect(Kernel::xpbd_mesh_contacts_gather, contact_counters[1],
-                                    {buffers.position, mesh_contacts->table, mesh_contacts->touched,
-                                     mesh_contacts->offsets, mesh_contacts->slots, mesh_contacts->delta},
-                                    m);
-          program.barrier();
-        }
-        if (mesh_contacts->device_colored)
-          append_device_colored_sweep(program, buffers, *mesh_contacts, device_colors, contact_counters, m);
-        else if (!mesh_contacts->jacobi)
-          append_contact_colors(program, buffers, *mesh_contacts, mesh_contacts->table, mesh_contacts->table,
-                                contact_counters, m);
+        append_mesh_contact_sweep(program, buffers, *mesh_contacts, contact_counters, m);
       }
       if (const SutureBuffers* sutures = extras.sutures) {  // last: they hold the tissue on the needles
         kernels::SutureParams q{};
@@ -280,6 +313,8 @@ FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& b
         sweep(program, block, block.color_counts.empty() ? whole : color_ranges(block), buffers.blocks[k], buffers, p);
       }
     }
+    for (int c = 0; c < solver.contact_sweeps; ++c)
+      append_contact_sweep(program, scene, buffers, solver, s, mesh_contacts, contact_counters);
     program.dispatch(Kernel::xpbd_update_velocity, particles, {buffers.position, buffers.previous, buffers.velocity},
                      update);
     program.barrier();

@@ -112,6 +112,40 @@ void append_device_colored_sweep(FrameProgram& program, const XpbdBuffers& buffe
                                  const DeviceColorTable& colored, std::span<const std::uint32_t> counters,
                                  kernels::MeshContactParams m);
 
+/// The counters of the mesh contacts' indirect dispatches in a frame
+/// program (begin_contacts), which every sweep over them names.
+struct ContactCounters {
+  std::vector<std::uint32_t> counters;  ///< colour k (host or device colours), or Jacobi's two
+  DeviceColorTable device_colors;       ///< ContactSchedule::device_colored only
+};
+
+/// Opens a frame program's mesh contacts: with the device colouring, its
+/// commands (once per frame, before anything moves) and counters
+/// (DeviceColoringCounters); then the counters each sweep dispatches by.
+/// Nothing without contacts (null). A program cut apart (solve_programs.h)
+/// declares the same counters in the same order, so the indices match.
+ContactCounters begin_contacts(FrameProgram& program, const XpbdBuffers& buffers,
+                               const MeshContactBuffers* mesh_contacts);
+
+/// The mesh contacts' parameters for a sweep of a substep ending at
+/// `substep_end` (fraction of the frame), with `inv_h2` = 1 / h^2 [1/s^2];
+/// reset_lambda 0 (the caller sets it for a substep's first sweep).
+kernels::MeshContactParams mesh_contact_params(const MeshContactBuffers& contacts, float inv_h2, float substep_end);
+
+/// One sweep over the mesh contacts in their schedule (host colours,
+/// Jacobi, device colours), with parameters `m`.
+void append_mesh_contact_sweep(FrameProgram& program, const XpbdBuffers& buffers, const MeshContactBuffers& contacts,
+                               const ContactCounters& counters, kernels::MeshContactParams m);
+
+/// One contact-only sweep at the end of substep `s` (SolverSettings::
+/// contact_sweeps): the colliders' and tools' contacts with the particles
+/// (the xpbd_solve_contacts block), then the mesh contacts (null: none),
+/// their multipliers carried on from the substep's sweeps (no reset), no
+/// other constraint. [in] counters: begin_contacts' of the same program.
+void append_contact_sweep(FrameProgram& program, const CompiledScene& scene, const XpbdBuffers& buffers,
+                          const SolverSettings& solver, int s, const MeshContactBuffers* mesh_contacts,
+                          const ContactCounters& counters);
+
 /// xpbd_predict's parameters for substeps of h [s] under `gravity`
 /// [m/s^2] over `particles` particles (shared by the VBD program).
 kernels::PredictParams predict_params(double h, const std::array<double, 3>& gravity, std::uint32_t particles);
@@ -143,7 +177,9 @@ Result<XpbdBuffers> upload_scene(Device& device, const CompiledScene& scene);
 /// MeshContactBuffers::device_colored the frame starts with the contacts'
 /// colouring (append_device_contact_coloring) and every sweep ends with
 /// append_device_colored_sweep; the program's first counters are then the
-/// colouring's, in device_coloring_counter() order.
+/// colouring's, in device_coloring_counter() order. With
+/// SolverSettings::contact_sweeps, each substep ends (after the measuring
+/// pass, before the velocity update) with that many append_contact_sweep.
 FrameProgram build_xpbd_program(const CompiledScene& scene, const XpbdBuffers& buffers, const SolverSettings& solver,
                                 const std::array<double, 3>& gravity, SweepExtras extras = {});
 

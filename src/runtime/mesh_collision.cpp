@@ -249,8 +249,13 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
   }
   // How far the frame's contacts ended inside their thickness, from the
   // very positions the next frame's detection starts from.
-  double worst = 0.0;
+  // Split by kind: a body against itself (both primitives of one body),
+  // and a face or segment against a tool (tool_slots_).
+  double worst = 0.0, worst_self = 0.0, worst_tool = 0.0;
   const auto slots = contact_count_ + static_cast<std::uint32_t>(appended_.size());
+  tool_slot_.assign(slots, 0);
+  for (const auto& [slot, tool] : tool_slots_)
+    if (slot < slots) tool_slot_[slot] = 1;
   for (std::uint32_t k = 0; k < slots; ++k) {
     double gap = 0.0;
     for (int a = 0; a < 3; ++a) {
@@ -261,9 +266,17 @@ Status MeshCollision::after_frame(Device& device, const XpbdBuffers& scene_buffe
       gap += along * upload_normals_[4 * std::size_t{k} + a];
     }
     gap += upload_normals_[4 * std::size_t{k} + 3];  // the offset (shape contacts)
-    worst = std::max(worst, desc_.thickness - gap);
+    const double inside = desc_.thickness - gap;
+    worst = std::max(worst, inside);
+    // A shape's contact repeats its first particle (mesh_contact_params.h);
+    // between primitives, particles 0 and 3 are on either side.
+    const std::uint32_t* v = &upload_particles_[4 * std::size_t{k}];
+    if (v[0] != v[1] && body_of_[v[0]] == body_of_[v[3]]) worst_self = std::max(worst_self, inside);
+    if (tool_slot_[k]) worst_tool = std::max(worst_tool, inside);
   }
   violation_ = worst;
+  self_violation_ = worst_self;
+  tool_violation_ = worst_tool;
   return {};
 }
 

@@ -150,6 +150,10 @@ class MeshCollision {
   /// How far the last frame's contacts ended inside their thickness [m]:
   /// the largest thickness - gap over them, 0 when none is inside.
   [[nodiscard]] double violation() const { return violation_; }
+  /// violation() over the contacts of a body with itself [m].
+  [[nodiscard]] double self_violation() const { return self_violation_; }
+  /// violation() over the contacts of faces and segments with the tools [m].
+  [[nodiscard]] double tool_violation() const { return tool_violation_; }
 
   [[nodiscard]] const MeshContactBuffers& buffers() const { return buffers_; }
   [[nodiscard]] std::uint32_t contacts() const { return contact_count_; }  ///< this frame's
@@ -258,7 +262,8 @@ class MeshCollision {
   bool want_colors_ = false, want_slots_ = false;
   std::vector<std::uint32_t> color_mask_;  // per particle: the appended colours it is in (bit k)
   double margin_ = 0.0;
-  double violation_ = 0.0;
+  double violation_ = 0.0, self_violation_ = 0.0, tool_violation_ = 0.0;
+  std::vector<std::uint8_t> tool_slot_;  // per contact slot: a tool's (after_frame's scratch)
   bool fresh_ = false;  // positions_ and velocities_ hold the device's current state
   bool restored_ = false;  // velocities_ were restored: the next read_back reads the positions only
   PositionsMirror* mirror_ = nullptr;
@@ -329,7 +334,8 @@ class MeshCollision {
   std::vector<collision::Pair> pairs_;
   std::vector<collision::Contact> found_, all_;
   std::vector<std::uint8_t> movable_;  // per particle (device order): inverse mass > 0
-  std::vector<std::uint8_t> face_hit_;  // per triangle: a triangle-shape contact in found_
+  std::vector<std::uint8_t> face_hit_;  // per triangle: its triangle-shape contacts in found_ (at most kManifold)
+  static constexpr std::size_t kManifold = 3;  // a face's contacts with one shape: its deepest point, its span's ends
   std::vector<std::uint32_t> kept_, contact_particles_, table_, upload_particles_;
   std::vector<float> upload_coefficients_, upload_normals_;
   std::vector<std::uint32_t> upload_offsets_, upload_touched_, upload_slots_, compact_offsets_;  // Jacobi

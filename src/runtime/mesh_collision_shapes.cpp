@@ -33,6 +33,58 @@ math::Vec3 carried(const PosedShape& s, const math::Vec3& local) {
   return math::add(s.position, math::rotate(s.rotation, local));
 }
 
+// The part of a capsule's axis (ends `axis`) over triangle (a, b, c): the
+// axis projected onto the triangle's plane and clipped to the triangle
+// (Sutherland and Hodgman's clipping, CACM 17(1), 1974, of a segment
+// against the three edges' half-planes). False when it misses the
+// triangle or the triangle has no area; else its two ends in `span` (one
+// point twice when the axis stands across the plane).
+bool axis_span(const std::array<math::Vec3, 2>& axis, const math::Vec3 (&corner)[3], math::Vec3 (&span)[2]) {
+  const math::Vec3 normal = math::cross(math::sub(corner[1], corner[0]), math::sub(corner[2], corner[0]));
+  const double area2 = math::dot(normal, normal);
+  if (!(area2 > 0.0)) return false;
+  math::Vec3 p[2];
+  for (int k = 0; k < 2; ++k)
+    p[k] = math::sub(axis[k], math::mul(normal, math::dot(normal, math::sub(axis[k], corner[0])) / area2));
+  const math::Vec3 along = math::sub(p[1], p[0]);
+  double t0 = 0.0, t1 = 1.0;
+  for (int e = 0; e < 3; ++e) {
+    const math::Vec3& from = corner[e];
+    const math::Vec3 inward = math::cross(normal, math::sub(corner[(e + 1) % 3], from));  // towards the third corner
+    const double at0 = math::dot(inward, math::sub(p[0], from)), rate = math::dot(inward, along);
+    if (rate == 0.0) {
+      if (at0 < 0.0) return false;
+    } else if (rate > 0.0) {
+      t0 = std::max(t0, -at0 / rate);
+    } else {
+      t1 = std::min(t1, -at0 / rate);
+    }
+  }
+  if (t0 > t1) return false;
+  span[0] = math::add(p[0], math::mul(along, t0));
+  span[1] = math::add(p[0], math::mul(along, t1));
+  return true;
+}
+
+// The barycentric weights of a point in triangle (a, b, c)'s plane.
+std::array<double, 3> barycentric(const math::Vec3& p, const math::Vec3 (&corner)[3]) {
+  const math::Vec3 e0 = math::sub(corner[1], corner[0]), e1 = math::sub(corner[2], corner[0]);
+  const math::Vec3 d = math::sub(p, corner[0]);
+  const double d00 = math::dot(e0, e0), d01 = math::dot(e0, e1), d11 = math::dot(e1, e1);
+  const double d20 = math::dot(d, e0), d21 = math::dot(d, e1);
+  const double den = d00 * d11 - d01 * d01;
+  const double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+  return {1.0 - v - w, v, w};
+}
+
+// The point of segment (a, b) nearest to p.
+math::Vec3 nearest_on_segment(const math::Vec3& a, const math::Vec3& b, const math::Vec3& p) {
+  const math::Vec3 ab = math::sub(b, a);
+  const double l2 = math::dot(ab, ab);
+  const double t = l2 > 0.0 ? std::clamp(math::dot(math::sub(p, a), ab) / l2, 0.0, 1.0) : 0.0;
+  return math::add(a, math::mul(ab, t));
+}
+
 }  // namespace
 
 void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<const PosedShape> ends, double common) {
@@ -84,9 +136,13 @@ void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<co
       }
     };
     if (shape.shape->shape == ColliderShape::plane) continue;
+    // A capsule's manifold (MeshCollisionDesc::face_manifold): its axis
+    // where the contacts are found (a tool's start, a collider's end pose).
+    const bool manifold = desc_.face_manifold && !level_set && shape.shape->shape == ColliderShape::capsule;
+    const std::array<math::Vec3, 2> axis = tools ? first : capsule_ends(shape);
     // Triangles in parallel (one evaluation each for most), joined in
     // triangle order so the contacts do not depend on the threads.
-    found_.assign(triangles, Contact{});
+    found_.assign(kManifold * triangles, Contact{});
     face_hit_.assign(triangles, 0);
     hooks::parallel_for(triangles, 256, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
@@ -99,11 +155,12 @@ void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<co
           speed = std::max(speed, speed_[v[k]]);
         }
         collision::TriangleContact hit;
+        const double reach = common + 2.0 * dt * speed + moved;
         if (!collision::triangle_against(*shape.shape, shape.position, shape.rotation, corner[0], corner[1],
-                                         corner[2], common + 2.0 * dt * speed + moved, hit))
+                                         corner[2], reach, hit))
           continue;
         if (std::max({hit.weights[0], hit.weights[1], hit.weights[2]}) > 1.0 - 1e-6) continue;  // a corner
-        Contact& c = found_[t];
+        Contact& c = found_[kManifold * t];
         c.kind = Contact::Kind::shape_face;
         c.v = {v[0], v[0], v[1], v[2]};
         c.w = {0.0f, float(hit.weights[0]), float(hit.weights[1]), float(hit.weights[2])};
@@ -111,11 +168,48 @@ void MeshCollision::shape_faces(std::span<const PosedShape> shapes, std::span<co
         c.distance = float(hit.distance);
         plane(c, hit.normal, hit.surface);
         c.shape = which;
-        face_hit_[t] = 1;
+        std::uint8_t made = 1;
+        // A capsule lying along the face: the two ends of its axis's span
+        // over the triangle too, each against the capsule's surface nearest
+        // to it (as the deepest point is), so the face is held along the
+        // whole line it touches instead of pivoting on one point. Kept
+        // where within reach, facing as the deepest point's contact does
+        // (within 30 degrees), inside the face or on an edge, and apart from
+        // the deepest point and each other (a tenth of the longest edge).
+        math::Vec3 span[2];
+        if (manifold && axis_span(axis, corner, span)) {
+          math::Vec3 deepest{0.0, 0.0, 0.0};
+          double longest = 0.0;
+          for (int k = 0; k < 3; ++k) {
+            deepest = math::add(deepest, math::mul(corner[k], hit.weights[k]));
+            longest = std::max(longest, math::norm(math::sub(corner[(k + 1) % 3], corner[k])));
+          }
+          math::Vec3 kept[kManifold] = {deepest, deepest, deepest};
+          for (const math::Vec3& p : span) {
+            bool near = false;
+            for (int k = 0; k < made; ++k) near |= math::norm(math::sub(p, kept[k])) < 0.1 * longest;
+            if (near) continue;
+            const std::array<double, 3> w = barycentric(p, corner);
+            if (std::min({w[0], w[1], w[2]}) < -1e-6 || std::max({w[0], w[1], w[2]}) > 1.0 - 1e-6) continue;
+            const math::Vec3 q = nearest_on_segment(axis[0], axis[1], p);
+            const double length = math::norm(math::sub(p, q));
+            if (!(length > 0.0)) continue;
+            const math::Vec3 n = math::mul(math::sub(p, q), 1.0 / length);
+            if (math::dot(n, hit.normal) < 0.866 || length - shape.shape->radius > reach) continue;
+            Contact& m = found_[kManifold * t + made];
+            m = c;
+            m.w = {0.0f, float(std::max(w[0], 0.0)), float(std::max(w[1], 0.0)), float(std::max(w[2], 0.0))};
+            m.normal = {float(n[0]), float(n[1]), float(n[2])};
+            m.distance = float(length - shape.shape->radius);
+            plane(m, n, math::add(q, math::mul(n, shape.shape->radius)));
+            kept[made++] = p;
+          }
+        }
+        face_hit_[t] = made;
       }
     });
     for (std::size_t t = 0; t < triangles; ++t)
-      if (face_hit_[t]) all_.push_back(found_[t]);
+      for (std::uint8_t k = 0; k < face_hit_[t]; ++k) all_.push_back(found_[kManifold * t + k]);
     // Segments (threads): the point deepest in the shape along each, by
     // golden-section search (collision::capsule_against, radius 0), kept
     // between its ends, on particles (a, a, b, b) with c = (0, 1 - s, 0, s).

@@ -17,6 +17,7 @@ void read_solver(const Json& v, const std::string& path, Context& ctx, SolverSet
   o.read("time_step", out.time_step);
   o.read("substeps", out.substeps);
   o.read("iterations", out.iterations);
+  o.read("contact_sweeps", out.contact_sweeps);
   o.read("measure_errors", out.measure_errors);
   o.read("reorder_particles", out.reorder_particles);
   o.read("residual_tolerance", out.residual_tolerance);
@@ -282,6 +283,7 @@ void read_mesh_collision(const Json& v, const std::string& path, Context& ctx, M
   o.read("self_collision", out.self_collision);
   o.read("self_culling", out.self_culling);
   o.read("tool_faces", out.tool_faces);
+  o.read("face_manifold", out.face_manifold);
   o.read("compliance", out.compliance);
   o.read("static_friction", out.static_friction);
   o.read("dynamic_friction", out.dynamic_friction);

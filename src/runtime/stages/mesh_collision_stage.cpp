@@ -69,6 +69,8 @@ class MeshCollisionStage final : public FrameStage {
     profile.set("pairs_capacity", static_cast<double>(MeshCollision::pair_capacity()));
     profile.set("margin_m", collision.margin());
     profile.set("violation_m", collision.violation());
+    profile.set("self_violation_m", collision.self_violation());
+    profile.set("tool_violation_m", collision.tool_violation());
   }
 
 
