@@ -325,6 +325,10 @@ TEST(SceneFile, LandmarkAndRelativeTrackErrors) {
   EXPECT_EQ(error_of(scene + R"({"actions": [{"frame": 1, "do": "close_grasper", "grasper": 0, "half_extents": [1, 1, 1],
                                   "at": {"body": 0, "vertices": []}}]}})"),
             "/script/actions/0/at/vertices: must not be empty");
+  // A landmark after a key that already failed: that error stands (the fuzzer's find: a null dereference).
+  EXPECT_EQ(error_of(scene + R"({"actions": [{"frame": 1, "do": "close_grasper", "half_extents": [1, 1, 1],
+                                  "at": {"body": 0, "vertices": [0]}}]}})"),
+            "/script/actions/0/grasper: is required");
   EXPECT_EQ(error_of(scene + R"({"poses": [{"collider": 0, "relative": true, "keys": [{"frame": 0, "position": [0, 0, 0]}]}]}})"),
             "/script/poses/0/relative: only a grasper's track can be relative (to the pose its jaws closed at)");
 }

@@ -62,7 +62,9 @@ void read_track(const Json& v, const std::string& path, Context& ctx, bool force
 // A landmark: {"body_kind", "body", "vertices": [...], "offset"}.
 void read_landmark(Object& o, const std::string& key, ScriptLandmark& out) {
   Context& ctx = o.ctx();
-  Object lo(*o.find(key), o.path(key), ctx);
+  const Json* v = o.find(key);  // null once an earlier key failed: that error stands
+  if (!v) return;
+  Object lo(*v, o.path(key), ctx);
   if (const Json* k = lo.find("body_kind")) read_body_kind(*k, lo.path("body_kind"), ctx, out.body_kind);
   lo.read("body", out.body, true);
   if (const Json* vs = lo.find("vertices")) {
