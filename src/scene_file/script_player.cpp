@@ -3,6 +3,7 @@
 // forces, then its actions, through the feature handles.
 #include <cmath>
 
+#include "math/vec3.h"
 #include "sinew/scene_file.h"
 #include "sinew/simulation.h"
 
@@ -74,15 +75,7 @@ Result<std::array<double, 3>> landmark_position(Simulation& sim, const ScriptLan
 
 // A relative grasper key on the pose the jaws closed at (ScriptTrack::relative).
 Pose relative_pose(const Pose& closed, const ScriptKey& k) {
-  Pose p;
-  for (int c = 0; c < 3; ++c) p.position[c] = closed.position[c] + k.position[c];
-  const auto& a = k.rotation;
-  const auto& b = closed.rotation;
-  p.rotation = {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-                a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-                a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-                a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
-  return p;
+  return {math::add(closed.position, k.position), math::qmul(k.rotation, closed.rotation)};
 }
 
 Status pose_track(Simulation& sim, const ScriptTrack& track, const ScriptKey& k, const std::vector<bool>& closed,
